@@ -1,0 +1,135 @@
+"""One exception hierarchy for synth, and friendly source-located messages.
+
+Every mistake in a user file (``.rules``, ``.g7``) becomes an :class:`InputError`
+carrying a :class:`Location`. Its :meth:`InputError.render` gives the format the
+CLI prints::
+
+    plants/tri.rules:12:21: error: unknown variable 'AVANCR1'
+       12 | constraint C1 "V1": AVANCR1 & RECULER1 = 0
+          |                     ^~~~~~~
+       = did you mean AVANCER1?
+
+Example
+-------
+>>> loc = Location("a.rules", 1, 5, "foo bar baz", 3)
+>>> print(InputError("unknown variable 'bar'", loc, suggestions=("baz",)).render())
+a.rules:1:5: error: unknown variable 'bar'
+    1 | foo bar baz
+      |     ^~~
+  = did you mean baz?
+"""
+
+from __future__ import annotations
+
+import difflib
+from dataclasses import dataclass
+from typing import Iterable, Sequence
+
+__all__ = [
+    "Location",
+    "SynthError",
+    "InputError",
+    "InputErrors",
+    "ModelError",
+    "LimitExceeded",
+    "close_names",
+    "location_in",
+]
+
+
+@dataclass(frozen=True)
+class Location:
+    """A position in a user file (1-based line and column) and the text of that line."""
+
+    file: str
+    line: int
+    column: int
+    text: str = ""
+    width: int = 1
+
+    def __str__(self) -> str:
+        return f"{self.file}:{self.line}:{self.column}"
+
+
+class SynthError(Exception):
+    """Base of every error synth raises on purpose."""
+
+
+class InputError(SynthError):
+    """A mistake in a user's input file: reported with file, line, column and a caret."""
+
+    def __init__(
+        self,
+        message: str,
+        location: Location | None,
+        *,
+        expected: Sequence[str] = (),
+        suggestions: Sequence[str] = (),
+        notes: Sequence[str] = (),
+    ) -> None:
+        super().__init__(message)
+        self.message = message
+        self.location = location
+        self.expected = tuple(expected)
+        self.suggestions = tuple(suggestions)
+        self.notes = tuple(notes)
+
+    def render(self) -> str:
+        loc = self.location
+        head = f"{loc}: error: {self.message}" if loc else f"error: {self.message}"
+        lines = [head]
+        if loc is not None and loc.text:
+            number = str(loc.line)
+            pad = " " * len(number)
+            text = loc.text.rstrip("\n").expandtabs(1)
+            lines.append(f"  {number} | {text}")
+            width = max(1, loc.width)
+            lines.append(f"  {pad} | " + " " * (loc.column - 1) + "^" + "~" * (width - 1))
+        if self.expected:
+            lines.append("  = expected " + ", ".join(self.expected))
+        if self.suggestions:
+            lines.append("  = did you mean " + " or ".join(self.suggestions) + "?")
+        for note in self.notes:
+            lines.append("  = note: " + note)
+        return "\n".join(lines)
+
+    def __str__(self) -> str:
+        return self.render()
+
+
+class InputErrors(SynthError):
+    """Several input errors found in one pass, reported together."""
+
+    def __init__(self, errors: Sequence[InputError]) -> None:
+        super().__init__("\n".join(e.render() for e in errors))
+        self.errors = tuple(errors)
+
+    def render(self) -> str:
+        return "\n\n".join(e.render() for e in self.errors)
+
+
+class ModelError(SynthError):
+    """A model is well-formed but cannot be processed (e.g. a Grafcet that never stabilises)."""
+
+
+class LimitExceeded(SynthError):
+    """An exploration stopped at the user's ``--max-states`` limit."""
+
+
+def close_names(name: str, candidates: Iterable[str], n: int = 3) -> tuple[str, ...]:
+    """The valid names closest to ``name`` (case-insensitive), best first.
+
+    >>> close_names("AVANCR1", ["AVANCER1", "RECULER1", "v10"])
+    ('AVANCER1',)
+    """
+    pool = sorted(set(candidates))
+    lowered = {c.lower(): c for c in pool}
+    hits = difflib.get_close_matches(name.lower(), list(lowered), n=n, cutoff=0.6)
+    return tuple(lowered[h] for h in hits)
+
+
+def location_in(file: str, source: str, line: int, column: int, width: int = 1) -> Location:
+    """A :class:`Location` whose ``text`` is taken from ``source``."""
+    lines = source.splitlines()
+    text = lines[line - 1] if 0 < line <= len(lines) else ""
+    return Location(file, line, column, text, width)

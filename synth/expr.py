@@ -1,0 +1,214 @@
+"""Boolean expressions over plant variables and their edges.
+
+Shared by the rules language (guards, incoherences, constraints) and the Grafcet
+language (receptivities, action conditions). Expressions are immutable and keep
+the :class:`~synth.errors.Location` of each name so that later checks can point
+at the offending token.
+
+Evaluation is generic: ``value(name)`` may return Python booleans or numpy
+boolean arrays (then the result is an array, broadcast as numpy does).
+
+Example
+-------
+>>> e = And((Var("a"), Not(Var("b"))))
+>>> e.evaluate(lambda n: {"a": True, "b": False}[n])
+True
+>>> e.text()
+'a & !b'
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import reduce
+from itertools import product
+from typing import Any, Callable, Iterator, Union
+
+import numpy as np
+
+from .errors import Location
+
+__all__ = [
+    "Expr",
+    "Var",
+    "Const",
+    "Not",
+    "And",
+    "Or",
+    "Edge",
+    "Literal",
+    "Monomial",
+    "disjunctive_normal_form",
+    "edge_text",
+]
+
+
+def edge_text(rising: bool, name: str) -> str:
+    """``↑name`` or ``↓name``."""
+    return ("↑" if rising else "↓") + name
+
+
+@dataclass(frozen=True)
+class Var:
+    name: str
+    loc: Location | None = field(default=None, compare=False)
+
+    def text(self) -> str:
+        return self.name
+
+
+@dataclass(frozen=True)
+class Const:
+    value: bool
+    loc: Location | None = field(default=None, compare=False)
+
+    def text(self) -> str:
+        return "1" if self.value else "0"
+
+
+@dataclass(frozen=True)
+class Edge:
+    """A rising (``↑x``) or falling (``↓x``) edge of a variable: an event, not a level."""
+
+    rising: bool
+    name: str
+    loc: Location | None = field(default=None, compare=False)
+
+    def text(self) -> str:
+        return edge_text(self.rising, self.name)
+
+    @property
+    def event(self) -> str:
+        return self.text()
+
+
+@dataclass(frozen=True)
+class Not:
+    arg: "Expr"
+    loc: Location | None = field(default=None, compare=False)
+
+    def text(self) -> str:
+        inner = self.arg.text()
+        return "!" + (inner if isinstance(self.arg, (Var, Const, Edge, Not)) else f"({inner})")
+
+
+@dataclass(frozen=True)
+class And:
+    args: tuple["Expr", ...]
+    loc: Location | None = field(default=None, compare=False)
+
+    def text(self) -> str:
+        return " & ".join(a.text() if not isinstance(a, Or) else f"({a.text()})" for a in self.args)
+
+
+@dataclass(frozen=True)
+class Or:
+    args: tuple["Expr", ...]
+    loc: Location | None = field(default=None, compare=False)
+
+    def text(self) -> str:
+        return " | ".join(a.text() for a in self.args)
+
+
+Expr = Union[Var, Const, Edge, Not, And, Or]
+
+
+def _evaluate(e: Expr, value: Callable[[str], Any], edge: Callable[[Edge], Any]) -> Any:
+    if isinstance(e, Var):
+        return value(e.name)
+    if isinstance(e, Const):
+        return e.value
+    if isinstance(e, Edge):
+        return edge(e)
+    if isinstance(e, Not):
+        r = _evaluate(e.arg, value, edge)
+        return (not r) if isinstance(r, bool) else np.logical_not(r)
+    parts = [_evaluate(a, value, edge) for a in e.args]
+    if all(isinstance(p, bool) for p in parts):
+        return all(parts) if isinstance(e, And) else any(parts)
+    op = np.logical_and if isinstance(e, And) else np.logical_or
+    return reduce(op, parts)
+
+
+def _no_edge(e: Edge) -> bool:
+    return False
+
+
+def evaluate(e: Expr, value: Callable[[str], Any], edge: Callable[[Edge], Any] = _no_edge) -> Any:
+    """Value of ``e``; names through ``value``, edges through ``edge`` (false by default)."""
+    return _evaluate(e, value, edge)
+
+
+def names(e: Expr) -> Iterator[Var | Edge]:
+    """Every variable and edge occurrence of ``e``, in text order."""
+    if isinstance(e, (Var, Edge)):
+        yield e
+    elif isinstance(e, Not):
+        yield from names(e.arg)
+    elif isinstance(e, (And, Or)):
+        for a in e.args:
+            yield from names(a)
+
+
+# Methods attached here so that the dataclasses stay plain data.
+for _cls in (Var, Const, Edge, Not, And, Or):
+    _cls.evaluate = evaluate  # type: ignore[attr-defined]
+    _cls.names = names  # type: ignore[attr-defined]
+
+
+@dataclass(frozen=True, order=True)
+class Literal:
+    """``name`` (positive) or ``!name``; ``edge`` is set for ``↑name`` / ``↓name``."""
+
+    name: str
+    positive: bool = True
+    edge: bool = False
+
+
+Monomial = frozenset[Literal]
+
+
+def disjunctive_normal_form(e: Expr, limit: int = 4096) -> list[Monomial]:
+    """The expression as a list of satisfiable monomials (conjunctions of literals).
+
+    Edges appear as literals with ``edge=True`` (``positive`` tells rising or falling).
+
+    >>> sorted(sorted(str(l.name) + str(l.positive) for l in m)
+    ...        for m in disjunctive_normal_form(And((Var("a"), Or((Var("b"), Not(Var("c"))))))))
+    [['aTrue', 'bTrue'], ['aTrue', 'cFalse']]
+    """
+
+    def dnf(x: Expr, positive: bool) -> list[frozenset[Literal]]:
+        if isinstance(x, Var):
+            return [frozenset({Literal(x.name, positive)})]
+        if isinstance(x, Edge):
+            if not positive:
+                raise ValueError("negated edge")
+            return [frozenset({Literal(x.name, x.rising, edge=True)})]
+        if isinstance(x, Const):
+            return [frozenset()] if x.value == positive else []
+        if isinstance(x, Not):
+            return dnf(x.arg, not positive)
+        conj = isinstance(x, And) == positive
+        parts = [dnf(a, positive) for a in x.args]
+        if not conj:
+            return [m for p in parts for m in p]
+        out: list[frozenset[Literal]] = []
+        for combo in product(*parts):
+            m = frozenset().union(*combo)
+            out.append(m)
+            if len(out) > limit:
+                raise ValueError("expression too large for normal form")
+        return out
+
+    result: list[Monomial] = []
+    for m in dnf(e, True):
+        levels = {(l.name, l.positive) for l in m if not l.edge}
+        if any((n, not p) in levels for n, p in levels):
+            continue  # x & !x
+        edges = [l for l in m if l.edge]
+        if len({(l.name, l.positive) for l in edges}) > 1:
+            continue  # two different events never happen at once
+        if m not in result:
+            result.append(m)
+    return result

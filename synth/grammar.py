@@ -1,0 +1,107 @@
+"""Loading the lark grammars shipped in ``grammars/`` and turning lark errors into
+:class:`~synth.errors.InputError` with a caret and what was expected."""
+
+from __future__ import annotations
+
+from functools import lru_cache
+from importlib import resources
+from pathlib import Path
+
+from lark import Lark, Token, UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
+
+from .errors import InputError, location_in
+
+__all__ = ["grammar_text", "parser", "syntax_error", "token_location"]
+
+# How terminals are shown to a user in "expected ..." lists.
+_TERMINAL_TEXT = {
+    "NAME": "a name",
+    "BIT": "0 or 1",
+    "STRING": 'a "quoted text"',
+    "RISE": "↑ (or ^)",
+    "FALL": "↓ (or _)",
+    "NOT": "! (not)",
+    "AND": "& (and)",
+    "OR": "| (or)",
+    "ARROW": "->",
+    "LBRACE": "{",
+    "RBRACE": "}",
+    "LPAR": "(",
+    "RPAR": ")",
+    "LSQB": "[",
+    "RSQB": "]",
+    "COLON": ":",
+    "SEMICOLON": ";",
+    "COMMA": ",",
+    "EQUAL": "=",
+    "LESSTHAN": "<",
+    "SLASH": "/",
+    "NUMBER": "a number",
+    "DURATION": "a duration such as 2s",
+    "_NL": "end of line",
+    "$END": "end of file",
+}
+
+
+def grammar_text(name: str) -> str:
+    """Text of ``grammars/<name>.lark``, from the installed package or the source tree."""
+    filename = f"{name}.lark"
+    try:
+        return resources.files("synth.grammars").joinpath(filename).read_text(encoding="utf-8")
+    except (ModuleNotFoundError, FileNotFoundError):
+        here = Path(__file__).resolve().parent.parent / "grammars" / filename
+        return here.read_text(encoding="utf-8")
+
+
+@lru_cache(maxsize=None)
+def parser(name: str) -> Lark:
+    """A cached LALR parser for ``grammars/<name>.lark`` (positions propagated)."""
+    return Lark(grammar_text(name), parser="lalr", propagate_positions=True, maybe_placeholders=True)
+
+
+def _shown(terminal: str, p: Lark) -> str:
+    if terminal in _TERMINAL_TEXT:
+        return _TERMINAL_TEXT[terminal]
+    try:
+        pattern = p.get_terminal(terminal).pattern
+    except KeyError:
+        return terminal.lower()
+    if pattern.type == "str":
+        return f"'{pattern.value}'"
+    return terminal.lower()
+
+
+def syntax_error(err: UnexpectedInput, file: str, source: str, p: Lark) -> InputError:
+    """An :class:`InputError` for a lark parse error, with what would have been accepted."""
+    line = getattr(err, "line", None) or 1
+    column = getattr(err, "column", None) or 1
+    if isinstance(err, UnexpectedEOF) or (
+        isinstance(err, UnexpectedToken) and err.token.type == "$END"
+    ):
+        lines = source.splitlines() or [""]
+        line = len(lines)
+        column = len(lines[-1]) + 1
+        found = "end of file"
+        width = 1
+        expected = err.expected
+    elif isinstance(err, UnexpectedToken):
+        found = f"'{err.token}'"
+        width = max(1, len(str(err.token)))
+        expected = err.accepts or err.expected
+    elif isinstance(err, UnexpectedCharacters):
+        found = f"character '{source[err.pos_in_stream]}'" if err.pos_in_stream < len(source) else "end of file"
+        width = 1
+        expected = err.allowed or set()
+    else:  # pragma: no cover - lark has no other kinds
+        found, width, expected = "input", 1, set()
+    shown = sorted({_shown(t, p) for t in expected if not t.startswith("__ANON")})
+    return InputError(
+        f"syntax error: unexpected {found}",
+        location_in(file, source, line, column, width),
+        expected=shown[:12],
+    )
+
+
+def token_location(tok: Token, file: str, source: str):
+    """Location of a lark token inside ``source``."""
+    return location_in(file, source, tok.line or 1, tok.column or 1, len(str(tok)))

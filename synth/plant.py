@@ -1,0 +1,194 @@
+"""Element automata: the boolean-state automaton of one plant element (METHOD.md §2).
+
+Construction (thesis lines 2470-2520), state-based reading of the rules:
+
+1. all 2^n vectors of the element's variables;
+2. remove the incoherent ones (and those where a held order has the other value);
+3. every state gets one controllable transition per (non-held) order: toggle it;
+4. uncontrollable transitions: a rule ``cause [guard] -> consequence`` enables its
+   consequence in every state where the cause's order has its post-edge value, the
+   guard holds, the consequence can happen and the target is coherent; a precedence
+   ``cause: u1 < u2`` adds "u1's effect already holds" to u2's condition. Free inputs
+   may change at any time.
+
+Only the states reachable from the initial state are kept.
+
+Example
+-------
+>>> from synth.rules import parse_rules
+>>> rs = parse_rules(open(_library("double_acting.rules")).read() +
+...     "element V1 = double_acting(AVANCER=AVANCER1, RECULER=RECULER1, v0=v10, v1=v11)")
+>>> a = element_automaton(rs.elements[0])
+>>> a.size, a.count(controllable=True), a.count(controllable=False)
+(12, 24, 12)
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .errors import InputError
+from .expr import edge_text, evaluate
+from .rules import ORDER, ElementSpec
+
+__all__ = ["ElementAutomaton", "element_automaton"]
+
+MAX_ELEMENT_VARIABLES = 20
+
+
+def _library(name: str) -> str:
+    return str(Path(__file__).resolve().parent.parent / "plants" / "lib" / name)
+
+
+@dataclass(frozen=True, eq=False)
+class ElementAutomaton:
+    """States are codes over the element's variables (bit i = ``variables[i]``).
+
+    ``codes[k]`` is the code of local state ``k`` (sorted ascending); transitions are
+    parallel arrays ``src``, ``dst`` (local state indices), ``var`` (index of the
+    variable that flips), ``controllable``.
+    """
+
+    name: str
+    variables: tuple[str, ...]
+    orders: frozenset[str]
+    codes: np.ndarray
+    initial: int
+    src: np.ndarray
+    dst: np.ndarray
+    var: np.ndarray
+    controllable: np.ndarray
+    spec: ElementSpec
+
+    @property
+    def size(self) -> int:
+        return int(self.codes.size)
+
+    def count(self, controllable: bool | None = None) -> int:
+        if controllable is None:
+            return int(self.src.size)
+        return int(np.count_nonzero(self.controllable == controllable))
+
+    def value(self, name: str) -> np.ndarray:
+        """Boolean array over local states: the value of variable ``name``."""
+        i = self.variables.index(name)
+        return ((self.codes >> i) & 1).astype(bool)
+
+    def event(self, t: int) -> str:
+        """Name of transition ``t``'s event, ``↑x`` or ``↓x`` (rising iff the target has x=1)."""
+        i = int(self.var[t])
+        rising = bool((self.codes[self.dst[t]] >> i) & 1)
+        return edge_text(rising, self.variables[i])
+
+    def events(self) -> list[str]:
+        return [self.event(t) for t in range(self.src.size)]
+
+    def true_variables(self, k: int) -> tuple[str, ...]:
+        code = int(self.codes[k])
+        return tuple(v for i, v in enumerate(self.variables) if (code >> i) & 1)
+
+    def state_label(self, k: int) -> str:
+        return "{" + ",".join(self.true_variables(k)) + "}"
+
+    def uncontrollable_closure(self) -> np.ndarray:
+        """``R[k, j]``: local state j is reachable from k by uncontrollable transitions (k included)."""
+        n = self.size
+        reach = np.eye(n, dtype=bool)
+        u = ~self.controllable
+        step = np.zeros((n, n), dtype=bool)
+        step[self.src[u], self.dst[u]] = True
+        while True:
+            nxt = reach | (reach.astype(np.uint8) @ step.astype(np.uint8) > 0)
+            if np.array_equal(nxt, reach):
+                return reach
+            reach = nxt
+
+
+def element_automaton(e: ElementSpec) -> ElementAutomaton:
+    """Build the automaton of element ``e`` (see module docstring)."""
+    names = tuple(v.name for v in e.variables)
+    n = len(names)
+    if n > MAX_ELEMENT_VARIABLES:
+        raise InputError(f"element {e.name} has {n} variables; at most {MAX_ELEMENT_VARIABLES} are supported", e.loc)
+    index = {v: i for i, v in enumerate(names)}
+    decl = {v.name: v for v in e.variables}
+
+    def value_of(code: int):
+        return lambda name: bool((code >> index[name]) & 1)
+
+    def coherent(code: int) -> bool:
+        val = value_of(code)
+        for v in e.variables:
+            if v.held and val(v.name) != v.initial:
+                return False
+        return not any(evaluate(inc, val) for inc in e.incoherences)
+
+    # per consequence event: list of (order index, post value, guard, extra conditions)
+    enablers: dict[tuple[int, bool], list] = {}
+    for r in e.rules:
+        extra = []
+        for p in e.precedences:
+            if p.cause == r.cause and p.then == r.consequence:
+                extra.append(p.first)
+        key = (index[r.consequence.name], r.consequence.rising)
+        enablers.setdefault(key, []).append((index[r.cause.name], r.cause.rising, r.guard, tuple(extra)))
+
+    def uncontrollable_moves(code: int):
+        val = value_of(code)
+        for v in e.variables:
+            if v.kind == ORDER:
+                continue
+            i = index[v.name]
+            bit = bool((code >> i) & 1)
+            rising = not bit
+            if v.kind == "free":
+                yield i
+                continue
+            for oi, post, guard, extra in enablers.get((i, rising), ()):
+                if bool((code >> oi) & 1) != post:
+                    continue
+                if guard is not None and not evaluate(guard, val):
+                    continue
+                if any(bool((code >> index[x.name]) & 1) != x.rising for x in extra):
+                    continue
+                yield i
+                break
+
+    init = sum(1 << index[v.name] for v in e.variables if v.initial)
+    if not coherent(init):  # caught with a location by the rules checker; defensive here
+        raise InputError(f"the initial state of element {e.name} is incoherent", e.loc)
+    order_bits = [index[v.name] for v in e.variables if v.kind == ORDER and not v.held]
+    seen = {init}
+    queue = deque([init])
+    edges: list[tuple[int, int, int, bool]] = []
+    while queue:
+        code = queue.popleft()
+        moves = [(i, True) for i in order_bits] + [(i, False) for i in uncontrollable_moves(code)]
+        for i, ctrl in moves:
+            target = code ^ (1 << i)
+            if not coherent(target):
+                continue
+            edges.append((code, target, i, ctrl))
+            if target not in seen:
+                seen.add(target)
+                queue.append(target)
+    codes = np.array(sorted(seen), dtype=np.int64)
+    pos = {int(c): k for k, c in enumerate(codes)}
+    edges.sort(key=lambda t: (pos[t[0]], t[2], pos[t[1]]))
+    arr = lambda f, dt: np.array([f(t) for t in edges], dtype=dt)  # noqa: E731
+    return ElementAutomaton(
+        name=e.name,
+        variables=names,
+        orders=frozenset(v.name for v in e.variables if v.kind == ORDER),
+        codes=codes,
+        initial=pos[init],
+        src=arr(lambda t: pos[t[0]], np.int64),
+        dst=arr(lambda t: pos[t[1]], np.int64),
+        var=arr(lambda t: t[2], np.int64),
+        controllable=arr(lambda t: t[3], bool),
+        spec=e,
+    )
