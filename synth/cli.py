@@ -1,0 +1,63 @@
+"""Command line: ``synth plant``, ``synth sup``, ``synth ass``, ``synth run``, ``synth validate``.
+
+Exit codes: 0 pass, 1 the model fails validation, 2 bad input (reported as
+``file:line:col: message`` with a caret, never a traceback).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from typing import Callable, Sequence
+
+from .errors import InputError, InputErrors, LimitExceeded, ModelError, SynthError
+
+__all__ = ["main", "build_parser"]
+
+EXIT_PASS, EXIT_FAIL, EXIT_INPUT = 0, 1, 2
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str) -> None:  # argparse's own errors: exit 2 as for bad input
+        self.print_usage(sys.stderr)
+        self.exit(EXIT_INPUT, f"{self.prog}: error: {message}\n")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    from . import cli_grafcet, cli_plant, cli_validate
+
+    p = _Parser(prog="synth", description="Validate a Grafcet against a rule-based plant model and its safety constraints.")
+    sub = p.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+    sub.required = True
+    for module in (cli_plant, cli_grafcet, cli_validate):
+        module.register(sub)
+    return p
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    handler: Callable[[argparse.Namespace], int] = args.handler
+    try:
+        return handler(args)
+    except (InputError, InputErrors) as err:
+        print(err.render(), file=sys.stderr)
+        return EXIT_INPUT
+    except ModelError as err:
+        print(f"error: {err}", file=sys.stderr)
+        return EXIT_INPUT
+    except LimitExceeded as err:
+        print(f"stopped: {err}", file=sys.stderr)
+        return EXIT_INPUT
+    except SynthError as err:
+        print(f"error: {err}", file=sys.stderr)
+        return EXIT_INPUT
+    except KeyboardInterrupt:
+        print("interrupted", file=sys.stderr)
+        return 130
+    except BrokenPipeError:
+        return EXIT_PASS
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,202 @@
+"""Asynchronous composition of element automata: the plant (METHOD.md §2).
+
+The plant is never built transition by transition. A global state is the tuple of
+the elements' local states, stored as a position in an N-dimensional numpy grid of
+shape ``(|Q_1|, ..., |Q_N|)`` (its flat index is the state's code). A transition of
+the product is a local transition of one element, the other coordinates unchanged,
+so "all global transitions of local transition t of element i" is the pair of grid
+slices ``[..., src_t, ...]`` and ``[..., dst_t, ...]`` along axis i: image and
+pre-image of a state set are a handful of vectorised slice operations.
+
+Every local state of every element is reachable (element automata keep only
+reachable states) and elements move independently, so every grid position is a
+reachable plant state: ``|Q| = Π|Q_i|`` and ``|δ| = Σ_i |δ_i| Π_{j≠i} |Q_j|``.
+
+Example
+-------
+>>> from synth.rules import load_rules
+>>> p = plant(load_rules(_plants("tri_annex.rules")))
+>>> p.size, p.count_transitions(controllable=False) > 0
+(15552, True)
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+from pathlib import Path
+from typing import Iterator, Mapping
+
+import numpy as np
+
+from .errors import SynthError, close_names
+from .expr import Expr, evaluate
+from .plant import ElementAutomaton, element_automaton
+from .rules import RuleSet
+
+__all__ = ["Plant", "plant", "asynchronous_composition", "LocalTransition"]
+
+
+def _plants(name: str) -> str:
+    return str(Path(__file__).resolve().parent.parent / "plants" / name)
+
+
+@dataclass(frozen=True)
+class LocalTransition:
+    """A transition of one element, seen from the grid: axis, local source/target, event."""
+
+    axis: int
+    src: int
+    dst: int
+    event: str
+    controllable: bool
+
+
+class Plant:
+    """The asynchronous product of element automata (see module docstring)."""
+
+    def __init__(self, elements: tuple[ElementAutomaton, ...], rules: RuleSet | None = None) -> None:
+        self.elements = elements
+        self.rules = rules
+        self.shape = tuple(e.size for e in elements)
+        self.ndim = len(elements)
+        self.size = int(np.prod(self.shape, dtype=np.int64)) if elements else 0
+        self.owner: dict[str, int] = {v: i for i, e in enumerate(elements) for v in e.variables}
+        self.initial = tuple(e.initial for e in elements)
+        if rules is not None:
+            self.inputs = tuple(rules.inputs)
+            self.outputs = tuple(rules.outputs)
+        else:
+            self.inputs = tuple(v for e in elements for v in e.variables if v not in e.orders)
+            self.outputs = tuple(v for e in elements for v in e.variables if v in e.orders)
+        self.variables = self.inputs + self.outputs
+
+    # ------------------------------------------------------------------ structure
+    @cached_property
+    def transitions(self) -> tuple[LocalTransition, ...]:
+        out = []
+        for i, e in enumerate(self.elements):
+            for t in range(e.src.size):
+                out.append(LocalTransition(i, int(e.src[t]), int(e.dst[t]), e.event(t), bool(e.controllable[t])))
+        return tuple(out)
+
+    @cached_property
+    def events(self) -> dict[str, bool]:
+        """Every event of the plant and whether it is controllable, sorted by name."""
+        return dict(sorted({t.event: t.controllable for t in self.transitions}.items()))
+
+    def count_transitions(self, controllable: bool | None = None) -> int:
+        total = 0
+        for i, e in enumerate(self.elements):
+            others = self.size // e.size
+            total += e.count(controllable) * others
+        return total
+
+    @property
+    def initial_index(self) -> int:
+        return int(np.ravel_multi_index(self.initial, self.shape))
+
+    def index(self, local: tuple[int, ...]) -> int:
+        return int(np.ravel_multi_index(local, self.shape))
+
+    def local(self, index: int) -> tuple[int, ...]:
+        return tuple(int(x) for x in np.unravel_index(index, self.shape))
+
+    # ------------------------------------------------------------------ values
+    def values(self, name: str) -> np.ndarray:
+        """Value of variable ``name`` as an array broadcastable to the grid."""
+        i = self.owner[name]
+        v = self.elements[i].value(name)
+        shape = [1] * self.ndim
+        shape[i] = v.size
+        return v.reshape(shape)
+
+    def grid(self, e: Expr) -> np.ndarray:
+        """The boolean grid of states where level expression ``e`` holds."""
+        r = evaluate(e, self.values)
+        return np.broadcast_to(np.asarray(r, dtype=bool), self.shape)
+
+    def valuation(self, local: tuple[int, ...]) -> dict[str, bool]:
+        """Every variable's value in the state ``local`` (a tuple of local indices)."""
+        out: dict[str, bool] = {}
+        for e, k in zip(self.elements, local):
+            code = int(e.codes[k])
+            for b, v in enumerate(e.variables):
+                out[v] = bool((code >> b) & 1)
+        return out
+
+    def label(self, local: tuple[int, ...]) -> str:
+        """``{TAPIS,v10,...}``: the true variables in E-then-Z order."""
+        val = self.valuation(local)
+        return "{" + ",".join(v for v in self.variables if val[v]) + "}"
+
+    def vectors(self, local: tuple[int, ...]) -> tuple[str, str]:
+        """The E and Z vectors as bit strings in declaration order."""
+        val = self.valuation(local)
+        return ("".join("1" if val[v] else "0" for v in self.inputs), "".join("1" if val[v] else "0" for v in self.outputs))
+
+    def parse_state(self, text: str) -> tuple[int, ...]:
+        """A state written as its true variables (``"TAPIS,v10,v20"`` or ``{...}``)."""
+        words = [w for w in text.replace("{", " ").replace("}", " ").replace(",", " ").split() if w]
+        true = set()
+        for w in words:
+            if w not in self.owner:
+                hint = close_names(w, self.owner)
+                raise SynthError(f"unknown variable '{w}' in state" + (f" (did you mean {' or '.join(hint)}?)" if hint else ""))
+            true.add(w)
+        local = []
+        for e in self.elements:
+            code = sum(1 << b for b, v in enumerate(e.variables) if v in true)
+            hits = np.nonzero(e.codes == code)[0]
+            if hits.size == 0:
+                shown = "{" + ",".join(v for v in e.variables if v in true) + "}"
+                raise SynthError(f"{shown} is not a state of element {e.name}: it is incoherent or unreachable in its rules")
+            local.append(int(hits[0]))
+        return tuple(local)
+
+    # ------------------------------------------------------------------ moves
+    def successors(self, local: tuple[int, ...]) -> Iterator[tuple[LocalTransition, tuple[int, ...]]]:
+        """Outgoing transitions of one state, in a stable order."""
+        for t in self.transitions:
+            if local[t.axis] == t.src:
+                nxt = list(local)
+                nxt[t.axis] = t.dst
+                yield t, tuple(nxt)
+
+    def slices(self, t: LocalTransition) -> tuple[tuple, tuple]:
+        """Grid index tuples selecting the sources and targets of ``t`` (views, no copy)."""
+        pre = (slice(None),) * t.axis
+        return pre + (t.src,), pre + (t.dst,)
+
+    def preimage(self, mask: np.ndarray, controllable: bool | None = None) -> np.ndarray:
+        """States with a transition (of the given kind) into ``mask``."""
+        out = np.zeros(self.shape, dtype=bool)
+        for t in self.transitions:
+            if controllable is not None and t.controllable != controllable:
+                continue
+            s, d = self.slices(t)
+            out[s] |= mask[d]
+        return out
+
+    def transition_arrays(self, keep: np.ndarray | None = None) -> Iterator[tuple[LocalTransition, np.ndarray, np.ndarray]]:
+        """For each local transition, flat source and target codes of its global copies
+        (restricted to sources and targets in ``keep`` when given)."""
+        flat = np.arange(self.size, dtype=np.int64).reshape(self.shape)
+        for t in self.transitions:
+            s, d = self.slices(t)
+            src, dst = flat[s], flat[d]
+            if keep is not None:
+                m = keep[s] & keep[d]
+                src, dst = src[m], dst[m]
+            yield t, src.ravel(), dst.ravel()
+
+
+def asynchronous_composition(elements: tuple[ElementAutomaton, ...], rules: RuleSet | None = None) -> Plant:
+    """The interleaving product of ``elements``."""
+    return Plant(elements, rules)
+
+
+def plant(rules: RuleSet) -> Plant:
+    """The plant of a rule set: its elements' automata, composed asynchronously."""
+    return asynchronous_composition(tuple(element_automaton(e) for e in rules.elements), rules)
+
