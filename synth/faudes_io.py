@@ -36,7 +36,7 @@ def faudes_event(event: str) -> str:
 def generator_text(
     name: str,
     n_states: int,
-    initial: int,
+    initial: int | None,
     events: dict[str, bool],
     src: np.ndarray,
     ev: np.ndarray,
@@ -51,7 +51,7 @@ def generator_text(
     states = "\n".join(str(i) for i in range(1, n_states + 1))
     return (
         f'<Generator>\n"{name}"\n<Alphabet>\n{alphabet}\n</Alphabet>\n<States>\n{states}\n</States>\n'
-        f"<TransRel>\n" + "\n".join(lines) + f"\n</TransRel>\n<InitStates>\n{initial + 1 if n_states else ''}\n</InitStates>\n"
+        f"<TransRel>\n" + "\n".join(lines) + f"\n</TransRel>\n<InitStates>\n{initial + 1 if initial is not None else ''}\n</InitStates>\n"
         f"<MarkedStates>\n{states}\n</MarkedStates>\n</Generator>\n"
     )
 
@@ -72,7 +72,7 @@ def _grid_generator(p: Plant, name: str, keep: np.ndarray, allowed) -> str:
         ev_all.append(np.full(srcs.size, ev_index[t.event], dtype=np.int64))
     cat = lambda xs: np.concatenate(xs) if xs else np.zeros(0, dtype=np.int64)  # noqa: E731
     n = int(np.count_nonzero(keep))
-    init = int(number[p.initial_index]) if n else 0
+    init = int(number[p.initial_index]) if keep[p.initial] else None
     return generator_text(name, n, init, events, cat(src_all), cat(ev_all), cat(dst_all))
 
 
