@@ -124,7 +124,7 @@ def close_names(name: str, candidates: Iterable[str], n: int = 3) -> tuple[str, 
     """
     pool = sorted(set(candidates))
     lowered = {c.lower(): c for c in pool}
-    hits = difflib.get_close_matches(name.lower(), list(lowered), n=n, cutoff=0.6)
+    hits = difflib.get_close_matches(name.lower(), list(lowered), n=n, cutoff=0.5)
     return tuple(lowered[h] for h in hits)
 
 
