@@ -196,26 +196,32 @@ def supremal_controllable(p: Plant, constraints: Sequence[Constraint], *, reach:
 
 
 def _explore(sup: Supervisor) -> None:
-    """Forward reachability inside SUP, frontier by frontier (vectorised per local transition)."""
+    """Forward reachability inside SUP.
+
+    Chaotic (Gauss-Seidel) iteration: each pass runs over the local transitions and
+    updates the reached set in place, so states found early in a pass propagate within
+    the same pass; passes repeat until one adds nothing. Each pass costs one sweep over
+    the plant's transitions as vectorised slice operations.
+    """
     p = sup.plant
-    sup.reachable[p.initial] = True
-    frontier = sup.reachable.copy()
+    reach = sup.reachable
+    reach[p.initial] = True
+    target_ok = ~sup.removed
     moves = []
     for t in p.transitions:
         s, d = p.slices(t)
-        ok = ~sup.removed[d]
-        if t.controllable and t.event in sup.forbid:
-            ok = ok & ~sup.forbid[t.event][s]
-        moves.append((s, d, ok))
-    while True:
-        new = np.zeros(p.shape, dtype=bool)
+        forbid = sup.forbid.get(t.event) if t.controllable else None
+        moves.append((s, d, None if forbid is None else ~forbid[s]))
+    before = -1
+    count = 1
+    while count != before:
+        before = count
         for s, d, ok in moves:
-            new[d] |= frontier[s] & ok
-        new &= ~sup.reachable
-        if not new.any():
-            return
-        sup.reachable |= new
-        frontier = new
+            add = reach[s] & target_ok[d]
+            if ok is not None:
+                add &= ok
+            reach[d] |= add
+        count = int(np.count_nonzero(reach))
 
 
 class LocalSupervisor:
