@@ -1,11 +1,72 @@
-"""CLI commands of the validate stage (registered by :mod:`synth.cli`)."""
+"""CLI command ``synth validate GRAFCET.g7 --plant RULES``."""
 
 from __future__ import annotations
 
 import argparse
+import json
+import sys
+from pathlib import Path
 
-__all__ = ["register"]
+from .files import write_atomic
+from .render import dot_graph
+from .report import write_report
+from .sync import stderr_progress
+from .validation import reduced_controller, validate
+
+__all__ = ["register", "cmd_validate"]
 
 
 def register(sub: "argparse._SubParsersAction") -> None:
-    """Add this stage's sub-commands to the ``synth`` parser."""
+    v = sub.add_parser(
+        "validate",
+        help="validate a Grafcet against a plant: blocking situations, prohibited orders, diagnoses",
+        description="Exit 0 when nothing is found, 1 when problems are found, 2 for bad input.",
+    )
+    v.add_argument("grafcet", metavar="GRAFCET.g7", help="the control program")
+    v.add_argument("--plant", metavar="RULES", required=True, help="the plant (.rules, with its constraints)")
+    v.add_argument("--expert", action="store_true", help="the Grafcet is trusted: blame element models and constraints")
+    v.add_argument("--report", metavar="DIR", nargs="?", const="", default=None,
+                   help="write DIR/index.html (default reports/<grafcet name>)")
+    v.add_argument("--json", action="store_true", help="print the result as JSON (docs/validate-json.md)")
+    v.add_argument("--cor", metavar="FILE", help="write the reduced controller as JSON to FILE and DOT beside it")
+    v.add_argument("--max-states", metavar="N", type=int, help="stop after N aggregated states")
+    v.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    v.set_defaults(handler=cmd_validate)
+
+
+def cmd_validate(args: argparse.Namespace) -> int:
+    show_progress = not args.quiet and sys.stderr.isatty()
+    result = validate(
+        args.grafcet,
+        args.plant,
+        expert=args.expert,
+        max_states=args.max_states,
+        progress=stderr_progress if show_progress else None,
+    )
+    if show_progress:
+        sys.stderr.write("\r\033[K")
+    if args.cor:
+        cor = reduced_controller(result)
+        path = Path(args.cor)
+        write_atomic(path, json.dumps(cor, indent=2, ensure_ascii=False) + "\n")
+        nodes = [(str(s["id"]), "{" + ", ".join(s["situation"]) + "}\n" + ", ".join(s["orders"]), {"shape": "box"})
+                 for s in cor["states"]]
+        edges = [(str(t["source"]), str(t["target"]), t["event"], {}) for t in cor["transitions"]]
+        write_atomic(path.with_suffix(".dot"), dot_graph("COR", nodes, edges))
+    report_path = None
+    if args.report is not None:
+        directory = args.report or str(Path("reports") / Path(args.grafcet).stem)
+        report_path = write_report(directory, result)
+    if args.json:
+        data = result.as_json()
+        if report_path is not None:
+            data["report"] = str(report_path)
+        json.dump(data, sys.stdout, indent=2, ensure_ascii=False)
+        sys.stdout.write("\n")
+    else:
+        print(result.text())
+        if report_path is not None:
+            print(f"\nreport: {report_path}")
+        if args.cor:
+            print(f"reduced controller: {args.cor} and {Path(args.cor).with_suffix('.dot')}")
+    return 0 if result.passed else 1

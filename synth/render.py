@@ -9,11 +9,14 @@ Example
 
 from __future__ import annotations
 
-from typing import Iterable, Mapping
+from typing import TYPE_CHECKING, Iterable, Mapping
 
 from .plant import ElementAutomaton
 
-__all__ = ["dot_graph", "dot_escape", "element_dot"]
+if TYPE_CHECKING:
+    from .sync import Sync
+
+__all__ = ["dot_graph", "dot_escape", "element_dot", "trace_dot", "sup_neighbourhood_dot", "aggregated_dot"]
 
 CONTROLLABLE_STYLE = {"color": "#1f5fa8", "fontcolor": "#1f5fa8"}
 UNCONTROLLABLE_STYLE = {"color": "#b03a2e", "fontcolor": "#b03a2e", "style": "dashed"}
@@ -69,3 +72,85 @@ def element_dot(a: ElementAutomaton, highlight: Iterable[str] = ()) -> str:
             style.update(HIGHLIGHT_STYLE)
         edges.append((str(int(a.src[t])), str(int(a.dst[t])), ev, style))
     return dot_graph(a.name, nodes, edges)
+
+
+def _vector_text(names: Iterable[str], values: Mapping[str, bool]) -> str:
+    return "[" + "".join("1" if values[n] else "0" for n in names) + "]"
+
+
+def trace_dot(sync: "Sync", nodes: Iterable[int], events: Iterable[str], blocking: int | None = None) -> str:
+    """A trace of the aggregated automaton drawn like the thesis's figure 2.10: each state
+    with Sit, ORD, PROH, E and Z; the blocking state in red with a double border."""
+    p = sync.plant
+    nodes = list(nodes)
+    out_nodes = []
+    for k, i in enumerate(nodes):
+        n = sync.nodes[i]
+        val = p.valuation(n.plant)
+        proh = ", ".join(f"{pr.order} ({', '.join(pr.constraints)})" for pr in n.proh)
+        label = (
+            f"{k}: Sit={n.situation.text()}\n"
+            f"ORD={{{', '.join(n.ord)}}}  PROH={{{proh}}}\n"
+            f"E={_vector_text(p.inputs, val)}  Z={_vector_text(p.outputs, val)}"
+        )
+        attrs = {"shape": "box", "style": "rounded"}
+        if k == 0:
+            attrs["peripheries"] = "2"
+        if i == blocking:
+            attrs.update({"color": "#c0392b", "penwidth": "2", "peripheries": "2", "fontcolor": "#c0392b"})
+        elif n.proh:
+            attrs.update({"color": "#e67e22"})
+        out_nodes.append((f"n{k}", label, attrs))
+    edges = [(f"n{k}", f"n{k + 1}", ev, dict(UNCONTROLLABLE_STYLE)) for k, ev in enumerate(events)]
+    legend = "E = [" + ", ".join(p.inputs) + "]\nZ = [" + ", ".join(p.outputs) + "]"
+    out_nodes.append(("legend", legend, {"shape": "note", "fontsize": "9"}))
+    return dot_graph("trace", out_nodes, edges, rankdir="TB")
+
+
+def sup_neighbourhood_dot(sync: "Sync", local: tuple[int, ...]) -> str:
+    """The plant state ``local`` and its one-step plant neighbours: transitions SUP keeps
+    (solid) and controllable ones it forbids (dotted, with the constraint ids)."""
+    p = sync.plant
+    oracle = sync.oracle
+    centre = p.label(local)
+    nodes = [("c", centre, {"shape": "box", "color": "#c0392b", "penwidth": "2"})]
+    edges = []
+    for k, (t, nxt) in enumerate(p.successors(local)):
+        nid = f"s{k}"
+        label = p.label(nxt)
+        if t.controllable:
+            ok, why = oracle.move(t, local)
+        else:
+            ok, why = oracle.kept(nxt), oracle.threatened(nxt)
+        if ok:
+            style = dict(CONTROLLABLE_STYLE if t.controllable else UNCONTROLLABLE_STYLE)
+            nodes.append((nid, label, {"shape": "box"}))
+            edges.append(("c", nid, t.event, style))
+        else:
+            nodes.append((nid, label, {"shape": "box", "color": "#999999", "fontcolor": "#999999"}))
+            edges.append(("c", nid, f"{t.event} ✗ {', '.join(why)}", {"style": "dotted", "color": "#c0392b", "fontcolor": "#c0392b"}))
+    return dot_graph("sup", nodes, edges)
+
+
+def aggregated_dot(sync: "Sync", keep: Iterable[int] | None = None, blocking: Iterable[int] = ()) -> str:
+    """The aggregated automaton (or its sub-graph ``keep``): one state per region."""
+    p = sync.plant
+    chosen = sorted(set(keep)) if keep is not None else list(range(len(sync.nodes)))
+    inside = set(chosen)
+    bad = set(blocking)
+    nodes = []
+    for i in chosen:
+        n = sync.nodes[i]
+        e, z = p.vectors(n.plant)
+        attrs = {"shape": "box", "style": "rounded"}
+        if i == 0:
+            attrs["peripheries"] = "2"
+        if i in bad:
+            attrs.update({"color": "#c0392b", "penwidth": "2"})
+        nodes.append((f"q{i}", f"q{i}: {n.situation.text()}\nORD={{{', '.join(n.ord)}}}\nE={e} Z={z}", attrs))
+    edges = [
+        (f"q{e.source}", f"q{e.target}", e.event, dict(UNCONTROLLABLE_STYLE))
+        for e in sync.edges
+        if e.source in inside and e.target in inside
+    ]
+    return dot_graph("aggregated", nodes, edges)

@@ -4,11 +4,15 @@ from __future__ import annotations
 
 import shutil
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from .errors import SynthError
 from .files import write_atomic
 
-__all__ = ["svg", "write_svg", "dot_available"]
+if TYPE_CHECKING:
+    from .validation import Validation
+
+__all__ = ["svg", "write_svg", "dot_available", "report_html", "write_report"]
 
 
 def dot_available() -> bool:
@@ -34,3 +38,118 @@ def svg(dot_text: str) -> str:
 def write_svg(path: str | Path, dot_text: str) -> Path:
     """Render and write an SVG file atomically."""
     return write_atomic(path, svg(dot_text))
+
+
+def _esc(text: str) -> str:
+    import html
+
+    return html.escape(text, quote=True)
+
+
+def _inline_svg(dot_text: str) -> str:
+    text = svg(dot_text)
+    start = text.find("<svg")
+    return f'<div class="figure">{text[start:] if start >= 0 else text}</div>'
+
+
+_CSS = """
+body { font-family: Helvetica, Arial, sans-serif; margin: 2em; color: #222; max-width: 1200px; }
+h1 { margin-bottom: 0.2em; } .pass { color: #1e8449; } .fail { color: #c0392b; }
+table { border-collapse: collapse; margin: 0.5em 0; } td, th { border: 1px solid #ccc; padding: 3px 8px; text-align: left; }
+code, .mono { font-family: Menlo, Consolas, monospace; } .figure { overflow-x: auto; margin: 1em 0; }
+.diag { background: #fdf2e9; border-left: 4px solid #e67e22; padding: 0.6em 1em; }
+.problem { border-top: 2px solid #ddd; margin-top: 2em; padding-top: 1em; }
+"""
+
+
+def report_html(v: "Validation") -> str:
+    """The self-contained HTML report of a validation (inline SVG made by Graphviz)."""
+    from .render import aggregated_dot, element_dot, sup_neighbourhood_dot, trace_dot
+
+    data = v.as_json()
+    a = v.analysis
+    verdict = data["verdict"]
+    parts = [
+        "<!DOCTYPE html>",
+        '<html lang="en"><head><meta charset="utf-8">',
+        f"<title>synth validate: {_esc(Path(v.grafcet.path).name)}</title>",
+        f"<style>{_CSS}</style></head><body>",
+        f'<h1 class="{verdict}">{verdict.upper()}</h1>',
+        f"<p>Grafcet <code>{_esc(v.grafcet.path)}</code>, plant <code>{_esc(v.rules.path)}</code>, "
+        f"{data['mode']} mode.</p>",
+        "<table><tr>" + "".join(f"<th>{_esc(k)}</th>" for k in data["stats"]) + "</tr><tr>"
+        + "".join(f"<td>{val}</td>" for val in data["stats"].values()) + "</tr></table>",
+        f"<p>{len(a.blocking)} blocking situation(s), {len(a.prohibited)} situation(s) with prohibited orders.</p>",
+    ]
+    if data["constraints"]:
+        parts.append("<details><summary>Constraints</summary><table>")
+        for c in v.rules.constraints:
+            parts.append(f"<tr><td>{_esc(c.id)}</td><td>{_esc(c.label)}</td><td><code>{_esc(c.text())}</code></td></tr>")
+        parts.append("</table></details>")
+    for k, (b, item) in enumerate(zip(a.blocking, data["blocking"]), 1):
+        d = v.diagnoses[b]
+        tr = a.traces[b]
+        parts += [
+            f'<div class="problem"><h2>Blocking {k}: situation {_esc(v.sync.nodes[b].situation.text())}</h2>',
+            _state_table(item),
+            f"<p>Trace: <code>{_esc(' '.join(tr.events) or '(initial state)')}</code></p>",
+            f'<div class="diag"><b>{_esc(d.verdict)}</b>: {_esc(d.summary)}<ul>'
+            + "".join(f"<li><code>{_esc(x.strip())}</code></li>" for x in d.details)
+            + "</ul></div>",
+            "<h3>Trace to the blocking state</h3>",
+            _inline_svg(trace_dot(v.sync, tr.nodes, tr.events, blocking=b)),
+        ]
+        elements, events = _involved(v, b, d)
+        for name in elements:
+            el = next(e for e in v.plant.elements if e.name == name)
+            parts += [f"<h3>Element {_esc(name)}</h3>", _inline_svg(element_dot(el, highlight=events))]
+        parts += [
+            "<h3>SUP around the blocking state</h3>",
+            _inline_svg(sup_neighbourhood_dot(v.sync, v.sync.nodes[b].plant)),
+            "</div>",
+        ]
+    for k, i in enumerate(a.prohibited, 1):
+        tr = a.traces[i]
+        items = [x for x in data["prohibited"] if x["trace"] == list(tr.events)]
+        parts += [
+            f'<div class="problem"><h2>Prohibited orders {k}: situation {_esc(v.sync.nodes[i].situation.text())}</h2>',
+            _state_table(items[0]) if items else "",
+            f"<p>Trace: <code>{_esc(' '.join(tr.events) or '(initial state)')}</code></p>",
+            "".join(f'<div class="diag">{_esc(x["diagnosis"])}</div>' for x in items),
+            _inline_svg(trace_dot(v.sync, tr.nodes, tr.events, blocking=None)),
+            "</div>",
+        ]
+    if len(v.sync.nodes) <= 120:
+        parts += ["<h2>Aggregated automaton</h2>", _inline_svg(aggregated_dot(v.sync, blocking=a.blocking))]
+    parts.append("</body></html>")
+    return "\n".join(parts) + "\n"
+
+
+def _state_table(item: dict) -> str:
+    e = " ".join(k for k, x in item["E"].items() if x) or "-"
+    z = " ".join(k for k, x in item["Z"].items() if x) or "-"
+    proh = ", ".join(f"{p['order']} ({', '.join(p['constraints'])})" for p in item["proh"]) or "-"
+    rows = [("Sit", ", ".join(item["situation"])), ("E (true)", e), ("Z (true)", z), ("ORD", ", ".join(item["ord"]) or "-"), ("PROH", proh)]
+    return "<table>" + "".join(f"<tr><th>{k}</th><td class='mono'>{_esc(val)}</td></tr>" for k, val in rows) + "</table>"
+
+
+def _involved(v: "Validation", b: int, d) -> tuple[list[str], set[str]]:
+    elements: list[str] = []
+    events: set[str] = set()
+    for aw in d.awaited:
+        for c in aw.causes:
+            if c.element and c.element not in elements:
+                elements.append(c.element)
+            events.add(c.event)
+            events.update(c.changes)
+    for pr in v.sync.nodes[b].proh:
+        owner = v.plant.owner.get(pr.order)
+        if owner is not None and v.plant.elements[owner].name not in elements:
+            elements.append(v.plant.elements[owner].name)
+        events.add(pr.event)
+    return elements, events
+
+
+def write_report(directory: str | Path, v: "Validation") -> Path:
+    """Write ``DIRECTORY/index.html`` atomically; returns its path."""
+    return write_atomic(Path(directory) / "index.html", report_html(v))

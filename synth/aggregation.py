@@ -1,0 +1,119 @@
+"""The aggregated automaton's verdicts: blocking states and shortest traces (METHOD.md §7).
+
+*Blocking* means the cycle can no longer be completed: the initial situation can
+never be reached again. Every such state leads into a terminal strongly connected
+component that does not contain the initial situation (a deadlock is the simplest
+one; an operator input toggling back and forth does not rescue it). synth reports
+each terminal component once, at the first state of it that a shortest trace from the
+initial state meets, and the *point of no return* on that trace: the first state from
+which the initial situation is unreachable.
+
+Example
+-------
+>>> # see tests/test_validate.py for end-to-end examples
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass
+
+import networkx as nx
+
+from .sync import Sync
+
+__all__ = ["Trace", "Analysis", "analyse", "coreachable", "shortest_paths"]
+
+
+@dataclass(frozen=True)
+class Trace:
+    """Nodes from the initial state to ``nodes[-1]`` and the events between them."""
+
+    nodes: tuple[int, ...]
+    events: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class Analysis:
+    blocking: tuple[int, ...]  # first state of each terminal component, by trace length
+    traces: dict[int, Trace]
+    no_return: dict[int, int]  # blocking node -> first node of its trace that cannot come back
+    coreachable: frozenset[int]
+    prohibited: tuple[int, ...]  # first node meeting each (steps, prohibited event)
+    components: dict[int, tuple[int, ...]]  # blocking node -> members of its terminal component
+
+
+def coreachable(sync: Sync, targets: set[int]) -> set[int]:
+    """Nodes from which some node of ``targets`` is reachable (targets included)."""
+    seen = set(targets)
+    queue = deque(sorted(targets))
+    while queue:
+        i = queue.popleft()
+        for e in sync.predecessors(i):
+            if e.source not in seen:
+                seen.add(e.source)
+                queue.append(e.source)
+    return seen
+
+
+def shortest_paths(sync: Sync) -> tuple[dict[int, int], dict[int, tuple[int, str]]]:
+    """Breadth-first distances from the initial node and parents (deterministic: events sorted)."""
+    dist = {0: 0} if sync.nodes else {}
+    parent: dict[int, tuple[int, str]] = {}
+    queue = deque([0] if sync.nodes else [])
+    while queue:
+        i = queue.popleft()
+        for e in sorted(sync.successors(i), key=lambda e: (e.event, e.target)):
+            if e.target not in dist:
+                dist[e.target] = dist[i] + 1
+                parent[e.target] = (i, e.event)
+                queue.append(e.target)
+    return dist, parent
+
+
+def _trace(parent: dict[int, tuple[int, str]], node: int) -> Trace:
+    nodes = [node]
+    events: list[str] = []
+    while nodes[-1] in parent:
+        prev, ev = parent[nodes[-1]]
+        events.append(ev)
+        nodes.append(prev)
+    return Trace(tuple(reversed(nodes)), tuple(reversed(events)))
+
+
+def analyse(sync: Sync) -> Analysis:
+    """Blocking states, their shortest traces and points of no return; prohibited orders."""
+    if not sync.nodes:
+        return Analysis((), {}, {}, frozenset(), (), {})
+    initial_steps = sync.nodes[0].situation
+    homes = {i for i, n in enumerate(sync.nodes) if n.situation == initial_steps}
+    back = coreachable(sync, homes)
+    dist, parent = shortest_paths(sync)
+    stuck = [i for i in range(len(sync.nodes)) if i not in back]
+    g = nx.DiGraph()
+    g.add_nodes_from(stuck)
+    g.add_edges_from((e.source, e.target) for e in sync.edges if e.source not in back and e.target not in back)
+    blocking: list[int] = []
+    components: dict[int, tuple[int, ...]] = {}
+    for comp in nx.strongly_connected_components(g):
+        if any(succ not in comp for i in comp for succ in g.successors(i)):
+            continue  # not terminal
+        entry = min(comp, key=lambda i: (dist.get(i, 1 << 30), i))
+        blocking.append(entry)
+        components[entry] = tuple(sorted(comp))
+    blocking.sort(key=lambda i: (dist.get(i, 1 << 30), i))
+    traces = {b: _trace(parent, b) for b in blocking}
+    no_return = {b: next(n for n in traces[b].nodes if n not in back) for b in blocking}
+    seen: set[tuple] = set()
+    prohibited: list[int] = []
+    for i in sorted(dist, key=lambda i: (dist[i], i)):
+        n = sync.nodes[i]
+        for p in n.proh:
+            key = (n.situation.steps, p.event)
+            if key not in seen:
+                seen.add(key)
+                if i not in prohibited:
+                    prohibited.append(i)
+    for i in prohibited:
+        traces.setdefault(i, _trace(parent, i))
+    return Analysis(tuple(blocking), traces, no_return, frozenset(back), tuple(prohibited), components)

@@ -1,0 +1,354 @@
+"""Diagnosis: the analysis the thesis leaves to a human (METHOD.md §7, lines 3360-3430).
+
+For a blocking state: which receptivities are awaited; which sensor events would make
+each one true; which orders cause those events, through which rules of which element;
+whether the situation emits those orders and whether SUP authorises them there, and if
+not which constraints forbid them. From that a verdict in plain words:
+
+- ``missing_order``: an order that would cause the awaited event is not emitted;
+- ``prohibited_order``: it is emitted but SUP forbids it (wrong control, or over-strict
+  constraint; in expert mode the Grafcet is trusted, so the constraint is blamed);
+- ``element_model`` (expert mode): the orders are emitted and authorised, yet the
+  element's rules never produce the awaited event from its current state;
+- ``unproducible_event``: no rule of any element produces the awaited event;
+- ``waiting``: the situation only waits on other steps (see the other grafcets' verdicts).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from itertools import combinations
+from typing import Any, Iterable
+
+import numpy as np
+
+from .composition import Plant
+from .expr import Edge, Var, edge_text, evaluate, names
+from .grafcet import Transition
+from .sync import Node, Prohibition, Sync
+
+__all__ = ["Cause", "Awaited", "Diagnosis", "diagnose", "diagnose_prohibition"]
+
+
+@dataclass(frozen=True)
+class Cause:
+    """How an awaited sensor event could happen, seen from its element."""
+
+    event: str
+    element: str | None
+    changes: tuple[str, ...] = ()  # order changes needed (↑AVANCER2)
+    rules: tuple[str, ...] = ()  # rules producing the event
+    emitted: bool = False  # the situation asks for those changes
+    authorised: bool = True  # SUP allows them here
+    constraints: tuple[str, ...] = ()  # constraints forbidding them
+    producible_now: bool = False  # under the current orders the element can produce it
+
+    def as_dict(self) -> dict[str, Any]:
+        return {
+            "event": self.event,
+            "element": self.element,
+            "orders": list(self.changes),
+            "rules": list(self.rules),
+            "emitted": self.emitted,
+            "authorised": self.authorised,
+            "constraints": list(self.constraints),
+            "producible_now": self.producible_now,
+        }
+
+
+@dataclass(frozen=True)
+class Awaited:
+    transition: str
+    grafcet: str
+    receptivity: str
+    events: tuple[str, ...]  # input events that would make it true (one event each)
+    steps: tuple[str, ...] = ()  # step variables it waits on, not active
+    causes: tuple[Cause, ...] = ()
+    sources: tuple[str, ...] = ()  # the transition's source steps
+
+    def as_dict(self) -> dict[str, Any]:
+        return {
+            "transition": self.transition,
+            "grafcet": self.grafcet,
+            "steps": list(self.sources),
+            "receptivity": self.receptivity,
+            "events": list(self.events),
+            "waits_on_steps": list(self.steps),
+            "causes": [c.as_dict() for c in self.causes],
+        }
+
+
+@dataclass(frozen=True)
+class Diagnosis:
+    verdict: str
+    summary: str
+    awaited: tuple[Awaited, ...] = ()
+    details: tuple[str, ...] = field(default=())
+
+    def as_dict(self) -> dict[str, Any]:
+        return {
+            "verdict": self.verdict,
+            "summary": self.summary,
+            "awaited": [a.as_dict() for a in self.awaited],
+            "details": list(self.details),
+        }
+
+
+def _value_fn(sync: Sync, node: Node, inputs: dict[str, bool]):
+    sit = node.situation
+    active = {f"X{s}" for s in sit.steps}
+    elapsed = set(sit.elapsed)
+
+    def value(name: str) -> bool:
+        if name in inputs:
+            return inputs[name]
+        if name in elapsed:
+            return True
+        return name in active
+
+    return value
+
+
+def _awaited_events(sync: Sync, node: Node, t: Transition) -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """Input events (single input changes) that make ``t``'s receptivity true, and the
+    step variables it reads that are not active."""
+    inputs = sync.inputs(node.plant)
+    used = sorted({n.name for n in names(t.receptivity) if n.name in inputs})
+    events = []
+    for x in used:
+        after = dict(inputs)
+        after[x] = not inputs[x]
+        rising = after[x]
+        val = _value_fn(sync, node, after)
+        ok = evaluate(t.receptivity, val, lambda e: e.name == x and e.rising == rising)
+        if ok:
+            events.append(edge_text(rising, x))
+    active = {f"X{s}" for s in node.situation.steps}
+    steps = tuple(
+        sorted({n.name for n in names(t.receptivity) if isinstance(n, Var) and n.name.startswith("X")
+                and n.name not in inputs and "/" not in n.name and n.name not in active})
+    )
+    return tuple(events), steps
+
+
+def _element_cause(sync: Sync, node: Node, event: str) -> Cause:
+    p: Plant = sync.plant
+    name = event[1:]
+    rising = event[0] == "↑"
+    if name not in p.owner:
+        return Cause(event, None)
+    axis = p.owner[name]
+    a = p.elements[axis]
+    spec = a.spec
+    rules = tuple(r.text() for r in spec.rules if r.consequence.name == name and r.consequence.rising == rising)
+    k = node.plant[axis]
+    code = int(a.codes[k])
+    bit = {v: i for i, v in enumerate(a.variables)}
+    orders = [v.name for v in spec.orders if not v.held]
+    closure = a.uncontrollable_closure()
+    ev_trans = [t for t in range(a.src.size) if not a.controllable[t] and a.event(t) == event]
+
+    def producible_from(local_code: int) -> bool:
+        hits = np.nonzero(a.codes == local_code)[0]
+        if hits.size == 0:
+            return False
+        reach = closure[int(hits[0])]
+        return any(reach[int(a.src[t])] for t in ev_trans)
+
+    now = producible_from(code)
+    best: tuple[str, ...] | None = None
+    for n_changes in range(1, len(orders) + 1):
+        for subset in combinations(orders, n_changes):
+            c = code
+            for o in subset:
+                c ^= 1 << bit[o]
+            if producible_from(c):
+                best = tuple(edge_text(bool((c >> bit[o]) & 1), o) for o in subset)
+                break
+        if best is not None:
+            break
+    if best is None:
+        return Cause(event, a.name, (), rules, producible_now=now)
+    wanted = node.emitted
+    emitted = all((ch[0] == "↑") == (ch[1:] in wanted) for ch in best)
+    constraints: list[str] = []
+    authorised = True
+    proh = {pr.event: pr for pr in node.proh}
+    for ch in best:
+        if ch in proh:
+            authorised = False
+            constraints += [c for c in proh[ch].constraints if c not in constraints]
+            continue
+        for t in p.transitions:
+            if t.controllable and t.event == ch and t.src == node.plant[t.axis]:
+                ok, why = sync.oracle.move(t, node.plant)
+                if not ok:
+                    authorised = False
+                    constraints += [c for c in why if c not in constraints]
+    return Cause(event, a.name, best, rules, emitted, authorised, tuple(constraints), now)
+
+
+def _emitting_steps(sync: Sync, node: Node, order: str) -> tuple[str, ...]:
+    g = sync.machine.grafcet
+    out = []
+    for s in node.situation.steps:
+        step = g.step(s)
+        if any(act.order == order for act in step.actions):
+            out.append(s)
+    return tuple(out)
+
+
+def _labels(sync: Sync) -> dict[str, str]:
+    return {c.id: c.label for c in sync.oracle.constraints}
+
+
+def _named(sync: Sync, ids: Iterable[str]) -> str:
+    labels = _labels(sync)
+    return ", ".join(f'{i} "{labels[i]}"' if labels.get(i) else i for i in ids)
+
+
+def diagnose(sync: Sync, node_index: int, *, expert: bool = False) -> Diagnosis:
+    """The diagnosis of a blocking node (see module docstring)."""
+    node = sync.nodes[node_index]
+    awaited: list[Awaited] = []
+    for t in sync.machine.awaited(node.situation):
+        events, steps = _awaited_events(sync, node, t)
+        causes = tuple(_element_cause(sync, node, e) for e in events)
+        awaited.append(Awaited(t.name, t.grafcet, t.receptivity.text(), events, steps, causes, tuple(t.sources)))
+    details = []
+    for a in awaited:
+        what = f"transition {a.transition} of {a.grafcet} awaits {a.receptivity}"
+        if a.events:
+            what += f": it becomes true with {' or '.join(a.events)}"
+        elif a.steps:
+            what += f": it waits on {', '.join(a.steps)}"
+        details.append(what)
+        for c in a.causes:
+            if c.element is None:
+                details.append(f"  {c.event}: no plant element drives {c.event[1:]}")
+                continue
+            rules = "; ".join(c.rules) if c.rules else "no rule"
+            if c.changes:
+                state = "emitted" if c.emitted else "not emitted"
+                sup = "authorised by SUP" if c.authorised else f"prohibited by {_named(sync, c.constraints)}"
+                details.append(f"  {c.event} (element {c.element}) needs {', '.join(c.changes)}: {state}, {sup}; rules: {rules}")
+            else:
+                details.append(f"  {c.event} (element {c.element}) cannot be produced from its current state; rules: {rules}")
+    verdict, summary = _verdict(sync, node, awaited, expert)
+    return Diagnosis(verdict, summary, tuple(awaited), tuple(details))
+
+
+def _verdict(sync: Sync, node: Node, awaited: list[Awaited], expert: bool) -> tuple[str, str]:
+    p = sync.plant
+    items = [(a, c) for a in awaited for c in a.causes]
+
+    def context(a: Awaited) -> str:
+        return f"transition {a.transition} of {a.grafcet} awaits {a.receptivity}"
+
+    def by_rule(c: Cause) -> str:
+        rules = [r for r in c.rules if any(ch[1:] in r.split("->")[0] for ch in c.changes)] or list(c.rules)
+        return f"element {c.element}" + (f", rule {rules[0]}" if rules else "")
+
+    # 1. an order the awaited event needs is emitted but prohibited by SUP
+    for a, c in items:
+        if c.changes and c.emitted and not c.authorised:
+            order = c.changes[0][1:]
+            steps = _emitting_steps(sync, node, order)
+            where = f" in step {', '.join(steps)}" if steps else ""
+            who = (
+                "the Grafcet is trusted, so the constraint is over-strict"
+                if expert
+                else "wrong control or over-strict constraint"
+            )
+            return (
+                "prohibited_order",
+                f"order {order}{where} prohibited by {_named(sync, c.constraints)}: {context(a)}, "
+                f"which needs {c.event}, caused by {order} ({by_rule(c)}); SUP forbids {c.changes[0]} here: {who}",
+            )
+    # prohibited orders of the situation that nothing above explained
+    if node.proh and expert:
+        pr = node.proh[0]
+        return (
+            "prohibited_order",
+            f"order {pr.order} prohibited by {_named(sync, pr.constraints)}: the trusted Grafcet emits it "
+            f"and SUP forbids {pr.event} here, so the constraint is over-strict",
+        )
+    # 2. expert: orders emitted and authorised, the element cannot produce the event
+    if expert:
+        for a, c in items:
+            if c.element is None or c.producible_now:
+                continue
+            axis = p.owner[c.event[1:]]
+            el = p.elements[axis]
+            own_orders = [o for o in el.variables if o in el.orders]
+            emitted_here = [o for o in own_orders if o in node.emitted]
+            if emitted_here and not any(pr.order in own_orders for pr in node.proh):
+                state = el.state_label(node.plant[axis])
+                reach = el.uncontrollable_closure()[node.plant[axis]]
+                moves = sorted({el.event(t) for t in range(el.src.size)
+                                if not el.controllable[t] and reach[int(el.src[t])]})
+                drift = f"; under these orders it only does {', '.join(moves)}" if moves else "; under these orders it does not move"
+                return (
+                    "element_model",
+                    f"element {c.element} cannot produce the awaited {c.event}: {', '.join(emitted_here)} "
+                    f"{'is' if len(emitted_here) == 1 else 'are'} emitted and authorised, {c.element} is in {state}, "
+                    f"and no rule of {c.element} produces {c.event} there: an occurrence rule is missing or its guard "
+                    f"is wrong ({context(a)}){drift}",
+                )
+    # 3. designer: an order the awaited event needs is not emitted
+    for a, c in items:
+        if c.changes and not c.emitted:
+            ch = c.changes[0]
+            order = ch[1:]
+            steps = a.sources
+            step_text = f" in step {', '.join(steps)}" if steps else ""
+            sup = "SUP authorises it here" if c.authorised else f"SUP forbids it here ({_named(sync, c.constraints)})"
+            if ch[0] == "↑":
+                return (
+                    "missing_order",
+                    f"missing order {order}{step_text}: {context(a)}, which needs {c.event}; "
+                    f"only {order} causes {c.event} ({by_rule(c)}) and {sup}",
+                )
+            return (
+                "missing_order",
+                f"order {order} must be released{step_text}: {context(a)}, which needs {c.event}; "
+                f"{c.event} only follows {ch} ({by_rule(c)}) and {sup}",
+            )
+    # 4. events nobody produces
+    for a, c in items:
+        if not c.changes and not c.rules:
+            owner = f"element {c.element}" if c.element else "no element"
+            return (
+                "unproducible_event",
+                f"awaited event {c.event} can never occur: {context(a)} and {owner} has no rule producing {c.event}",
+            )
+    for a, c in items:
+        if not c.changes:
+            return (
+                "unproducible_event",
+                f"awaited event {c.event} cannot occur from the current state of element {c.element}: {context(a)}",
+            )
+    if node.proh:
+        pr = node.proh[0]
+        return (
+            "prohibited_order",
+            f"order {pr.order} prohibited by {_named(sync, pr.constraints)}: the situation emits it and SUP forbids {pr.event}",
+        )
+    waits = sorted({s for a in awaited for s in a.steps})
+    if waits:
+        return ("waiting", f"the situation only waits on steps {', '.join(waits)}, which can no longer become active")
+    return ("unknown", "no awaited receptivity can become true and no order change is prohibited")
+
+
+def diagnose_prohibition(sync: Sync, node_index: int, pr: Prohibition) -> str:
+    """Plain words for a prohibited order met on the way."""
+    node = sync.nodes[node_index]
+    order = pr.order
+    steps = _emitting_steps(sync, node, order)
+    where = f" by step {', '.join(steps)}" if steps else ""
+    verb = "emitted" if pr.event[0] == "↑" else "released"
+    return (
+        f"order {order} {verb}{where} in situation {node.situation.text()} is prohibited by "
+        f"{_named(sync, pr.constraints)}: SUP forbids {pr.event} there"
+    )
+

@@ -1,0 +1,250 @@
+"""SYNC: the Grafcet's stable situations running against SUP (METHOD.md §6).
+
+A SYNC state pairs a plant state of SUP with a stable situation. In a situation the
+controller wants the orders it emits: the controllable transitions that change Z one
+order at a time towards them, when SUP allows them, are *intra-region*; the states
+so linked form the situation's *region*. The PLC writes its outputs at the end of a
+cycle, before the plant can react, so the plant's uncontrollable events (sensor
+edges, free inputs) and the Grafcet's timers leave a region from its *settled*
+states: those where no allowed order change towards the emitted orders remains.
+They are the *inter-region* transitions and lead to the next stable situation.
+
+SUP membership is decided state by state (:class:`~synth.supervisor.LocalSupervisor`),
+so the cost follows the reachable part of SYNC, never the size of the plant.
+
+Example
+-------
+>>> from synth.rules import load_rules
+>>> from synth.composition import plant, _plants
+>>> from synth.grafcet import load_grafcet
+>>> from synth.stable_situations import GrafcetMachine
+>>> rs = load_rules(_plants("tri.rules"))
+>>> p = plant(rs)
+>>> g = load_grafcet(_plants("../grafcets/tri.g7"), inputs=p.inputs, outputs=p.outputs)
+>>> s = synchronous_product(p, rs.constraints, GrafcetMachine(g))
+>>> s.nodes[0].situation.text()
+'{X0, X100, X200, X300}'
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from collections import deque
+from dataclasses import dataclass, field
+from typing import Callable, Sequence
+
+from .composition import LocalTransition, Plant
+from .errors import LimitExceeded
+from .rules import Constraint
+from .stable_situations import GrafcetMachine, Situation
+from .supervisor import LocalSupervisor
+
+__all__ = ["Prohibition", "Node", "Edge", "Sync", "synchronous_product", "region"]
+
+Local = tuple[int, ...]
+
+
+@dataclass(frozen=True, order=True)
+class Prohibition:
+    """An order change the situation asks for and SUP refuses: ``event`` is ``↑Z``/``↓Z``."""
+
+    event: str
+    constraints: tuple[str, ...]
+
+    @property
+    def order(self) -> str:
+        return self.event[1:]
+
+
+@dataclass(frozen=True)
+class Node:
+    """A state of the aggregated automaton: a situation and the settled plant state of its region."""
+
+    situation: Situation
+    plant: Local
+    emitted: frozenset[str]  # orders the situation emits
+    ord: tuple[str, ...]  # emitted orders that are set (authorised by SUP)
+    proh: tuple[Prohibition, ...]  # order changes SUP refuses here
+    region_size: int = 1
+
+
+@dataclass(frozen=True)
+class Edge:
+    source: int
+    event: str  # ↑v11, ↓dcy, 2s/X101
+    target: int
+
+
+@dataclass
+class Sync:
+    """The aggregated view of SYNC, explored from the initial state."""
+
+    plant: Plant
+    oracle: LocalSupervisor
+    machine: GrafcetMachine
+    nodes: list[Node] = field(default_factory=list)
+    edges: list[Edge] = field(default_factory=list)
+    sync_states: int = 0  # SYNC states (all region members)
+    sync_transitions: int = 0
+
+    def successors(self, i: int) -> list[Edge]:
+        return self._out[i]
+
+    def predecessors(self, i: int) -> list[Edge]:
+        return self._in[i]
+
+    def index(self) -> None:
+        self._out: list[list[Edge]] = [[] for _ in self.nodes]
+        self._in: list[list[Edge]] = [[] for _ in self.nodes]
+        for e in self.edges:
+            self._out[e.source].append(e)
+            self._in[e.target].append(e)
+
+    def inputs(self, local: Local) -> dict[str, bool]:
+        val = self.plant.valuation(local)
+        return {n: val[n] for n in self.machine.inputs if n in val}
+
+    def vectors(self, i: int) -> tuple[str, str]:
+        return self.plant.vectors(self.nodes[i].plant)
+
+
+def _order_moves(p: Plant) -> dict[str, list[LocalTransition]]:
+    moves: dict[str, list[LocalTransition]] = {}
+    for t in p.transitions:
+        if t.controllable:
+            moves.setdefault(t.event[1:], []).append(t)
+    return moves
+
+
+def region(
+    p: Plant,
+    oracle: LocalSupervisor,
+    entry: Local,
+    wanted: frozenset[str],
+    order_moves: dict[str, list[LocalTransition]] | None = None,
+) -> tuple[list[Local], list[tuple[Local, tuple[Prohibition, ...]]]]:
+    """The region entered at ``entry`` when the controller emits ``wanted``.
+
+    Returns its members (entry first) and its settled states, each with the order
+    changes SUP refuses there.
+    """
+    moves = order_moves if order_moves is not None else _order_moves(p)
+    members = [entry]
+    seen = {entry}
+    settled: list[tuple[Local, tuple[Prohibition, ...]]] = []
+    queue = deque([entry])
+    while queue:
+        cur = queue.popleft()
+        val = p.valuation(cur)
+        progressed = False
+        refused: list[Prohibition] = []
+        for order in sorted(moves):
+            want = order in wanted
+            if val[order] == want:
+                continue
+            for t in moves[order]:
+                if t.src != cur[t.axis]:
+                    continue
+                ok, why = oracle.move(t, cur)
+                if not ok:
+                    refused.append(Prohibition(t.event, tuple(why)))
+                    continue
+                progressed = True
+                nxt = list(cur)
+                nxt[t.axis] = t.dst
+                n = tuple(nxt)
+                if n not in seen:
+                    seen.add(n)
+                    members.append(n)
+                    queue.append(n)
+        if not progressed:
+            settled.append((cur, tuple(sorted(refused))))
+    return members, settled
+
+
+def synchronous_product(
+    p: Plant,
+    constraints: Sequence[Constraint],
+    machine: GrafcetMachine,
+    *,
+    max_states: int | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> Sync:
+    """Explore SYNC from (initial plant state, initial situation), aggregated per region."""
+    oracle = LocalSupervisor(p, constraints)
+    sync = Sync(p, oracle, machine)
+    moves = _order_moves(p)
+    uncontrollable = [t for t in p.transitions if not t.controllable]
+    index: dict[tuple[Situation, Local], int] = {}
+    region_cache: dict[tuple[Situation, Local], list[tuple[Local, tuple[Prohibition, ...]]]] = {}
+    sync_seen: set[tuple[Situation, Local]] = set()
+
+    def enter(sit: Situation, entry: Local) -> list[int]:
+        key = (sit, entry)
+        if key not in region_cache:
+            wanted = machine.orders(sit, sync.inputs(entry))
+            members, settled = region(p, oracle, entry, wanted, moves)
+            for m in members:
+                if (sit, m) not in sync_seen:
+                    sync_seen.add((sit, m))
+            region_cache[key] = settled
+            sync.sync_transitions += len(members) - 1 + max(0, len(settled) - 1)
+        out = []
+        for q, proh in region_cache[key]:
+            nk = (sit, q)
+            if nk not in index:
+                wanted = machine.orders(sit, sync.inputs(q))
+                val = p.valuation(q)
+                ords = tuple(sorted(o for o in wanted if val.get(o, False)))
+                index[nk] = len(sync.nodes)
+                sync.nodes.append(Node(sit, q, frozenset(wanted), ords, proh))
+                queue.append(index[nk])
+                if max_states is not None and len(sync.nodes) > max_states:
+                    raise LimitExceeded(
+                        f"more than {max_states} aggregated states; raise --max-states or simplify the model"
+                    )
+            out.append(index[nk])
+        return out
+
+    queue: deque[int] = deque()
+    if not oracle.kept(p.initial):
+        sync.index()
+        return sync
+    sit0 = machine.initial(sync.inputs(p.initial))
+    enter(sit0, p.initial)
+    last = time.monotonic()
+    while queue:
+        i = queue.popleft()
+        node = sync.nodes[i]
+        cur = node.plant
+        before = sync.inputs(cur)
+        for t in uncontrollable:
+            if t.src != cur[t.axis]:
+                continue
+            nxt = list(cur)
+            nxt[t.axis] = t.dst
+            n = tuple(nxt)
+            if not oracle.kept(n):  # cannot happen from a SUP state; kept for safety
+                continue
+            after = sync.inputs(n)
+            sit = machine.react(node.situation, before, after)
+            for j in enter(sit, n):
+                sync.edges.append(Edge(i, t.event, j))
+        for timer in machine.timers(node.situation):
+            sit = machine.fire_timer(node.situation, timer, before)
+            for j in enter(sit, cur):
+                sync.edges.append(Edge(i, timer, j))
+        if progress is not None and time.monotonic() - last > 0.5:
+            progress(len(sync.nodes), len(queue))
+            last = time.monotonic()
+    sync.sync_states = len(sync_seen)
+    sync.sync_transitions += len(sync.edges)
+    sync.index()
+    return sync
+
+
+def stderr_progress(nodes: int, pending: int) -> None:  # pragma: no cover - terminal only
+    sys.stderr.write(f"\rexploring SYNC: {nodes} aggregated states, {pending} to visit ")
+    sys.stderr.flush()
+
