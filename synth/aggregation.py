@@ -18,11 +18,9 @@ from __future__ import annotations
 from collections import deque
 from dataclasses import dataclass
 
-import networkx as nx
-
 from .sync import Sync
 
-__all__ = ["Trace", "Analysis", "analyse", "coreachable", "shortest_paths"]
+__all__ = ["Trace", "Analysis", "analyse", "coreachable", "shortest_paths", "strongly_connected_components"]
 
 
 @dataclass(frozen=True)
@@ -81,6 +79,53 @@ def _trace(parent: dict[int, tuple[int, str]], node: int) -> Trace:
     return Trace(tuple(reversed(nodes)), tuple(reversed(events)))
 
 
+def strongly_connected_components(nodes: list[int], succ: dict[int, list[int]]) -> list[set[int]]:
+    """Tarjan's algorithm, iterative (no recursion limit), over ``nodes`` and ``succ``.
+
+    >>> sorted(map(sorted, strongly_connected_components([0, 1, 2], {0: [1], 1: [0, 2], 2: []})))
+    [[0, 1], [2]]
+    """
+    index: dict[int, int] = {}
+    low: dict[int, int] = {}
+    on_stack: set[int] = set()
+    stack: list[int] = []
+    out: list[set[int]] = []
+    counter = 0
+    for root in nodes:
+        if root in index:
+            continue
+        work = [(root, 0)]
+        while work:
+            v, k = work.pop()
+            if k == 0:
+                index[v] = low[v] = counter
+                counter += 1
+                stack.append(v)
+                on_stack.add(v)
+            children = succ.get(v, [])
+            if k < len(children):
+                work.append((v, k + 1))
+                w = children[k]
+                if w not in index:
+                    work.append((w, 0))
+                elif w in on_stack:
+                    low[v] = min(low[v], index[w])
+                continue
+            if low[v] == index[v]:
+                comp = set()
+                while True:
+                    w = stack.pop()
+                    on_stack.discard(w)
+                    comp.add(w)
+                    if w == v:
+                        break
+                out.append(comp)
+            if work:
+                parent = work[-1][0]
+                low[parent] = min(low[parent], low[v])
+    return out
+
+
 def analyse(sync: Sync) -> Analysis:
     """Blocking states, their shortest traces and points of no return; prohibited orders."""
     if not sync.nodes:
@@ -90,13 +135,11 @@ def analyse(sync: Sync) -> Analysis:
     back = coreachable(sync, homes)
     dist, parent = shortest_paths(sync)
     stuck = [i for i in range(len(sync.nodes)) if i not in back]
-    g = nx.DiGraph()
-    g.add_nodes_from(stuck)
-    g.add_edges_from((e.source, e.target) for e in sync.edges if e.source not in back and e.target not in back)
+    succ = {i: sorted({e.target for e in sync.successors(i)}) for i in stuck}
     blocking: list[int] = []
     components: dict[int, tuple[int, ...]] = {}
-    for comp in nx.strongly_connected_components(g):
-        if any(succ not in comp for i in comp for succ in g.successors(i)):
+    for comp in strongly_connected_components(stuck, succ):
+        if any(s not in comp for i in comp for s in succ[i]):
             continue  # not terminal
         entry = min(comp, key=lambda i: (dist.get(i, 1 << 30), i))
         blocking.append(entry)

@@ -5,17 +5,17 @@ carrying a :class:`Location`. Its :meth:`InputError.render` gives the format the
 CLI prints::
 
     plants/tri.rules:12:21: error: unknown variable 'AVANCR1'
-       12 | constraint C1 "V1": AVANCR1 & RECULER1 = 0
-          |                     ^~~~~~~
-       = did you mean AVANCER1?
+      12 | constraint C1 "V1": AVANCR1 & RECULER1 = 0
+         |                     ^~~~~~~
+      = did you mean AVANCER1?
 
 Example
 -------
 >>> loc = Location("a.rules", 1, 5, "foo bar baz", 3)
 >>> print(InputError("unknown variable 'bar'", loc, suggestions=("baz",)).render())
 a.rules:1:5: error: unknown variable 'bar'
-    1 | foo bar baz
-      |     ^~~
+  1 | foo bar baz
+    |     ^~~
   = did you mean baz?
 """
 

@@ -56,7 +56,12 @@ def grammar_text(name: str) -> str:
 @lru_cache(maxsize=None)
 def parser(name: str) -> Lark:
     """A cached LALR parser for ``grammars/<name>.lark`` (positions propagated)."""
-    return Lark(grammar_text(name), parser="lalr", propagate_positions=True, maybe_placeholders=True)
+    options = dict(parser="lalr", propagate_positions=True, maybe_placeholders=True)
+    text = grammar_text(name)
+    try:  # lark caches the compiled LALR tables in the temporary folder, keyed by grammar and options
+        return Lark(text, cache=True, **options)
+    except OSError:  # a read-only temporary folder: build the tables again
+        return Lark(text, **options)
 
 
 def _shown(terminal: str, p: Lark) -> str:

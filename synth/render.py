@@ -3,7 +3,7 @@
 Example
 -------
 >>> print(dot_graph("g", [("a", "a", {}), ("b", "b", {"peripheries": "2"})],
-...                 [("a", "b", "↑x", {})]).splitlines()[3])
+...                 [("a", "b", "↑x", {})]).splitlines()[4])
   "a" [label="a"];
 """
 
