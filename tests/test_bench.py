@@ -1,0 +1,70 @@
+"""The benchmark generator (bench/gen_line.py) and the libFAUDES route (bench/faudes_route.py).
+
+No timing assertions: the timings live in docs/performance.md (bench/compare.py).
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import pytest
+
+from synth.composition import plant
+from synth.faudes_io import supervisor_generator
+from synth.rules import load_rules
+from synth.supervisor import supremal_controllable
+
+from conftest import ROOT
+
+BENCH = ROOT / "bench"
+if str(BENCH) not in sys.path:
+    sys.path.insert(0, str(BENCH))
+
+
+def _generate(n, tmp_path):
+    done = subprocess.run(
+        [sys.executable, str(BENCH / "gen_line.py"), str(n), str(tmp_path)], capture_output=True, text=True, check=True
+    )
+    paths = [tmp_path / f"line_{n}.rules", tmp_path / f"line_{n}.g7", tmp_path / f"line_{n}_missing.g7"]
+    assert done.stdout.split() == [str(p) for p in paths]
+    return paths
+
+
+def test_gen_line_2_loads_with_144_states(tmp_path):
+    rules, g7, missing = _generate(2, tmp_path)
+    assert "use " not in rules.read_text()  # the model is inlined: the file stands alone
+    rs = load_rules(rules)
+    p = plant(rs)
+    assert p.size == 144 == 12**2
+    assert p.count_transitions() == 36 * 2 * 12
+    for e in p.elements:
+        assert (e.size, e.count(True), e.count(False)) == (12, 24, 12)
+    assert [c.id for c in rs.constraints] == ["K1", "K2", "N1"]
+    assert "R1" in g7.read_text() and "R1 missing" in missing.read_text()
+
+
+def test_gen_line_grafcets_parse(tmp_path):
+    grafcet = pytest.importorskip("synth.grafcet")
+    rules, g7, missing = _generate(3, tmp_path)
+    rs = load_rules(rules)
+    for path in (g7, missing):
+        g = grafcet.load_grafcet(path, inputs=rs.inputs, outputs=rs.outputs)
+        assert len(g.grafcets) == 1 and len(g.grafcets[0].steps) == 7
+
+
+@pytest.mark.parametrize("n", [2, 3])
+def test_line_sup_equals_libfaudes(n, tmp_path):
+    faudes = pytest.importorskip("faudes")
+    from faudes_route import run_faudes, write_inputs
+
+    rules, _, _ = _generate(n, tmp_path)
+    rs = load_rules(rules)
+    p = plant(rs)
+    sup = supremal_controllable(p, rs.constraints)
+    theirs = run_faudes(write_inputs(rs, tmp_path / "faudes"), faudes)
+    assert (theirs["plant"].Size(), theirs["plant"].TransRelSize()) == (p.size, p.count_transitions())
+    assert (theirs["sup"].Size(), theirs["sup"].TransRelSize()) == (sup.size, sup.count_transitions())
+    ours = tmp_path / "ours.gen"
+    ours.write_text(supervisor_generator(sup))
+    assert faudes.LanguageEquality(theirs["sup"], faudes.System(str(ours)))
