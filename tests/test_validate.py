@@ -1,0 +1,190 @@
+"""End to end: synth validate on the box-sorting example (issue: SYNC, aggregation, diagnosis)."""
+
+from __future__ import annotations
+
+import json
+import shutil
+
+import pytest
+
+from synth.composition import plant
+from synth.grafcet import load_grafcet
+from synth.rules import load_rules
+from synth.stable_situations import GrafcetMachine
+from synth.supervisor import supremal_controllable
+from synth.sync import synchronous_product
+
+from conftest import ROOT
+
+G = ROOT / "grafcets"
+P = ROOT / "plants"
+MISSING_TRACE = ["↑dcy", "↑cp12", "2s/X101", "↓v10", "↑v11"]
+
+
+def _json(cli, *args):
+    code, out, err = cli("validate", *args, "--json")
+    assert "Traceback" not in err
+    return code, json.loads(out)
+
+
+def test_tri_passes(cli):
+    code, data = _json(cli, G / "tri.g7", "--plant", P / "tri.rules")
+    assert code == 0
+    assert data["verdict"] == "pass"
+    assert data["blocking"] == [] and data["prohibited"] == []
+    assert data["stats"]["aggregated_states"] > 20
+
+
+def test_tri_text_exit_0(cli):
+    code, out, _ = cli("validate", G / "tri.g7", "--plant", P / "tri.rules")
+    assert code == 0
+    assert out.startswith("PASS: 0 blocking situation(s), 0 situation(s) with prohibited orders")
+
+
+def test_missing_order(cli):
+    code, data = _json(cli, G / "tri_missing_order.g7", "--plant", P / "tri.rules")
+    assert code == 1
+    assert data["verdict"] == "fail"
+    assert len(data["blocking"]) == 1
+    b = data["blocking"][0]
+    assert b["trace"] == MISSING_TRACE
+    assert b["situation"] == ["X1", "X103", "X200", "X300"]
+    assert {k for k, v in b["E"].items() if v} == {"dcy", "v11", "v20", "v30", "v40", "cp12"}
+    assert {k for k, v in b["Z"].items() if v} == {"TAPIS"}
+    assert b["ord"] == ["TAPIS"] and b["proh"] == []
+    assert b["no_return"] == {"situation": ["X1", "X101", "X200", "X300"], "after": ["↑dcy", "↑cp12"]}
+    d = b["diagnosis"]
+    assert d["verdict"] == "missing_order"
+    assert d["summary"] == (
+        "missing order AVANCER2 in step 103: transition 103->104 of G2 awaits v21 & v11, which needs ↑v21; "
+        "only AVANCER2 causes ↑v21 (element V2, rule ↑AVANCER2 [!v20 & !v21] -> ↑v21) and SUP authorises it here"
+    )
+    cause = next(c for a in d["awaited"] for c in a["causes"])
+    assert cause == {
+        "event": "↑v21", "element": "V2", "orders": ["↑AVANCER2"],
+        "rules": ["↑AVANCER2 [!v20 & !v21] -> ↑v21", "↓AVANCER2 [!v20 & !v21] -> ↑v21"],
+        "emitted": False, "authorised": True, "constraints": [], "producible_now": False,
+    }
+
+
+def test_missing_order_terminal_text(cli):
+    code, out, _ = cli("validate", G / "tri_missing_order.g7", "--plant", P / "tri.rules")
+    assert code == 1
+    lines = out.splitlines()
+    assert lines[2] == "Blocking 1: situation {X1, X103, X200, X300}"
+    assert lines[3] == "  E: dcy v11 v20 v30 v40 cp12"
+    assert lines[4] == "  Z: TAPIS"
+    assert lines[6] == "  trace: ↑dcy ↑cp12 2s/X101 ↓v10 ↑v11"
+    assert lines[8].startswith("  diagnosis [missing_order]: missing order AVANCER2 in step 103")
+
+
+def test_wrong_v1_caught_before_synthesis(cli):
+    code, out, err = cli("validate", G / "tri.g7", "--plant", P / "tri_wrong_v1.rules")
+    assert code == 2 and out == ""
+    first = err.splitlines()[0]
+    assert "tri_wrong_v1.rules:16:34: error: rule of element V1 produces ↑v21, but v21 is a sensor of element V2" in first
+
+
+def test_expert_missing_rule(cli):
+    code, data = _json(cli, G / "tri.g7", "--plant", P / "tri_missing_rule.rules", "--expert")
+    assert code == 1
+    assert data["mode"] == "expert"
+    b = data["blocking"][0]
+    assert b["trace"] == MISSING_TRACE
+    assert b["situation"] == ["X1", "X103", "X200", "X300"]
+    assert b["ord"] == ["AVANCER2", "TAPIS"] and b["proh"] == []
+    assert {k for k, v in b["Z"].items() if v} == {"AVANCER2", "TAPIS"}
+    d = b["diagnosis"]
+    assert d["verdict"] == "element_model"
+    assert d["summary"].startswith(
+        "element V2 cannot produce the awaited ↑v21: AVANCER2 is emitted and authorised, V2 is in {AVANCER2,v20}, "
+        "and no rule of V2 produces ↑v21 there"
+    )
+
+
+def test_overstrict_constraint(cli):
+    code, data = _json(cli, G / "tri.g7", "--plant", P / "tri_overstrict.rules", "--expert")
+    assert code == 1
+    b = data["blocking"][0]
+    assert b["situation"] == ["X1", "X104", "X200", "X301"]
+    assert b["proh"] == [{"order": "AVANCER4", "event": "↑AVANCER4", "constraints": ["C2_9"]}]
+    d = b["diagnosis"]
+    assert d["verdict"] == "prohibited_order"
+    assert 'C2_9 "V4 must not advance while V1 is out (v11)"' in d["summary"]
+    assert "over-strict" in d["summary"]
+    assert data["prohibited"][0]["order"] == "AVANCER4"
+
+
+def test_report_html_and_svg(cli, tmp_path):
+    if shutil.which("dot") is None:
+        pytest.fail("Graphviz's dot is required (CI installs it)")
+    out_dir = tmp_path / "rep"
+    code, out, _ = cli("validate", G / "tri_missing_order.g7", "--plant", P / "tri.rules", "--report", out_dir)
+    assert code == 1
+    assert f"report: {out_dir / 'index.html'}" in out
+    html = (out_dir / "index.html").read_text()
+    assert html.startswith("<!DOCTYPE html>")
+    assert html.count("<svg") >= 3  # trace, element V2, SUP neighbourhood (+ aggregated automaton)
+    assert "Sit={X1, X103, X200, X300}" in html  # the blocking state drawn like figure 2.10
+    assert "missing order AVANCER2 in step 103" in html
+    assert "<h3>Element V2</h3>" in html
+    assert "↑AVANCER2 ✗" not in html  # SUP authorises AVANCER2 there
+    assert list(out_dir.iterdir()) == [out_dir / "index.html"]  # no temporary left behind
+
+
+def test_cor(cli, tmp_path):
+    cor = tmp_path / "cor.json"
+    code, _, _ = cli("validate", G / "tri_missing_order.g7", "--plant", P / "tri.rules", "--cor", cor)
+    assert code == 1
+    data = json.loads(cor.read_text())
+    assert data["removed_states"] > 0
+    assert all(s["situation"] != ["X1", "X103", "X200", "X300"] for s in data["states"])
+    assert data["states"][0]["situation"] == ["X0", "X100", "X200", "X300"]
+    assert (tmp_path / "cor.dot").read_text().startswith('digraph "COR"')
+
+
+def test_deterministic_json(cli):
+    a = cli("validate", G / "tri_missing_order.g7", "--plant", P / "tri.rules", "--json")[1]
+    b = cli("validate", G / "tri_missing_order.g7", "--plant", P / "tri.rules", "--json")[1]
+    assert a == b
+
+
+class _GridOracle:
+    """SUP membership read from the full SUP grid: the plain path the on-the-fly one must match."""
+
+    def __init__(self, sup, lazy):
+        self.sup, self.lazy = sup, lazy
+        self.constraints = lazy.constraints
+
+    def kept(self, local):
+        return bool(self.sup.reachable[local]) or not bool(self.sup.removed[local])
+
+    def move(self, t, local):
+        target = list(local)
+        target[t.axis] = t.dst
+        ok = not self.sup.removed[tuple(target)]
+        if t.controllable and t.event in self.sup.forbid:
+            ok = ok and not self.sup.forbid[t.event][local]
+        return ok, ([] if ok else self.lazy.move(t, local)[1])
+
+    def __getattr__(self, name):
+        return getattr(self.lazy, name)
+
+
+@pytest.mark.parametrize("g,r", [("tri.g7", "tri.rules"), ("tri_missing_order.g7", "tri.rules"),
+                                 ("tri.g7", "tri_overstrict.rules")])
+def test_on_the_fly_sync_equals_grid_sync(g, r, monkeypatch):
+    rs = load_rules(P / r)
+    p = plant(rs)
+    machine = GrafcetMachine(load_grafcet(G / g, inputs=p.inputs, outputs=p.outputs))
+    lazy = synchronous_product(p, rs.constraints, machine)
+    sup = supremal_controllable(p, rs.constraints)
+    import synth.sync as sync_mod
+
+    real = sync_mod.LocalSupervisor
+    monkeypatch.setattr(sync_mod, "LocalSupervisor", lambda p_, c_: _GridOracle(sup, real(p_, c_)))
+    plain = synchronous_product(p, rs.constraints, machine)
+    assert [(n.situation, n.plant, n.proh) for n in plain.nodes] == [(n.situation, n.plant, n.proh) for n in lazy.nodes]
+    assert plain.edges == lazy.edges
+    # every SYNC plant state lies in SUP's reachable part
+    assert all(sup.reachable[n.plant] for n in lazy.nodes)
