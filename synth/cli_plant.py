@@ -5,10 +5,11 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+import time
 from typing import Any
 
 from .composition import Plant, plant
-from .errors import SynthError, close_names
+from .errors import LimitExceeded, SynthError, close_names
 from .faudes_io import element_generator, plant_generator, supervisor_generator
 from .files import write_atomic
 from .plant import ElementAutomaton
@@ -20,6 +21,7 @@ from .supervisor import explain, supremal_controllable
 __all__ = ["register", "plant_summary", "element_summary"]
 
 MAX_DRAWN_STATES = 400
+DEFAULT_MAX_STATES = 500_000_000
 
 
 def register(sub: "argparse._SubParsersAction") -> None:
@@ -38,6 +40,9 @@ def register(sub: "argparse._SubParsersAction") -> None:
     s.add_argument("--json", action="store_true", help="print JSON instead of text")
     s.add_argument("--export", metavar="FILE.gen", help="write SUP as a libFAUDES System (.gen)")
     s.add_argument("--why", metavar="STATE", help="explain one state, written as its true variables, e.g. 'TAPIS,v10,v20,v30,v40'")
+    s.add_argument("--max-states", metavar="N", type=int, default=DEFAULT_MAX_STATES,
+                   help=f"refuse plants larger than N states (default {DEFAULT_MAX_STATES}); synth validate needs no such limit")
+    s.add_argument("--quiet", action="store_true", help="no progress on stderr")
     s.set_defaults(handler=cmd_sup)
 
 
@@ -162,10 +167,32 @@ def _plant_dot(p: Plant) -> str:
     return dot_graph("plant", nodes, edges)
 
 
+def _progress(enabled: bool):
+    if not enabled:
+        return None
+    start = time.monotonic()
+
+    def show(text: str) -> None:
+        sys.stderr.write(f"\r\033[K[{time.monotonic() - start:6.1f}s] {text}")
+        sys.stderr.flush()
+
+    return show
+
+
 def cmd_sup(args: argparse.Namespace) -> int:
     rs = load_rules(args.rules)
     p = plant(rs)
-    sup = supremal_controllable(p, rs.constraints)
+    if p.size > args.max_states:
+        raise LimitExceeded(
+            f"the plant of {args.rules} has {p.size} states, more than --max-states {args.max_states}; "
+            "SUP over the whole plant would need about "
+            f"{6 * p.size / 2**30:.1f} GiB. Raise --max-states, or validate a Grafcet with "
+            "`synth validate`, which decides SUP membership on the fly"
+        )
+    show = _progress(not args.quiet and sys.stderr.isatty())
+    sup = supremal_controllable(p, rs.constraints, progress=show)
+    if show is not None:
+        sys.stderr.write("\r\033[K")
     labels = {c.id: c.label for c in rs.constraints}
     if args.why:
         local = p.parse_state(args.why)

@@ -83,8 +83,17 @@ def plant_generator(p: Plant, name: str = "plant") -> str:
 
 
 def supervisor_generator(sup: "Supervisor", name: str = "sup") -> str:
-    """SUP: its reachable states and allowed transitions."""
-    return _grid_generator(sup.plant, name, sup.reachable, sup.allowed)
+    """SUP: its states and the transitions it keeps (no plant-sized array is built)."""
+    events = sup.plant.events
+    ev_index = {e: i for i, e in enumerate(events)}
+    src_all, ev_all, dst_all = [], [], []
+    for t, src, dst, ok in sup.moves(sup.states):
+        src_all.append(np.searchsorted(sup.states, src[ok]))
+        dst_all.append(np.searchsorted(sup.states, dst[ok]))
+        ev_all.append(np.full(int(np.count_nonzero(ok)), ev_index[t.event], dtype=np.int64))
+    cat = lambda xs: np.concatenate(xs) if xs else np.zeros(0, dtype=np.int64)  # noqa: E731
+    init = int(np.searchsorted(sup.states, sup.plant.initial_index)) if sup.size else None
+    return generator_text(name, sup.size, init, events, cat(src_all), cat(ev_all), cat(dst_all))
 
 
 def element_generator(a: ElementAutomaton, name: str | None = None) -> str:

@@ -34,12 +34,12 @@ from __future__ import annotations
 from collections import deque
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import Iterable, Sequence
+from typing import Callable, Iterable, Iterator, Sequence
 
 import numpy as np
 
 from .composition import LocalTransition, Plant, _plants
-from .expr import Literal, disjunctive_normal_form, edge_text, evaluate
+from .expr import disjunctive_normal_form, edge_text
 from .rules import Constraint
 
 __all__ = [
@@ -88,140 +88,247 @@ def _product(p: Plant, factors: Iterable[tuple[int, np.ndarray]]) -> np.ndarray:
     return grid
 
 
-@dataclass(eq=False)
+def _closed(closures: Sequence[np.ndarray], factors: Iterable[tuple[int, np.ndarray]]) -> tuple[tuple[int, np.ndarray], ...]:
+    """Per-element factors of "can reach, by own uncontrollable moves, a satisfying state"."""
+    return tuple((a, (closures[a] @ v.astype(np.uint8)) > 0) for a, v in factors)
+
+
+def _holds(factors: Sequence[tuple[int, np.ndarray]], digits: np.ndarray) -> np.ndarray:
+    """Whether a product term holds at each of the states whose digits (ndim × n) are given."""
+    out = np.ones(digits.shape[1], dtype=bool)
+    for a, vec in factors:
+        out &= vec[digits[a]]
+    return out
+
+
+GRID_LIMIT = 200_000_000
+"""Plant-wide statistics (illegal, defended, ... counts over every plant state) need
+grids of the plant's size; above this many states they are not computed."""
+
+
 class Supervisor:
-    """SUP over the plant grid; every array has the plant's grid shape."""
+    """SUP: its states as a sorted array of plant state codes, explored from the initial
+    state; SUP membership of any state is the closed form of the module docstring.
 
-    plant: Plant
-    constraints: tuple[Constraint, ...]
-    illegal: np.ndarray
-    removed: np.ndarray
-    defended: np.ndarray
-    forbid: dict[str, np.ndarray]
-    reachable: np.ndarray
-    terms: list[_Term] = field(repr=False, default_factory=list)
+    Grids over the whole plant (``illegal``, ``removed``, ``defended``, ``forbid``,
+    ``reachable``) are built on first use, for plants that fit in memory.
+    """
 
+    def __init__(self, p: Plant, constraints: Sequence[Constraint], states: np.ndarray | None = None) -> None:
+        self.plant = p
+        self.constraints = tuple(constraints)
+        self.terms = _terms(p, constraints)
+        closures = [e.uncontrollable_closure().astype(np.uint8) for e in p.elements]
+        self.level_terms = [t for t in self.terms if t.event is None]
+        self.level_reach = [_closed(closures, t.factors) for t in self.level_terms]
+        self.edge_terms: dict[str, list[_Term]] = {}
+        for t in self.terms:
+            if t.event is not None:
+                self.edge_terms.setdefault(t.event, []).append(t)
+        self.strides = np.array(
+            [int(np.prod(p.shape[i + 1:], dtype=np.int64)) for i in range(p.ndim)], dtype=np.int64
+        )
+        self.radices = np.array(p.shape, dtype=np.int64)
+        self.states = states if states is not None else np.zeros(0, dtype=np.int64)
+
+    # ------------------------------------------------------------------ vectorised membership
+    def digits(self, codes: np.ndarray) -> np.ndarray:
+        """Local state indices (ndim × n) of the plant states with these codes."""
+        return (codes[None, :] // self.strides[:, None]) % self.radices[:, None]
+
+    def kept_digits(self, digits: np.ndarray) -> np.ndarray:
+        """Not removed: no violation reachable by uncontrollable events."""
+        bad = np.zeros(digits.shape[1], dtype=bool)
+        for factors in self.level_reach:
+            bad |= _holds(factors, digits)
+        return ~bad
+
+    def forbidden_digits(self, event: str, digits: np.ndarray) -> np.ndarray:
+        """Edge constraints forbid controllable ``event`` at these source states."""
+        out = np.zeros(digits.shape[1], dtype=bool)
+        for t in self.edge_terms.get(event, ()):
+            out |= _holds(t.factors, digits)
+        return out
+
+    # ------------------------------------------------------------------ SUP
     @property
     def size(self) -> int:
-        return int(np.count_nonzero(self.reachable))
+        return int(self.states.size)
 
     @property
     def empty(self) -> bool:
-        return not bool(self.reachable[self.plant.initial])
+        return self.states.size == 0
 
-    def allowed(self, t: LocalTransition) -> np.ndarray:
-        """Sources (grid view shape) from which ``t`` stays in SUP."""
-        s, d = self.plant.slices(t)
-        ok = self.reachable[s] & ~self.removed[d]
-        if t.controllable and t.event in self.forbid:
-            ok = ok & ~self.forbid[t.event][s]
-        return ok
+    def moves(self, codes: np.ndarray) -> Iterator[tuple[LocalTransition, np.ndarray, np.ndarray, np.ndarray]]:
+        """For each local transition: the sources among ``codes`` it leaves, their targets,
+        and whether SUP keeps the move."""
+        digits = self.digits(codes)
+        for t in self.plant.transitions:
+            sel = digits[t.axis] == t.src
+            if not sel.any():
+                continue
+            src = codes[sel]
+            dst = src + (t.dst - t.src) * self.strides[t.axis]
+            tdig = digits[:, sel].copy()
+            tdig[t.axis] = t.dst
+            ok = self.kept_digits(tdig)
+            if t.controllable and t.event in self.edge_terms:
+                ok &= ~self.forbidden_digits(t.event, digits[:, sel])
+            yield t, src, dst, ok
+
+    @cached_property
+    def _counts(self) -> tuple[int, int, int]:
+        """(controllable kept, uncontrollable kept, controllable cut), one sweep over SUP."""
+        kept = [0, 0]
+        cut = 0
+        for start in range(0, self.states.size, 1 << 20):
+            for t, _, _, ok in self.moves(self.states[start:start + (1 << 20)]):
+                n_ok = int(np.count_nonzero(ok))
+                kept[0 if t.controllable else 1] += n_ok
+                if t.controllable:
+                    cut += ok.size - n_ok
+        return kept[0], kept[1], cut
 
     def count_transitions(self, controllable: bool | None = None) -> int:
-        return sum(
-            int(np.count_nonzero(self.allowed(t)))
-            for t in self.plant.transitions
-            if controllable is None or t.controllable == controllable
-        )
+        c, u, _ = self._counts
+        return c + u if controllable is None else (c if controllable else u)
+
+    @property
+    def forbidden_transitions(self) -> int:
+        """Controllable transitions leaving SUP states that SUP cuts."""
+        return self._counts[2]
 
     def forbidden_counts(self) -> dict[str, int]:
-        """Controllable transitions leaving SUP states that SUP cuts, per constraint id
-        (a transition counts for every constraint that makes it forbidden)."""
-        counts: dict[str, int] = {}
-        for c in self.constraints:
-            sub = supremal_controllable(self.plant, [c], reach=False)
-            n = 0
+        """The cut controllable transitions per constraint id (a transition counts for
+        every constraint whose violation it would make reachable, or that forbids its event)."""
+        counts = {c.id: 0 for c in self.constraints}
+        for start in range(0, self.states.size, 1 << 20):
+            codes = self.states[start:start + (1 << 20)]
+            digits = self.digits(codes)
             for t in self.plant.transitions:
                 if not t.controllable:
                     continue
-                s, d = self.plant.slices(t)
-                bad = sub.removed[d]
-                if t.event in sub.forbid:
-                    bad = bad | sub.forbid[t.event][s]
-                n += int(np.count_nonzero(self.reachable[s] & bad))
-            if n:
-                counts[c.id] = n
-        return counts
+                sel = digits[t.axis] == t.src
+                if not sel.any():
+                    continue
+                sdig = digits[:, sel]
+                tdig = sdig.copy()
+                tdig[t.axis] = t.dst
+                per: dict[str, np.ndarray] = {}
+                for term, factors in zip(self.level_terms, self.level_reach):
+                    h = _holds(factors, tdig)
+                    per[term.constraint] = per[term.constraint] | h if term.constraint in per else h
+                for term in self.edge_terms.get(t.event, ()):
+                    h = _holds(term.factors, sdig)
+                    per[term.constraint] = per[term.constraint] | h if term.constraint in per else h
+                for cid, h in per.items():
+                    counts[cid] += int(np.count_nonzero(h))
+        return {k: v for k, v in counts.items() if v}
+
+    def contains(self, codes: np.ndarray) -> np.ndarray:
+        """Whether each plant state code is a SUP state."""
+        pos = np.searchsorted(self.states, codes)
+        pos = np.minimum(pos, max(self.states.size - 1, 0))
+        return (self.states[pos] == codes) if self.states.size else np.zeros(np.shape(codes), dtype=bool)
+
+    # ------------------------------------------------------------------ grids (on demand)
+    def _grid(self, terms: Iterable[tuple[int, np.ndarray]]) -> np.ndarray:
+        out = np.zeros(self.plant.shape, dtype=bool)
+        for factors in terms:
+            out |= _product(self.plant, factors)
+        return out
 
     @cached_property
-    def forbidden_transitions(self) -> int:
-        n = 0
-        for t in self.plant.transitions:
-            if not t.controllable:
-                continue
-            s, d = self.plant.slices(t)
-            bad = self.removed[d]
-            if t.event in self.forbid:
-                bad = bad | self.forbid[t.event][s]
-            n += int(np.count_nonzero(self.reachable[s] & bad))
-        return n
+    def illegal(self) -> np.ndarray:
+        return self._grid(t.factors for t in self.level_terms)
 
-    def summary(self) -> dict[str, int]:
-        legal = ~self.illegal
-        weak = self.removed & legal & ~self.defended
-        kept = ~self.removed
-        return {
+    @cached_property
+    def removed(self) -> np.ndarray:
+        return self._grid(self.level_reach)
+
+    @cached_property
+    def defended(self) -> np.ndarray:
+        return self.plant.preimage(self.illegal, controllable=False) & ~self.illegal
+
+    @cached_property
+    def forbid(self) -> dict[str, np.ndarray]:
+        return {e: self._grid(t.factors for t in ts) for e, ts in self.edge_terms.items()}
+
+    @cached_property
+    def reachable(self) -> np.ndarray:
+        grid = np.zeros(self.plant.size, dtype=bool)
+        grid[self.states] = True
+        return grid.reshape(self.plant.shape)
+
+    def summary(self) -> dict[str, int | None]:
+        out: dict[str, int | None] = {
             "states": self.size,
             "transitions": self.count_transitions(),
             "controllable": self.count_transitions(True),
             "uncontrollable": self.count_transitions(False),
             "forbidden_transitions": self.forbidden_transitions,
-            "illegal": int(np.count_nonzero(self.illegal)),
-            "defended": int(np.count_nonzero(self.defended)),
-            "weakly_defended": int(np.count_nonzero(weak)),
-            "unreachable_removed": int(np.count_nonzero(kept & ~self.reachable)),
         }
+        if self.plant.size > GRID_LIMIT:
+            out.update({"illegal": None, "defended": None, "weakly_defended": None, "unreachable_removed": None})
+            return out
+        legal = ~self.illegal
+        weak = self.removed & legal & ~self.defended
+        out.update(
+            {
+                "illegal": int(np.count_nonzero(self.illegal)),
+                "defended": int(np.count_nonzero(self.defended)),
+                "weakly_defended": int(np.count_nonzero(weak)),
+                "unreachable_removed": int(np.count_nonzero(~self.removed)) - self.size,
+            }
+        )
+        return out
 
 
-def supremal_controllable(p: Plant, constraints: Sequence[Constraint], *, reach: bool = True) -> Supervisor:
-    """SUP of plant ``p`` under ``constraints`` (see module docstring)."""
-    terms = _terms(p, constraints)
-    closures = [e.uncontrollable_closure() for e in p.elements]
-    illegal = np.zeros(p.shape, dtype=bool)
-    removed = np.zeros(p.shape, dtype=bool)
-    forbid: dict[str, np.ndarray] = {}
-    for term in terms:
-        if term.event is not None:
-            g = _product(p, term.factors)
-            forbid[term.event] = forbid[term.event] | g if term.event in forbid else g
-            continue
-        illegal |= _product(p, term.factors)
-        removed |= _product(p, ((a, (closures[a].astype(np.uint8) @ v.astype(np.uint8)) > 0) for a, v in term.factors))
-    defended = p.preimage(illegal, controllable=False) & ~illegal
-    reachable = np.zeros(p.shape, dtype=bool)
-    sup = Supervisor(p, tuple(constraints), illegal, removed, defended, forbid, reachable, terms)
-    if reach and not removed[p.initial]:
-        _explore(sup)
-    return sup
+def supremal_controllable(
+    p: Plant,
+    constraints: Sequence[Constraint],
+    *,
+    progress: Callable[[str], None] | None = None,
+) -> Supervisor:
+    """SUP of plant ``p`` under ``constraints`` (see module docstring).
 
-
-def _explore(sup: Supervisor) -> None:
-    """Forward reachability inside SUP.
-
-    Chaotic (Gauss-Seidel) iteration: each pass runs over the local transitions and
-    updates the reached set in place, so states found early in a pass propagate within
-    the same pass; passes repeat until one adds nothing. Each pass costs one sweep over
-    the plant's transitions as vectorised slice operations.
+    Breadth-first exploration from the initial state over codes held in numpy arrays,
+    frontier by frontier: each frontier costs a few vectorised operations per local
+    transition, so the work is linear in SUP's transitions and no array of the plant's
+    size is built beyond a bitmap of visited states. ``progress`` receives a short text
+    after each frontier.
     """
-    p = sup.plant
-    reach = sup.reachable
-    reach[p.initial] = True
-    target_ok = ~sup.removed
-    moves = []
-    for t in p.transitions:
-        s, d = p.slices(t)
-        forbid = sup.forbid.get(t.event) if t.controllable else None
-        moves.append((s, d, None if forbid is None else ~forbid[s]))
-    before = -1
-    count = 1
-    while count != before:
-        before = count
-        for s, d, ok in moves:
-            add = reach[s] & target_ok[d]
-            if ok is not None:
-                add &= ok
-            reach[d] |= add
-        count = int(np.count_nonzero(reach))
+    sup = Supervisor(p, constraints)
+    init = np.array([p.initial_index], dtype=np.int64)
+    if not sup.kept_digits(sup.digits(init))[0]:
+        return sup
+    visited = np.zeros((p.size + 7) // 8, dtype=np.uint8)
+
+    def mark(codes: np.ndarray) -> None:
+        np.bitwise_or.at(visited, codes >> 3, (1 << (codes & 7)).astype(np.uint8))
+
+    def seen(codes: np.ndarray) -> np.ndarray:
+        return ((visited[codes >> 3] >> (codes & 7).astype(np.uint8)) & 1).astype(bool)
+
+    mark(init)
+    parts = [init]
+    frontier = init
+    depth = 0
+    while frontier.size:
+        new_parts = []
+        for t, src, dst, ok in sup.moves(frontier):
+            dst = dst[ok]
+            dst = np.unique(dst[~seen(dst)])
+            if dst.size:
+                mark(dst)
+                new_parts.append(dst)
+        frontier = np.concatenate(new_parts) if new_parts else np.zeros(0, dtype=np.int64)
+        parts.append(frontier)
+        depth += 1
+        if progress is not None:
+            progress(f"exploring SUP: depth {depth}, {sum(x.size for x in parts)} states")
+    sup.states = np.sort(np.concatenate(parts))
+    return sup
 
 
 class LocalSupervisor:
@@ -235,11 +342,9 @@ class LocalSupervisor:
         self.plant = p
         self.constraints = tuple(constraints)
         self.terms = _terms(p, constraints)
-        closures = [e.uncontrollable_closure() for e in p.elements]
+        closures = [e.uncontrollable_closure().astype(np.uint8) for e in p.elements]
         self._level = [t for t in self.terms if t.event is None]
-        self._reach = [
-            tuple((a, (closures[a].astype(np.uint8) @ v.astype(np.uint8)) > 0) for a, v in t.factors) for t in self._level
-        ]
+        self._reach = [_closed(closures, t.factors) for t in self._level]
 
     def kept(self, local: tuple[int, ...]) -> bool:
         return not any(all(vec[local[a]] for a, vec in factors) for factors in self._reach)
@@ -328,15 +433,16 @@ def explain(sup: Supervisor, local: tuple[int, ...]) -> Explanation:
     p = sup.plant
     oracle = LocalSupervisor(p, sup.constraints)
     label = p.label(local)
-    if sup.illegal[local]:
-        return Explanation(label, "illegal", tuple(oracle.violated(local)))
-    if sup.removed[local]:
+    violated = oracle.violated(local)
+    if violated:
+        return Explanation(label, "illegal", tuple(violated))
+    if not oracle.kept(local):
         # breadth-first search over uncontrollable moves to the nearest violation
         parent: dict[tuple[int, ...], tuple[tuple[int, ...], str] | None] = {local: None}
         queue = deque([local])
         while queue:
             cur = queue.popleft()
-            if sup.illegal[cur]:
+            if oracle.violated(cur):
                 path = []
                 node = cur
                 while parent[node] is not None:
@@ -357,5 +463,6 @@ def explain(sup: Supervisor, local: tuple[int, ...]) -> Explanation:
             ok, why = oracle.move(t, local)
             if not ok:
                 forbidden.append((t.event, tuple(why)))
-    status = "kept" if sup.reachable[local] else "unreachable"
+    inside = bool(sup.contains(np.array([p.index(local)], dtype=np.int64))[0])
+    status = "kept" if inside else "unreachable"
     return Explanation(label, status, (), (), tuple(forbidden))
