@@ -21,7 +21,7 @@ from .supervisor import explain, supremal_controllable
 __all__ = ["register", "plant_summary", "element_summary"]
 
 MAX_DRAWN_STATES = 400
-DEFAULT_MAX_STATES = 500_000_000
+DEFAULT_MAX_STATES = 2**34
 
 
 def register(sub: "argparse._SubParsersAction") -> None:
@@ -185,8 +185,8 @@ def cmd_sup(args: argparse.Namespace) -> int:
     if p.size > args.max_states:
         raise LimitExceeded(
             f"the plant of {args.rules} has {p.size} states, more than --max-states {args.max_states}; "
-            "SUP over the whole plant would need about "
-            f"{6 * p.size / 2**30:.1f} GiB. Raise --max-states, or validate a Grafcet with "
+            f"exploring SUP keeps a bitmap of visited states ({p.size / 8 / 2**30:.1f} GiB here). "
+            "Raise --max-states, or validate a Grafcet with "
             "`synth validate`, which decides SUP membership on the fly"
         )
     show = _progress(not args.quiet and sys.stderr.isatty())

@@ -159,22 +159,57 @@ class Supervisor:
     def empty(self) -> bool:
         return self.states.size == 0
 
-    def moves(self, codes: np.ndarray) -> Iterator[tuple[LocalTransition, np.ndarray, np.ndarray, np.ndarray]]:
-        """For each local transition: the sources among ``codes`` it leaves, their targets,
-        and whether SUP keeps the move."""
+    def _move_terms(self, codes: np.ndarray) -> Iterator[tuple[LocalTransition, np.ndarray, np.ndarray, list[tuple[str, np.ndarray]]]]:
+        """For each local transition leaving some of ``codes`` (kept states): its sources,
+        targets, and per constraint term the sources where the term makes the move bad.
+
+        A move on element ``a`` changes only digit ``a``, and no term holds at a kept
+        source, so only the terms with a factor on ``a`` can hold at the target: each is
+        its factor's value at the target digit (a constant per local transition) and the
+        product of its other factors at the source (computed once per call).
+        """
         digits = self.digits(codes)
+        rest: dict[tuple[int, int], np.ndarray] = {}
+        for k, factors in enumerate(self.level_reach):
+            values = {a: vec[digits[a]] for a, vec in factors}
+            for a, _ in factors:
+                r = np.ones(codes.size, dtype=bool)
+                for b, v in values.items():
+                    if b != a:
+                        r &= v
+                rest[(k, a)] = r
         for t in self.plant.transitions:
             sel = digits[t.axis] == t.src
             if not sel.any():
                 continue
             src = codes[sel]
             dst = src + (t.dst - t.src) * self.strides[t.axis]
-            tdig = digits[:, sel].copy()
-            tdig[t.axis] = t.dst
-            ok = self.kept_digits(tdig)
-            if t.controllable and t.event in self.edge_terms:
-                ok &= ~self.forbidden_digits(t.event, digits[:, sel])
-            yield t, src, dst, ok
+            hits = [
+                (self.level_terms[k].constraint, rest[(k, t.axis)][sel])
+                for k, a, vec in self._on_axis[t.axis]
+                if vec[t.dst]
+            ]
+            if t.controllable:
+                for term in self.edge_terms.get(t.event, ()):
+                    hits.append((term.constraint, _holds(term.factors, digits[:, sel])))
+            yield t, src, dst, hits
+
+    @cached_property
+    def _on_axis(self) -> list[list[tuple[int, int, np.ndarray]]]:
+        out: list[list[tuple[int, int, np.ndarray]]] = [[] for _ in range(self.plant.ndim)]
+        for k, factors in enumerate(self.level_reach):
+            for a, vec in factors:
+                out[a].append((k, a, vec))
+        return out
+
+    def moves(self, codes: np.ndarray) -> Iterator[tuple[LocalTransition, np.ndarray, np.ndarray, np.ndarray]]:
+        """For each local transition: the sources among ``codes`` (kept states) it leaves,
+        their targets, and whether SUP keeps the move."""
+        for t, src, dst, hits in self._move_terms(codes):
+            bad = np.zeros(src.size, dtype=bool)
+            for _, h in hits:
+                bad |= h
+            yield t, src, dst, ~bad
 
     @cached_property
     def _counts(self) -> tuple[int, int, int]:
@@ -203,24 +238,12 @@ class Supervisor:
         every constraint whose violation it would make reachable, or that forbids its event)."""
         counts = {c.id: 0 for c in self.constraints}
         for start in range(0, self.states.size, 1 << 20):
-            codes = self.states[start:start + (1 << 20)]
-            digits = self.digits(codes)
-            for t in self.plant.transitions:
+            for t, src, _, hits in self._move_terms(self.states[start:start + (1 << 20)]):
                 if not t.controllable:
                     continue
-                sel = digits[t.axis] == t.src
-                if not sel.any():
-                    continue
-                sdig = digits[:, sel]
-                tdig = sdig.copy()
-                tdig[t.axis] = t.dst
                 per: dict[str, np.ndarray] = {}
-                for term, factors in zip(self.level_terms, self.level_reach):
-                    h = _holds(factors, tdig)
-                    per[term.constraint] = per[term.constraint] | h if term.constraint in per else h
-                for term in self.edge_terms.get(t.event, ()):
-                    h = _holds(term.factors, sdig)
-                    per[term.constraint] = per[term.constraint] | h if term.constraint in per else h
+                for cid, h in hits:
+                    per[cid] = per[cid] | h if cid in per else h
                 for cid, h in per.items():
                     counts[cid] += int(np.count_nonzero(h))
         return {k: v for k, v in counts.items() if v}
