@@ -153,3 +153,58 @@ def test_sup_export_reads_in_faudes(cli, tmp_path):
     s = faudes.System(str(gen))
     assert (s.Size(), s.TransRelSize()) == (1626, 10738)
     assert "AVANCER1_up" in s.ControllableEvents().ToString()
+
+
+def _plain_tajer(p, constraints):
+    """Tajer's algorithm written the plain way, state by state: the reference the
+    vectorised closed form must match."""
+    from synth.expr import evaluate
+
+    states = [p.local(c) for c in range(p.size)]
+
+    def violates(local):
+        val = p.valuation(local)
+        return any(evaluate(c.forbidden, val.__getitem__) for c in constraints)
+
+    def forbidden_edge(local, event):
+        val = p.valuation(local)
+        for c in constraints:
+            if evaluate(c.forbidden, val.__getitem__, lambda e: e.text() == event):
+                return True
+        return False
+
+    bad = {s for s in states if violates(s)}
+    changed = True
+    while changed:  # defended, then weakly defended, until nothing changes
+        changed = False
+        for s in states:
+            if s in bad:
+                continue
+            if any(not t.controllable and n in bad for t, n in p.successors(s)):
+                bad.add(s)
+                changed = True
+    if p.initial in bad:
+        return set(), 0
+    seen = {p.initial}
+    stack = [p.initial]
+    transitions = 0
+    while stack:
+        s = stack.pop()
+        for t, n in p.successors(s):
+            if n in bad or (t.controllable and forbidden_edge(s, t.event)):
+                continue
+            transitions += 1
+            if n not in seen:
+                seen.add(n)
+                stack.append(n)
+    return seen, transitions
+
+
+@pytest.mark.parametrize("seed", range(30, 42))
+def test_sparse_sup_equals_plain_tajer(seed):
+    rs = parse_rules(random_rules(seed), f"random{seed}.rules")
+    p = plant(rs)
+    sup = supremal_controllable(p, rs.constraints)
+    states, transitions = _plain_tajer(p, rs.constraints)
+    assert {p.local(int(c)) for c in sup.states} == states
+    assert sup.count_transitions() == transitions
