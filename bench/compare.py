@@ -209,6 +209,13 @@ def machine() -> dict:
     except OSError:
         pass
     try:
+        head = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True, text=True)
+        dirty = subprocess.run(["git", "status", "--porcelain", "--", "synth"], cwd=ROOT, capture_output=True, text=True)
+        info["commit"] = head.stdout.strip() + (" (synth/ modified)" if dirty.stdout.strip() else "")
+    except OSError:
+        pass
+    info["loadavg"] = os.getloadavg()
+    try:
         import numpy
 
         info["numpy"] = numpy.__version__
@@ -297,7 +304,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--max-n", type=int, default=7)
     ap.add_argument("--timeout", type=float, default=60.0, help="seconds per tool and N (default 60)")
     ap.add_argument("--mem-limit", type=_parse_size, default=8 * 2**30, help="address space per tool run (default 8G)")
-    ap.add_argument("--repeat", type=int, default=3, help="runs per tool and N, median kept (default 3)")
+    ap.add_argument("--repeat", type=int, default=5, help="runs per tool and N, median kept (default 5)")
     ap.add_argument("--repeat-below", type=float, default=5.0, help="repeat only runs shorter than this (s)")
     ap.add_argument("--check-max", type=int, default=4, help="check LanguageEquality up to this N (default 4)")
     ap.add_argument("--tools", default="synth,faudes", help="comma-separated: synth,faudes")
@@ -328,6 +335,7 @@ def main(argv: list[str] | None = None) -> int:
         directory = Path(tmp.name)
     rows: list[dict] = []
     failed: set[str] = set()
+    start_machine = machine()
     try:
         for n in range(args.min_n, args.max_n + 1):
             row: dict = {"n": n}
@@ -369,6 +377,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"MISMATCH between synth and libFAUDES at N = {mismatch}")
     if args.json:
         data = {
+            "machine_at_start": start_machine,
             "machine": machine(),
             "settings": {k: getattr(args, k) for k in ("min_n", "max_n", "timeout", "mem_limit", "repeat", "repeat_below", "check_max")},
             "rows": rows,

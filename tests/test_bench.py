@@ -68,3 +68,17 @@ def test_line_sup_equals_libfaudes(n, tmp_path):
     ours = tmp_path / "ours.gen"
     ours.write_text(supervisor_generator(sup))
     assert faudes.LanguageEquality(theirs["sup"], faudes.System(str(ours)))
+
+
+def test_line_grafcets_validate(tmp_path, cli):
+    """The complete line passes; the one without the middle retraction blocks there."""
+    from synth.cli import build_parser
+
+    if "validate" not in build_parser().format_help():
+        pytest.skip("synth validate is not available")
+    rules, g7, missing = _generate(3, tmp_path)
+    code, out, _ = cli("validate", g7, "--plant", rules, "--quiet")
+    assert code == 0, out
+    code, out, _ = cli("validate", missing, "--plant", rules, "--quiet")
+    assert code == 1
+    assert "missing order R2" in out
