@@ -21,7 +21,7 @@ from .supervisor import explain, supremal_controllable
 __all__ = ["register", "plant_summary", "element_summary"]
 
 MAX_DRAWN_STATES = 400
-DEFAULT_MAX_STATES = 2**34
+DEFAULT_MAX_STATES = 2**36
 
 
 def register(sub: "argparse._SubParsersAction") -> None:
