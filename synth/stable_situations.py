@@ -171,6 +171,7 @@ class GrafcetMachine:
         for t in grafcet.timers:
             self._timers_of_step[t.step] = self._timers_of_step.get(t.step, ()) + (t.id,)
         self._rec = [_compile(t.receptivity, steps, timers) for t in self.transitions]
+        self._enabled_cache: dict[frozenset[str], tuple[int, ...]] = {}
         self._rec_inputs = [frozenset(receptivity_inputs(t, self.inputs)) for t in self.transitions]
         self._steps = {s.name: s for s in grafcet.steps}
         self._cond: dict[tuple[str, int], _Fn] = {}
@@ -208,6 +209,13 @@ class GrafcetMachine:
         if len(changed) > 1:
             raise ValueError(f"one input changes per event, not {len(changed)}: {', '.join(changed)}")
         event = (changed[0], bool(after[changed[0]])) if changed else None
+        return self.react_event(sit, event, after)
+
+    def react_event(
+        self, sit: Situation, event: tuple[str, bool] | None, after: Mapping[str, bool]
+    ) -> tuple[Situation, tuple[tuple[Transition, ...], ...]]:
+        """The stable situation after input ``event`` (``("dcy", True)`` is ``↑dcy``),
+        ``after`` being the input values once it happened; with the rounds fired."""
         st = self._state(sit)
         if event is not None:
             self._event_actions(st, after, event)
@@ -274,6 +282,14 @@ class GrafcetMachine:
         return frozenset(used)
 
     # ------------------------------------------------------------------ internals
+    def _enabled(self, active: frozenset[str]) -> tuple[int, ...]:
+        """Indices of the transitions enabled by ``active`` (cached)."""
+        hit = self._enabled_cache.get(active)
+        if hit is None:
+            hit = tuple(i for i, t in enumerate(self.transitions) if all(s in active for s in t.sources))
+            self._enabled_cache[active] = hit
+        return hit
+
     def _state(self, sit: Situation) -> _State:
         return _State(set(sit.steps), set(sit.stored), set(sit.elapsed))
 
@@ -321,10 +337,8 @@ class GrafcetMachine:
                 seen[key] = len(history)
             active, elapsed = frozenset(st.active), frozenset(st.elapsed)
             ev = event if first else None
-            fire = tuple(
-                t for i, t in enumerate(self.transitions)
-                if all(s in active for s in t.sources) and self._rec[i](inputs, active, elapsed, ev)
-            )
+            rec = self._rec
+            fire = tuple(self.transitions[i] for i in self._enabled(active) if rec[i](inputs, active, elapsed, ev))
             first = False
             if not fire:
                 return
@@ -430,69 +444,131 @@ class ASS:
         return tuple(t for t in self.transitions if t.source == state)
 
 
-def _condition_text(on: set[tuple[bool, ...]], off: set[tuple[bool, ...]], names: Sequence[str]) -> str:
-    """A small DNF true on every ``on`` vector and false on every ``off`` one (others: don't care).
+class _Cubes:
+    """Sets of input vectors as Python integers (bit ``v`` set iff vector ``v`` is in the set).
 
-    >>> _condition_text({(True, False), (True, True)}, {(False, True)}, ["a", "b"])
+    A vector ``v`` has bit ``i`` set iff input ``i`` is 1. Set operations are integer
+    bit operations, so whole sets are handled at once.
+    """
+
+    def __init__(self, n: int) -> None:
+        self.n = n
+        self.size = 1 << n
+        self.full = (1 << self.size) - 1
+        self.one: list[int] = []
+        for i in range(n):
+            block = ((1 << (1 << i)) - 1) << (1 << i)  # 2^i zeros then 2^i ones
+            period = 1 << (i + 1)
+            m = 0
+            for start in range(0, self.size, period):
+                m |= block << start
+            self.one.append(m)
+        self.zero = [self.full ^ m for m in self.one]
+
+    def flip(self, s: int, i: int) -> int:
+        """Every vector of ``s`` with input ``i`` flipped."""
+        d = 1 << i
+        return ((s & self.zero[i]) << d) | ((s & self.one[i]) >> d)
+
+    def cube(self, literals: Mapping[int, bool]) -> int:
+        """Vectors where input ``i`` equals ``literals[i]`` for every given ``i``."""
+        c = self.full
+        for i, value in literals.items():
+            c &= self.one[i] if value else self.zero[i]
+        return c
+
+    def members(self, s: int) -> list[int]:
+        out = []
+        while s:
+            low = s & -s
+            out.append(low.bit_length() - 1)
+            s ^= low
+        return out
+
+
+def _condition_text(cubes: _Cubes, on: int, off: int, names: Sequence[str], free: Sequence[int]) -> str:
+    """A small DNF over inputs ``free`` true on every vector of ``on`` and false on every
+    vector of ``off`` (other vectors: don't care); ``any`` when ``off`` is empty.
+
+    >>> c = _Cubes(2)
+    >>> on = c.cube({0: True}) & ~c.cube({1: True})       # a & !b
+    >>> off = c.cube({0: False})                          # !a
+    >>> _condition_text(c, on, off, ["a", "b"], [0, 1])
     'a'
-    >>> _condition_text({(True,)}, set(), ["a"])
+    >>> _condition_text(c, on, 0, ["a", "b"], [0, 1])
     'any'
     """
     if not off:
         return "any"
-    keep = list(range(len(names)))
-    for i in list(keep):
-        trial = [k for k in keep if k != i]
-        pon = {tuple(v[k] for k in trial) for v in on}
-        poff = {tuple(v[k] for k in trial) for v in off}
-        if not pon & poff:
-            keep = trial
-    pon = {tuple(v[k] for k in keep) for v in on}
-    poff = {tuple(v[k] for k in keep) for v in off}
-    n = len(keep)
-    if n > 10:  # too many variables to minimise: list the vectors
-        cubes = sorted(pon, reverse=True)
-        return " | ".join(_cube_text(c, [names[k] for k in keep]) for c in cubes)
-
-    def covers(cube: tuple[bool | None, ...], v: tuple[bool, ...]) -> bool:
-        return all(c is None or c == x for c, x in zip(cube, v))
-
-    valid = [
-        c for c in product((None, True, False), repeat=n)
-        if not any(covers(c, v) for v in poff) and any(covers(c, v) for v in pon)
+    keep = list(free)
+    cl_on, cl_off = on, off
+    for i in list(keep):  # drop every variable not needed to tell on from off
+        t_on = cl_on | cubes.flip(cl_on, i)
+        t_off = cl_off | cubes.flip(cl_off, i)
+        if not t_on & t_off:
+            keep.remove(i)
+            cl_on, cl_off = t_on, t_off
+    if len(keep) > 8:  # too many variables to minimise: list the vectors
+        vecs = sorted({tuple(bool(v >> i & 1) for i in keep) for v in cubes.members(on)}, reverse=True)
+        return " | ".join(_cube_text(dict(zip(keep, vec)), names) for vec in vecs)
+    candidates: list[tuple[dict[int, bool], int]] = []
+    for values in product((None, True, False), repeat=len(keep)):
+        lits = {i: v for i, v in zip(keep, values) if v is not None}
+        c = cubes.cube(lits)
+        if not c & off and c & on:
+            candidates.append((lits, c))
+    primes = [
+        (l, c) for l, c in candidates
+        if not any(c != d and c & d == c for _, d in candidates)
     ]
-
-    def sub(a: tuple[bool | None, ...], b: tuple[bool | None, ...]) -> bool:  # a strictly inside b
-        return a != b and all(y is None or x == y for x, y in zip(a, b))
-
-    primes = [c for c in valid if not any(sub(c, d) for d in valid)]
-    uncovered = set(pon)
-    chosen: list[tuple[bool | None, ...]] = []
+    uncovered = on
+    chosen: list[dict[int, bool]] = []
     while uncovered:
-        best = max(
+        lits, c = max(
             primes,
-            key=lambda c: (
-                sum(covers(c, v) for v in uncovered),
-                -sum(x is not None for x in c),
-                tuple(0 if x is None else (2 if x else 1) for x in c),
+            key=lambda lc: (
+                (lc[1] & uncovered).bit_count(),
+                -len(lc[0]),
+                tuple(2 if lc[0].get(i) is None else int(lc[0][i]) for i in keep),
             ),
         )
-        chosen.append(best)
-        uncovered = {v for v in uncovered if not covers(best, v)}
-    kept = [names[k] for k in keep]
-    return " | ".join(_cube_text(c, kept) for c in chosen)
+        chosen.append(lits)
+        uncovered &= ~c
+    return " | ".join(_cube_text(l, names) for l in chosen)
 
 
-def _cube_text(cube: tuple[bool | None, ...], names: Sequence[str]) -> str:
-    lits = [(n if v else "!" + n) for n, v in zip(names, cube) if v is not None]
-    return " & ".join(lits) if lits else "1"
+def _cube_text(lits: Mapping[int, bool], names: Sequence[str]) -> str:
+    parts = [(names[i] if v else "!" + names[i]) for i, v in sorted(lits.items())]
+    return " & ".join(parts) if parts else "1"
+
+
+class _Reader:
+    """Input values from a vector, remembering which inputs were read (for memoisation)."""
+
+    __slots__ = ("mask", "index", "base", "read")
+
+    def __init__(self, mask: int, index: Mapping[str, int], base: Mapping[str, bool]) -> None:
+        self.mask = mask
+        self.index = index
+        self.base = base
+        self.read = 0
+
+    def __getitem__(self, name: str) -> bool:
+        i = self.index.get(name)
+        if i is None:
+            return self.base[name]
+        self.read |= 1 << i
+        return bool(self.mask >> i & 1)
+
+
+MAX_INPUTS = 20
 
 
 def stable_situation_automaton(
     machine: GrafcetMachine,
     *,
     initial_inputs: Mapping[str, bool] | None = None,
-    max_states: int = 2_000_000,
+    max_states: int = 100_000,
 ) -> ASS:
     """The ASS of ``machine``, explored from its initial situation.
 
@@ -500,75 +576,144 @@ def stable_situation_automaton(
     Grafcet reads); from each, every read input may flip (one event) and every running
     timer may elapse. Pairs are then projected on situations. ``initial_inputs`` gives
     the initial input values (default: all 0; inputs not read never matter).
+    Sets of valuations are handled as bit sets, so a situation is processed at once
+    for all the valuations that reach it.
+
+    >>> from synth.grafcet import parse_grafcet
+    >>> g = parse_grafcet("grafcet G { initial step 0 step 1: A "
+    ...                   "transition 0 -> 1 when ↑a . b  transition 1 -> 0 when !b }")
+    >>> ass = stable_situation_automaton(GrafcetMachine(g))
+    >>> [(s.id, s.situation.text(), s.orders) for s in ass.states]
+    [(0, '{X0}', ()), (1, '{X1}', ('A',))]
+    >>> [(t.source, t.event, t.condition, t.target) for t in ass.transitions]
+    [(0, '↑a', 'b', 1), (1, '↓b', 'any', 0)]
     """
     base = {n: bool((initial_inputs or {}).get(n, False)) for n in machine.inputs}
     names = machine.read_inputs
+    n_in = len(names)
+    if n_in > MAX_INPUTS:
+        raise LimitExceeded(f"the Grafcet reads {n_in} inputs; the ASS is explored for at most {MAX_INPUTS}")
     index = {n: i for i, n in enumerate(names)}
+    cubes = _Cubes(n_in)
 
-    def valuation(v: tuple[bool, ...]) -> dict[str, bool]:
+    def valuation(v: int) -> dict[str, bool]:
         d = dict(base)
-        d.update(zip(names, v))
+        for n, i in index.items():
+            d[n] = bool(v >> i & 1)
         return d
 
-    v0 = tuple(base[n] for n in names)
-    s0 = machine.initial(valuation(v0))
-    order: dict[Situation, int] = {s0: 0}
-    vectors: dict[Situation, set[tuple[bool, ...]]] = {s0: {v0}}
-    # (situation, event) -> {vector before: target situation}
-    moves: dict[tuple[Situation, str], dict[tuple[bool, ...], Situation]] = {}
-    relevant: dict[Situation, frozenset[str]] = {}
-    queue: deque[tuple[Situation, tuple[bool, ...]]] = deque([(s0, v0)])
-    seen = {(s0, v0)}
-    events: list[tuple[str, bool]] = [(n, r) for n in names for r in (True, False)]
+    v0 = sum(1 << i for n, i in index.items() if base[n])
+    s0 = machine.initial(base)
+    sits: list[Situation] = [s0]
+    sid: dict[Situation, int] = {s0: 0}
+    reached: list[int] = [1 << v0]
+    pending: list[int] = [1 << v0]
+    relevant: list[int] = []
+    timers: list[tuple[str, ...]] = []
+    labels: list[str] = [edge_text(r, n) for n in names for r in (True, False)]
+    # (situation, label) -> [(vectors covered, target)], from memoised runs
+    memo: dict[tuple[int, str], list[tuple[int, int]]] = {}
+    # (situation, label) -> {target: vectors before the event}
+    moves: dict[tuple[int, str], dict[int, int]] = {}
+    queue: deque[int] = deque([0])
+    queued = {0}
+
+    def known(sit: Situation) -> int:
+        k = sid.get(sit)
+        if k is None:
+            if len(sits) >= max_states:
+                raise LimitExceeded(f"more than {max_states} stable situations while building the ASS")
+            k = sid[sit] = len(sits)
+            sits.append(sit)
+            reached.append(0)
+            pending.append(0)
+        while len(relevant) < len(sits):
+            j = len(relevant)
+            relevant.append(sum(1 << index[x] for x in machine.relevant_inputs(sits[j]) if x in index))
+            timers.append(machine.timers(sits[j]))
+        return k
+
+    known(s0)
+
+    def classify(k: int, label: str, event: tuple[str, bool] | str, after: int) -> dict[int, int]:
+        """Target situation of each vector of ``after`` (values once the event happened)."""
+        entries = memo.setdefault((k, label), [])
+        out: dict[int, int] = {}
+        rest = after
+        for covered, target in entries:
+            hit = rest & covered
+            if hit:
+                out[target] = out.get(target, 0) | hit
+                rest &= ~covered
+        while rest:
+            v = (rest & -rest).bit_length() - 1
+            reader = _Reader(v, index, base)
+            if isinstance(event, str):
+                result = machine.fire_timer_with_trace(sits[k], event, reader)[0]  # type: ignore[arg-type]
+            else:
+                result = machine.react_event(sits[k], event, reader)[0]  # type: ignore[arg-type]
+            target = known(result)
+            covered = cubes.cube({i: bool(v >> i & 1) for i in range(n_in) if reader.read >> i & 1})
+            entries.append((covered, target))
+            out[target] = out.get(target, 0) | (rest & covered)
+            rest &= ~covered
+        return out
+
+    def add(k: int, vectors: int) -> None:
+        new = vectors & ~reached[k]
+        if new:
+            reached[k] |= new
+            pending[k] |= new
+            if k not in queued:
+                queued.add(k)
+                queue.append(k)
+
     while queue:
-        sit, v = queue.popleft()
-        if sit not in relevant:
-            relevant[sit] = machine.relevant_inputs(sit)
-        rel = relevant[sit]
-        succ: list[tuple[str, Situation, tuple[bool, ...]]] = []
-        for n, rising in events:
-            i = index[n]
-            if v[i] == rising:
-                continue
-            w = v[:i] + (rising,) + v[i + 1:]
-            target = machine.react(sit, valuation(v), valuation(w)) if n in rel else sit
-            succ.append((edge_text(rising, n), target, w))
-        for t in machine.timers(sit):
-            succ.append((t, machine.fire_timer(sit, t, valuation(v)), v))
-        for label, target, w in succ:
-            moves.setdefault((sit, label), {})[v] = target
-            if target not in order:
-                order[target] = len(order)
-                vectors[target] = set()
-            if (target, w) not in seen:
-                if len(seen) >= max_states:
-                    raise LimitExceeded(f"more than {max_states} (situation, inputs) pairs while building the ASS")
-                seen.add((target, w))
-                vectors[target].add(w)
-                queue.append((target, w))
-    # states
+        k = queue.popleft()
+        queued.discard(k)
+        todo, pending[k] = pending[k], 0
+        for i, n in enumerate(names):
+            for rising in (True, False):
+                src = todo & (cubes.zero[i] if rising else cubes.one[i])
+                if not src:
+                    continue
+                after = cubes.flip(src, i)
+                if not relevant[k] >> i & 1:
+                    add(k, after)
+                    continue
+                label = labels[2 * i + (0 if rising else 1)]
+                for target, vecs in classify(k, label, (n, rising), after).items():
+                    add(target, vecs)
+                    if target != k:
+                        m = moves.setdefault((k, label), {})
+                        m[target] = m.get(target, 0) | cubes.flip(vecs, i)
+        for t in timers[k]:
+            for target, vecs in classify(k, t, t, todo).items():
+                add(target, vecs)
+                if target != k:
+                    m = moves.setdefault((k, t), {})
+                    m[target] = m.get(target, 0) | vecs
+    # states, with the orders they emit
     states: list[ASSState] = []
-    for sit, i in sorted(order.items(), key=lambda kv: kv[1]):
-        emitted = [machine.orders(sit, valuation(v)) for v in sorted(vectors[sit])]
+    for k, sit in enumerate(sits):
+        emitted = {machine.orders(sit, valuation(v)) for v in cubes.members(reached[k])}
         union = frozenset().union(*emitted) if emitted else frozenset()
         always = frozenset.intersection(*emitted) if emitted else frozenset()
         outs = tuple(o for o in machine.outputs if o in union)
-        cond = tuple(o for o in outs if o not in always)
-        states.append(ASSState(i, sit, outs, cond))
+        states.append(ASSState(k, sit, outs, tuple(o for o in outs if o not in always)))
     # transitions, with the condition on the other inputs
-    event_rank = {edge_text(r, n): k for k, (n, r) in enumerate(events)}
+    rank = {label: r for r, label in enumerate(labels)}
     trans: list[ASSTransition] = []
-    for (sit, label), by_vector in moves.items():
-        if label in event_rank:
-            name = label[1:]
-            others = [k for k, n in enumerate(names) if n != name]
+    for (k, label), by_target in moves.items():
+        if label in rank:
+            x = rank[label] // 2
+            domain = reached[k] & (cubes.zero[x] if rank[label] % 2 == 0 else cubes.one[x])
+            free = [i for i in range(n_in) if i != x]
         else:
-            others = list(range(len(names)))
-        other_names = [names[k] for k in others]
-        targets = {t for t in by_vector.values() if t != sit}
-        for target in targets:
-            on = {tuple(v[k] for k in others) for v, t in by_vector.items() if t == target}
-            off = {tuple(v[k] for k in others) for v, t in by_vector.items() if t != target}
-            trans.append(ASSTransition(order[sit], label, _condition_text(on, off, other_names), order[target]))
-    trans.sort(key=lambda t: (t.source, event_rank.get(t.event, len(event_rank)), t.event, t.target))
+            domain = reached[k]
+            free = list(range(n_in))
+        for target in sorted(by_target):
+            on = by_target[target] & domain
+            trans.append(ASSTransition(k, label, _condition_text(cubes, on, domain & ~on, names, free), target))
+    trans.sort(key=lambda t: (t.source, rank.get(t.event, len(rank)), t.event, t.target))
     return ASS(tuple(states), tuple(trans), 0, names, tuple((n, base[n]) for n in names))
