@@ -1,11 +1,272 @@
-"""CLI commands of the grafcet stage (registered by :mod:`synth.cli`)."""
+"""CLI commands of the Grafcet stage: ``synth ass`` and ``synth run``.
+
+``synth ass FILE.g7 [--plant RULES] [--json] [--dot FILE] [--svg FILE]`` prints the
+automaton of the stable situations; ``synth run FILE.g7 [--plant RULES] --events
+"↑dcy,↑cp12,2s/X101,↓v10"`` simulates the Grafcet event by event and prints each
+stable situation with its orders (the initial one first).
+
+Example (text output of ``synth run``)::
+
+    0  initial   {X0, X100, X200, X300}   orders: -
+    1  ↑dcy      {X1, X100, X200, X300}   orders: TAPIS   fired: 0->1
+"""
 
 from __future__ import annotations
 
 import argparse
+import json
+import sys
+from typing import Any, Mapping, Sequence
 
-__all__ = ["register"]
+from .errors import InputError, Location, close_names
+from .files import write_atomic
+from .grafcet import Grafcet, load_grafcet
+from .stable_situations import ASS, GrafcetMachine, stable_situation_automaton
+
+__all__ = ["register", "ass_text", "ass_json", "ass_dot", "parse_events", "cmd_ass", "cmd_run"]
+
+
+# --------------------------------------------------------------------------- loading
+
+
+def _load(args: argparse.Namespace) -> tuple[Grafcet, dict[str, bool]]:
+    """The Grafcet (checked against the plant if given) and the initial input values."""
+    initial: dict[str, bool] = {}
+    if args.plant:
+        from .rules import load_rules
+
+        rs = load_rules(args.plant)
+        grafcet = load_grafcet(args.file, inputs=rs.inputs, outputs=rs.outputs)
+        initial = {v.name: v.initial for v in rs.variables if v.is_input}
+    else:
+        grafcet = load_grafcet(args.file)
+    initial = {n: initial.get(n, False) for n in grafcet.inputs}
+    if args.initial:
+        initial.update(_parse_initial(args.initial, grafcet.inputs))
+    return grafcet, initial
+
+
+def _parse_initial(text: str, inputs: Sequence[str]) -> dict[str, bool]:
+    """``"v10=1, v20=1"`` (or ``"v10, v20"``) → values; errors point into the option text."""
+    out: dict[str, bool] = {}
+    col = 1
+    for part in text.split(","):
+        item = part.strip()
+        start = col + (len(part) - len(part.lstrip()))
+        col += len(part) + 1
+        if not item:
+            continue
+        name, _, value = item.partition("=")
+        name = name.strip()
+        loc = Location("--initial", 1, start, text, max(1, len(name)))
+        if name not in inputs:
+            raise InputError(f"unknown input '{name}'", loc, suggestions=close_names(name, inputs))
+        if value.strip() not in ("", "0", "1"):
+            raise InputError(f"the value of {name} must be 0 or 1", loc)
+        out[name] = value.strip() != "0"
+    return out
+
+
+def parse_events(text: str, grafcet: Grafcet) -> list[tuple[str, tuple[str, bool] | str, Location]]:
+    """``"↑dcy, ^cp12, 2s/X101, _v10"`` → ``[(text, event, location), ...]``.
+
+    An input event is ``(name, rising)``; a timer event is its id. Unknown names are
+    :class:`InputError` located in the option text, with suggestions.
+    """
+    out: list[tuple[str, tuple[str, bool] | str, Location]] = []
+    timers = [t.id for t in grafcet.timers]
+    col = 1
+    for part in text.split(","):
+        item = part.strip()
+        start = col + (len(part) - len(part.lstrip()))
+        col += len(part) + 1
+        if not item:
+            continue
+        loc = Location("--events", 1, start, text, len(item))
+        if item[0] in "↑^↓_":
+            rising = item[0] in "↑^"
+            name = item[1:].strip()
+            if name not in grafcet.inputs:
+                raise InputError(
+                    f"unknown input '{name}' in event {item}",
+                    Location("--events", 1, start + 1, text, max(1, len(name))),
+                    suggestions=tuple(item[0] + c for c in close_names(name, grafcet.inputs)),
+                    notes=("inputs: " + ", ".join(grafcet.inputs),) if grafcet.inputs else (),
+                )
+            out.append((("↑" if rising else "↓") + name, (name, rising), loc))
+        elif item in timers:
+            out.append((item, item, loc))
+        else:
+            hint = close_names(item, timers + ["↑" + i for i in grafcet.inputs] + ["↓" + i for i in grafcet.inputs])
+            raise InputError(
+                f"unknown event '{item}'",
+                loc,
+                suggestions=hint,
+                notes=("an event is ↑x / ^x (rising), ↓x / _x (falling) of an input, or a timer of the Grafcet"
+                       + (": " + ", ".join(timers) if timers else ""),),
+            )
+    return out
+
+
+# --------------------------------------------------------------------------- rendering
+
+
+def _orders_text(orders: Sequence[str], conditional: Sequence[str] = ()) -> str:
+    if not orders:
+        return "-"
+    return ", ".join(o + ("?" if o in conditional else "") for o in orders)
+
+
+def ass_text(ass: ASS, title: str = "") -> str:
+    """The ASS as a readable listing (pure function)."""
+    lines = []
+    head = f"ASS{' of ' + title if title else ''}: {len(ass.states)} stable situations, {len(ass.transitions)} transitions"
+    lines.append(head)
+    lines.append("inputs explored: " + (", ".join(ass.inputs) if ass.inputs else "none"))
+    if any(s.conditional for s in ass.states):
+        lines.append("(an order marked ? is emitted only under some input values: conditional action)")
+    for s in ass.states:
+        mark = "  (initial)" if s.id == ass.initial else ""
+        lines.append("")
+        lines.append(f"S{s.id}  {s.situation.text()}{mark}")
+        lines.append(f"    orders: {_orders_text(s.orders, s.conditional)}")
+        for t in ass.successors(s.id):
+            cond = "" if t.condition == "any" else f"  [{t.condition}]"
+            lines.append(f"    {t.event}{cond} -> S{t.target}")
+    return "\n".join(lines) + "\n"
+
+
+def ass_json(ass: ASS) -> dict[str, Any]:
+    """The ASS as JSON-ready data (pure function)."""
+    return {
+        "initial": ass.initial,
+        "inputs": list(ass.inputs),
+        "states": [
+            {
+                "id": s.id,
+                "situation": list(s.situation.steps),
+                "stored": list(s.situation.stored),
+                "elapsed": list(s.situation.elapsed),
+                "orders": list(s.orders),
+                "conditional_orders": list(s.conditional),
+            }
+            for s in ass.states
+        ],
+        "transitions": [
+            {"source": t.source, "event": t.event, "condition": t.condition, "target": t.target}
+            for t in ass.transitions
+        ],
+    }
+
+
+def _dot_string(text: str) -> str:
+    return '"' + text.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n") + '"'
+
+
+def ass_dot(ass: ASS, title: str = "ASS") -> str:
+    """Graphviz DOT text of the ASS (pure function)."""
+    lines = [f"digraph {_dot_string(title)} {{", "  rankdir=TB;", '  node [shape=box, fontname="Helvetica"];',
+             '  edge [fontname="Helvetica", fontsize=10];']
+    for s in ass.states:
+        label = f"S{s.id}\n{s.situation.text()}\n{_orders_text(s.orders, s.conditional)}"
+        extra = ", peripheries=2" if s.id == ass.initial else ""
+        lines.append(f"  S{s.id} [label={_dot_string(label)}{extra}];")
+    for t in ass.transitions:
+        label = t.event if t.condition == "any" else f"{t.event}\n[{t.condition}]"
+        lines.append(f"  S{t.source} -> S{t.target} [label={_dot_string(label)}];")
+    lines.append("}")
+    return "\n".join(lines) + "\n"
+
+
+def _render_svg(dot: str) -> bytes:
+    import graphviz
+
+    try:
+        return graphviz.Source(dot).pipe(format="svg")
+    except (graphviz.ExecutableNotFound, graphviz.CalledProcessError) as exc:  # pragma: no cover - environment
+        raise InputError(f"cannot run Graphviz's dot: {exc}", None) from None
+
+
+# --------------------------------------------------------------------------- commands
+
+
+def cmd_ass(args: argparse.Namespace) -> int:
+    grafcet, initial = _load(args)
+    machine = GrafcetMachine(grafcet)
+    ass = stable_situation_automaton(machine, initial_inputs=initial)
+    dot = ass_dot(ass, grafcet.path)
+    if args.dot:
+        write_atomic(args.dot, dot)
+    if args.svg:
+        write_atomic(args.svg, _render_svg(dot))
+    if args.json:
+        sys.stdout.write(json.dumps(ass_json(ass), indent=2, ensure_ascii=False) + "\n")
+    else:
+        sys.stdout.write(ass_text(ass, grafcet.path))
+    return 0
+
+
+def _inputs_text(values: Mapping[str, bool], names: Sequence[str]) -> str:
+    ones = [n for n in names if values[n]]
+    return ", ".join(ones) if ones else "-"
+
+
+def cmd_run(args: argparse.Namespace) -> int:
+    grafcet, inputs = _load(args)
+    machine = GrafcetMachine(grafcet)
+    events = parse_events(args.events or "", grafcet)
+    sit = machine.initial(inputs)
+    rows: list[tuple[str, str, str, str]] = [("initial", sit.text(), _orders_text(sorted(machine.orders(sit, inputs), key=grafcet.outputs.index)), "")]
+    for text, event, loc in events:
+        if isinstance(event, str):
+            if event not in machine.timers(sit):
+                step = next(t.step for t in grafcet.timers if t.id == event)
+                why = "it has already elapsed" if event in sit.elapsed else f"step {step} is not active"
+                raise InputError(f"timer {event} cannot elapse now: {why}", loc, notes=(f"situation: {sit.text()}",))
+            sit, rounds = machine.fire_timer_with_trace(sit, event, inputs)
+        else:
+            name, rising = event
+            if inputs[name] == rising:
+                raise InputError(
+                    f"{text} cannot happen: {name} is already {int(rising)}", loc,
+                    notes=("inputs at 1 now: " + _inputs_text(inputs, grafcet.inputs),),
+                )
+            after = dict(inputs)
+            after[name] = rising
+            sit, rounds = machine.react_with_trace(sit, inputs, after)
+            inputs = after
+        fired = "; ".join(", ".join(t.name for t in r) for r in rounds)
+        orders = sorted(machine.orders(sit, inputs), key=grafcet.outputs.index)
+        rows.append((text, sit.text(), _orders_text(orders), fired))
+    w_event = max(len(r[0]) for r in rows)
+    w_sit = max(len(r[1]) for r in rows)
+    out = sys.stdout
+    for i, (ev, s, orders, fired) in enumerate(rows):
+        line = f"{i:<3}{ev:<{w_event}}  {s:<{w_sit}}  orders: {orders}"
+        if fired:
+            line += f"   fired: {fired}"
+        out.write(line.rstrip() + "\n")
+    return 0
+
+
+def _common(p: argparse.ArgumentParser) -> None:
+    p.add_argument("file", metavar="FILE.g7", help="the Grafcet")
+    p.add_argument("--plant", metavar="RULES", help="plant .rules file: its inputs/outputs and initial input values")
+    p.add_argument("--initial", metavar="X=1,...", help="initial input values (default: the plant's, else all 0)")
 
 
 def register(sub: "argparse._SubParsersAction") -> None:
     """Add this stage's sub-commands to the ``synth`` parser."""
+    p = sub.add_parser("ass", help="automaton of the stable situations of a Grafcet",
+                       description="Build the automaton of the stable situations (ASS) of a Grafcet.")
+    _common(p)
+    p.add_argument("--json", action="store_true", help="print JSON instead of text")
+    p.add_argument("--dot", metavar="FILE", help="write the Graphviz DOT text")
+    p.add_argument("--svg", metavar="FILE", help="write an SVG drawing (Graphviz)")
+    p.set_defaults(handler=cmd_ass)
+    p = sub.add_parser("run", help="simulate a Grafcet event by event",
+                       description="Simulate a Grafcet: print each stable situation and its orders.")
+    _common(p)
+    p.add_argument("--events", metavar="EVENTS", default="",
+                   help='comma-separated events: "↑dcy,^cp12,2s/X101,↓v10,_v11"')
+    p.set_defaults(handler=cmd_run)
