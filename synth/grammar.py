@@ -38,6 +38,7 @@ _TERMINAL_TEXT = {
     "SLASH": "/",
     "NUMBER": "a number",
     "DURATION": "a duration such as 2s",
+    "TIMER": "a timer such as 2s/X12",
     "_NL": "end of line",
     "$END": "end of file",
 }
