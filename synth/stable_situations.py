@@ -50,7 +50,7 @@ from itertools import product
 from typing import Callable, Mapping, Sequence
 
 from .errors import InputError, LimitExceeded
-from .expr import And, Const, Edge, Expr, Not, Or, Var, edge_text
+from .expr import And, Const, Edge, Expr, Not, Or, Var, edge_text, names
 from .grafcet import (
     CONDITIONAL,
     CONTINUOUS,
@@ -75,6 +75,7 @@ __all__ = [
     "load_grafcet",
     "receptivity_inputs",
     "parse_event",
+    "event_text",
     "Event",
 ]
 
@@ -184,7 +185,7 @@ class GrafcetMachine:
             used: set[str] = set()
             for a in s.actions:
                 if a.kind == STORED and a.when == ON_EVENT and a.condition is not None:
-                    used.update(n.name for n in _names(a.condition))
+                    used.update(n.name for n in names(a.condition))
             self._event_inputs[s.name] = frozenset(used)
 
     # ------------------------------------------------------------------ public API
@@ -369,12 +370,6 @@ class GrafcetMachine:
         )
 
 
-def _names(e: Expr) -> list[Var | Edge]:
-    from .expr import names
-
-    return list(names(e))
-
-
 # --------------------------------------------------------------------------- events
 
 
@@ -394,6 +389,7 @@ def parse_event(text: str) -> Event:
 
 
 def event_text(event: Event) -> str:
+    """``("dcy", True)`` → ``"↑dcy"``; a timer id is returned as is."""
     return event if isinstance(event, str) else edge_text(event[1], event[0])
 
 
@@ -589,11 +585,11 @@ def stable_situation_automaton(
     [(0, '↑a', 'b', 1), (1, '↓b', 'any', 0)]
     """
     base = {n: bool((initial_inputs or {}).get(n, False)) for n in machine.inputs}
-    names = machine.read_inputs
-    n_in = len(names)
+    read = machine.read_inputs
+    n_in = len(read)
     if n_in > MAX_INPUTS:
         raise LimitExceeded(f"the Grafcet reads {n_in} inputs; the ASS is explored for at most {MAX_INPUTS}")
-    index = {n: i for i, n in enumerate(names)}
+    index = {n: i for i, n in enumerate(read)}
     cubes = _Cubes(n_in)
 
     def valuation(v: int) -> dict[str, bool]:
@@ -610,7 +606,7 @@ def stable_situation_automaton(
     pending: list[int] = [1 << v0]
     relevant: list[int] = []
     timers: list[tuple[str, ...]] = []
-    labels: list[str] = [edge_text(r, n) for n in names for r in (True, False)]
+    labels: list[str] = [edge_text(r, n) for n in read for r in (True, False)]
     # (situation, label) -> [(vectors covered, target)], from memoised runs
     memo: dict[tuple[int, str], list[tuple[int, int]]] = {}
     # (situation, label) -> {target: vectors before the event}
@@ -672,7 +668,7 @@ def stable_situation_automaton(
         k = queue.popleft()
         queued.discard(k)
         todo, pending[k] = pending[k], 0
-        for i, n in enumerate(names):
+        for i, n in enumerate(read):
             for rising in (True, False):
                 src = todo & (cubes.zero[i] if rising else cubes.one[i])
                 if not src:
@@ -714,6 +710,6 @@ def stable_situation_automaton(
             free = list(range(n_in))
         for target in sorted(by_target):
             on = by_target[target] & domain
-            trans.append(ASSTransition(k, label, _condition_text(cubes, on, domain & ~on, names, free), target))
+            trans.append(ASSTransition(k, label, _condition_text(cubes, on, domain & ~on, read, free), target))
     trans.sort(key=lambda t: (t.source, rank.get(t.event, len(rank)), t.event, t.target))
-    return ASS(tuple(states), tuple(trans), 0, names, tuple((n, base[n]) for n in names))
+    return ASS(tuple(states), tuple(trans), 0, read, tuple((n, base[n]) for n in read))
