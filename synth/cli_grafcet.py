@@ -16,7 +16,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from typing import Any, Mapping, Sequence
+from typing import Any, Iterator, Mapping, Sequence
 
 from .errors import InputError, Location, close_names
 from .files import write_atomic
@@ -46,16 +46,25 @@ def _load(args: argparse.Namespace) -> tuple[Grafcet, dict[str, bool]]:
     return grafcet, initial
 
 
-def _parse_initial(text: str, inputs: Sequence[str]) -> dict[str, bool]:
-    """``"v10=1, v20=1"`` (or ``"v10, v20"``) → values; errors point into the option text."""
-    out: dict[str, bool] = {}
+def _comma_items(text: str) -> Iterator[tuple[str, int]]:
+    """The non-empty comma-separated items of an option's text, with their 1-based columns.
+
+    >>> list(_comma_items("a, b,,c"))
+    [('a', 1), ('b', 4), ('c', 7)]
+    """
     col = 1
     for part in text.split(","):
         item = part.strip()
         start = col + (len(part) - len(part.lstrip()))
         col += len(part) + 1
-        if not item:
-            continue
+        if item:
+            yield item, start
+
+
+def _parse_initial(text: str, inputs: Sequence[str]) -> dict[str, bool]:
+    """``"v10=1, v20=1"`` (or ``"v10, v20"``) → values; errors point into the option text."""
+    out: dict[str, bool] = {}
+    for item, start in _comma_items(text):
         name, _, value = item.partition("=")
         name = name.strip()
         loc = Location("--initial", 1, start, text, max(1, len(name)))
@@ -75,13 +84,7 @@ def parse_events(text: str, grafcet: Grafcet) -> list[tuple[str, tuple[str, bool
     """
     out: list[tuple[str, tuple[str, bool] | str, Location]] = []
     timers = [t.id for t in grafcet.timers]
-    col = 1
-    for part in text.split(","):
-        item = part.strip()
-        start = col + (len(part) - len(part.lstrip()))
-        col += len(part) + 1
-        if not item:
-            continue
+    for item, start in _comma_items(text):
         loc = Location("--events", 1, start, text, len(item))
         if item[0] in "↑^↓_":
             rising = item[0] in "↑^"

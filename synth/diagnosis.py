@@ -23,7 +23,7 @@ from typing import Any, Iterable
 import numpy as np
 
 from .composition import Plant
-from .expr import Edge, Var, edge_text, evaluate, names
+from .expr import Var, edge_text, evaluate, names
 from .grafcet import Transition
 from .sync import Node, Prohibition, Sync
 

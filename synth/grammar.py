@@ -7,11 +7,12 @@ from functools import lru_cache
 from importlib import resources
 from pathlib import Path
 
-from lark import Lark, Token, UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
+from lark import Lark, Token, Transformer, Tree, UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
 
-from .errors import InputError, location_in
+from .errors import InputError, Location, location_in
+from .expr import And, Const, Edge, Not, Or, Var
 
-__all__ = ["grammar_text", "parser", "syntax_error", "token_location"]
+__all__ = ["grammar_text", "parser", "syntax_error", "token_location", "ExprTransformer"]
 
 # How terminals are shown to a user in "expected ..." lists.
 _TERMINAL_TEXT = {
@@ -111,3 +112,45 @@ def syntax_error(err: UnexpectedInput, file: str, source: str, p: Lark) -> Input
 def token_location(tok: Token, file: str, source: str):
     """Location of a lark token inside ``source``."""
     return location_in(file, source, tok.line or 1, tok.column or 1, len(str(tok)))
+
+
+class ExprTransformer(Transformer):
+    """The expression rules shared by both grammars (``var``, ``const``, ``rise``,
+    ``fall``, ``neg``, ``and_expr``, ``or_expr``) → :mod:`synth.expr` objects that keep
+    their :class:`~synth.errors.Location`."""
+
+    def __init__(self, file: str, source: str) -> None:
+        super().__init__()
+        self.file = file
+        self.source = source
+
+    def _loc(self, tok: Token | Tree, width: int | None = None) -> Location:
+        if isinstance(tok, Token):
+            return location_in(self.file, self.source, tok.line or 1, tok.column or 1, width or len(str(tok)))
+        meta = tok.meta
+        return location_in(self.file, self.source, meta.line, meta.column, width or 1)
+
+    def var(self, items: list) -> Var:
+        (tok,) = items
+        return Var(str(tok), self._loc(tok))
+
+    def const(self, items: list) -> Const:
+        (tok,) = items
+        return Const(str(tok) == "1", self._loc(tok))
+
+    def rise(self, items: list) -> Edge:
+        _, tok = items
+        return Edge(True, str(tok), self._loc(tok))
+
+    def fall(self, items: list) -> Edge:
+        _, tok = items
+        return Edge(False, str(tok), self._loc(tok))
+
+    def neg(self, items: list) -> Not:
+        return Not(items[-1])
+
+    def and_expr(self, items: list) -> And:
+        return And(tuple(i for i in items if not isinstance(i, Token)))
+
+    def or_expr(self, items: list) -> Or:
+        return Or(tuple(i for i in items if not isinstance(i, Token)))

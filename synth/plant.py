@@ -115,7 +115,6 @@ def element_automaton(e: ElementSpec) -> ElementAutomaton:
     if n > MAX_ELEMENT_VARIABLES:
         raise InputError(f"element {e.name} has {n} variables; at most {MAX_ELEMENT_VARIABLES} are supported", e.loc)
     index = {v: i for i, v in enumerate(names)}
-    decl = {v.name: v for v in e.variables}
 
     def value_of(code: int):
         return lambda name: bool((code >> index[name]) & 1)

@@ -29,11 +29,11 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Iterable, Mapping
 
-from lark import Token, Transformer, Tree, UnexpectedInput, v_args
+from lark import Token, UnexpectedInput
 
 from .errors import InputError, InputErrors, Location, close_names, location_in
-from .expr import And, Const, Edge, Expr, Not, Or, Var, evaluate, names
-from .grammar import parser, syntax_error
+from .expr import Const, Edge, Expr, Not, Var, evaluate, names
+from .grammar import ExprTransformer, parser, syntax_error
 
 __all__ = [
     "VarDecl",
@@ -206,45 +206,8 @@ class _Hold:
     decls: tuple[VarDecl, ...]
 
 
-class _ToModel(Transformer):
+class _ToModel(ExprTransformer):
     """Parse tree → plain frozen objects that keep their locations."""
-
-    def __init__(self, file: str, source: str) -> None:
-        super().__init__()
-        self.file = file
-        self.source = source
-
-    def _loc(self, tok: Token | Tree, width: int | None = None) -> Location:
-        if isinstance(tok, Token):
-            return location_in(self.file, self.source, tok.line or 1, tok.column or 1, width or len(str(tok)))
-        meta = tok.meta
-        return location_in(self.file, self.source, meta.line, meta.column, width or 1)
-
-    # expressions
-    def var(self, items: list) -> Var:
-        (tok,) = items
-        return Var(str(tok), self._loc(tok))
-
-    def const(self, items: list) -> Const:
-        (tok,) = items
-        return Const(str(tok) == "1", self._loc(tok))
-
-    def rise(self, items: list) -> Edge:
-        sym, tok = items
-        return Edge(True, str(tok), self._loc(tok))
-
-    def fall(self, items: list) -> Edge:
-        sym, tok = items
-        return Edge(False, str(tok), self._loc(tok))
-
-    def neg(self, items: list) -> Not:
-        return Not(items[1])
-
-    def and_expr(self, items: list) -> And:
-        return And(tuple(i for i in items if not isinstance(i, Token)))
-
-    def or_expr(self, items: list) -> Or:
-        return Or(tuple(i for i in items if not isinstance(i, Token)))
 
     # declarations
     def decl(self, items: list) -> tuple[Token, Token]:

@@ -50,7 +50,7 @@ from itertools import product
 from typing import Callable, Mapping, Sequence
 
 from .errors import InputError, LimitExceeded
-from .expr import And, Const, Edge, Expr, Not, Or, Var, edge_text, names
+from .expr import And, Const, Edge, Expr, Not, Var, edge_text, names
 from .grafcet import (
     CONDITIONAL,
     CONTINUOUS,

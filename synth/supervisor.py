@@ -32,7 +32,7 @@ Example
 from __future__ import annotations
 
 from collections import deque
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from functools import cached_property
 from typing import Callable, Iterable, Iterator, Sequence
 
@@ -106,15 +106,12 @@ GRID_LIMIT = 200_000_000
 grids of the plant's size; above this many states they are not computed."""
 
 
-class Supervisor:
-    """SUP: its states as a sorted array of plant state codes, explored from the initial
-    state; SUP membership of any state is the closed form of the module docstring.
+class CompiledConstraints:
+    """Constraints compiled against a plant: each monomial as per-element factors
+    (``level_terms`` / ``edge_terms``), and for level terms the factors of "can reach a
+    violating local state by the element's own uncontrollable moves" (``level_reach``)."""
 
-    Grids over the whole plant (``illegal``, ``removed``, ``defended``, ``forbid``,
-    ``reachable``) are built on first use, for plants that fit in memory.
-    """
-
-    def __init__(self, p: Plant, constraints: Sequence[Constraint], states: np.ndarray | None = None) -> None:
+    def __init__(self, p: Plant, constraints: Sequence[Constraint]) -> None:
         self.plant = p
         self.constraints = tuple(constraints)
         self.terms = _terms(p, constraints)
@@ -125,6 +122,18 @@ class Supervisor:
         for t in self.terms:
             if t.event is not None:
                 self.edge_terms.setdefault(t.event, []).append(t)
+
+
+class Supervisor(CompiledConstraints):
+    """SUP: its states as a sorted array of plant state codes, explored from the initial
+    state; SUP membership of any state is the closed form of the module docstring.
+
+    Grids over the whole plant (``illegal``, ``removed``, ``defended``, ``forbid``,
+    ``reachable``) are built on first use, for plants that fit in memory.
+    """
+
+    def __init__(self, p: Plant, constraints: Sequence[Constraint], states: np.ndarray | None = None) -> None:
+        super().__init__(p, constraints)
         self.strides = np.array(
             [int(np.prod(p.shape[i + 1:], dtype=np.int64)) for i in range(p.ndim)], dtype=np.int64
         )
@@ -354,28 +363,20 @@ def supremal_controllable(
     return sup
 
 
-class LocalSupervisor:
+class LocalSupervisor(CompiledConstraints):
     """SUP membership decided state by state, without building the plant grid.
 
     ``kept(local)`` is true iff no constraint violation is reachable from the state by
     uncontrollable events; cost O(monomials × elements) per query.
     """
 
-    def __init__(self, p: Plant, constraints: Sequence[Constraint]) -> None:
-        self.plant = p
-        self.constraints = tuple(constraints)
-        self.terms = _terms(p, constraints)
-        closures = [e.uncontrollable_closure().astype(np.uint8) for e in p.elements]
-        self._level = [t for t in self.terms if t.event is None]
-        self._reach = [_closed(closures, t.factors) for t in self._level]
-
     def kept(self, local: tuple[int, ...]) -> bool:
-        return not any(all(vec[local[a]] for a, vec in factors) for factors in self._reach)
+        return not any(all(vec[local[a]] for a, vec in factors) for factors in self.level_reach)
 
     def violated(self, local: tuple[int, ...]) -> list[str]:
         """Ids of the constraints the state violates (levels)."""
         ids = []
-        for t in self._level:
+        for t in self.level_terms:
             if all(vec[local[a]] for a, vec in t.factors) and t.constraint not in ids:
                 ids.append(t.constraint)
         return ids
@@ -383,7 +384,7 @@ class LocalSupervisor:
     def threatened(self, local: tuple[int, ...]) -> list[str]:
         """Ids of the constraints whose violation is reachable by uncontrollable events."""
         ids = []
-        for t, factors in zip(self._level, self._reach):
+        for t, factors in zip(self.level_terms, self.level_reach):
             if all(vec[local[a]] for a, vec in factors) and t.constraint not in ids:
                 ids.append(t.constraint)
         return ids
