@@ -216,13 +216,12 @@ def diagnose(sync: Sync, node_index: int, *, expert: bool = False) -> Diagnosis:
         causes = tuple(_element_cause(sync, node, e) for e in events)
         awaited.append(Awaited(t.name, t.grafcet, t.receptivity.text(), events, steps, causes, tuple(t.sources)))
     details = []
+    waiting = []
     for a in awaited:
-        what = f"transition {a.transition} of {a.grafcet} awaits {a.receptivity}"
-        if a.events:
-            what += f": it becomes true with {' or '.join(a.events)}"
-        elif a.steps:
-            what += f": it waits on {', '.join(a.steps)}"
-        details.append(what)
+        if not a.events:
+            waiting.append(f"{a.grafcet} {a.transition}" + (f" ({', '.join(a.steps)})" if a.steps else f" ({a.receptivity})"))
+            continue
+        details.append(f"transition {a.transition} of {a.grafcet} awaits {a.receptivity}: it becomes true with {' or '.join(a.events)}")
         for c in a.causes:
             if c.element is None:
                 details.append(f"  {c.event}: no plant element drives {c.event[1:]}")
@@ -234,6 +233,8 @@ def diagnose(sync: Sync, node_index: int, *, expert: bool = False) -> Diagnosis:
                 details.append(f"  {c.event} (element {c.element}) needs {', '.join(c.changes)}: {state}, {sup}; rules: {rules}")
             else:
                 details.append(f"  {c.event} (element {c.element}) cannot be produced from its current state; rules: {rules}")
+    if waiting:
+        details.append("waiting on steps: " + "; ".join(waiting))
     verdict, summary = _verdict(sync, node, awaited, expert)
     return Diagnosis(verdict, summary, tuple(awaited), tuple(details))
 
