@@ -16,7 +16,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from typing import Any, Iterator, Mapping, Sequence
+from typing import Any, Callable, Iterator, Mapping, Sequence
 
 from .errors import InputError, Location, close_names
 from .files import write_atomic
@@ -29,21 +29,25 @@ __all__ = ["register", "ass_text", "ass_json", "ass_dot", "parse_events", "cmd_a
 # --------------------------------------------------------------------------- loading
 
 
-def _load(args: argparse.Namespace) -> tuple[Grafcet, dict[str, bool]]:
-    """The Grafcet (checked against the plant if given) and the initial input values."""
+def _load(args: argparse.Namespace) -> tuple[Grafcet, dict[str, bool], Callable[[Mapping[str, bool]], bool] | None]:
+    """The Grafcet (checked against the plant if given), the initial input values, and
+    the plant's test of admissible input vectors (None without a plant)."""
     initial: dict[str, bool] = {}
+    admissible = None
     if args.plant:
+        from .composition import plant
         from .rules import load_rules
 
         rs = load_rules(args.plant)
         grafcet = load_grafcet(args.file, inputs=rs.inputs, outputs=rs.outputs)
         initial = {v.name: v.initial for v in rs.variables if v.is_input}
+        admissible = plant(rs).admissible_inputs()
     else:
         grafcet = load_grafcet(args.file)
     initial = {n: initial.get(n, False) for n in grafcet.inputs}
     if args.initial:
         initial.update(_parse_initial(args.initial, grafcet.inputs))
-    return grafcet, initial
+    return grafcet, initial, admissible
 
 
 def _comma_items(text: str) -> Iterator[tuple[str, int]]:
@@ -194,9 +198,9 @@ def _render_svg(dot: str) -> bytes:
 
 
 def cmd_ass(args: argparse.Namespace) -> int:
-    grafcet, initial = _load(args)
+    grafcet, initial, admissible = _load(args)
     machine = GrafcetMachine(grafcet)
-    ass = stable_situation_automaton(machine, initial_inputs=initial)
+    ass = stable_situation_automaton(machine, initial_inputs=initial, admissible=admissible)
     dot = ass_dot(ass, grafcet.path)
     if args.dot:
         write_atomic(args.dot, dot)
@@ -215,7 +219,7 @@ def _inputs_text(values: Mapping[str, bool], names: Sequence[str]) -> str:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    grafcet, inputs = _load(args)
+    grafcet, inputs, _ = _load(args)
     machine = GrafcetMachine(grafcet)
     events = parse_events(args.events or "", grafcet)
     sit = machine.initial(inputs)

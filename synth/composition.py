@@ -25,7 +25,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
-from typing import Iterator
+from typing import Callable, Iterator, Mapping
 
 import numpy as np
 
@@ -134,6 +134,34 @@ class Plant:
         """The E and Z vectors as bit strings in declaration order."""
         val = self.valuation(local)
         return ("".join("1" if val[v] else "0" for v in self.inputs), "".join("1" if val[v] else "0" for v in self.outputs))
+
+    def admissible_inputs(self) -> "Callable[[Mapping[str, bool]], bool]":
+        """A test of whether an input vector (a mapping over some plant inputs; the others
+        are free) agrees with some plant state: each element's inputs must match one of its
+        local states. Used to keep a Grafcet's exploration to vectors the plant can produce.
+
+        >>> from synth.rules import load_rules
+        >>> ok = plant(load_rules(_plants("tri.rules"))).admissible_inputs()
+        >>> ok({"cp11": True, "cp12": False}), ok({"cp11": True, "cp12": True})
+        (True, False)
+        """
+        per_element = []
+        for e in self.elements:
+            names = [v for v in e.variables if v not in e.orders]
+            if not names:
+                continue
+            bits = [e.variables.index(v) for v in names]
+            rows = {tuple(bool((int(c) >> b) & 1) for b in bits) for c in e.codes}
+            per_element.append((names, rows))
+
+        def admissible(values: Mapping[str, bool]) -> bool:
+            for names, rows in per_element:
+                known = [(k, values[n]) for k, n in enumerate(names) if n in values]
+                if known and not any(all(r[k] == v for k, v in known) for r in rows):
+                    return False
+            return True
+
+        return admissible
 
     def parse_state(self, text: str) -> tuple[int, ...]:
         """A state written as its true variables (``"TAPIS,v10,v20"`` or ``{...}``)."""

@@ -565,6 +565,7 @@ def stable_situation_automaton(
     *,
     initial_inputs: Mapping[str, bool] | None = None,
     max_states: int = 100_000,
+    admissible: Callable[[Mapping[str, bool]], bool] | None = None,
 ) -> ASS:
     """The ASS of ``machine``, explored from its initial situation.
 
@@ -599,6 +600,9 @@ def stable_situation_automaton(
         return d
 
     v0 = sum(1 << i for n, i in index.items() if base[n])
+    allowed = -1  # every vector
+    if admissible is not None and n_in <= 16:
+        allowed = sum(1 << v for v in range(1 << n_in) if admissible(valuation(v))) | (1 << v0)
     s0 = machine.initial(base)
     sits: list[Situation] = [s0]
     sid: dict[Situation, int] = {s0: 0}
@@ -673,7 +677,9 @@ def stable_situation_automaton(
                 src = todo & (cubes.zero[i] if rising else cubes.one[i])
                 if not src:
                     continue
-                after = cubes.flip(src, i)
+                after = cubes.flip(src, i) & allowed
+                if not after:
+                    continue
                 if not relevant[k] >> i & 1:
                     add(k, after)
                     continue
