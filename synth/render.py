@@ -56,13 +56,16 @@ def dot_graph(
     return "\n".join(out) + "\n"
 
 
-def element_dot(a: ElementAutomaton, highlight: Iterable[str] = ()) -> str:
+def element_dot(a: ElementAutomaton, highlight: Iterable[str] = (), current: int | None = None) -> str:
     """An element automaton; controllable edges solid blue, uncontrollable dashed red;
-    transitions whose event is in ``highlight`` drawn thick orange."""
+    transitions whose event is in ``highlight`` drawn thick orange; the local state
+    ``current`` (e.g. the element's state in a blocking situation) filled."""
     marked = set(highlight)
     nodes = []
     for k in range(a.size):
         attrs = {"peripheries": "2"} if k == a.initial else {}
+        if k == current:
+            attrs.update({"style": "filled", "fillcolor": "#fadbd8", "color": "#c0392b", "penwidth": "2"})
         nodes.append((str(k), a.state_label(k), attrs))
     edges = []
     for t in range(a.src.size):

@@ -101,8 +101,15 @@ def report_html(v: "Validation") -> str:
         ]
         elements, events = _involved(v, b, d)
         for name in elements:
-            el = next(e for e in v.plant.elements if e.name == name)
-            parts += [f"<h3>Element {_esc(name)}</h3>", _inline_svg(element_dot(el, highlight=events))]
+            axis = next(i for i, e in enumerate(v.plant.elements) if e.name == name)
+            el = v.plant.elements[axis]
+            here = v.sync.nodes[b].plant[axis]
+            parts += [
+                f"<h3>Element {_esc(name)}</h3>",
+                f"<p>In the blocking state {_esc(name)} is in {_esc(el.state_label(here))} (filled); "
+                "the awaited event and the orders that cause it are drawn thick.</p>",
+                _inline_svg(element_dot(el, highlight=events, current=here)),
+            ]
         parts += [
             "<h3>SUP around the blocking state</h3>",
             _inline_svg(sup_neighbourhood_dot(v.sync, v.sync.nodes[b].plant)),
