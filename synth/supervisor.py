@@ -14,10 +14,13 @@ orders and each element moves on its own, so the states reachable from ``s`` by
 uncontrollable events are the product ``U_1(s_1) × … × U_N(s_N)`` of per-element
 closures. Writing each constraint as a disjunction of monomials, ``s`` is removed iff
 for some monomial ``m`` every element ``i`` can reach, by its own uncontrollable
-moves, a local state satisfying ``m``'s literals on its variables. That is an outer
-product of N small boolean vectors per monomial: linear in the plant size, and
-evaluable state by state (:class:`LocalSupervisor`) when the plant is too large to
-exist (on-the-fly validation).
+moves, a local state satisfying ``m``'s literals on its variables: a product of N
+small boolean vectors per monomial, evaluated for whole arrays of states at once
+(:class:`Supervisor`), for one state (:class:`LocalSupervisor`, on-the-fly validation),
+or over the whole plant grid when it fits in memory (the plant-wide statistics).
+
+SUP's states are then explored breadth-first from the initial state over state codes
+held in numpy arrays: the work is linear in SUP's transitions, not in the plant.
 
 Example
 -------
