@@ -38,7 +38,7 @@ from lark import Token, UnexpectedInput
 
 from .errors import InputError, InputErrors, Location, close_names, location_in
 from .expr import Const, Edge, Expr, Var, names
-from .grammar import ExprTransformer, parser, syntax_error
+from .grammar import ExprTransformer, parser, read_source, syntax_error
 
 __all__ = [
     "CONTINUOUS",
@@ -670,11 +670,4 @@ def load_grafcet(
     outputs: Sequence[str] | None = None,
 ) -> Grafcet:
     """Read, parse and check a ``.g7`` file (see :func:`parse_grafcet`)."""
-    p = Path(path)
-    try:
-        source = p.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise InputError(f"cannot read '{path}': {exc.strerror or exc}", None) from None
-    except UnicodeDecodeError:
-        raise InputError(f"'{path}' is not UTF-8 text", None) from None
-    return parse_grafcet(source, str(path), inputs=inputs, outputs=outputs)
+    return parse_grafcet(read_source(path), str(path), inputs=inputs, outputs=outputs)

@@ -12,7 +12,7 @@ from lark import Lark, Token, Transformer, Tree, UnexpectedCharacters, Unexpecte
 from .errors import InputError, Location, location_in
 from .expr import And, Const, Edge, Not, Or, Var
 
-__all__ = ["grammar_text", "parser", "syntax_error", "token_location", "ExprTransformer"]
+__all__ = ["grammar_text", "parser", "syntax_error", "token_location", "read_source", "ExprTransformer"]
 
 # How terminals are shown to a user in "expected ..." lists.
 _TERMINAL_TEXT = {
@@ -107,6 +107,16 @@ def syntax_error(err: UnexpectedInput, file: str, source: str, p: Lark) -> Input
         location_in(file, source, line, column, width),
         expected=shown[:12],
     )
+
+
+def read_source(path: str | Path) -> str:
+    """The text of a user file; an unreadable or non-UTF-8 file is an :class:`InputError`."""
+    try:
+        return Path(path).read_text(encoding="utf-8")
+    except OSError as exc:
+        raise InputError(f"cannot read '{path}': {exc.strerror or exc}", None) from None
+    except UnicodeDecodeError:
+        raise InputError(f"'{path}' is not UTF-8 text", None) from None
 
 
 def token_location(tok: Token, file: str, source: str):

@@ -33,7 +33,7 @@ from lark import Token, UnexpectedInput
 
 from .errors import InputError, InputErrors, Location, close_names, location_in
 from .expr import Const, Edge, Expr, Not, Var, evaluate, names
-from .grammar import ExprTransformer, parser, syntax_error
+from .grammar import ExprTransformer, parser, read_source, syntax_error
 
 __all__ = [
     "VarDecl",
@@ -350,6 +350,9 @@ class _Checker:
         except OSError as exc:
             self.fail(f"cannot read '{u.path}': {exc.strerror or exc}", u.loc)
             return
+        except UnicodeDecodeError:
+            self.fail(f"'{u.path}' is not UTF-8 text", u.loc)
+            return
         self.loaded.add(resolved)
         try:
             items = _parse(source, str(target))
@@ -548,6 +551,8 @@ def parse_rules(source: str, file: str = "<rules>", base: Path | None = None) ->
     """Parse and check rules text; ``base`` is the folder ``use`` paths are relative to."""
     items = _parse(source, file)
     checker = _Checker()
+    if base is not None:
+        checker.loaded.add((base / Path(file).name).resolve())  # a file that uses itself back
     checker.collect(items, base)
     if not checker.errors:
         checker.check()
@@ -566,11 +571,4 @@ def parse_rules(source: str, file: str = "<rules>", base: Path | None = None) ->
 
 def load_rules(path: str | Path) -> RuleSet:
     """Read, parse and check a ``.rules`` file."""
-    p = Path(path)
-    try:
-        source = p.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise InputError(f"cannot read '{path}': {exc.strerror or exc}", None) from None
-    except UnicodeDecodeError:
-        raise InputError(f"'{path}' is not UTF-8 text", None) from None
-    return parse_rules(source, str(path), p.parent)
+    return parse_rules(read_source(path), str(path), Path(path).parent)
