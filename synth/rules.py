@@ -141,18 +141,26 @@ class RuleSet:
     elements: tuple[ElementSpec, ...]
     constraints: tuple[Constraint, ...]
     path: str = "<rules>"
+    order: tuple[str, ...] = ()  # names listed by `inputs` / `outputs`, first in the vectors
 
     @property
     def variables(self) -> tuple[VarDecl, ...]:
         return tuple(v for e in self.elements for v in e.variables)
 
+    def _vector(self, inputs: bool) -> tuple[str, ...]:
+        names = [v.name for v in self.variables if v.is_input == inputs]
+        listed = [n for n in self.order if n in names]
+        return tuple(listed + [n for n in names if n not in listed])
+
     @property
     def inputs(self) -> tuple[str, ...]:
-        return tuple(v.name for v in self.variables if v.is_input)
+        """The vector E: listed inputs first (``inputs ...``), then the others as declared."""
+        return self._vector(True)
 
     @property
     def outputs(self) -> tuple[str, ...]:
-        return tuple(v.name for v in self.variables if v.kind == ORDER)
+        """The vector Z: listed orders first (``outputs ...``), then the others as declared."""
+        return self._vector(False)
 
     def owner(self, name: str) -> ElementSpec | None:
         return next((e for e in self.elements if e.variable(name) is not None), None)
@@ -204,6 +212,12 @@ class _Use:
 @dataclass(frozen=True)
 class _Hold:
     decls: tuple[VarDecl, ...]
+
+
+@dataclass(frozen=True)
+class _Vector:
+    kind: str  # "inputs" | "outputs"
+    names: tuple[tuple[str, Location], ...]
 
 
 class _ToModel(ExprTransformer):
@@ -275,6 +289,10 @@ class _ToModel(ExprTransformer):
         ren = tuple(r for r in ren if r is not None)
         return _Instance(str(name), str(model), ren, self._loc(name), self._loc(model))
 
+    def vector(self, items: list) -> _Vector:
+        kind, *names = items
+        return _Vector(str(kind), tuple((str(n), self._loc(n)) for n in names))
+
     def use(self, items: list) -> _Use:
         (tok,) = items
         return _Use(str(tok)[1:-1], self._loc(tok))
@@ -309,6 +327,8 @@ class _Checker:
         self.constraints: list[Constraint] = []
         self.holds: list[VarDecl] = []
         self.top_free: list[VarDecl] = []
+        self.vectors: list[_Vector] = []
+        self.order: tuple[str, ...] = ()
         self.errors: list[InputError] = []
         self.loaded: set[Path] = set()
 
@@ -339,6 +359,8 @@ class _Checker:
                 self.top_free.extend(it)
             elif isinstance(it, Constraint):
                 self.constraints.append(it)
+            elif isinstance(it, _Vector):
+                self.vectors.append(it)
 
     def use(self, u: _Use, base: Path | None) -> None:
         target = (base / u.path) if base is not None else Path(u.path)
@@ -432,6 +454,21 @@ class _Checker:
             self.check_element(e, owner)
             final.append(e)
         self.elements = final
+        listed: dict[str, Location] = {}
+        for vec in self.vectors:
+            want_input = vec.kind == "inputs"
+            pool = [n for n, (_, d) in owner.items() if d.is_input == want_input]
+            for n, loc in vec.names:
+                if n in listed:
+                    self.fail(f"'{n}' is listed twice in the vectors", loc, notes=(f"first listed at {listed[n]}",))
+                elif n not in owner:
+                    self.fail(f"{vec.kind}: unknown variable '{n}'", loc, suggestions=close_names(n, pool))
+                elif owner[n][1].is_input != want_input:
+                    what = "an input" if owner[n][1].is_input else "an order"
+                    self.fail(f"{vec.kind}: '{n}' is {what} of element {owner[n][0].name}", loc)
+                else:
+                    listed[n] = loc
+        self.order = tuple(listed)
         all_names = set(owner)
         ids: dict[str, Constraint] = {}
         for c in self.constraints:
@@ -566,7 +603,7 @@ def parse_rules(source: str, file: str = "<rules>", base: Path | None = None) ->
         raise checker.errors[0]
     if checker.errors:
         raise InputErrors(checker.errors)
-    return RuleSet(tuple(checker.elements), tuple(checker.constraints), file)
+    return RuleSet(tuple(checker.elements), tuple(checker.constraints), file, checker.order)
 
 
 def load_rules(path: str | Path) -> RuleSet:

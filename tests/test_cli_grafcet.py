@@ -38,13 +38,13 @@ def test_run_box_sorting_cycle(capsys):
         "0  initial  {X0, X100, X200, X300}  orders: -",
         "1  ↑dcy     {X1, X100, X200, X300}  orders: TAPIS   fired: 0->1",
         "2  ↑cp12    {X1, X101, X200, X300}  orders: TAPIS   fired: 100->101",
-        "3  2s/X101  {X1, X102, X200, X300}  orders: AVANCER1, TAPIS   fired: 101->102",
-        "4  ↓v10     {X1, X102, X200, X300}  orders: AVANCER1, TAPIS",
-        "5  ↑v11     {X1, X103, X200, X300}  orders: AVANCER2, TAPIS   fired: 102->103",
-        "6  ↓v20     {X1, X103, X200, X300}  orders: AVANCER2, TAPIS",
-        "7  ↑v21     {X1, X104, X200, X301}  orders: AVANCER4, TAPIS   fired: 103->104; 300->301",
-        "8  ↓v40     {X1, X104, X200, X301}  orders: AVANCER4, TAPIS",
-        "9  ↑v41     {X1, X105, X200, X302}  orders: RECULER1, RECULER2, TAPIS   fired: 301->302; 104->105",
+        "3  2s/X101  {X1, X102, X200, X300}  orders: TAPIS, AVANCER1   fired: 101->102",
+        "4  ↓v10     {X1, X102, X200, X300}  orders: TAPIS, AVANCER1",
+        "5  ↑v11     {X1, X103, X200, X300}  orders: TAPIS, AVANCER2   fired: 102->103",
+        "6  ↓v20     {X1, X103, X200, X300}  orders: TAPIS, AVANCER2",
+        "7  ↑v21     {X1, X104, X200, X301}  orders: TAPIS, AVANCER4   fired: 103->104; 300->301",
+        "8  ↓v40     {X1, X104, X200, X301}  orders: TAPIS, AVANCER4",
+        "9  ↑v41     {X1, X105, X200, X302}  orders: TAPIS, RECULER1, RECULER2   fired: 301->302; 104->105",
     ]
 
 

@@ -85,7 +85,9 @@ def test_tri_annex_plant_size(cli):
     assert code == 0
     assert data["states"] == 15552 == 12 * 12 * 6 * 6 * 3
     assert data["transitions"] % 1296 == 0
-    assert data["initial"]["E"] == "1010101000" and data["initial"]["Z"] == "0000001"
+    # E0 and Z0 of the annex, in the thesis's order (declared with `inputs` / `outputs`)
+    assert data["initial"]["E"] == "1010101000" and data["initial"]["Z"] == "1000000"
+    assert data["outputs"][0] == "TAPIS" and data["inputs"][-2:] == ["cp11", "cp12"]
 
 
 def test_composition_counts_match_enumeration():

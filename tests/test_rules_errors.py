@@ -100,6 +100,9 @@ def test_missing_file(cli, tmp_path):
     ("element A {\n order X = 0\n}\nelement A {\n order Y = 0\n}\n", "element 'A' is declared twice"),
     (V1 + 'constraint C1 "a": v10 = 0\nconstraint C1 "b": v11 = 0\n', "constraint id 'C1' is used twice"),
     (V1 + "hold v10 = 1\n", "only orders can be held"),
+    (V1 + "outputs AVANCER1, v10\n", "outputs: 'v10' is an input of element V1"),
+    (V1 + "inputs v10, v10\n", "'v10' is listed twice in the vectors"),
+    (V1 + "inputs v01\n", "did you mean v10"),
     (V1.replace("↑AVANCER1 [v10] -> ↓v10", "↑v10 -> ↓v11"), "the cause of a rule must be an edge of one of V1's orders"),
 ])
 def test_other_checks(cli, tmp_path, text, needle):

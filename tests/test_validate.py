@@ -82,7 +82,7 @@ def test_wrong_v1_caught_before_synthesis(cli):
     code, out, err = cli("validate", G / "tri.g7", "--plant", P / "tri_wrong_v1.rules")
     assert code == 2 and out == ""
     first = err.splitlines()[0]
-    assert "tri_wrong_v1.rules:16:34: error: rule of element V1 produces ↑v21, but v21 is a sensor of element V2" in first
+    assert "tri_wrong_v1.rules:17:34: error: rule of element V1 produces ↑v21, but v21 is a sensor of element V2" in first
 
 
 def test_expert_missing_rule(cli):
