@@ -102,7 +102,7 @@ def test_missing_file(cli, tmp_path):
     (V1 + "hold v10 = 1\n", "only orders can be held"),
     (V1 + "outputs AVANCER1, v10\n", "outputs: 'v10' is an input of element V1"),
     (V1 + "inputs v10, v10\n", "'v10' is listed twice in the vectors"),
-    (V1 + "inputs v01\n", "did you mean v10"),
+    (V1 + "inputs v01\n", "did you mean v11 or v10?"),
     (V1.replace("↑AVANCER1 [v10] -> ↓v10", "↑v10 -> ↓v11"), "the cause of a rule must be an edge of one of V1's orders"),
 ])
 def test_other_checks(cli, tmp_path, text, needle):
