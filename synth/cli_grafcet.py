@@ -20,10 +20,12 @@ from typing import Any, Callable, Iterator, Mapping, Sequence
 
 from .errors import InputError, Location, close_names
 from .files import write_atomic
+from .render import ass_dot, orders_text as _orders_text
+from .report import write_svg
 from .grafcet import Grafcet, load_grafcet
 from .stable_situations import ASS, GrafcetMachine, stable_situation_automaton
 
-__all__ = ["register", "ass_text", "ass_json", "ass_dot", "parse_events", "cmd_ass", "cmd_run"]
+__all__ = ["register", "ass_text", "ass_json", "parse_events", "cmd_ass", "cmd_run"]
 
 
 # --------------------------------------------------------------------------- loading
@@ -118,12 +120,6 @@ def parse_events(text: str, grafcet: Grafcet) -> list[tuple[str, tuple[str, bool
 # --------------------------------------------------------------------------- rendering
 
 
-def _orders_text(orders: Sequence[str], conditional: Sequence[str] = ()) -> str:
-    if not orders:
-        return "-"
-    return ", ".join(o + ("?" if o in conditional else "") for o in orders)
-
-
 def ass_text(ass: ASS, title: str = "") -> str:
     """The ASS as a readable listing (pure function)."""
     lines = []
@@ -166,34 +162,6 @@ def ass_json(ass: ASS) -> dict[str, Any]:
     }
 
 
-def _dot_string(text: str) -> str:
-    return '"' + text.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n") + '"'
-
-
-def ass_dot(ass: ASS, title: str = "ASS") -> str:
-    """Graphviz DOT text of the ASS (pure function)."""
-    lines = [f"digraph {_dot_string(title)} {{", "  rankdir=TB;", '  node [shape=box, fontname="Helvetica"];',
-             '  edge [fontname="Helvetica", fontsize=10];']
-    for s in ass.states:
-        label = f"S{s.id}\n{s.situation.text()}\n{_orders_text(s.orders, s.conditional)}"
-        extra = ", peripheries=2" if s.id == ass.initial else ""
-        lines.append(f"  S{s.id} [label={_dot_string(label)}{extra}];")
-    for t in ass.transitions:
-        label = t.event if t.condition == "any" else f"{t.event}\n[{t.condition}]"
-        lines.append(f"  S{t.source} -> S{t.target} [label={_dot_string(label)}];")
-    lines.append("}")
-    return "\n".join(lines) + "\n"
-
-
-def _render_svg(dot: str) -> bytes:
-    import graphviz
-
-    try:
-        return graphviz.Source(dot).pipe(format="svg")
-    except (graphviz.ExecutableNotFound, graphviz.CalledProcessError) as exc:  # pragma: no cover - environment
-        raise InputError(f"cannot run Graphviz's dot: {exc}", None) from None
-
-
 # --------------------------------------------------------------------------- commands
 
 
@@ -205,7 +173,7 @@ def cmd_ass(args: argparse.Namespace) -> int:
     if args.dot:
         write_atomic(args.dot, dot)
     if args.svg:
-        write_atomic(args.svg, _render_svg(dot))
+        write_svg(args.svg, dot)
     if args.json:
         sys.stdout.write(json.dumps(ass_json(ass), indent=2, ensure_ascii=False) + "\n")
     else:

@@ -9,14 +9,15 @@ Example
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Iterable, Mapping
+from typing import TYPE_CHECKING, Iterable, Mapping, Sequence
 
 from .plant import ElementAutomaton
 
 if TYPE_CHECKING:
+    from .stable_situations import ASS
     from .sync import Sync
 
-__all__ = ["dot_graph", "dot_escape", "element_dot", "trace_dot", "sup_neighbourhood_dot", "aggregated_dot"]
+__all__ = ["dot_graph", "dot_escape", "element_dot", "trace_dot", "sup_neighbourhood_dot", "aggregated_dot", "ass_dot", "orders_text"]
 
 CONTROLLABLE_STYLE = {"color": "#1f5fa8", "fontcolor": "#1f5fa8"}
 UNCONTROLLABLE_STYLE = {"color": "#b03a2e", "fontcolor": "#b03a2e", "style": "dashed"}
@@ -157,3 +158,29 @@ def aggregated_dot(sync: "Sync", keep: Iterable[int] | None = None, blocking: It
         if e.source in inside and e.target in inside
     ]
     return dot_graph("aggregated", nodes, edges)
+
+
+def orders_text(orders: Sequence[str], conditional: Sequence[str] = ()) -> str:
+    """``A, B?`` (``?`` marks an order emitted only under some inputs); ``-`` for none."""
+    if not orders:
+        return "-"
+    return ", ".join(o + ("?" if o in conditional else "") for o in orders)
+
+
+def _dot_string(text: str) -> str:
+    return '"' + text.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n") + '"'
+
+
+def ass_dot(ass: "ASS", title: str = "ASS") -> str:
+    """Graphviz DOT text of the ASS (pure function)."""
+    lines = [f"digraph {_dot_string(title)} {{", "  rankdir=TB;", '  node [shape=box, fontname="Helvetica"];',
+             '  edge [fontname="Helvetica", fontsize=10];']
+    for s in ass.states:
+        label = f"S{s.id}\n{s.situation.text()}\n{orders_text(s.orders, s.conditional)}"
+        extra = ", peripheries=2" if s.id == ass.initial else ""
+        lines.append(f"  S{s.id} [label={_dot_string(label)}{extra}];")
+    for t in ass.transitions:
+        label = t.event if t.condition == "any" else f"{t.event}\n[{t.condition}]"
+        lines.append(f"  S{t.source} -> S{t.target} [label={_dot_string(label)}];")
+    lines.append("}")
+    return "\n".join(lines) + "\n"

@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 from synth.cli import main
-from synth.cli_grafcet import ass_dot
+from synth.render import ass_dot
 from synth.stable_situations import GrafcetMachine, load_grafcet, stable_situation_automaton
 
 ROOT = Path(__file__).resolve().parent.parent
