@@ -66,7 +66,6 @@ class Node:
     emitted: frozenset[str]  # orders the situation emits
     ord: tuple[str, ...]  # emitted orders that are set (authorised by SUP)
     proh: tuple[Prohibition, ...]  # order changes SUP refuses here
-    region_size: int = 1
 
 
 @dataclass(frozen=True)
@@ -86,7 +85,6 @@ class Sync:
     nodes: list[Node] = field(default_factory=list)
     edges: list[Edge] = field(default_factory=list)
     sync_states: int = 0  # SYNC states (all region members)
-    sync_transitions: int = 0
 
     def successors(self, i: int) -> list[Edge]:
         return self._out[i]
@@ -185,11 +183,8 @@ def synchronous_product(
         if key not in region_cache:
             wanted = machine.orders(sit, sync.inputs(entry))
             members, settled = region(p, oracle, entry, wanted, moves)
-            for m in members:
-                if (sit, m) not in sync_seen:
-                    sync_seen.add((sit, m))
+            sync_seen.update((sit, m) for m in members)
             region_cache[key] = settled
-            sync.sync_transitions += len(members) - 1 + max(0, len(settled) - 1)
         out = []
         for q, proh in region_cache[key]:
             nk = (sit, q)
@@ -239,7 +234,6 @@ def synchronous_product(
             progress(len(sync.nodes), len(queue))
             last = time.monotonic()
     sync.sync_states = len(sync_seen)
-    sync.sync_transitions += len(sync.edges)
     sync.index()
     return sync
 
