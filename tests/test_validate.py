@@ -188,3 +188,22 @@ def test_on_the_fly_sync_equals_grid_sync(g, r, monkeypatch):
     assert plain.edges == lazy.edges
     # every SYNC plant state lies in SUP's reachable part
     assert all(sup.reachable[n.plant] for n in lazy.nodes)
+
+
+def test_max_states_stops_with_a_message(cli):
+    code, out, err = cli("validate", G / "tri.g7", "--plant", P / "tri.rules", "--max-states", "5")
+    assert code == 2 and out == ""
+    assert err.strip() == "stopped: more than 5 aggregated states; raise --max-states or simplify the model"
+
+
+def test_empty_sup_fails_validation(cli, tmp_path):
+    rules = tmp_path / "tri_empty.rules"
+    text = (P / "tri.rules").read_text().replace('use "lib/', f'use "{P}/lib/')
+    rules.write_text(text + 'constraint K "V1 never at rest": v10 = 0\n')
+    code, data = _json(cli, G / "tri.g7", "--plant", rules)
+    assert code == 1
+    assert data["sup_empty"] is True and data["verdict"] == "fail"
+    code, out, _ = cli("sup", rules)
+    assert code == 0
+    assert "SUP is empty" in out
+    assert '{v10,v20,v30,v40} is illegal: it violates K "V1 never at rest"' in out
