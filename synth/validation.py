@@ -34,6 +34,12 @@ class Validation:
     sup_empty: bool
 
     @property
+    def unreached_steps(self) -> list[str]:
+        """Steps active in no stable situation SYNC reaches: dead code under this plant."""
+        active = {st for n in self.sync.nodes for st in n.situation.steps}
+        return [f"X{s.name}" for s in self.grafcet.steps if s.name not in active]
+
+    @property
     def passed(self) -> bool:
         return not self.sup_empty and not self.analysis.blocking and not self.analysis.prohibited
 
@@ -96,6 +102,7 @@ class Validation:
             "constraints": {c.id: c.label for c in self.rules.constraints},
             "blocking": blocking,
             "prohibited": prohibited,
+            "unreached_steps": self.unreached_steps,
         }
 
     # ------------------------------------------------------------------ text
@@ -110,6 +117,11 @@ class Validation:
         ]
         if self.sup_empty:
             lines.append("SUP is empty: the initial plant state is illegal, defended or weakly defended")
+        if self.unreached_steps and not self.sup_empty:
+            lines.append(
+                f"note: {len(self.unreached_steps)} step(s) never active in any reachable stable situation: "
+                + ", ".join(self.unreached_steps)
+            )
         for k, b in enumerate(a.blocking, 1):
             lines += [""] + self._problem_lines(f"Blocking {k}", b)
             tr = a.traces[b]

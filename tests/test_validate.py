@@ -32,6 +32,7 @@ def test_tri_passes(cli):
     assert code == 0
     assert data["verdict"] == "pass"
     assert data["blocking"] == [] and data["prohibited"] == []
+    assert data["unreached_steps"] == []
     assert data["stats"]["aggregated_states"] > 20
 
 
@@ -52,6 +53,7 @@ def test_missing_order(cli):
     assert {k for k, v in b["E"].items() if v} == {"dcy", "v11", "v20", "v30", "v40", "cp12"}
     assert {k for k, v in b["Z"].items() if v} == {"TAPIS"}
     assert b["ord"] == ["TAPIS"] and b["proh"] == []
+    assert data["unreached_steps"] == ["X104", "X105", "X106", "X301", "X302"]
     assert b["no_return"] == {"situation": ["X1", "X101", "X200", "X300"], "after": ["↑dcy", "↑cp12"]}
     d = b["diagnosis"]
     assert d["verdict"] == "missing_order"
@@ -71,11 +73,12 @@ def test_missing_order_terminal_text(cli):
     code, out, _ = cli("validate", G / "tri_missing_order.g7", "--plant", P / "tri.rules")
     assert code == 1
     lines = out.splitlines()
-    assert lines[2] == "Blocking 1: situation {X1, X103, X200, X300}"
-    assert lines[3] == "  E: dcy v11 v20 v30 v40 cp12"
-    assert lines[4] == "  Z: TAPIS"
-    assert lines[6] == "  trace: ↑dcy ↑cp12 2s/X101 ↓v10 ↑v11"
-    assert lines[8].startswith("  diagnosis [missing_order]: missing order AVANCER2 in step 103")
+    assert lines[1] == "note: 5 step(s) never active in any reachable stable situation: X104, X105, X106, X301, X302"
+    assert lines[3] == "Blocking 1: situation {X1, X103, X200, X300}"
+    assert lines[4] == "  E: dcy v11 v20 v30 v40 cp12"
+    assert lines[5] == "  Z: TAPIS"
+    assert lines[7] == "  trace: ↑dcy ↑cp12 2s/X101 ↓v10 ↑v11"
+    assert lines[9].startswith("  diagnosis [missing_order]: missing order AVANCER2 in step 103")
 
 
 def test_wrong_v1_caught_before_synthesis(cli):
