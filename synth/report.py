@@ -81,6 +81,12 @@ def report_html(v: "Validation") -> str:
         + "".join(f"<td>{val}</td>" for val in data["stats"].values()) + "</tr></table>",
         f"<p>{len(a.blocking)} blocking situation(s), {len(a.prohibited)} situation(s) with prohibited orders.</p>",
     ]
+    if data["unreached_steps"]:
+        parts.append(
+            "<p>Steps never active in a reachable stable situation: <code>"
+            + _esc(", ".join(data["unreached_steps"]))
+            + "</code></p>"
+        )
     if data["constraints"]:
         parts.append("<details><summary>Constraints</summary><table>")
         for c in v.rules.constraints:
