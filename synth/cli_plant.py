@@ -18,7 +18,7 @@ from .report import write_svg
 from .rules import RuleSet, load_rules
 from .supervisor import explain, supremal_controllable
 
-__all__ = ["register", "plant_summary", "element_summary"]
+__all__ = ["register", "plant_summary", "element_summary", "print_warnings"]
 
 MAX_DRAWN_STATES = 400
 DEFAULT_MAX_STATES = 2**36
@@ -99,6 +99,12 @@ def _find_element(p: Plant, rs: RuleSet, name: str) -> ElementAutomaton:
     )
 
 
+def print_warnings(p: Plant) -> None:
+    """Warnings about the plant model (rules that never apply), on stderr."""
+    for w in p.warnings:
+        print(w.render(), file=sys.stderr)
+
+
 def _print_json(data: Any) -> None:
     json.dump(data, sys.stdout, indent=2, ensure_ascii=False)
     sys.stdout.write("\n")
@@ -107,6 +113,7 @@ def _print_json(data: Any) -> None:
 def cmd_plant(args: argparse.Namespace) -> int:
     rs = load_rules(args.rules)
     p = plant(rs)
+    print_warnings(p)
     if args.element:
         a = _find_element(p, rs, args.element)
         data = element_summary(a, detail=True)
@@ -182,6 +189,7 @@ def _progress(enabled: bool):
 def cmd_sup(args: argparse.Namespace) -> int:
     rs = load_rules(args.rules)
     p = plant(rs)
+    print_warnings(p)
     if p.size > args.max_states:
         raise LimitExceeded(
             f"the plant of {args.rules} has {p.size} states, more than --max-states {args.max_states}; "

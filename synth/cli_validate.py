@@ -7,6 +7,7 @@ import json
 import sys
 from pathlib import Path
 
+from .cli_plant import print_warnings
 from .files import write_atomic
 from .render import dot_graph
 from .report import write_report
@@ -45,6 +46,7 @@ def cmd_validate(args: argparse.Namespace) -> int:
     )
     if show_progress:
         sys.stderr.write("\r\033[K")
+    print_warnings(result.plant)
     if args.cor:
         cor = reduced_controller(result)
         path = Path(args.cor)

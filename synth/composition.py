@@ -71,6 +71,11 @@ class Plant:
             self.outputs = tuple(v for e in elements for v in e.variables if v in e.orders)
         self.variables = self.inputs + self.outputs
 
+    @property
+    def warnings(self) -> tuple:
+        """Warnings found while building the element automata (rules that never apply)."""
+        return tuple(w for e in self.elements for w in e.warnings)
+
     # ------------------------------------------------------------------ structure
     @cached_property
     def transitions(self) -> tuple[LocalTransition, ...]:

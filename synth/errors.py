@@ -66,8 +66,10 @@ class InputError(SynthError):
         expected: Sequence[str] = (),
         suggestions: Sequence[str] = (),
         notes: Sequence[str] = (),
+        severity: str = "error",
     ) -> None:
         super().__init__(message)
+        self.severity = severity
         self.message = message
         self.location = location
         self.expected = tuple(expected)
@@ -76,7 +78,7 @@ class InputError(SynthError):
 
     def render(self) -> str:
         loc = self.location
-        head = f"{loc}: error: {self.message}" if loc else f"error: {self.message}"
+        head = f"{loc}: {self.severity}: {self.message}" if loc else f"{self.severity}: {self.message}"
         lines = [head]
         if loc is not None and loc.text:
             number = str(loc.line)

@@ -63,6 +63,7 @@ class ElementAutomaton:
     var: np.ndarray
     controllable: np.ndarray
     spec: ElementSpec
+    warnings: tuple[InputError, ...] = ()
 
     @property
     def size(self) -> int:
@@ -126,15 +127,15 @@ def element_automaton(e: ElementSpec) -> ElementAutomaton:
                 return False
         return not any(evaluate(inc, val) for inc in e.incoherences)
 
-    # per consequence event: list of (order index, post value, guard, extra conditions)
+    # per consequence event: list of (rule number, order index, post value, guard, extra conditions)
     enablers: dict[tuple[int, bool], list] = {}
-    for r in e.rules:
+    for k, r in enumerate(e.rules):
         extra = []
         for p in e.precedences:
             if p.cause == r.cause and p.then == r.consequence:
                 extra.append(p.first)
         key = (index[r.consequence.name], r.consequence.rising)
-        enablers.setdefault(key, []).append((index[r.cause.name], r.cause.rising, r.guard, tuple(extra)))
+        enablers.setdefault(key, []).append((k, index[r.cause.name], r.cause.rising, r.guard, tuple(extra)))
 
     def uncontrollable_moves(code: int):
         val = value_of(code)
@@ -145,17 +146,19 @@ def element_automaton(e: ElementSpec) -> ElementAutomaton:
             bit = bool((code >> i) & 1)
             rising = not bit
             if v.kind == "free":
-                yield i
+                yield i, ()
                 continue
-            for oi, post, guard, extra in enablers.get((i, rising), ()):
+            applying = []
+            for k, oi, post, guard, extra in enablers.get((i, rising), ()):
                 if bool((code >> oi) & 1) != post:
                     continue
                 if guard is not None and not evaluate(guard, val):
                     continue
                 if any(bool((code >> index[x.name]) & 1) != x.rising for x in extra):
                     continue
-                yield i
-                break
+                applying.append(k)
+            if applying:
+                yield i, tuple(applying)
 
     init = sum(1 << index[v.name] for v in e.variables if v.initial)
     if not coherent(init):  # caught with a location by the rules checker; defensive here
@@ -164,13 +167,15 @@ def element_automaton(e: ElementSpec) -> ElementAutomaton:
     seen = {init}
     queue = deque([init])
     edges: list[tuple[int, int, int, bool]] = []
+    applied: set[int] = set()
     while queue:
         code = queue.popleft()
-        moves = [(i, True) for i in order_bits] + [(i, False) for i in uncontrollable_moves(code)]
-        for i, ctrl in moves:
+        moves = [(i, True, ()) for i in order_bits] + [(i, False, ks) for i, ks in uncontrollable_moves(code)]
+        for i, ctrl, ks in moves:
             target = code ^ (1 << i)
             if not coherent(target):
                 continue
+            applied.update(ks)
             edges.append((code, target, i, ctrl))
             if target not in seen:
                 seen.add(target)
@@ -190,4 +195,15 @@ def element_automaton(e: ElementSpec) -> ElementAutomaton:
         var=arr(lambda t: t[2], np.int64),
         controllable=arr(lambda t: t[3], bool),
         spec=e,
+        warnings=tuple(
+            InputError(
+                f"rule {r.text()} of element {e.name} never applies in any reachable state",
+                r.loc,
+                notes=("its guard, a precedence or the incoherences rule it out everywhere: the element will never "
+                       f"produce {r.consequence.text()} this way",),
+                severity="warning",
+            )
+            for k, r in enumerate(e.rules)
+            if k not in applied
+        ),
     )

@@ -126,3 +126,16 @@ def test_unknown_element_is_an_error(cli):
     code, _, err = cli("plant", ROOT / "plants" / "tri.rules", "--element", "V5")
     assert code == 2
     assert "did you mean" in err and "Traceback" not in err
+
+
+def test_rule_that_never_applies_is_a_warning(cli, tmp_path):
+    f = tmp_path / "dead.rules"
+    f.write_text(
+        "element V3 {\n  order A = 0\n  sensors v0 = 1, v1 = 0\n  incoherent v0 & v1\n"
+        "  ↑A [v0] -> ↓v0\n  ↑A [v0 & v1] -> ↑v1\n  ↓A [!v0 & !v1] -> ↑v0\n}\n"
+    )
+    code, out, err = cli("plant", f)
+    assert code == 0  # a warning, not an error
+    assert err.splitlines()[0] == f"{f}:6:4: warning: rule ↑A [v0 & v1] -> ↑v1 of element V3 never applies in any reachable state"
+    code, _, err = cli("plant", ROOT / "plants" / "tri.rules")
+    assert err == ""  # the library models have no dead rule
