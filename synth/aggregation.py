@@ -55,10 +55,10 @@ def coreachable(sync: Sync, targets: set[int]) -> set[int]:
 
 
 def shortest_paths(sync: Sync) -> tuple[dict[int, int], dict[int, tuple[int, str]]]:
-    """Breadth-first distances from the initial node and parents (deterministic: events sorted)."""
-    dist = {0: 0} if sync.nodes else {}
+    """Breadth-first distances from the initial nodes and parents (deterministic: events sorted)."""
+    dist = {i: 0 for i in sync.initial}
     parent: dict[int, tuple[int, str]] = {}
-    queue = deque([0] if sync.nodes else [])
+    queue = deque(sync.initial)
     while queue:
         i = queue.popleft()
         for e in sorted(sync.successors(i), key=lambda e: (e.event, e.target)):

@@ -12,7 +12,7 @@ from typing import Callable, Sequence
 
 from .errors import InputError, InputErrors, LimitExceeded, ModelError, SynthError
 
-__all__ = ["main", "build_parser"]
+__all__ = ["main", "entry", "build_parser"]
 
 EXIT_PASS, EXIT_FAIL, EXIT_INPUT = 0, 1, 2
 
@@ -52,12 +52,24 @@ def main(argv: Sequence[str] | None = None) -> int:
     except SynthError as err:
         print(f"error: {err}", file=sys.stderr)
         return EXIT_INPUT
+    except OSError as err:  # an output file that cannot be written
+        where = f" '{err.filename}'" if getattr(err, "filename", None) else ""
+        print(f"error: cannot write{where}: {err.strerror or err}", file=sys.stderr)
+        return EXIT_INPUT
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)
         return 130
-    except BrokenPipeError:
-        return EXIT_PASS
+
+
+def entry() -> None:
+    """The ``synth`` console script: like other Unix tools, die quietly on a closed pipe
+    (``synth validate … | head``) instead of claiming an exit code it did not reach."""
+    import signal
+
+    if hasattr(signal, "SIGPIPE"):
+        signal.signal(signal.SIGPIPE, signal.SIG_DFL)
+    sys.exit(main())
 
 
 if __name__ == "__main__":  # pragma: no cover
-    sys.exit(main())
+    entry()

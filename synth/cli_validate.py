@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 
 from .cli_plant import print_warnings
+from .errors import SynthError
 from .files import write_atomic
 from .render import dot_graph
 from .report import write_report
@@ -36,6 +37,8 @@ def register(sub: "argparse._SubParsersAction") -> None:
 
 
 def cmd_validate(args: argparse.Namespace) -> int:
+    if args.cor and Path(args.cor).suffix == ".dot":
+        raise SynthError(f"--cor {args.cor}: the JSON file must not end in .dot, the DOT file is written beside it")
     show_progress = not args.quiet and sys.stderr.isatty()
     result = validate(
         args.grafcet,

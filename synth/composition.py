@@ -22,6 +22,7 @@ Example
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
@@ -60,7 +61,8 @@ class Plant:
         self.rules = rules
         self.shape = tuple(e.size for e in elements)
         self.ndim = len(elements)
-        self.size = int(np.prod(self.shape, dtype=np.int64)) if elements else 0
+        self.size = math.prod(self.shape) if elements else 0  # a Python int: no overflow
+        self.strides = tuple(math.prod(self.shape[i + 1:]) for i in range(len(self.shape)))
         self.owner: dict[str, int] = {v: i for i, e in enumerate(elements) for v in e.variables}
         self.initial = tuple(e.initial for e in elements)
         if rules is not None:
@@ -99,13 +101,13 @@ class Plant:
 
     @property
     def initial_index(self) -> int:
-        return int(np.ravel_multi_index(self.initial, self.shape))
+        return self.index(self.initial)
 
     def index(self, local: tuple[int, ...]) -> int:
-        return int(np.ravel_multi_index(local, self.shape))
+        return sum(k * st for k, st in zip(local, self.strides))
 
     def local(self, index: int) -> tuple[int, ...]:
-        return tuple(int(x) for x in np.unravel_index(index, self.shape))
+        return tuple((index // st) % n for st, n in zip(self.strides, self.shape))
 
     # ------------------------------------------------------------------ values
     def values(self, name: str) -> np.ndarray:

@@ -11,6 +11,8 @@ not which constraints forbid them. From that a verdict in plain words:
 - ``element_model`` (expert mode): the orders are emitted and authorised, yet the
   element's rules never produce the awaited event from its current state;
 - ``unproducible_event``: no rule of any element produces the awaited event;
+- ``trap``: the Grafcet still moves on operator inputs, in a closed loop of situations;
+- ``dead_end``: no transition leaves the active steps;
 - ``waiting``: the situation only waits on other steps (see the other grafcets' verdicts).
 """
 
@@ -18,7 +20,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from itertools import combinations
-from typing import Any, Iterable
+from typing import Any, Iterable, Sequence
 
 import numpy as np
 
@@ -42,6 +44,7 @@ class Cause:
     authorised: bool = True  # SUP allows them here
     constraints: tuple[str, ...] = ()  # constraints forbidding them
     producible_now: bool = False  # under the current orders the element can produce it
+    free: bool = False  # an operator input: it may change at any time
 
     def as_dict(self) -> dict[str, Any]:
         return {
@@ -53,6 +56,7 @@ class Cause:
             "authorised": self.authorised,
             "constraints": list(self.constraints),
             "producible_now": self.producible_now,
+            "free": self.free,
         }
 
 
@@ -140,6 +144,9 @@ def _element_cause(sync: Sync, node: Node, event: str) -> Cause:
     axis = p.owner[name]
     a = p.elements[axis]
     spec = a.spec
+    decl = spec.variable(name)
+    if decl is not None and decl.kind == "free":
+        return Cause(event, a.name, producible_now=True, free=True)
     rules = tuple(r.text() for r in spec.rules if r.consequence.name == name and r.consequence.rising == rising)
     k = node.plant[axis]
     code = int(a.codes[k])
@@ -207,8 +214,9 @@ def _named(sync: Sync, ids: Iterable[str]) -> str:
     return ", ".join(f'{i} "{labels[i]}"' if labels.get(i) else i for i in ids)
 
 
-def diagnose(sync: Sync, node_index: int, *, expert: bool = False) -> Diagnosis:
-    """The diagnosis of a blocking node (see module docstring)."""
+def diagnose(sync: Sync, node_index: int, *, expert: bool = False, component: Sequence[int] = ()) -> Diagnosis:
+    """The diagnosis of a blocking node (see module docstring); ``component`` is the
+    terminal component it belongs to (the states it can still move between)."""
     node = sync.nodes[node_index]
     awaited: list[Awaited] = []
     for t in sync.machine.awaited(node.situation):
@@ -226,6 +234,9 @@ def diagnose(sync: Sync, node_index: int, *, expert: bool = False) -> Diagnosis:
             if c.element is None:
                 details.append(f"  {c.event}: no plant element drives {c.event[1:]}")
                 continue
+            if c.free:
+                details.append(f"  {c.event}: an operator input, it may change at any time")
+                continue
             rules = "; ".join(c.rules) if c.rules else "no rule"
             if c.changes:
                 state = "emitted" if c.emitted else "not emitted"
@@ -235,13 +246,23 @@ def diagnose(sync: Sync, node_index: int, *, expert: bool = False) -> Diagnosis:
                 details.append(f"  {c.event} (element {c.element}) cannot be produced from its current state; rules: {rules}")
     if waiting:
         details.append("waiting on steps: " + "; ".join(waiting))
-    verdict, summary = _verdict(sync, node, awaited, expert)
+    verdict, summary = _verdict(sync, node, awaited, expert, component)
     return Diagnosis(verdict, summary, tuple(awaited), tuple(details))
 
 
-def _verdict(sync: Sync, node: Node, awaited: list[Awaited], expert: bool) -> tuple[str, str]:
+def _verdict(
+    sync: Sync, node: Node, awaited: list[Awaited], expert: bool, component: Sequence[int]
+) -> tuple[str, str]:
     p = sync.plant
-    items = [(a, c) for a in awaited for c in a.causes]
+    if not awaited:
+        steps = ", ".join(f"X{s}" for s in node.situation.steps)
+        return (
+            "dead_end",
+            f"no transition leaves the active steps {{{steps}}}: the Grafcet stops here and never returns "
+            "to its initial situation",
+        )
+    free = [(a, c) for a in awaited for c in a.causes if c.free]
+    items = [(a, c) for a in awaited for c in a.causes if not c.free]
 
     def context(a: Awaited) -> str:
         return f"transition {a.transition} of {a.grafcet} awaits {a.receptivity}"
@@ -315,7 +336,17 @@ def _verdict(sync: Sync, node: Node, awaited: list[Awaited], expert: bool) -> tu
                 f"order {order} must be released{step_text}: {context(a)}, which needs {c.event}; "
                 f"{c.event} only follows {ch} ({by_rule(c)}) and {sup}",
             )
-    # 4. events nobody produces
+    # 4. the Grafcet still moves, on operator inputs, but in a closed set of situations
+    if free:
+        sits = sorted({sync.nodes[i].situation for i in component} or {node.situation})
+        events = sorted({c.event for _, c in free})
+        return (
+            "trap",
+            f"the Grafcet keeps evolving on operator inputs ({', '.join(events)}) between "
+            f"{', '.join(s.text() for s in sits)} but can never return to its initial situation: "
+            f"a loop with no way out ({context(free[0][0])})",
+        )
+    # 5. events nobody produces
     for a, c in items:
         if not c.changes and not c.rules:
             owner = f"element {c.element}" if c.element else "no element"

@@ -488,7 +488,11 @@ class _Checker:
         if inputs is not None:
             for n in inputs:
                 if n in step_vars:
-                    self.fail(f"input '{n}' has the name of the step variable of step {n[1:]}; rename the input or the step", None)
+                    step = self.steps[n[1:]][0]
+                    self.fail(
+                        f"input '{n}' has the name of the step variable of step {n[1:]}; rename the input or the step",
+                        step.loc,
+                    )
         # infer inputs/outputs when neither the file nor the caller gave them
         if inputs is None:
             inputs = self.infer_inputs(grafs, step_vars)

@@ -112,7 +112,7 @@ def syntax_error(err: UnexpectedInput, file: str, source: str, p: Lark) -> Input
 def read_source(path: str | Path) -> str:
     """The text of a user file; an unreadable or non-UTF-8 file is an :class:`InputError`."""
     try:
-        return Path(path).read_text(encoding="utf-8")
+        return Path(path).read_text(encoding="utf-8-sig")  # a byte-order mark is dropped
     except OSError as exc:
         raise InputError(f"cannot read '{path}': {exc.strerror or exc}", None) from None
     except UnicodeDecodeError:

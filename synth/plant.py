@@ -164,6 +164,7 @@ def element_automaton(e: ElementSpec) -> ElementAutomaton:
     if not coherent(init):  # caught with a location by the rules checker; defensive here
         raise InputError(f"the initial state of element {e.name} is incoherent", e.loc)
     order_bits = [index[v.name] for v in e.variables if v.kind == ORDER and not v.held]
+    held = {v.name: v.initial for v in e.variables if v.held}  # a rule caused by the other edge never applies, by design
     seen = {init}
     queue = deque([init])
     edges: list[tuple[int, int, int, bool]] = []
@@ -204,6 +205,6 @@ def element_automaton(e: ElementSpec) -> ElementAutomaton:
                 severity="warning",
             )
             for k, r in enumerate(e.rules)
-            if k not in applied
+            if k not in applied and not (held.get(r.cause.name) is not None and held[r.cause.name] != r.cause.rising)
         ),
     )

@@ -32,7 +32,7 @@ from typing import Iterable, Mapping
 from lark import Token, UnexpectedInput
 
 from .errors import InputError, InputErrors, Location, close_names, location_in
-from .expr import Const, Edge, Expr, Not, Var, evaluate, names
+from .expr import Const, Edge, Expr, Not, Var, disjunctive_normal_form, evaluate, names
 from .grammar import ExprTransformer, parser, read_source, syntax_error
 
 __all__ = [
@@ -368,7 +368,7 @@ class _Checker:
             resolved = target.resolve()
             if resolved in self.loaded:
                 return
-            source = target.read_text(encoding="utf-8")
+            source = target.read_text(encoding="utf-8-sig")
         except OSError as exc:
             self.fail(f"cannot read '{u.path}': {exc.strerror or exc}", u.loc)
             return
@@ -404,6 +404,9 @@ class _Checker:
                     expected=(", ".join(sorted(declared)),),
                 )
                 continue
+            if old in mapping:
+                self.fail(f"'{old}' is renamed twice in element {inst.name}", old_loc)
+                continue
             mapping[old] = new
         self.add_element(_rename(inst.name, model, mapping, inst.loc))
 
@@ -421,6 +424,15 @@ class _Checker:
         for v in self.top_free:
             elements.append(ElementSpec(v.name, (v,), loc=v.loc))
         elements.extend(self.elements)
+        named: dict[str, ElementSpec] = {}
+        for e in elements:
+            if e.name in named and e.loc is not None:
+                self.fail(
+                    f"element '{e.name}' is declared twice",
+                    e.loc,
+                    notes=(f"first declared at {named[e.name].loc} (a top-level free input is an element of its own)",),
+                )
+            named.setdefault(e.name, e)
         for e in elements:
             for v in e.variables:
                 if v.name in owner:
@@ -475,6 +487,21 @@ class _Checker:
             if c.id in ids:
                 self.fail(f"constraint id '{c.id}' is used twice", c.loc, notes=(f"first used at {ids[c.id].loc}",))
             ids[c.id] = c
+            try:
+                disjunctive_normal_form(c.forbidden)
+            except ValueError as exc:
+                if "negated" in str(exc):
+                    self.fail(
+                        f"constraint {c.id}: an edge cannot be negated (or the constraint written = 1 around an edge)",
+                        c.loc,
+                        notes=("write the forbidden case as a conjunction, e.g. `↓AVANCER1 & !v11 = 0`",),
+                    )
+                else:
+                    self.fail(
+                        f"constraint {c.id} is too large once expanded into monomials (more than 4096)",
+                        c.loc,
+                        notes=("split it into several constraints",),
+                    )
             for n in names(c.expr):
                 if n.name not in all_names:
                     what = "edge of an undeclared variable" if isinstance(n, Edge) else "undeclared variable"
@@ -540,9 +567,12 @@ class _Checker:
             if r.guard is not None:
                 levels_only(r.guard, "guard")
         for p in e.precedences:
-            for x in (p.cause, p.first, p.then):
+            for role, x in (("cause", p.cause), ("first", p.first), ("then", p.then)):
                 if x.name not in own:
                     unknown(x, "precedence")
+                elif (own[x.name].kind == ORDER) != (role == "cause"):
+                    want = "an edge of one of its orders" if role == "cause" else "an edge of one of its sensors"
+                    self.fail(f"in a precedence of {e.name}, the {role} must be {want}; '{x.name}' is not", x.loc)
         # the initial state must be coherent
         init = {v.name: v.initial for v in e.variables}
         for inc in e.incoherences:

@@ -42,6 +42,7 @@ from typing import Callable, Iterable, Iterator, Sequence
 import numpy as np
 
 from .composition import LocalTransition, Plant, _plants
+from .errors import LimitExceeded
 from .expr import disjunctive_normal_form, edge_text
 from .rules import Constraint
 
@@ -137,9 +138,9 @@ class Supervisor(CompiledConstraints):
 
     def __init__(self, p: Plant, constraints: Sequence[Constraint], states: np.ndarray | None = None) -> None:
         super().__init__(p, constraints)
-        self.strides = np.array(
-            [int(np.prod(p.shape[i + 1:], dtype=np.int64)) for i in range(p.ndim)], dtype=np.int64
-        )
+        if p.size >= 2**62:
+            raise LimitExceeded(f"the plant has {p.size} states; SUP state codes must fit in 62 bits")
+        self.strides = np.array(p.strides, dtype=np.int64)
         self.radices = np.array(p.shape, dtype=np.int64)
         self.states = states if states is not None else np.zeros(0, dtype=np.int64)
 

@@ -84,6 +84,7 @@ class Sync:
     machine: GrafcetMachine
     nodes: list[Node] = field(default_factory=list)
     edges: list[Edge] = field(default_factory=list)
+    initial: tuple[int, ...] = ()  # the initial region may settle in several plant states
     sync_states: int = 0  # SYNC states (all region members)
 
     def successors(self, i: int) -> list[Edge]:
@@ -207,7 +208,7 @@ def synchronous_product(
         sync.index()
         return sync
     sit0 = machine.initial(sync.inputs(p.initial))
-    enter(sit0, p.initial)
+    sync.initial = tuple(enter(sit0, p.initial))
     last = time.monotonic()
     while queue:
         i = queue.popleft()

@@ -172,7 +172,7 @@ def validate(
     sup_empty = not LocalSupervisor(p, rs.constraints).kept(p.initial)
     sync = synchronous_product(p, rs.constraints, machine, max_states=max_states, progress=progress)
     analysis = analyse(sync)
-    diagnoses = {b: diagnose(sync, b, expert=expert) for b in analysis.blocking}
+    diagnoses = {b: diagnose(sync, b, expert=expert, component=analysis.components[b]) for b in analysis.blocking}
     return Validation(rs, p, g, sync, analysis, diagnoses, expert, sup_empty)
 
 
@@ -193,4 +193,4 @@ def reduced_controller(v: Validation) -> dict[str, Any]:
     ]
     transitions.sort(key=lambda t: (t["source"], t["event"], t["target"]))
     removed = len(v.sync.nodes) - len(keep)
-    return {"states": states, "transitions": transitions, "initial": 0 if keep else None, "removed_states": removed}
+    return {"states": states, "transitions": transitions, "initial": sorted(number[i] for i in v.sync.initial if i in number), "removed_states": removed}

@@ -103,7 +103,29 @@ def test_missing_file(cli, tmp_path):
     (V1 + "outputs AVANCER1, v10\n", "outputs: 'v10' is an input of element V1"),
     (V1 + "inputs v10, v10\n", "'v10' is listed twice in the vectors"),
     (V1 + "inputs v01\n", "did you mean v11 or v10?"),
+    (V1 + 'constraint C1 "x": ↑AVANCER1 = 1\n', "constraint C1: an edge cannot be negated"),
+    (V1 + 'constraint C1 "x": !(↑AVANCER1 & v10) = 0\n', "constraint C1: an edge cannot be negated"),
+    (V1.replace("↑AVANCER1 [v10] -> ↓v10", "↑v10: ↓v10 < ↑v11"), "the cause must be an edge of one of its orders"),
+    ("free E = 0\nelement E {\n order A = 0\n}\n", "element 'E' is declared twice"),
+    ((ROOT / "plants" / "lib" / "single_acting.rules").read_text()
+     + "element V3 = single_acting(AVANCER=A3, AVANCER=B3)\n", "'AVANCER' is renamed twice"),
     (V1.replace("↑AVANCER1 [v10] -> ↓v10", "↑v10 -> ↓v11"), "the cause of a rule must be an edge of one of V1's orders"),
 ])
 def test_other_checks(cli, tmp_path, text, needle):
     assert needle in _run(cli, tmp_path, text)
+
+
+def test_not_keyword_and_byte_order_mark(cli, tmp_path):
+    f = tmp_path / "bom.rules"
+    f.write_bytes("\ufeff".encode() + (V1 + 'constraint C1 "x": not v10 & not v11 & AVANCER1 = 0\n').encode())
+    code, out, err = cli("sup", f)
+    assert code == 0, err
+
+
+def test_constraint_too_large(cli, tmp_path):
+    big = " | ".join(f"(A{i} & B{i})" for i in range(13))
+    decl_a = ", ".join(f"A{i} = 0" for i in range(13))
+    decl_b = ", ".join(f"B{i} = 0" for i in range(13))
+    text = f"element EA {{ orders {decl_a} }}\nelement EB {{ orders {decl_b} }}\nconstraint C1 \"pairs\": {big} = 1\n"
+    err = _run(cli, tmp_path, text)
+    assert "constraint C1 is too large once expanded" in err

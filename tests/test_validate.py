@@ -65,7 +65,7 @@ def test_missing_order(cli):
     assert cause == {
         "event": "↑v21", "element": "V2", "orders": ["↑AVANCER2"],
         "rules": ["↑AVANCER2 [!v20 & !v21] -> ↑v21", "↓AVANCER2 [!v20 & !v21] -> ↑v21"],
-        "emitted": False, "authorised": True, "constraints": [], "producible_now": False,
+        "emitted": False, "authorised": True, "constraints": [], "producible_now": False, "free": False,
     }
 
 
@@ -210,3 +210,55 @@ def test_empty_sup_fails_validation(cli, tmp_path):
     assert code == 0
     assert "SUP is empty" in out
     assert '{v10,v20,v30,v40} is illegal: it violates K "V1 never at rest"' in out
+
+
+def _small(tmp_path, rules: str, g7: str):
+    (tmp_path / "p.rules").write_text(rules)
+    (tmp_path / "g.g7").write_text(g7)
+    return tmp_path / "g.g7", tmp_path / "p.rules"
+
+
+TWO = (
+    "element EA { order A = 0  sensor a = 0  ↑A -> ↑a  ↓A -> ↓a }\n"
+    "element EB { order B = 0  sensor b = 0  ↑B -> ↑b  ↓B -> ↓b }\n"
+    'constraint C1 "not both": A & B = 0\n'
+)
+
+
+def test_initial_region_settling_in_two_states(cli, tmp_path):
+    """SUP lets the initial situation set A or B, not both: two initial aggregated states,
+    each with its own prohibition; traces start from either."""
+    g, r = _small(tmp_path, TWO, "grafcet G { initial step 0: A, B   step 1   transition 0 -> 1 when b }\n")
+    code, data = _json(cli, g, "--plant", r)
+    assert code == 1
+    assert sorted((p["order"], p["trace"]) for p in data["prohibited"]) == [("A", []), ("B", [])]
+    (b,) = data["blocking"]
+    assert b["trace"] == ["↑b", "↓b"]
+    assert b["diagnosis"]["verdict"] == "dead_end"
+
+
+def test_trap_on_operator_inputs(cli, tmp_path):
+    g, r = _small(
+        tmp_path,
+        "free dcy = 0\nelement EA { order A = 0  sensor a = 0  ↑A -> ↑a  ↓A -> ↓a }\n",
+        "grafcet G { initial step 0  step 1  step 2: A\n"
+        " transition 0 -> 1 when dcy  transition 1 -> 2 when !dcy  transition 2 -> 1 when dcy }\n",
+    )
+    code, data = _json(cli, g, "--plant", r)
+    assert code == 1
+    (b,) = data["blocking"]
+    assert b["diagnosis"]["verdict"] == "trap"
+    assert b["diagnosis"]["summary"].startswith(
+        "the Grafcet keeps evolving on operator inputs (↓dcy) between {X1}, {X2} but can never return"
+    )
+
+
+def test_unwritable_report_is_bad_input(cli):
+    code, _, err = cli("validate", G / "tri.g7", "--plant", P / "tri.rules", "--report", "/proc/synth-no/dir")
+    assert code == 2
+    assert err.startswith("error: cannot write")
+
+
+def test_cor_must_not_end_in_dot(cli, tmp_path):
+    code, _, err = cli("validate", G / "tri.g7", "--plant", P / "tri.rules", "--cor", tmp_path / "c.dot")
+    assert code == 2 and "must not end in .dot" in err
