@@ -196,7 +196,12 @@ def cmd_run(args: argparse.Namespace) -> int:
         if isinstance(event, str):
             if event not in machine.timers(sit):
                 step = next(t.step for t in grafcet.timers if t.id == event)
-                why = "it has already elapsed" if event in sit.elapsed else f"step {step} is not active"
+                if event in sit.elapsed:
+                    why = "it has already elapsed"
+                elif step not in sit.steps:
+                    why = f"step {step} is not active"
+                else:
+                    why = f"a shorter timer of step {step} must elapse first ({', '.join(machine.timers(sit))})"
                 raise InputError(f"timer {event} cannot elapse now: {why}", loc, notes=(f"situation: {sit.text()}",))
             sit, rounds = machine.fire_timer_with_trace(sit, event, inputs)
         else:

@@ -168,6 +168,7 @@ class GrafcetMachine:
         steps = {s.name for s in grafcet.steps}
         timers = {t.id for t in grafcet.timers}
         self._timer_step = {t.id: t.step for t in grafcet.timers}
+        self._seconds = {t.id: t.seconds for t in grafcet.timers}
         self._timers_of_step: dict[str, tuple[str, ...]] = {}
         for t in grafcet.timers:
             self._timers_of_step[t.step] = self._timers_of_step.get(t.step, ()) + (t.id,)
@@ -225,9 +226,17 @@ class GrafcetMachine:
         return self._situation(st), tuple(rounds)
 
     def timers(self, sit: Situation) -> tuple[str, ...]:
-        """Timer events that can occur now: step active, timer not yet elapsed (sorted)."""
+        """Timer events that can occur now (sorted): the step is active, the timer has not
+        elapsed, and no shorter timer of the same step is still running (timers of one
+        step start together, so ``2s/X1`` always elapses before ``5s/X1``)."""
         done = set(sit.elapsed)
-        return tuple(sorted(t for s in sit.steps for t in self._timers_of_step.get(s, ()) if t not in done))
+        out = []
+        for s in sit.steps:
+            running = [t for t in self._timers_of_step.get(s, ()) if t not in done]
+            if running:
+                first = min(self._seconds[t] for t in running)
+                out += [t for t in running if self._seconds[t] == first]
+        return tuple(sorted(out))
 
     def fire_timer(self, sit: Situation, timer: str, inputs: Mapping[str, bool]) -> Situation:
         """The stable situation after ``timer`` elapses (inputs unchanged)."""

@@ -501,3 +501,15 @@ def test_ass_of_the_box_sorting_grafcet():
     # deterministic
     b = stable_situation_automaton(GrafcetMachine(g), initial_inputs=init)
     assert a == b
+
+
+def test_timers_of_one_step_elapse_shortest_first():
+    g = parse_grafcet(
+        "inputs a\ngrafcet G { initial step 0  step 1  step 2\n"
+        " transition 0 -> 1 when ↑a  transition 1 -> 0 when 2s/X1  transition 1 -> 2 when 5s/X1 }\n"
+    )
+    m = GrafcetMachine(g)
+    s1 = m.react(m.initial({"a": False}), {"a": False}, {"a": True})
+    assert s1.steps == ("1",)
+    assert m.timers(s1) == ("2s/X1",)  # 5s/X1 cannot elapse before 2s/X1
+    assert m.fire_timer(s1, "2s/X1", {"a": True}).steps == ("0",)
