@@ -123,7 +123,7 @@ def report_html(v: "Validation") -> str:
         ]
     for k, i in enumerate(a.prohibited, 1):
         tr = a.traces[i]
-        items = [x for x in data["prohibited"] if x["trace"] == list(tr.events)]
+        items = v.prohibited_data(i)
         parts += [
             f'<div class="problem"><h2>Prohibited orders {k}: situation {_esc(v.sync.nodes[i].situation.text())}</h2>',
             _state_table(items[0]) if items else "",

@@ -57,6 +57,23 @@ class Validation:
             "proh": [{"order": p.order, "event": p.event, "constraints": list(p.constraints)} for p in n.proh],
         }
 
+    def prohibited_data(self, i: int) -> list[dict[str, Any]]:
+        """One entry per order change SUP refuses in aggregated state ``i``."""
+        out = []
+        for pr in self.sync.nodes[i].proh:
+            d = self.state_data(i)
+            d.update(
+                {
+                    "order": pr.order,
+                    "event": pr.event,
+                    "constraints": list(pr.constraints),
+                    "trace": list(self.analysis.traces[i].events),
+                    "diagnosis": diagnose_prohibition(self.sync, i, pr),
+                }
+            )
+            out.append(d)
+        return out
+
     def as_json(self) -> dict[str, Any]:
         a = self.analysis
         blocking = []
@@ -73,20 +90,7 @@ class Validation:
             d["component_size"] = len(a.components[b])
             d["diagnosis"] = self.diagnoses[b].as_dict()
             blocking.append(d)
-        prohibited = []
-        for i in a.prohibited:
-            for pr in self.sync.nodes[i].proh:
-                d = self.state_data(i)
-                d.update(
-                    {
-                        "order": pr.order,
-                        "event": pr.event,
-                        "constraints": list(pr.constraints),
-                        "trace": list(a.traces[i].events),
-                        "diagnosis": diagnose_prohibition(self.sync, i, pr),
-                    }
-                )
-                prohibited.append(d)
+        prohibited = [d for i in a.prohibited for d in self.prohibited_data(i)]
         return {
             "verdict": "pass" if self.passed else "fail",
             "mode": "expert" if self.expert else "designer",

@@ -262,3 +262,17 @@ def test_unwritable_report_is_bad_input(cli):
 def test_cor_must_not_end_in_dot(cli, tmp_path):
     code, _, err = cli("validate", G / "tri.g7", "--plant", P / "tri.rules", "--cor", tmp_path / "c.dot")
     assert code == 2 and "must not end in .dot" in err
+
+
+def test_report_sections_for_prohibitions_with_the_same_trace(cli, tmp_path):
+    g, r = _small(
+        tmp_path,
+        "free go = 0\n" + TWO,
+        "grafcet G { initial step 0  step 1: A, B  transition 0 -> 1 when ↑go  transition 1 -> 0 when ↓go }\n",
+    )
+    code, out, _ = cli("validate", g, "--plant", r, "--report", tmp_path / "rep")
+    assert code == 1
+    html = (tmp_path / "rep" / "index.html").read_text()
+    first, second = html.split("Prohibited orders 1")[1].split("Prohibited orders 2")
+    assert "SUP forbids ↑B there" in first and "SUP forbids ↑A there" not in first
+    assert "SUP forbids ↑A there" in second and "SUP forbids ↑B there" not in second
