@@ -157,6 +157,6 @@ def analyse(sync: Sync) -> Analysis:
                 seen.add(key)
                 if i not in prohibited:
                     prohibited.append(i)
-    for i in prohibited:
+    for i in prohibited + [c.node for c in sync.conflicts]:
         traces.setdefault(i, _trace(parent, i))
     return Analysis(tuple(blocking), traces, no_return, frozenset(back), tuple(prohibited), components)

@@ -81,6 +81,12 @@ def report_html(v: "Validation") -> str:
         + "".join(f"<td>{val}</td>" for val in data["stats"].values()) + "</tr></table>",
         f"<p>{len(a.blocking)} blocking situation(s), {len(a.prohibited)} situation(s) with prohibited orders.</p>",
     ]
+    for c in data["conflicts"]:
+        parts.append(
+            f"<p class='diag'>Transitions <code>{_esc(', '.join(c['transitions']))}</code> leaving step "
+            f"<code>{_esc(c['step'])}</code> fired together after <code>{_esc(' '.join(c['trace']))}</code>: "
+            "every branch of the divergence became active.</p>"
+        )
     if data["unreached_steps"]:
         parts.append(
             "<p>Steps never active in a reachable stable situation: <code>"

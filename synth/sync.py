@@ -40,7 +40,7 @@ from .rules import Constraint
 from .stable_situations import GrafcetMachine, Situation
 from .supervisor import LocalSupervisor
 
-__all__ = ["Prohibition", "Node", "Edge", "Sync", "synchronous_product", "region"]
+__all__ = ["Prohibition", "Node", "Edge", "Conflict", "Sync", "synchronous_product", "region"]
 
 Local = tuple[int, ...]
 
@@ -75,6 +75,17 @@ class Edge:
     target: int
 
 
+@dataclass(frozen=True)
+class Conflict:
+    """Transitions leaving the same step fired together (an OR divergence whose
+    receptivities were true at once): every branch became active."""
+
+    node: int  # the aggregated state the event left
+    event: str
+    step: str
+    transitions: tuple[str, ...]
+
+
 @dataclass
 class Sync:
     """The aggregated view of SYNC, explored from the initial state."""
@@ -85,6 +96,7 @@ class Sync:
     nodes: list[Node] = field(default_factory=list)
     edges: list[Edge] = field(default_factory=list)
     initial: tuple[int, ...] = ()  # the initial region may settle in several plant states
+    conflicts: list["Conflict"] = field(default_factory=list)
     sync_states: int = 0  # SYNC states (all region members)
 
     def successors(self, i: int) -> list[Edge]:
@@ -203,6 +215,19 @@ def synchronous_product(
             out.append(index[nk])
         return out
 
+    seen_conflicts: set[tuple[str, tuple[str, ...]]] = set()
+
+    def note_conflicts(i: int, event: str, rounds) -> None:
+        for fired in rounds:
+            by_step: dict[str, list[str]] = {}
+            for tr in fired:
+                for st in tr.sources:
+                    by_step.setdefault(st, []).append(tr.name)
+            for st, names in by_step.items():
+                if len(names) > 1 and (st, tuple(names)) not in seen_conflicts:
+                    seen_conflicts.add((st, tuple(names)))
+                    sync.conflicts.append(Conflict(i, event, st, tuple(names)))
+
     queue: deque[int] = deque()
     if not oracle.kept(p.initial):
         sync.index()
@@ -224,11 +249,13 @@ def synchronous_product(
             if not oracle.kept(n):  # cannot happen from a SUP state; kept for safety
                 continue
             after = sync.inputs(n)
-            sit = machine.react(node.situation, before, after)
+            sit, rounds = machine.react_with_trace(node.situation, before, after)
+            note_conflicts(i, t.event, rounds)
             for j in enter(sit, n):
                 sync.edges.append(Edge(i, t.event, j))
         for timer in machine.timers(node.situation):
-            sit = machine.fire_timer(node.situation, timer, before)
+            sit, rounds = machine.fire_timer_with_trace(node.situation, timer, before)
+            note_conflicts(i, timer, rounds)
             for j in enter(sit, cur):
                 sync.edges.append(Edge(i, timer, j))
         if progress is not None and time.monotonic() - last > 0.5:

@@ -107,6 +107,16 @@ class Validation:
             "blocking": blocking,
             "prohibited": prohibited,
             "unreached_steps": self.unreached_steps,
+            "conflicts": [
+                {
+                    "step": f"X{c.step}",
+                    "transitions": list(c.transitions),
+                    "event": c.event,
+                    "situation": [f"X{s}" for s in self.sync.nodes[c.node].situation.steps],
+                    "trace": list(self.analysis.traces[c.node].events) + [c.event],
+                }
+                for c in self.sync.conflicts
+            ],
         }
 
     # ------------------------------------------------------------------ text
@@ -121,6 +131,12 @@ class Validation:
         ]
         if self.sup_empty:
             lines.append("SUP is empty: the initial plant state is illegal, defended or weakly defended")
+        for c in self.sync.conflicts:
+            lines.append(
+                f"warning: transitions {', '.join(c.transitions)} leaving step {c.step} fired together on {c.event} "
+                f"in {self.sync.nodes[c.node].situation.text()}: every branch of the divergence became active "
+                "(make their receptivities exclusive if they are meant as alternatives)"
+            )
         if self.unreached_steps and not self.sup_empty:
             lines.append(
                 f"note: {len(self.unreached_steps)} step(s) never active in any reachable stable situation: "

@@ -276,3 +276,13 @@ def test_report_sections_for_prohibitions_with_the_same_trace(cli, tmp_path):
     first, second = html.split("Prohibited orders 1")[1].split("Prohibited orders 2")
     assert "SUP forbids ↑B there" in first and "SUP forbids ↑A there" not in first
     assert "SUP forbids ↑A there" in second and "SUP forbids ↑B there" not in second
+
+
+def test_or_divergence_conflict_is_reported(cli):
+    code, data = _json(cli, ROOT / "tests" / "data" / "or_conflict.g7", "--plant", P / "tri.rules")
+    assert data["conflicts"] == [
+        {"step": "X100", "transitions": ["100->101", "100->111"], "event": "↑cp12",
+         "situation": ["X1", "X100"], "trace": ["↑dcy", "↑cp12"]}
+    ]
+    code, data = _json(cli, G / "tri.g7", "--plant", P / "tri.rules")
+    assert data["conflicts"] == []
