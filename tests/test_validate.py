@@ -286,3 +286,20 @@ def test_or_divergence_conflict_is_reported(cli):
     ]
     code, data = _json(cli, G / "tri.g7", "--plant", P / "tri.rules")
     assert data["conflicts"] == []
+
+
+def test_unproducible_event(cli, tmp_path):
+    g, r = _small(
+        tmp_path,
+        "free go = 0\nelement E { order A = 0  sensor s = 0  ↑A -> ↑s }\n"
+        "element F { order B = 0  sensor t = 0 }\n",
+        "grafcet G { initial step 0  step 1: B  transition 0 -> 1 when ↑go  transition 1 -> 0 when t }\n",
+    )
+    code, data = _json(cli, g, "--plant", r)
+    assert code == 1
+    (b,) = data["blocking"]
+    assert b["trace"] == ["↑go"]
+    assert b["diagnosis"]["verdict"] == "unproducible_event"
+    assert b["diagnosis"]["summary"] == (
+        "awaited event ↑t can never occur: transition 1->0 of G awaits t and element F has no rule producing ↑t"
+    )
