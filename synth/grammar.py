@@ -12,7 +12,7 @@ from lark import Lark, Token, Transformer, Tree, UnexpectedCharacters, Unexpecte
 from .errors import InputError, Location, location_in
 from .expr import And, Const, Edge, Not, Or, Var
 
-__all__ = ["grammar_text", "parser", "syntax_error", "token_location", "read_source", "ExprTransformer"]
+__all__ = ["grammar_text", "parser", "syntax_error", "read_source", "ExprTransformer"]
 
 # How terminals are shown to a user in "expected ..." lists.
 _TERMINAL_TEXT = {
@@ -117,11 +117,6 @@ def read_source(path: str | Path) -> str:
         raise InputError(f"cannot read '{path}': {exc.strerror or exc}", None) from None
     except UnicodeDecodeError:
         raise InputError(f"'{path}' is not UTF-8 text", None) from None
-
-
-def token_location(tok: Token, file: str, source: str):
-    """Location of a lark token inside ``source``."""
-    return location_in(file, source, tok.line or 1, tok.column or 1, len(str(tok)))
 
 
 class ExprTransformer(Transformer):

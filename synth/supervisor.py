@@ -156,13 +156,6 @@ class Supervisor(CompiledConstraints):
             bad |= _holds(factors, digits)
         return ~bad
 
-    def forbidden_digits(self, event: str, digits: np.ndarray) -> np.ndarray:
-        """Edge constraints forbid controllable ``event`` at these source states."""
-        out = np.zeros(digits.shape[1], dtype=bool)
-        for t in self.edge_terms.get(event, ()):
-            out |= _holds(t.factors, digits)
-        return out
-
     # ------------------------------------------------------------------ SUP
     @property
     def size(self) -> int:
