@@ -120,6 +120,19 @@ def test_element_svg_and_export(cli, tmp_path):
     assert text.lstrip().startswith("<?xml") or "<svg" in text
     assert "↑AVANCER1" in text
     assert '"AVANCER1_up" +C+' in gen.read_text()
+    faudes = pytest.importorskip("faudes")
+    g = faudes.System(str(gen))
+    assert (g.Size(), g.TransRelSize()) == (12, 36)
+    assert faudes.System(str(gen)).ControllableEvents().Size() == 4
+
+
+def test_plant_export_reads_in_faudes(cli, tmp_path):
+    faudes = pytest.importorskip("faudes")
+    gen = tmp_path / "annex.gen"
+    code, _, _ = cli("plant", ROOT / "plants" / "tri_annex.rules", "--export", gen)
+    assert code == 0
+    g = faudes.System(str(gen))
+    assert (g.Size(), g.TransRelSize()) == (15552, 155520)
 
 
 def test_unknown_element_is_an_error(cli):
