@@ -168,7 +168,7 @@ def orders_text(orders: Sequence[str], conditional: Sequence[str] = ()) -> str:
 
 
 def _dot_string(text: str) -> str:
-    return '"' + text.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n") + '"'
+    return f'"{dot_escape(text)}"'
 
 
 def ass_dot(ass: "ASS", title: str = "ASS") -> str:

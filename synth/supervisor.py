@@ -128,6 +128,41 @@ class CompiledConstraints:
                 self.edge_terms.setdefault(t.event, []).append(t)
 
 
+    # ------------------------------------------------------------------ one state at a time
+    @staticmethod
+    def _ids(pairs: Iterable[tuple[_Term, Sequence[tuple[int, np.ndarray]]]], local: tuple[int, ...]) -> list[str]:
+        """Constraint ids (first-seen order, no repeats) of the terms whose factors hold at ``local``."""
+        ids: list[str] = []
+        for term, factors in pairs:
+            if term.constraint not in ids and all(vec[local[a]] for a, vec in factors):
+                ids.append(term.constraint)
+        return ids
+
+    def kept(self, local: tuple[int, ...]) -> bool:
+        """No constraint violation is reachable from ``local`` by uncontrollable events."""
+        return not any(all(vec[local[a]] for a, vec in factors) for factors in self.level_reach)
+
+    def violated(self, local: tuple[int, ...]) -> list[str]:
+        """Ids of the constraints the state violates (levels)."""
+        return self._ids(((t, t.factors) for t in self.level_terms), local)
+
+    def threatened(self, local: tuple[int, ...]) -> list[str]:
+        """Ids of the constraints whose violation is reachable by uncontrollable events."""
+        return self._ids(zip(self.level_terms, self.level_reach), local)
+
+    def forbidding(self, event: str, local: tuple[int, ...]) -> list[str]:
+        """Ids of the edge constraints that forbid controllable ``event`` in this state."""
+        return self._ids(((t, t.factors) for t in self.edge_terms.get(event, ())), local)
+
+    def move(self, t: LocalTransition, local: tuple[int, ...]) -> tuple[bool, list[str]]:
+        """Whether SUP allows transition ``t`` from ``local`` (a source in SUP), and if
+        not, the ids of the constraints responsible."""
+        target = list(local)
+        target[t.axis] = t.dst
+        why = self.forbidding(t.event, local) if t.controllable else []
+        why += [c for c in self.threatened(tuple(target)) if c not in why]
+        return (not why, why)
+
 class Supervisor(CompiledConstraints):
     """SUP: its states as a sorted array of plant state codes, explored from the initial
     state; SUP membership of any state is the closed form of the module docstring.
@@ -361,48 +396,10 @@ def supremal_controllable(
 
 
 class LocalSupervisor(CompiledConstraints):
-    """SUP membership decided state by state, without building the plant grid.
-
-    ``kept(local)`` is true iff no constraint violation is reachable from the state by
-    uncontrollable events; cost O(monomials × elements) per query.
+    """SUP membership decided state by state, without building the plant grid:
+    ``kept``, ``violated``, ``threatened``, ``forbidding`` and ``move`` cost
+    O(monomials × elements) per query.
     """
-
-    def kept(self, local: tuple[int, ...]) -> bool:
-        return not any(all(vec[local[a]] for a, vec in factors) for factors in self.level_reach)
-
-    def violated(self, local: tuple[int, ...]) -> list[str]:
-        """Ids of the constraints the state violates (levels)."""
-        ids = []
-        for t in self.level_terms:
-            if all(vec[local[a]] for a, vec in t.factors) and t.constraint not in ids:
-                ids.append(t.constraint)
-        return ids
-
-    def threatened(self, local: tuple[int, ...]) -> list[str]:
-        """Ids of the constraints whose violation is reachable by uncontrollable events."""
-        ids = []
-        for t, factors in zip(self.level_terms, self.level_reach):
-            if all(vec[local[a]] for a, vec in factors) and t.constraint not in ids:
-                ids.append(t.constraint)
-        return ids
-
-    def forbidding(self, event: str, local: tuple[int, ...]) -> list[str]:
-        """Ids of the edge constraints that forbid controllable ``event`` in this state."""
-        ids = []
-        for t in self.terms:
-            if t.event == event and all(vec[local[a]] for a, vec in t.factors) and t.constraint not in ids:
-                ids.append(t.constraint)
-        return ids
-
-    def move(self, t: LocalTransition, local: tuple[int, ...]) -> tuple[bool, list[str]]:
-        """Whether SUP allows transition ``t`` from ``local`` (a source in SUP), and if
-        not, the ids of the constraints responsible."""
-        target = list(local)
-        target[t.axis] = t.dst
-        target_t = tuple(target)
-        why = self.forbidding(t.event, local) if t.controllable else []
-        why += [c for c in self.threatened(target_t) if c not in why]
-        return (not why, why)
 
 
 @dataclass(frozen=True)
@@ -452,18 +449,17 @@ class Explanation:
 def explain(sup: Supervisor, local: tuple[int, ...]) -> Explanation:
     """Why ``local`` is in SUP or not, with the shortest uncontrollable path to a violation."""
     p = sup.plant
-    oracle = LocalSupervisor(p, sup.constraints)
     label = p.label(local)
-    violated = oracle.violated(local)
+    violated = sup.violated(local)
     if violated:
         return Explanation(label, "illegal", tuple(violated))
-    if not oracle.kept(local):
+    if not sup.kept(local):
         # breadth-first search over uncontrollable moves to the nearest violation
         parent: dict[tuple[int, ...], tuple[tuple[int, ...], str] | None] = {local: None}
         queue = deque([local])
         while queue:
             cur = queue.popleft()
-            if oracle.violated(cur):
+            if sup.violated(cur):
                 path = []
                 node = cur
                 while parent[node] is not None:
@@ -472,7 +468,7 @@ def explain(sup: Supervisor, local: tuple[int, ...]) -> Explanation:
                     node = prev
                 path.reverse()
                 status = "defended" if len(path) == 1 else "weakly_defended"
-                return Explanation(label, status, tuple(oracle.violated(cur)), tuple(path))
+                return Explanation(label, status, tuple(sup.violated(cur)), tuple(path))
             for t, nxt in p.successors(cur):
                 if not t.controllable and nxt not in parent:
                     parent[nxt] = (cur, t.event)
@@ -481,7 +477,7 @@ def explain(sup: Supervisor, local: tuple[int, ...]) -> Explanation:
     forbidden = []
     for t, nxt in p.successors(local):
         if t.controllable:
-            ok, why = oracle.move(t, local)
+            ok, why = sup.move(t, local)
             if not ok:
                 forbidden.append((t.event, tuple(why)))
     inside = bool(sup.contains(np.array([p.index(local)], dtype=np.int64))[0])

@@ -57,6 +57,15 @@ class Validation:
             "proh": [{"order": p.order, "event": p.event, "constraints": list(p.constraints)} for p in n.proh],
         }
 
+    @property
+    def stats(self) -> dict[str, int]:
+        return {
+            "plant_states": self.plant.size,
+            "sync_states": self.sync.sync_states,
+            "aggregated_states": len(self.sync.nodes),
+            "aggregated_transitions": len(self.sync.edges),
+        }
+
     def prohibited_data(self, i: int) -> list[dict[str, Any]]:
         """One entry per order change SUP refuses in aggregated state ``i``."""
         out = []
@@ -97,12 +106,7 @@ class Validation:
             "grafcet": self.grafcet.path,
             "plant": self.rules.path,
             "sup_empty": self.sup_empty,
-            "stats": {
-                "plant_states": self.plant.size,
-                "sync_states": self.sync.sync_states,
-                "aggregated_states": len(self.sync.nodes),
-                "aggregated_transitions": len(self.sync.edges),
-            },
+            "stats": self.stats,
             "constraints": {c.id: c.label for c in self.rules.constraints},
             "blocking": blocking,
             "prohibited": prohibited,
@@ -122,7 +126,7 @@ class Validation:
     # ------------------------------------------------------------------ text
     def text(self) -> str:
         a = self.analysis
-        st = self.as_json()["stats"]
+        st = self.stats
         head = "PASS" if self.passed else "FAIL"
         lines = [
             f"{head}: {len(a.blocking)} blocking situation(s), {len(a.prohibited)} situation(s) with prohibited orders"
