@@ -268,7 +268,10 @@ def _verdict(
         return f"transition {a.transition} of {a.grafcet} awaits {a.receptivity}"
 
     def by_rule(c: Cause) -> str:
-        rules = [r for r in c.rules if any(ch[1:] in r.split("->")[0] for ch in c.changes)] or list(c.rules)
+        """The element, and its first rule producing the event whose cause is a needed change."""
+        spec = p.elements[p.owner[c.event[1:]]].spec
+        causing = [r.text() for r in spec.rules if r.cause.text() in c.changes and r.consequence.text() == c.event]
+        rules = causing or list(c.rules)
         return f"element {c.element}" + (f", rule {rules[0]}" if rules else "")
 
     # 1. an order the awaited event needs is emitted but prohibited by SUP
