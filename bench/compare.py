@@ -51,10 +51,10 @@ def _maxrss_mib() -> float:
 
 def _worker_synth(rules: Path, out: dict) -> None:
     t0 = time.perf_counter()
-    from synth.composition import plant
-    from synth.grammar import parser
-    from synth.rules import load_rules
-    from synth.supervisor import supremal_controllable
+    from synth.plant.composition import plant
+    from synth.syntax import parser
+    from synth.plant.rules import load_rules
+    from synth.sup.supervisor import supremal_controllable
 
     parser("rules")  # one-time start-up: lark builds the LALR tables (about 0.1 s)
     import numpy
@@ -89,7 +89,7 @@ def _worker_faudes(rules: Path, workdir: Path, out: dict) -> None:
     import faudes  # prints two harmless WARNING lines (no matplotlib/pillow)
 
     from faudes_route import run_faudes, write_inputs
-    from synth.rules import load_rules
+    from synth.plant.rules import load_rules
 
     out["import_s"] = time.perf_counter() - t0
     out["base_mib"] = _maxrss_mib()
@@ -113,10 +113,10 @@ def _worker_check(rules: Path, workdir: Path, out: dict) -> None:
     import faudes
 
     from faudes_route import run_faudes, write_inputs
-    from synth.composition import plant
-    from synth.faudes_io import supervisor_generator
-    from synth.rules import load_rules
-    from synth.supervisor import supremal_controllable
+    from synth.plant.composition import plant
+    from synth.output.faudes import supervisor_generator
+    from synth.plant.rules import load_rules
+    from synth.sup.supervisor import supremal_controllable
 
     rs = load_rules(rules)
     sup = supremal_controllable(plant(rs), rs.constraints)

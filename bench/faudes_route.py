@@ -39,10 +39,10 @@ ROOT = Path(__file__).resolve().parent.parent
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from synth.expr import Edge, evaluate, names  # noqa: E402
-from synth.faudes_io import element_generator, generator_text  # noqa: E402
-from synth.plant import element_automaton  # noqa: E402
-from synth.rules import ORDER, Constraint, RuleSet  # noqa: E402
+from synth.logic.expr import Edge, evaluate, names  # noqa: E402
+from synth.output.faudes import element_generator, generator_text  # noqa: E402
+from synth.plant.element import element_automaton  # noqa: E402
+from synth.plant.rules import ORDER, Constraint, RuleSet  # noqa: E402
 
 __all__ = ["FaudesInputs", "constraint_observer", "write_inputs", "run_faudes"]
 

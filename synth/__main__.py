@@ -1,3 +1,3 @@
-from .cli import entry
+from synth.cli.main import entry
 
 entry()

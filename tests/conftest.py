@@ -11,7 +11,7 @@ ROOT = Path(__file__).resolve().parent.parent
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from synth.cli import main  # noqa: E402
+from synth.cli.main import main  # noqa: E402
 
 
 @pytest.fixture

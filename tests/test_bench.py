@@ -12,10 +12,10 @@ import sys
 
 import pytest
 
-from synth.composition import plant
-from synth.faudes_io import supervisor_generator
-from synth.rules import load_rules
-from synth.supervisor import supremal_controllable
+from synth.plant.composition import plant
+from synth.output.faudes import supervisor_generator
+from synth.plant.rules import load_rules
+from synth.sup.supervisor import supremal_controllable
 
 from conftest import ROOT
 

@@ -10,9 +10,11 @@ from pathlib import Path
 
 import pytest
 
-from synth.cli import main
-from synth.render import ass_dot
-from synth.stable_situations import GrafcetMachine, load_grafcet, stable_situation_automaton
+from synth.cli.main import main
+from synth.output.dot import ass_dot
+from synth.grafcet.ass import stable_situation_automaton
+from synth.grafcet.language import load_grafcet
+from synth.grafcet.machine import GrafcetMachine
 
 ROOT = Path(__file__).resolve().parent.parent
 

@@ -7,8 +7,8 @@ from pathlib import Path
 import pytest
 
 from synth.errors import InputError, InputErrors
-from synth.expr import Edge, Var, names
-from synth.grafcet import (
+from synth.logic.expr import Edge, Var, names
+from synth.grafcet.language import (
     CONDITIONAL,
     CONTINUOUS,
     ON_ACTIVATION,
@@ -123,7 +123,7 @@ def test_source_and_sink_transitions():
 
 
 def test_tri_grafcet_loads_with_the_plant():
-    from synth.rules import load_rules
+    from synth.plant.rules import load_rules
 
     rs = load_rules(ROOT / "plants/tri.rules")
     g = load_grafcet(ROOT / "grafcets/tri.g7", inputs=rs.inputs, outputs=rs.outputs)

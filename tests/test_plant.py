@@ -7,9 +7,9 @@ import json
 import numpy as np
 import pytest
 
-from synth.composition import plant
-from synth.plant import element_automaton
-from synth.rules import load_rules, parse_rules
+from synth.plant.composition import plant
+from synth.plant.element import element_automaton
+from synth.plant.rules import load_rules, parse_rules
 
 from conftest import ROOT
 

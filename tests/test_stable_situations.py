@@ -7,14 +7,11 @@ from pathlib import Path
 import pytest
 
 from synth.errors import InputError
-from synth.grafcet import parse_grafcet
-from synth.stable_situations import (
-    GrafcetMachine,
-    Situation,
-    load_grafcet,
-    parse_event,
-    stable_situation_automaton,
-)
+from synth.grafcet.language import parse_grafcet
+from synth.grafcet.ass import stable_situation_automaton
+from synth.grafcet.language import load_grafcet
+from synth.grafcet.machine import GrafcetMachine, Situation
+from synth.logic.events import parse_event
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -459,7 +456,7 @@ def test_ass_never_stable_is_reported():
 
 
 def test_ass_of_the_box_sorting_grafcet():
-    from synth.rules import load_rules
+    from synth.plant.rules import load_rules
 
     rs = load_rules(ROOT / "plants/tri.rules")
     g = load_grafcet(ROOT / "grafcets/tri.g7", inputs=rs.inputs, outputs=rs.outputs)

@@ -7,10 +7,12 @@ import json
 import numpy as np
 import pytest
 
-from synth.composition import plant
-from synth.faudes_io import _grid_generator, plant_generator, supervisor_generator
-from synth.rules import load_rules, parse_rules
-from synth.supervisor import LocalSupervisor, explain, supremal_controllable
+from synth.plant.composition import plant
+from synth.output.faudes import _grid_generator, plant_generator, supervisor_generator
+from synth.plant.rules import load_rules, parse_rules
+from synth.sup.constraints import CompiledConstraints
+from synth.sup.explain import explain
+from synth.sup.supervisor import supremal_controllable
 
 from conftest import ROOT
 from randrules import random_rules
@@ -115,7 +117,7 @@ def test_local_supervisor_agrees_with_grid():
     rs = load_rules(ROOT / "plants" / "tri.rules")
     p = plant(rs)
     sup = supremal_controllable(p, rs.constraints)
-    oracle = LocalSupervisor(p, rs.constraints)
+    oracle = CompiledConstraints(p, rs.constraints)
     rng = np.random.default_rng(7)
     for code in rng.integers(0, p.size, 3000).tolist():
         local = p.local(code)
@@ -158,7 +160,7 @@ def test_sup_export_reads_in_faudes(cli, tmp_path):
 def _plain_tajer(p, constraints):
     """Tajer's algorithm written the plain way, state by state: the reference the
     vectorised closed form must match."""
-    from synth.expr import evaluate
+    from synth.logic.expr import evaluate
 
     states = [p.local(c) for c in range(p.size)]
 

@@ -7,12 +7,12 @@ import shutil
 
 import pytest
 
-from synth.composition import plant
-from synth.grafcet import load_grafcet
-from synth.rules import load_rules
-from synth.stable_situations import GrafcetMachine
-from synth.supervisor import supremal_controllable
-from synth.sync import synchronous_product
+from synth.plant.composition import plant
+from synth.grafcet.language import load_grafcet
+from synth.plant.rules import load_rules
+from synth.grafcet.machine import GrafcetMachine
+from synth.sup.supervisor import supremal_controllable
+from synth.validation.sync import synchronous_product
 
 from conftest import ROOT
 
@@ -182,10 +182,10 @@ def test_on_the_fly_sync_equals_grid_sync(g, r, monkeypatch):
     machine = GrafcetMachine(load_grafcet(G / g, inputs=p.inputs, outputs=p.outputs))
     lazy = synchronous_product(p, rs.constraints, machine)
     sup = supremal_controllable(p, rs.constraints)
-    import synth.sync as sync_mod
+    import synth.validation.sync as sync_mod
 
-    real = sync_mod.LocalSupervisor
-    monkeypatch.setattr(sync_mod, "LocalSupervisor", lambda p_, c_: _GridOracle(sup, real(p_, c_)))
+    real = sync_mod.CompiledConstraints
+    monkeypatch.setattr(sync_mod, "CompiledConstraints", lambda p_, c_: _GridOracle(sup, real(p_, c_)))
     plain = synchronous_product(p, rs.constraints, machine)
     assert [(n.situation, n.plant, n.proh) for n in plain.nodes] == [(n.situation, n.plant, n.proh) for n in lazy.nodes]
     assert plain.edges == lazy.edges

@@ -24,10 +24,10 @@ from typing import Any, Iterable, Sequence
 
 import numpy as np
 
-from .composition import Plant
-from .expr import Var, edge_text, evaluate, names
-from .grafcet import Transition
-from .sync import Node, Prohibition, Sync
+from synth.plant.composition import Plant
+from synth.logic.expr import Var, edge_text, evaluate, names
+from synth.grafcet.language import Transition
+from synth.validation.sync import Node, Prohibition, Sync
 
 __all__ = ["Cause", "Awaited", "Diagnosis", "diagnose", "diagnose_prohibition"]
 

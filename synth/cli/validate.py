@@ -7,13 +7,13 @@ import json
 import sys
 from pathlib import Path
 
-from .cli_plant import print_warnings
-from .errors import SynthError
-from .files import write_atomic
-from .render import dot_graph
-from .report import write_report
-from .sync import stderr_progress
-from .validation import reduced_controller, validate
+from synth.cli.plant import print_warnings
+from synth.errors import SynthError
+from synth.output.files import write_atomic
+from synth.output.dot import dot_graph
+from synth.output.html import write_report
+from synth.validation.sync import stderr_progress
+from synth.validation.validate import reduced_controller, validate
 
 __all__ = ["register", "cmd_validate"]
 

@@ -18,7 +18,7 @@ from __future__ import annotations
 from collections import deque
 from dataclasses import dataclass
 
-from .sync import Sync
+from synth.validation.sync import Sync
 
 __all__ = ["Trace", "Analysis", "analyse", "coreachable", "shortest_paths", "strongly_connected_components"]
 

@@ -1,7 +1,7 @@
 """``synth validate``: plant + constraints + Grafcet → verdict, problems, traces, diagnoses.
 
 The result is plain data (:meth:`Validation.as_json`, schema in ``docs/validate-json.md``)
-and terminal text; the HTML report is written by :mod:`synth.report`.
+and terminal text; the HTML report is written by :mod:`synth.output.html`.
 """
 
 from __future__ import annotations
@@ -10,14 +10,14 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable
 
-from .aggregation import Analysis, analyse
-from .composition import Plant, plant
-from .diagnosis import Diagnosis, diagnose, diagnose_prohibition
-from .grafcet import Grafcet, load_grafcet
-from .rules import RuleSet, load_rules
-from .stable_situations import GrafcetMachine
-from .supervisor import LocalSupervisor
-from .sync import Node, Sync, synchronous_product
+from synth.validation.analysis import Analysis, analyse
+from synth.plant.composition import Plant, plant
+from synth.validation.diagnosis import Diagnosis, diagnose, diagnose_prohibition
+from synth.grafcet.language import Grafcet, load_grafcet
+from synth.plant.rules import RuleSet, load_rules
+from synth.grafcet.machine import GrafcetMachine
+from synth.sup.constraints import CompiledConstraints
+from synth.validation.sync import Node, Sync, synchronous_product
 
 __all__ = ["Validation", "validate", "reduced_controller"]
 
@@ -193,7 +193,7 @@ def validate(
     p = plant(rs)
     g = load_grafcet(grafcet_path, inputs=p.inputs, outputs=p.outputs)
     machine = GrafcetMachine(g)
-    sup_empty = not LocalSupervisor(p, rs.constraints).kept(p.initial)
+    sup_empty = not CompiledConstraints(p, rs.constraints).kept(p.initial)
     sync = synchronous_product(p, rs.constraints, machine, max_states=max_states, progress=progress)
     analysis = analyse(sync)
     diagnoses = {b: diagnose(sync, b, expert=expert, component=analysis.components[b]) for b in analysis.blocking}

@@ -6,8 +6,8 @@ All states are marked: SUP is a closed-behaviour notion and language comparisons
 
 Example
 -------
->>> from synth.rules import load_rules
->>> from synth.composition import plant, _plants
+>>> from synth.plant.rules import load_rules
+>>> from synth.plant.composition import plant, _plants
 >>> text = plant_generator(plant(load_rules(_plants("tri_annex.rules"))), "tri")
 >>> text.splitlines()[0], "+C+" in text
 ('<Generator>', True)
@@ -19,11 +19,11 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .composition import Plant
-from .plant import ElementAutomaton
+from synth.plant.composition import Plant
+from synth.plant.element import ElementAutomaton
 
 if TYPE_CHECKING:
-    from .supervisor import Supervisor
+    from synth.sup.supervisor import Supervisor
 
 __all__ = ["faudes_event", "generator_text", "plant_generator", "supervisor_generator", "element_generator"]
 

@@ -9,8 +9,8 @@ from pathlib import Path
 
 from lark import Lark, Token, Transformer, Tree, UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
 
-from .errors import InputError, Location, location_in
-from .expr import And, Const, Edge, Not, Or, Var
+from synth.errors import InputError, Location, location_in
+from synth.logic.expr import And, Const, Edge, Not, Or, Var
 
 __all__ = ["grammar_text", "parser", "syntax_error", "read_source", "ExprTransformer"]
 
@@ -121,7 +121,7 @@ def read_source(path: str | Path) -> str:
 
 class ExprTransformer(Transformer):
     """The expression rules shared by both grammars (``var``, ``const``, ``rise``,
-    ``fall``, ``neg``, ``and_expr``, ``or_expr``) → :mod:`synth.expr` objects that keep
+    ``fall``, ``neg``, ``and_expr``, ``or_expr``) → :mod:`synth.logic.expr` objects that keep
     their :class:`~synth.errors.Location`."""
 
     def __init__(self, file: str, source: str) -> None:

@@ -15,7 +15,7 @@ Only the states reachable from the initial state are kept.
 
 Example
 -------
->>> from synth.rules import parse_rules
+>>> from synth.plant.rules import parse_rules
 >>> rs = parse_rules(open(_library("double_acting.rules")).read() +
 ...     "element V1 = double_acting(AVANCER=AVANCER1, RECULER=RECULER1, v0=v10, v1=v11)")
 >>> a = element_automaton(rs.elements[0])
@@ -31,9 +31,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import InputError
-from .expr import edge_text, evaluate
-from .rules import ORDER, ElementSpec
+from synth.errors import InputError
+from synth.logic.expr import edge_text, evaluate
+from synth.plant.rules import ORDER, ElementSpec
 
 __all__ = ["ElementAutomaton", "element_automaton"]
 
@@ -41,7 +41,7 @@ MAX_ELEMENT_VARIABLES = 20
 
 
 def _library(name: str) -> str:
-    return str(Path(__file__).resolve().parent.parent / "plants" / "lib" / name)
+    return str(Path(__file__).resolve().parents[2] / "plants" / "lib" / name)
 
 
 @dataclass(frozen=True, eq=False)

@@ -14,7 +14,7 @@ reachable plant state: ``|Q| = Π|Q_i|`` and ``|δ| = Σ_i |δ_i| Π_{j≠i} |Q_
 
 Example
 -------
->>> from synth.rules import load_rules
+>>> from synth.plant.rules import load_rules
 >>> p = plant(load_rules(_plants("tri_annex.rules")))
 >>> p.size, p.count_transitions(controllable=False) > 0
 (15552, True)
@@ -30,16 +30,16 @@ from typing import Callable, Iterator, Mapping
 
 import numpy as np
 
-from .errors import SynthError, close_names
-from .expr import Expr, evaluate
-from .plant import ElementAutomaton, element_automaton
-from .rules import RuleSet
+from synth.errors import SynthError, close_names
+from synth.logic.expr import Expr, evaluate
+from synth.plant.element import ElementAutomaton, element_automaton
+from synth.plant.rules import RuleSet
 
 __all__ = ["Plant", "plant", "asynchronous_composition", "LocalTransition"]
 
 
 def _plants(name: str) -> str:
-    return str(Path(__file__).resolve().parent.parent / "plants" / name)
+    return str(Path(__file__).resolve().parents[2] / "plants" / name)
 
 
 @dataclass(frozen=True)
@@ -147,7 +147,7 @@ class Plant:
         are free) agrees with some plant state: each element's inputs must match one of its
         local states. Used to keep a Grafcet's exploration to vectors the plant can produce.
 
-        >>> from synth.rules import load_rules
+        >>> from synth.plant.rules import load_rules
         >>> ok = plant(load_rules(_plants("tri.rules"))).admissible_inputs()
         >>> ok({"cp11": True, "cp12": False}), ok({"cp11": True, "cp12": True})
         (True, False)

@@ -6,11 +6,11 @@ import shutil
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from .errors import SynthError
-from .files import write_atomic
+from synth.errors import SynthError
+from synth.output.files import write_atomic
 
 if TYPE_CHECKING:
-    from .validation import Validation
+    from synth.validation.validate import Validation
 
 __all__ = ["svg", "write_svg", "dot_available", "report_html", "write_report"]
 
@@ -64,7 +64,7 @@ code, .mono { font-family: Menlo, Consolas, monospace; } .figure { overflow-x: a
 
 def report_html(v: "Validation") -> str:
     """The self-contained HTML report of a validation (inline SVG made by Graphviz)."""
-    from .render import aggregated_dot, element_dot, sup_neighbourhood_dot, trace_dot
+    from synth.output.dot import aggregated_dot, element_dot, sup_neighbourhood_dot, trace_dot
 
     data = v.as_json()
     a = v.analysis

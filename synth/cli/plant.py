@@ -8,15 +8,16 @@ import sys
 import time
 from typing import Any
 
-from .composition import Plant, plant
-from .errors import LimitExceeded, SynthError, close_names
-from .faudes_io import element_generator, plant_generator, supervisor_generator
-from .files import write_atomic
-from .plant import ElementAutomaton
-from .render import element_dot
-from .report import write_svg
-from .rules import RuleSet, load_rules
-from .supervisor import explain, supremal_controllable
+from synth.plant.composition import Plant, plant
+from synth.errors import LimitExceeded, SynthError, close_names
+from synth.output.faudes import element_generator, plant_generator, supervisor_generator
+from synth.output.files import write_atomic
+from synth.plant.element import ElementAutomaton
+from synth.output.dot import element_dot
+from synth.output.html import write_svg
+from synth.plant.rules import RuleSet, load_rules
+from synth.sup.explain import explain
+from synth.sup.supervisor import supremal_controllable
 
 __all__ = ["register", "plant_summary", "element_summary", "print_warnings"]
 
@@ -159,7 +160,7 @@ def cmd_plant(args: argparse.Namespace) -> int:
 
 
 def _plant_dot(p: Plant) -> str:
-    from .render import CONTROLLABLE_STYLE, UNCONTROLLABLE_STYLE, dot_graph
+    from synth.output.dot import CONTROLLABLE_STYLE, UNCONTROLLABLE_STYLE, dot_graph
 
     nodes = []
     for code in range(p.size):

@@ -16,7 +16,7 @@ closures. Writing each constraint as a disjunction of monomials, ``s`` is remove
 for some monomial ``m`` every element ``i`` can reach, by its own uncontrollable
 moves, a local state satisfying ``m``'s literals on its variables: a product of N
 small boolean vectors per monomial, evaluated for whole arrays of states at once
-(:class:`Supervisor`), for one state (:class:`LocalSupervisor`, on-the-fly validation),
+(:class:`Supervisor`), for one state (:class:`~synth.sup.constraints.CompiledConstraints`, on-the-fly validation),
 or over the whole plant grid when it fits in memory (the plant-wide statistics).
 
 SUP's states are then explored breadth-first from the initial state over state codes
@@ -24,144 +24,28 @@ held in numpy arrays: the work is linear in SUP's transitions, not in the plant.
 
 Example
 -------
->>> from synth.rules import load_rules
->>> from synth.composition import plant
+>>> from synth.plant.rules import load_rules
+>>> from synth.plant.composition import plant
 >>> rs = load_rules(_plants("tri_annex.rules"))
 >>> sup = supremal_controllable(plant(rs), rs.constraints)
 >>> sup.size > 0, sup.size < sup.plant.size
 (True, True)
 """
-
 from __future__ import annotations
 
 from collections import deque
-from dataclasses import dataclass
 from functools import cached_property
 from typing import Callable, Iterable, Iterator, Sequence
 
 import numpy as np
 
-from .composition import LocalTransition, Plant, _plants
-from .errors import LimitExceeded
-from .expr import disjunctive_normal_form, edge_text
-from .rules import Constraint
+from synth.errors import LimitExceeded
+from synth.plant.composition import LocalTransition, Plant, _plants
+from synth.plant.rules import Constraint
+from synth.sup.constraints import GRID_LIMIT, CompiledConstraints, _closed, _holds, _product
 
-__all__ = [
-    "Supervisor",
-    "LocalSupervisor",
-    "Explanation",
-    "supremal_controllable",
-    "explain",
-]
+__all__ = ["Supervisor", "supremal_controllable"]
 
-
-@dataclass(frozen=True)
-class _Term:
-    """One monomial of a constraint, split per element: ``factors[axis]`` is the set of
-    local states satisfying its level literals on that element."""
-
-    constraint: str
-    factors: tuple[tuple[int, np.ndarray], ...]
-    event: str | None  # the edge literal's event, if any
-
-
-def _terms(p: Plant, constraints: Sequence[Constraint]) -> list[_Term]:
-    out: list[_Term] = []
-    for c in constraints:
-        for m in disjunctive_normal_form(c.forbidden):
-            edges = [l for l in m if l.edge]
-            per_axis: dict[int, np.ndarray] = {}
-            for l in sorted(m):
-                if l.edge:
-                    continue
-                axis = p.owner[l.name]
-                v = p.elements[axis].value(l.name)
-                sat = v if l.positive else ~v
-                per_axis[axis] = per_axis.get(axis, np.ones_like(sat)) & sat
-            event = edge_text(edges[0].positive, edges[0].name) if edges else None
-            out.append(_Term(c.id, tuple(sorted(per_axis.items(), key=lambda kv: kv[0])), event))
-    return out
-
-
-def _product(p: Plant, factors: Iterable[tuple[int, np.ndarray]]) -> np.ndarray:
-    grid = np.ones(p.shape, dtype=bool)
-    for axis, vec in factors:
-        shape = [1] * p.ndim
-        shape[axis] = vec.size
-        grid &= vec.reshape(shape)
-    return grid
-
-
-def _closed(closures: Sequence[np.ndarray], factors: Iterable[tuple[int, np.ndarray]]) -> tuple[tuple[int, np.ndarray], ...]:
-    """Per-element factors of "can reach, by own uncontrollable moves, a satisfying state"."""
-    return tuple((a, (closures[a] @ v.astype(np.uint8)) > 0) for a, v in factors)
-
-
-def _holds(factors: Sequence[tuple[int, np.ndarray]], digits: np.ndarray) -> np.ndarray:
-    """Whether a product term holds at each of the states whose digits (ndim × n) are given."""
-    out = np.ones(digits.shape[1], dtype=bool)
-    for a, vec in factors:
-        out &= vec[digits[a]]
-    return out
-
-
-GRID_LIMIT = 200_000_000
-"""Plant-wide statistics (illegal, defended, ... counts over every plant state) need
-grids of the plant's size; above this many states they are not computed."""
-
-
-class CompiledConstraints:
-    """Constraints compiled against a plant: each monomial as per-element factors
-    (``level_terms`` / ``edge_terms``), and for level terms the factors of "can reach a
-    violating local state by the element's own uncontrollable moves" (``level_reach``)."""
-
-    def __init__(self, p: Plant, constraints: Sequence[Constraint]) -> None:
-        self.plant = p
-        self.constraints = tuple(constraints)
-        self.terms = _terms(p, constraints)
-        closures = [e.uncontrollable_closure().astype(np.uint8) for e in p.elements]
-        self.level_terms = [t for t in self.terms if t.event is None]
-        self.level_reach = [_closed(closures, t.factors) for t in self.level_terms]
-        self.edge_terms: dict[str, list[_Term]] = {}
-        for t in self.terms:
-            if t.event is not None:
-                self.edge_terms.setdefault(t.event, []).append(t)
-
-
-    # ------------------------------------------------------------------ one state at a time
-    @staticmethod
-    def _ids(pairs: Iterable[tuple[_Term, Sequence[tuple[int, np.ndarray]]]], local: tuple[int, ...]) -> list[str]:
-        """Constraint ids (first-seen order, no repeats) of the terms whose factors hold at ``local``."""
-        ids: list[str] = []
-        for term, factors in pairs:
-            if term.constraint not in ids and all(vec[local[a]] for a, vec in factors):
-                ids.append(term.constraint)
-        return ids
-
-    def kept(self, local: tuple[int, ...]) -> bool:
-        """No constraint violation is reachable from ``local`` by uncontrollable events."""
-        return not any(all(vec[local[a]] for a, vec in factors) for factors in self.level_reach)
-
-    def violated(self, local: tuple[int, ...]) -> list[str]:
-        """Ids of the constraints the state violates (levels)."""
-        return self._ids(((t, t.factors) for t in self.level_terms), local)
-
-    def threatened(self, local: tuple[int, ...]) -> list[str]:
-        """Ids of the constraints whose violation is reachable by uncontrollable events."""
-        return self._ids(zip(self.level_terms, self.level_reach), local)
-
-    def forbidding(self, event: str, local: tuple[int, ...]) -> list[str]:
-        """Ids of the edge constraints that forbid controllable ``event`` in this state."""
-        return self._ids(((t, t.factors) for t in self.edge_terms.get(event, ())), local)
-
-    def move(self, t: LocalTransition, local: tuple[int, ...]) -> tuple[bool, list[str]]:
-        """Whether SUP allows transition ``t`` from ``local`` (a source in SUP), and if
-        not, the ids of the constraints responsible."""
-        target = list(local)
-        target[t.axis] = t.dst
-        why = self.forbidding(t.event, local) if t.controllable else []
-        why += [c for c in self.threatened(tuple(target)) if c not in why]
-        return (not why, why)
 
 class Supervisor(CompiledConstraints):
     """SUP: its states as a sorted array of plant state codes, explored from the initial
@@ -393,93 +277,3 @@ def supremal_controllable(
             progress(f"exploring SUP: depth {depth}, {sum(x.size for x in parts)} states")
     sup.states = np.sort(np.concatenate(parts))
     return sup
-
-
-class LocalSupervisor(CompiledConstraints):
-    """SUP membership decided state by state, without building the plant grid:
-    ``kept``, ``violated``, ``threatened``, ``forbidding`` and ``move`` cost
-    O(monomials × elements) per query.
-    """
-
-
-@dataclass(frozen=True)
-class Explanation:
-    """Why a state is kept in or removed from SUP."""
-
-    state: str
-    status: str  # illegal | defended | weakly_defended | kept | unreachable
-    constraints: tuple[str, ...] = ()
-    path: tuple[str, ...] = ()  # uncontrollable events leading to the violation
-    forbidden: tuple[tuple[str, tuple[str, ...]], ...] = ()  # (event, constraint ids) cut from here
-
-    def as_dict(self) -> dict:
-        return {
-            "state": self.state,
-            "status": self.status,
-            "constraints": list(self.constraints),
-            "path": list(self.path),
-            "forbidden": [{"event": e, "constraints": list(c)} for e, c in self.forbidden],
-        }
-
-    def text(self, labels: dict[str, str] | None = None) -> str:
-        labels = labels or {}
-
-        def named(ids: Iterable[str]) -> str:
-            return ", ".join(f'{i} "{labels[i]}"' if labels.get(i) else i for i in ids)
-
-        s = self.state
-        if self.status == "illegal":
-            return f"{s} is illegal: it violates {named(self.constraints)}"
-        if self.status == "defended":
-            return f"{s} is defended: the uncontrollable event {self.path[0]} leads to a state violating {named(self.constraints)}"
-        if self.status == "weakly_defended":
-            return (
-                f"{s} is weakly defended: the uncontrollable path {' '.join(self.path)} leads to a state "
-                f"violating {named(self.constraints)}"
-            )
-        head = f"{s} is kept in SUP" if self.status == "kept" else f"{s} is legal and not defended, but unreachable in SUP"
-        if not self.forbidden:
-            return head + "; no controllable event is forbidden there"
-        lines = [head + "; forbidden controllable events from it:"]
-        for e, ids in self.forbidden:
-            lines.append(f"  {e}: {named(ids)}")
-        return "\n".join(lines)
-
-
-def explain(sup: Supervisor, local: tuple[int, ...]) -> Explanation:
-    """Why ``local`` is in SUP or not, with the shortest uncontrollable path to a violation."""
-    p = sup.plant
-    label = p.label(local)
-    violated = sup.violated(local)
-    if violated:
-        return Explanation(label, "illegal", tuple(violated))
-    if not sup.kept(local):
-        # breadth-first search over uncontrollable moves to the nearest violation
-        parent: dict[tuple[int, ...], tuple[tuple[int, ...], str] | None] = {local: None}
-        queue = deque([local])
-        while queue:
-            cur = queue.popleft()
-            if sup.violated(cur):
-                path = []
-                node = cur
-                while parent[node] is not None:
-                    prev, ev = parent[node]  # type: ignore[misc]
-                    path.append(ev)
-                    node = prev
-                path.reverse()
-                status = "defended" if len(path) == 1 else "weakly_defended"
-                return Explanation(label, status, tuple(sup.violated(cur)), tuple(path))
-            for t, nxt in p.successors(cur):
-                if not t.controllable and nxt not in parent:
-                    parent[nxt] = (cur, t.event)
-                    queue.append(nxt)
-        raise AssertionError("removed state with no uncontrollable path to a violation")  # pragma: no cover
-    forbidden = []
-    for t, nxt in p.successors(local):
-        if t.controllable:
-            ok, why = sup.move(t, local)
-            if not ok:
-                forbidden.append((t.event, tuple(why)))
-    inside = bool(sup.contains(np.array([p.index(local)], dtype=np.int64))[0])
-    status = "kept" if inside else "unreachable"
-    return Explanation(label, status, (), (), tuple(forbidden))

@@ -9,15 +9,15 @@ edges, free inputs) and the Grafcet's timers leave a region from its *settled*
 states: those where no allowed order change towards the emitted orders remains.
 They are the *inter-region* transitions and lead to the next stable situation.
 
-SUP membership is decided state by state (:class:`~synth.supervisor.LocalSupervisor`),
+SUP membership is decided state by state (:class:`~synth.sup.constraints.CompiledConstraints`),
 so the cost follows the reachable part of SYNC, never the size of the plant.
 
 Example
 -------
->>> from synth.rules import load_rules
->>> from synth.composition import plant, _plants
->>> from synth.grafcet import load_grafcet
->>> from synth.stable_situations import GrafcetMachine
+>>> from synth.plant.rules import load_rules
+>>> from synth.plant.composition import plant, _plants
+>>> from synth.grafcet.language import load_grafcet
+>>> from synth.grafcet.machine import GrafcetMachine
 >>> rs = load_rules(_plants("tri.rules"))
 >>> p = plant(rs)
 >>> g = load_grafcet(_plants("../grafcets/tri.g7"), inputs=p.inputs, outputs=p.outputs)
@@ -34,11 +34,11 @@ from collections import deque
 from dataclasses import dataclass, field
 from typing import Callable, Sequence
 
-from .composition import LocalTransition, Plant
-from .errors import LimitExceeded
-from .rules import Constraint
-from .stable_situations import GrafcetMachine, Situation
-from .supervisor import LocalSupervisor
+from synth.plant.composition import LocalTransition, Plant
+from synth.errors import LimitExceeded
+from synth.plant.rules import Constraint
+from synth.grafcet.machine import GrafcetMachine, Situation
+from synth.sup.constraints import CompiledConstraints
 
 __all__ = ["Prohibition", "Node", "Edge", "Conflict", "Sync", "synchronous_product", "region"]
 
@@ -91,7 +91,7 @@ class Sync:
     """The aggregated view of SYNC, explored from the initial state."""
 
     plant: Plant
-    oracle: LocalSupervisor
+    oracle: CompiledConstraints
     machine: GrafcetMachine
     nodes: list[Node] = field(default_factory=list)
     edges: list[Edge] = field(default_factory=list)
@@ -130,7 +130,7 @@ def _order_moves(p: Plant) -> dict[str, list[LocalTransition]]:
 
 def region(
     p: Plant,
-    oracle: LocalSupervisor,
+    oracle: CompiledConstraints,
     entry: Local,
     wanted: frozenset[str],
     order_moves: dict[str, list[LocalTransition]] | None = None,
@@ -183,7 +183,7 @@ def synchronous_product(
     progress: Callable[[int, int], None] | None = None,
 ) -> Sync:
     """Explore SYNC from (initial plant state, initial situation), aggregated per region."""
-    oracle = LocalSupervisor(p, constraints)
+    oracle = CompiledConstraints(p, constraints)
     sync = Sync(p, oracle, machine)
     moves = _order_moves(p)
     uncontrollable = [t for t in p.transitions if not t.controllable]

@@ -5,7 +5,7 @@
 their receptivities). Every mistake is an :class:`~synth.errors.InputError`
 pointing at the offending token. The syntax is described in ``docs/grafcet.md``.
 
-Receptivities and action conditions are :mod:`synth.expr` expressions in which
+Receptivities and action conditions are :mod:`synth.logic.expr` expressions in which
 
 * a plant input is ``Var("dcy")``, its edges ``Edge(True, "dcy")`` (``↑dcy``);
 * a step variable is ``Var("X12")`` (true while step ``12`` is active);
@@ -36,9 +36,9 @@ from typing import Iterator, Sequence
 
 from lark import Token, UnexpectedInput
 
-from .errors import InputError, InputErrors, Location, close_names, location_in
-from .expr import Const, Edge, Expr, Var, names
-from .grammar import ExprTransformer, parser, read_source, syntax_error
+from synth.errors import InputError, InputErrors, Location, close_names, location_in
+from synth.logic.expr import Const, Edge, Expr, Var, names
+from synth.syntax import ExprTransformer, parser, read_source, syntax_error
 
 __all__ = [
     "CONTINUOUS",

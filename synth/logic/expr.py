@@ -26,7 +26,7 @@ from typing import Any, Callable, Iterator, Union
 
 import numpy as np
 
-from .errors import Location
+from synth.errors import Location
 
 __all__ = [
     "Expr",

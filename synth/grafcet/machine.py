@@ -1,4 +1,5 @@
-"""IEC 60848 evolution of a Grafcet and the automaton of its stable situations (ASS).
+"""IEC 60848 evolution of a Grafcet: the machine that ``synth run``, the ASS, validation and
+code generation all follow.
 
 :class:`GrafcetMachine` applies the five evolution rules with search for stability:
 
@@ -17,13 +18,9 @@ Continuous and conditional actions are emitted in stable situations only; stored
 actions (``set``/``reset``) run on every activation/deactivation, transient ones
 included. A transient cycle that never stabilises is an :class:`InputError`.
 
-:func:`stable_situation_automaton` explores all stable situations reachable from the
-initial one, with every input the Grafcet reads free to change (one at a time) and
-every running timer free to elapse.
-
 Example
 -------
->>> from synth.grafcet import parse_grafcet
+>>> from synth.grafcet.language import parse_grafcet
 >>> g = parse_grafcet('''
 ... grafcet G { initial step 0
 ...   step 1: A
@@ -46,12 +43,12 @@ from __future__ import annotations
 
 from collections import deque
 from dataclasses import dataclass, field
-from itertools import product
 from typing import Callable, Mapping, Sequence
 
-from .errors import InputError, LimitExceeded
-from .expr import And, Const, Edge, Expr, Not, Var, edge_text, names
-from .grafcet import (
+from synth.errors import InputError, LimitExceeded
+from synth.logic.events import Event
+from synth.logic.expr import And, Const, Edge, Expr, Not, Var, edge_text, names
+from synth.grafcet.language import (
     CONDITIONAL,
     CONTINUOUS,
     ON_ACTIVATION,
@@ -60,27 +57,11 @@ from .grafcet import (
     STORED,
     Grafcet,
     Transition,
-    load_grafcet,
     receptivity_inputs,
     step_key,
 )
 
-__all__ = [
-    "Situation",
-    "GrafcetMachine",
-    "ASSState",
-    "ASSTransition",
-    "ASS",
-    "stable_situation_automaton",
-    "load_grafcet",
-    "receptivity_inputs",
-    "parse_event",
-    "event_text",
-    "Event",
-]
-
-# (input name, rising) for an input edge, or a timer id
-Event = tuple[str, bool] | str
+__all__ = ["Situation", "GrafcetMachine"]
 
 
 def _sorted_steps(steps: Sequence[str] | set[str] | frozenset[str]) -> tuple[str, ...]:
@@ -377,354 +358,3 @@ class GrafcetMachine:
                 f"with inputs {values}" if values else "whatever the inputs",
             ),
         )
-
-
-# --------------------------------------------------------------------------- events
-
-
-def parse_event(text: str) -> Event:
-    """``"↑dcy"``/``"^dcy"`` → ``("dcy", True)``, ``"↓v10"``/``"_v10"`` → ``("v10", False)``,
-    a timer ``"2s/X101"`` stays a string.
-
-    >>> parse_event("^dcy"), parse_event("↓v10"), parse_event("2s/X101")
-    (('dcy', True), ('v10', False), '2s/X101')
-    """
-    t = text.strip()
-    if t[:1] in ("↑", "^"):
-        return (t[1:].strip(), True)
-    if t[:1] in ("↓", "_"):
-        return (t[1:].strip(), False)
-    return t
-
-
-def event_text(event: Event) -> str:
-    """``("dcy", True)`` → ``"↑dcy"``; a timer id is returned as is."""
-    return event if isinstance(event, str) else edge_text(event[1], event[0])
-
-
-# --------------------------------------------------------------------------- ASS
-
-
-@dataclass(frozen=True)
-class ASSState:
-    """A stable situation of the ASS, with the orders it emits.
-
-    ``orders``: every order emitted for some reachable input valuation;
-    ``conditional``: those among them emitted only for some valuations.
-    """
-
-    id: int
-    situation: Situation
-    orders: tuple[str, ...]
-    conditional: tuple[str, ...] = ()
-
-
-@dataclass(frozen=True)
-class ASSTransition:
-    """``source --event [condition]--> target`` (condition on the other inputs, ``any`` if none)."""
-
-    source: int
-    event: str
-    condition: str
-    target: int
-
-
-@dataclass(frozen=True)
-class ASS:
-    """The automaton of the stable situations."""
-
-    states: tuple[ASSState, ...]
-    transitions: tuple[ASSTransition, ...]
-    initial: int = 0
-    inputs: tuple[str, ...] = ()
-    initial_inputs: tuple[tuple[str, bool], ...] = field(default=())
-
-    def state_of(self, sit: Situation) -> ASSState:
-        for s in self.states:
-            if s.situation == sit:
-                return s
-        raise KeyError(sit.text())
-
-    def successors(self, state: int) -> tuple[ASSTransition, ...]:
-        return tuple(t for t in self.transitions if t.source == state)
-
-
-class _Cubes:
-    """Sets of input vectors as Python integers (bit ``v`` set iff vector ``v`` is in the set).
-
-    A vector ``v`` has bit ``i`` set iff input ``i`` is 1. Set operations are integer
-    bit operations, so whole sets are handled at once.
-    """
-
-    def __init__(self, n: int) -> None:
-        self.n = n
-        self.size = 1 << n
-        self.full = (1 << self.size) - 1
-        self.one: list[int] = []
-        for i in range(n):
-            block = ((1 << (1 << i)) - 1) << (1 << i)  # 2^i zeros then 2^i ones
-            period = 1 << (i + 1)
-            m = 0
-            for start in range(0, self.size, period):
-                m |= block << start
-            self.one.append(m)
-        self.zero = [self.full ^ m for m in self.one]
-
-    def flip(self, s: int, i: int) -> int:
-        """Every vector of ``s`` with input ``i`` flipped."""
-        d = 1 << i
-        return ((s & self.zero[i]) << d) | ((s & self.one[i]) >> d)
-
-    def cube(self, literals: Mapping[int, bool]) -> int:
-        """Vectors where input ``i`` equals ``literals[i]`` for every given ``i``."""
-        c = self.full
-        for i, value in literals.items():
-            c &= self.one[i] if value else self.zero[i]
-        return c
-
-    def members(self, s: int) -> list[int]:
-        out = []
-        while s:
-            low = s & -s
-            out.append(low.bit_length() - 1)
-            s ^= low
-        return out
-
-
-def _condition_text(cubes: _Cubes, on: int, off: int, names: Sequence[str], free: Sequence[int]) -> str:
-    """A small DNF over inputs ``free`` true on every vector of ``on`` and false on every
-    vector of ``off`` (other vectors: don't care); ``any`` when ``off`` is empty.
-
-    >>> c = _Cubes(2)
-    >>> on = c.cube({0: True}) & ~c.cube({1: True})       # a & !b
-    >>> off = c.cube({0: False})                          # !a
-    >>> _condition_text(c, on, off, ["a", "b"], [0, 1])
-    'a'
-    >>> _condition_text(c, on, 0, ["a", "b"], [0, 1])
-    'any'
-    """
-    if not off:
-        return "any"
-    keep = list(free)
-    cl_on, cl_off = on, off
-    for i in list(keep):  # drop every variable not needed to tell on from off
-        t_on = cl_on | cubes.flip(cl_on, i)
-        t_off = cl_off | cubes.flip(cl_off, i)
-        if not t_on & t_off:
-            keep.remove(i)
-            cl_on, cl_off = t_on, t_off
-    if len(keep) > 8:  # too many variables to minimise: list the vectors
-        vecs = sorted({tuple(bool(v >> i & 1) for i in keep) for v in cubes.members(on)}, reverse=True)
-        return " | ".join(_cube_text(dict(zip(keep, vec)), names) for vec in vecs)
-    candidates: list[tuple[dict[int, bool], int]] = []
-    for values in product((None, True, False), repeat=len(keep)):
-        lits = {i: v for i, v in zip(keep, values) if v is not None}
-        c = cubes.cube(lits)
-        if not c & off and c & on:
-            candidates.append((lits, c))
-    primes = [
-        (l, c) for l, c in candidates
-        if not any(c != d and c & d == c for _, d in candidates)
-    ]
-    uncovered = on
-    chosen: list[dict[int, bool]] = []
-    while uncovered:
-        lits, c = max(
-            primes,
-            key=lambda lc: (
-                (lc[1] & uncovered).bit_count(),
-                -len(lc[0]),
-                tuple(2 if lc[0].get(i) is None else int(lc[0][i]) for i in keep),
-            ),
-        )
-        chosen.append(lits)
-        uncovered &= ~c
-    return " | ".join(_cube_text(l, names) for l in chosen)
-
-
-def _cube_text(lits: Mapping[int, bool], names: Sequence[str]) -> str:
-    parts = [(names[i] if v else "!" + names[i]) for i, v in sorted(lits.items())]
-    return " & ".join(parts) if parts else "1"
-
-
-class _Reader:
-    """Input values from a vector, remembering which inputs were read (for memoisation)."""
-
-    __slots__ = ("mask", "index", "base", "read")
-
-    def __init__(self, mask: int, index: Mapping[str, int], base: Mapping[str, bool]) -> None:
-        self.mask = mask
-        self.index = index
-        self.base = base
-        self.read = 0
-
-    def __getitem__(self, name: str) -> bool:
-        i = self.index.get(name)
-        if i is None:
-            return self.base[name]
-        self.read |= 1 << i
-        return bool(self.mask >> i & 1)
-
-
-MAX_INPUTS = 20
-
-
-def stable_situation_automaton(
-    machine: GrafcetMachine,
-    *,
-    initial_inputs: Mapping[str, bool] | None = None,
-    max_states: int = 100_000,
-    admissible: Callable[[Mapping[str, bool]], bool] | None = None,
-) -> ASS:
-    """The ASS of ``machine``, explored from its initial situation.
-
-    The exploration runs over pairs (stable situation, valuation of the inputs the
-    Grafcet reads); from each, every read input may flip (one event) and every running
-    timer may elapse. Pairs are then projected on situations. ``initial_inputs`` gives
-    the initial input values (default: all 0; inputs not read never matter).
-    Sets of valuations are handled as bit sets, so a situation is processed at once
-    for all the valuations that reach it.
-
-    >>> from synth.grafcet import parse_grafcet
-    >>> g = parse_grafcet("grafcet G { initial step 0 step 1: A "
-    ...                   "transition 0 -> 1 when ↑a . b  transition 1 -> 0 when !b }")
-    >>> ass = stable_situation_automaton(GrafcetMachine(g))
-    >>> [(s.id, s.situation.text(), s.orders) for s in ass.states]
-    [(0, '{X0}', ()), (1, '{X1}', ('A',))]
-    >>> [(t.source, t.event, t.condition, t.target) for t in ass.transitions]
-    [(0, '↑a', 'b', 1), (1, '↓b', 'any', 0)]
-    """
-    base = {n: bool((initial_inputs or {}).get(n, False)) for n in machine.inputs}
-    read = machine.read_inputs
-    n_in = len(read)
-    if n_in > MAX_INPUTS:
-        raise LimitExceeded(f"the Grafcet reads {n_in} inputs; the ASS is explored for at most {MAX_INPUTS}")
-    index = {n: i for i, n in enumerate(read)}
-    cubes = _Cubes(n_in)
-
-    def valuation(v: int) -> dict[str, bool]:
-        d = dict(base)
-        for n, i in index.items():
-            d[n] = bool(v >> i & 1)
-        return d
-
-    v0 = sum(1 << i for n, i in index.items() if base[n])
-    allowed = -1  # every vector
-    if admissible is not None and n_in <= 16:
-        allowed = sum(1 << v for v in range(1 << n_in) if admissible(valuation(v))) | (1 << v0)
-    s0 = machine.initial(base)
-    sits: list[Situation] = [s0]
-    sid: dict[Situation, int] = {s0: 0}
-    reached: list[int] = [1 << v0]
-    pending: list[int] = [1 << v0]
-    relevant: list[int] = []
-    timers: list[tuple[str, ...]] = []
-    labels: list[str] = [edge_text(r, n) for n in read for r in (True, False)]
-    # (situation, label) -> [(vectors covered, target)], from memoised runs
-    memo: dict[tuple[int, str], list[tuple[int, int]]] = {}
-    # (situation, label) -> {target: vectors before the event}
-    moves: dict[tuple[int, str], dict[int, int]] = {}
-    queue: deque[int] = deque([0])
-    queued = {0}
-
-    def known(sit: Situation) -> int:
-        k = sid.get(sit)
-        if k is None:
-            if len(sits) >= max_states:
-                raise LimitExceeded(f"more than {max_states} stable situations while building the ASS")
-            k = sid[sit] = len(sits)
-            sits.append(sit)
-            reached.append(0)
-            pending.append(0)
-        while len(relevant) < len(sits):
-            j = len(relevant)
-            relevant.append(sum(1 << index[x] for x in machine.relevant_inputs(sits[j]) if x in index))
-            timers.append(machine.timers(sits[j]))
-        return k
-
-    known(s0)
-
-    def classify(k: int, label: str, event: tuple[str, bool] | str, after: int) -> dict[int, int]:
-        """Target situation of each vector of ``after`` (values once the event happened)."""
-        entries = memo.setdefault((k, label), [])
-        out: dict[int, int] = {}
-        rest = after
-        for covered, target in entries:
-            hit = rest & covered
-            if hit:
-                out[target] = out.get(target, 0) | hit
-                rest &= ~covered
-        while rest:
-            v = (rest & -rest).bit_length() - 1
-            reader = _Reader(v, index, base)
-            if isinstance(event, str):
-                result = machine.fire_timer_with_trace(sits[k], event, reader)[0]  # type: ignore[arg-type]
-            else:
-                result = machine.react_event(sits[k], event, reader)[0]  # type: ignore[arg-type]
-            target = known(result)
-            covered = cubes.cube({i: bool(v >> i & 1) for i in range(n_in) if reader.read >> i & 1})
-            entries.append((covered, target))
-            out[target] = out.get(target, 0) | (rest & covered)
-            rest &= ~covered
-        return out
-
-    def add(k: int, vectors: int) -> None:
-        new = vectors & ~reached[k]
-        if new:
-            reached[k] |= new
-            pending[k] |= new
-            if k not in queued:
-                queued.add(k)
-                queue.append(k)
-
-    while queue:
-        k = queue.popleft()
-        queued.discard(k)
-        todo, pending[k] = pending[k], 0
-        for i, n in enumerate(read):
-            for rising in (True, False):
-                src = todo & (cubes.zero[i] if rising else cubes.one[i])
-                if not src:
-                    continue
-                after = cubes.flip(src, i) & allowed
-                if not after:
-                    continue
-                if not relevant[k] >> i & 1:
-                    add(k, after)
-                    continue
-                label = labels[2 * i + (0 if rising else 1)]
-                for target, vecs in classify(k, label, (n, rising), after).items():
-                    add(target, vecs)
-                    if target != k:
-                        m = moves.setdefault((k, label), {})
-                        m[target] = m.get(target, 0) | cubes.flip(vecs, i)
-        for t in timers[k]:
-            for target, vecs in classify(k, t, t, todo).items():
-                add(target, vecs)
-                if target != k:
-                    m = moves.setdefault((k, t), {})
-                    m[target] = m.get(target, 0) | vecs
-    # states, with the orders they emit
-    states: list[ASSState] = []
-    for k, sit in enumerate(sits):
-        emitted = {machine.orders(sit, valuation(v)) for v in cubes.members(reached[k])}
-        union = frozenset().union(*emitted) if emitted else frozenset()
-        always = frozenset.intersection(*emitted) if emitted else frozenset()
-        outs = tuple(o for o in machine.outputs if o in union)
-        states.append(ASSState(k, sit, outs, tuple(o for o in outs if o not in always)))
-    # transitions, with the condition on the other inputs
-    rank = {label: r for r, label in enumerate(labels)}
-    trans: list[ASSTransition] = []
-    for (k, label), by_target in moves.items():
-        if label in rank:
-            x = rank[label] // 2
-            domain = reached[k] & (cubes.zero[x] if rank[label] % 2 == 0 else cubes.one[x])
-            free = [i for i in range(n_in) if i != x]
-        else:
-            domain = reached[k]
-            free = list(range(n_in))
-        for target in sorted(by_target):
-            on = by_target[target] & domain
-            trans.append(ASSTransition(k, label, _condition_text(cubes, on, domain & ~on, read, free), target))
-    trans.sort(key=lambda t: (t.source, rank.get(t.event, len(rank)), t.event, t.target))
-    return ASS(tuple(states), tuple(trans), 0, read, tuple((n, base[n]) for n in read))

@@ -18,12 +18,13 @@ import json
 import sys
 from typing import Any, Callable, Iterator, Mapping, Sequence
 
-from .errors import InputError, Location, close_names
-from .files import write_atomic
-from .render import ass_dot, orders_text as _orders_text
-from .report import write_svg
-from .grafcet import Grafcet, load_grafcet
-from .stable_situations import ASS, GrafcetMachine, stable_situation_automaton
+from synth.errors import InputError, Location, close_names
+from synth.output.files import write_atomic
+from synth.output.dot import ass_dot, orders_text as _orders_text
+from synth.output.html import write_svg
+from synth.grafcet.language import Grafcet, load_grafcet
+from synth.grafcet.ass import ASS, stable_situation_automaton
+from synth.grafcet.machine import GrafcetMachine
 
 __all__ = ["register", "ass_text", "ass_json", "parse_events", "cmd_ass", "cmd_run"]
 
@@ -37,8 +38,8 @@ def _load(args: argparse.Namespace) -> tuple[Grafcet, dict[str, bool], Callable[
     initial: dict[str, bool] = {}
     admissible = None
     if args.plant:
-        from .composition import plant
-        from .rules import load_rules
+        from synth.plant.composition import plant
+        from synth.plant.rules import load_rules
 
         rs = load_rules(args.plant)
         grafcet = load_grafcet(args.file, inputs=rs.inputs, outputs=rs.outputs)

@@ -10,7 +10,7 @@ import argparse
 import sys
 from typing import Callable, Sequence
 
-from .errors import InputError, InputErrors, LimitExceeded, ModelError, SynthError
+from synth.errors import InputError, InputErrors, LimitExceeded, ModelError, SynthError
 
 __all__ = ["main", "entry", "build_parser"]
 
@@ -24,7 +24,7 @@ class _Parser(argparse.ArgumentParser):
 
 
 def build_parser() -> argparse.ArgumentParser:
-    from . import cli_grafcet, cli_plant, cli_validate
+    from synth.cli import grafcet as cli_grafcet, plant as cli_plant, validate as cli_validate
 
     p = _Parser(prog="synth", description="Validate a Grafcet against a rule-based plant model and its safety constraints.")
     sub = p.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)

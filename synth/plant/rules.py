@@ -31,9 +31,9 @@ from typing import Iterable, Mapping
 
 from lark import Token, UnexpectedInput
 
-from .errors import InputError, InputErrors, Location, close_names, location_in
-from .expr import Const, Edge, Expr, Not, Var, disjunctive_normal_form, evaluate, names
-from .grammar import ExprTransformer, parser, read_source, syntax_error
+from synth.errors import InputError, InputErrors, Location, close_names, location_in
+from synth.logic.expr import Const, Edge, Expr, Not, Var, disjunctive_normal_form, evaluate, names
+from synth.syntax import ExprTransformer, parser, read_source, syntax_error
 
 __all__ = [
     "VarDecl",

@@ -1,4 +1,4 @@
-"""DOT text for automata (pure functions; only :mod:`synth.report` calls Graphviz).
+"""DOT text for automata (pure functions; only :mod:`synth.output.html` calls Graphviz).
 
 Example
 -------
@@ -11,11 +11,11 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Iterable, Mapping, Sequence
 
-from .plant import ElementAutomaton
+from synth.plant.element import ElementAutomaton
 
 if TYPE_CHECKING:
-    from .stable_situations import ASS
-    from .sync import Sync
+    from synth.grafcet.ass import ASS
+    from synth.validation.sync import Sync
 
 __all__ = ["dot_graph", "dot_escape", "element_dot", "trace_dot", "sup_neighbourhood_dot", "aggregated_dot", "ass_dot", "orders_text"]
 

@@ -1,0 +1,248 @@
+"""The automaton of the stable situations (ASS) of a Grafcet.
+
+:func:`stable_situation_automaton` explores all stable situations reachable from the
+initial one, with every input the Grafcet reads free to change (one at a time) and
+every running timer free to elapse (see :mod:`synth.grafcet.machine` for the evolution
+rules and ``docs/method.md`` for the reading of the thesis).
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass, field
+from typing import Callable, Mapping, Sequence
+
+from synth.errors import LimitExceeded
+from synth.logic.cubes import Cubes, condition_text
+from synth.logic.expr import edge_text
+from synth.grafcet.machine import GrafcetMachine, Situation
+
+__all__ = ["ASSState", "ASSTransition", "ASS", "stable_situation_automaton", "MAX_INPUTS"]
+
+
+
+@dataclass(frozen=True)
+class ASSState:
+    """A stable situation of the ASS, with the orders it emits.
+
+    ``orders``: every order emitted for some reachable input valuation;
+    ``conditional``: those among them emitted only for some valuations.
+    """
+
+    id: int
+    situation: Situation
+    orders: tuple[str, ...]
+    conditional: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class ASSTransition:
+    """``source --event [condition]--> target`` (condition on the other inputs, ``any`` if none)."""
+
+    source: int
+    event: str
+    condition: str
+    target: int
+
+
+@dataclass(frozen=True)
+class ASS:
+    """The automaton of the stable situations."""
+
+    states: tuple[ASSState, ...]
+    transitions: tuple[ASSTransition, ...]
+    initial: int = 0
+    inputs: tuple[str, ...] = ()
+    initial_inputs: tuple[tuple[str, bool], ...] = field(default=())
+
+    def state_of(self, sit: Situation) -> ASSState:
+        for s in self.states:
+            if s.situation == sit:
+                return s
+        raise KeyError(sit.text())
+
+    def successors(self, state: int) -> tuple[ASSTransition, ...]:
+        return tuple(t for t in self.transitions if t.source == state)
+
+
+class _Reader:
+    """Input values from a vector, remembering which inputs were read (for memoisation)."""
+
+    __slots__ = ("mask", "index", "base", "read")
+
+    def __init__(self, mask: int, index: Mapping[str, int], base: Mapping[str, bool]) -> None:
+        self.mask = mask
+        self.index = index
+        self.base = base
+        self.read = 0
+
+    def __getitem__(self, name: str) -> bool:
+        i = self.index.get(name)
+        if i is None:
+            return self.base[name]
+        self.read |= 1 << i
+        return bool(self.mask >> i & 1)
+
+
+MAX_INPUTS = 20
+
+
+def stable_situation_automaton(
+    machine: GrafcetMachine,
+    *,
+    initial_inputs: Mapping[str, bool] | None = None,
+    max_states: int = 100_000,
+    admissible: Callable[[Mapping[str, bool]], bool] | None = None,
+) -> ASS:
+    """The ASS of ``machine``, explored from its initial situation.
+
+    The exploration runs over pairs (stable situation, valuation of the inputs the
+    Grafcet reads); from each, every read input may flip (one event) and every running
+    timer may elapse. Pairs are then projected on situations. ``initial_inputs`` gives
+    the initial input values (default: all 0; inputs not read never matter).
+    Sets of valuations are handled as bit sets, so a situation is processed at once
+    for all the valuations that reach it.
+
+    >>> from synth.grafcet.language import parse_grafcet
+    >>> g = parse_grafcet("grafcet G { initial step 0 step 1: A "
+    ...                   "transition 0 -> 1 when ↑a . b  transition 1 -> 0 when !b }")
+    >>> ass = stable_situation_automaton(GrafcetMachine(g))
+    >>> [(s.id, s.situation.text(), s.orders) for s in ass.states]
+    [(0, '{X0}', ()), (1, '{X1}', ('A',))]
+    >>> [(t.source, t.event, t.condition, t.target) for t in ass.transitions]
+    [(0, '↑a', 'b', 1), (1, '↓b', 'any', 0)]
+    """
+    base = {n: bool((initial_inputs or {}).get(n, False)) for n in machine.inputs}
+    read = machine.read_inputs
+    n_in = len(read)
+    if n_in > MAX_INPUTS:
+        raise LimitExceeded(f"the Grafcet reads {n_in} inputs; the ASS is explored for at most {MAX_INPUTS}")
+    index = {n: i for i, n in enumerate(read)}
+    cubes = Cubes(n_in)
+
+    def valuation(v: int) -> dict[str, bool]:
+        d = dict(base)
+        for n, i in index.items():
+            d[n] = bool(v >> i & 1)
+        return d
+
+    v0 = sum(1 << i for n, i in index.items() if base[n])
+    allowed = -1  # every vector
+    if admissible is not None and n_in <= 16:
+        allowed = sum(1 << v for v in range(1 << n_in) if admissible(valuation(v))) | (1 << v0)
+    s0 = machine.initial(base)
+    sits: list[Situation] = [s0]
+    sid: dict[Situation, int] = {s0: 0}
+    reached: list[int] = [1 << v0]
+    pending: list[int] = [1 << v0]
+    relevant: list[int] = []
+    timers: list[tuple[str, ...]] = []
+    labels: list[str] = [edge_text(r, n) for n in read for r in (True, False)]
+    # (situation, label) -> [(vectors covered, target)], from memoised runs
+    memo: dict[tuple[int, str], list[tuple[int, int]]] = {}
+    # (situation, label) -> {target: vectors before the event}
+    moves: dict[tuple[int, str], dict[int, int]] = {}
+    queue: deque[int] = deque([0])
+    queued = {0}
+
+    def known(sit: Situation) -> int:
+        k = sid.get(sit)
+        if k is None:
+            if len(sits) >= max_states:
+                raise LimitExceeded(f"more than {max_states} stable situations while building the ASS")
+            k = sid[sit] = len(sits)
+            sits.append(sit)
+            reached.append(0)
+            pending.append(0)
+        while len(relevant) < len(sits):
+            j = len(relevant)
+            relevant.append(sum(1 << index[x] for x in machine.relevant_inputs(sits[j]) if x in index))
+            timers.append(machine.timers(sits[j]))
+        return k
+
+    known(s0)
+
+    def classify(k: int, label: str, event: tuple[str, bool] | str, after: int) -> dict[int, int]:
+        """Target situation of each vector of ``after`` (values once the event happened)."""
+        entries = memo.setdefault((k, label), [])
+        out: dict[int, int] = {}
+        rest = after
+        for covered, target in entries:
+            hit = rest & covered
+            if hit:
+                out[target] = out.get(target, 0) | hit
+                rest &= ~covered
+        while rest:
+            v = (rest & -rest).bit_length() - 1
+            reader = _Reader(v, index, base)
+            if isinstance(event, str):
+                result = machine.fire_timer_with_trace(sits[k], event, reader)[0]  # type: ignore[arg-type]
+            else:
+                result = machine.react_event(sits[k], event, reader)[0]  # type: ignore[arg-type]
+            target = known(result)
+            covered = cubes.cube({i: bool(v >> i & 1) for i in range(n_in) if reader.read >> i & 1})
+            entries.append((covered, target))
+            out[target] = out.get(target, 0) | (rest & covered)
+            rest &= ~covered
+        return out
+
+    def add(k: int, vectors: int) -> None:
+        new = vectors & ~reached[k]
+        if new:
+            reached[k] |= new
+            pending[k] |= new
+            if k not in queued:
+                queued.add(k)
+                queue.append(k)
+
+    while queue:
+        k = queue.popleft()
+        queued.discard(k)
+        todo, pending[k] = pending[k], 0
+        for i, n in enumerate(read):
+            for rising in (True, False):
+                src = todo & (cubes.zero[i] if rising else cubes.one[i])
+                if not src:
+                    continue
+                after = cubes.flip(src, i) & allowed
+                if not after:
+                    continue
+                if not relevant[k] >> i & 1:
+                    add(k, after)
+                    continue
+                label = labels[2 * i + (0 if rising else 1)]
+                for target, vecs in classify(k, label, (n, rising), after).items():
+                    add(target, vecs)
+                    if target != k:
+                        m = moves.setdefault((k, label), {})
+                        m[target] = m.get(target, 0) | cubes.flip(vecs, i)
+        for t in timers[k]:
+            for target, vecs in classify(k, t, t, todo).items():
+                add(target, vecs)
+                if target != k:
+                    m = moves.setdefault((k, t), {})
+                    m[target] = m.get(target, 0) | vecs
+    # states, with the orders they emit
+    states: list[ASSState] = []
+    for k, sit in enumerate(sits):
+        emitted = {machine.orders(sit, valuation(v)) for v in cubes.members(reached[k])}
+        union = frozenset().union(*emitted) if emitted else frozenset()
+        always = frozenset.intersection(*emitted) if emitted else frozenset()
+        outs = tuple(o for o in machine.outputs if o in union)
+        states.append(ASSState(k, sit, outs, tuple(o for o in outs if o not in always)))
+    # transitions, with the condition on the other inputs
+    rank = {label: r for r, label in enumerate(labels)}
+    trans: list[ASSTransition] = []
+    for (k, label), by_target in moves.items():
+        if label in rank:
+            x = rank[label] // 2
+            domain = reached[k] & (cubes.zero[x] if rank[label] % 2 == 0 else cubes.one[x])
+            free = [i for i in range(n_in) if i != x]
+        else:
+            domain = reached[k]
+            free = list(range(n_in))
+        for target in sorted(by_target):
+            on = by_target[target] & domain
+            trans.append(ASSTransition(k, label, condition_text(cubes, on, domain & ~on, read, free), target))
+    trans.sort(key=lambda t: (t.source, rank.get(t.event, len(rank)), t.event, t.target))
+    return ASS(tuple(states), tuple(trans), 0, read, tuple((n, base[n]) for n in read))

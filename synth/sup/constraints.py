@@ -1,0 +1,139 @@
+"""Safety constraints compiled against a plant, for SUP queries state by state.
+
+Each constraint is put in disjunctive normal form; each monomial becomes per-element
+factors (the local states satisfying its level literals on that element). "Can reach a
+violation by uncontrollable events" is then a product of per-element closures
+(see :mod:`synth.sup.supervisor` and ``docs/method.md``). Every query costs
+O(monomials × elements), with no plant grid: this is what on-the-fly validation uses.
+
+Example
+-------
+>>> from synth.plant.rules import load_rules
+>>> from synth.plant.composition import plant, _plants
+>>> rs = load_rules(_plants("tri_annex.rules"))
+>>> cc = CompiledConstraints(plant(rs), rs.constraints)
+>>> cc.kept(cc.plant.initial)
+True
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Iterable, Sequence
+
+import numpy as np
+
+from synth.logic.expr import disjunctive_normal_form, edge_text
+from synth.plant.composition import LocalTransition, Plant
+from synth.plant.rules import Constraint
+
+__all__ = ["CompiledConstraints", "GRID_LIMIT"]
+
+
+@dataclass(frozen=True)
+class _Term:
+    """One monomial of a constraint, split per element: ``factors[axis]`` is the set of
+    local states satisfying its level literals on that element."""
+
+    constraint: str
+    factors: tuple[tuple[int, np.ndarray], ...]
+    event: str | None  # the edge literal's event, if any
+
+
+def _terms(p: Plant, constraints: Sequence[Constraint]) -> list[_Term]:
+    out: list[_Term] = []
+    for c in constraints:
+        for m in disjunctive_normal_form(c.forbidden):
+            edges = [l for l in m if l.edge]
+            per_axis: dict[int, np.ndarray] = {}
+            for l in sorted(m):
+                if l.edge:
+                    continue
+                axis = p.owner[l.name]
+                v = p.elements[axis].value(l.name)
+                sat = v if l.positive else ~v
+                per_axis[axis] = per_axis.get(axis, np.ones_like(sat)) & sat
+            event = edge_text(edges[0].positive, edges[0].name) if edges else None
+            out.append(_Term(c.id, tuple(sorted(per_axis.items(), key=lambda kv: kv[0])), event))
+    return out
+
+
+def _product(p: Plant, factors: Iterable[tuple[int, np.ndarray]]) -> np.ndarray:
+    grid = np.ones(p.shape, dtype=bool)
+    for axis, vec in factors:
+        shape = [1] * p.ndim
+        shape[axis] = vec.size
+        grid &= vec.reshape(shape)
+    return grid
+
+
+def _closed(closures: Sequence[np.ndarray], factors: Iterable[tuple[int, np.ndarray]]) -> tuple[tuple[int, np.ndarray], ...]:
+    """Per-element factors of "can reach, by own uncontrollable moves, a satisfying state"."""
+    return tuple((a, (closures[a] @ v.astype(np.uint8)) > 0) for a, v in factors)
+
+
+def _holds(factors: Sequence[tuple[int, np.ndarray]], digits: np.ndarray) -> np.ndarray:
+    """Whether a product term holds at each of the states whose digits (ndim × n) are given."""
+    out = np.ones(digits.shape[1], dtype=bool)
+    for a, vec in factors:
+        out &= vec[digits[a]]
+    return out
+
+
+GRID_LIMIT = 200_000_000
+"""Plant-wide statistics (illegal, defended, ... counts over every plant state) need
+grids of the plant's size; above this many states they are not computed."""
+
+
+class CompiledConstraints:
+    """Constraints compiled against a plant: each monomial as per-element factors
+    (``level_terms`` / ``edge_terms``), and for level terms the factors of "can reach a
+    violating local state by the element's own uncontrollable moves" (``level_reach``)."""
+
+    def __init__(self, p: Plant, constraints: Sequence[Constraint]) -> None:
+        self.plant = p
+        self.constraints = tuple(constraints)
+        self.terms = _terms(p, constraints)
+        closures = [e.uncontrollable_closure().astype(np.uint8) for e in p.elements]
+        self.level_terms = [t for t in self.terms if t.event is None]
+        self.level_reach = [_closed(closures, t.factors) for t in self.level_terms]
+        self.edge_terms: dict[str, list[_Term]] = {}
+        for t in self.terms:
+            if t.event is not None:
+                self.edge_terms.setdefault(t.event, []).append(t)
+
+
+    # ------------------------------------------------------------------ one state at a time
+    @staticmethod
+    def _ids(pairs: Iterable[tuple[_Term, Sequence[tuple[int, np.ndarray]]]], local: tuple[int, ...]) -> list[str]:
+        """Constraint ids (first-seen order, no repeats) of the terms whose factors hold at ``local``."""
+        ids: list[str] = []
+        for term, factors in pairs:
+            if term.constraint not in ids and all(vec[local[a]] for a, vec in factors):
+                ids.append(term.constraint)
+        return ids
+
+    def kept(self, local: tuple[int, ...]) -> bool:
+        """No constraint violation is reachable from ``local`` by uncontrollable events."""
+        return not any(all(vec[local[a]] for a, vec in factors) for factors in self.level_reach)
+
+    def violated(self, local: tuple[int, ...]) -> list[str]:
+        """Ids of the constraints the state violates (levels)."""
+        return self._ids(((t, t.factors) for t in self.level_terms), local)
+
+    def threatened(self, local: tuple[int, ...]) -> list[str]:
+        """Ids of the constraints whose violation is reachable by uncontrollable events."""
+        return self._ids(zip(self.level_terms, self.level_reach), local)
+
+    def forbidding(self, event: str, local: tuple[int, ...]) -> list[str]:
+        """Ids of the edge constraints that forbid controllable ``event`` in this state."""
+        return self._ids(((t, t.factors) for t in self.edge_terms.get(event, ())), local)
+
+    def move(self, t: LocalTransition, local: tuple[int, ...]) -> tuple[bool, list[str]]:
+        """Whether SUP allows transition ``t`` from ``local`` (a source in SUP), and if
+        not, the ids of the constraints responsible."""
+        target = list(local)
+        target[t.axis] = t.dst
+        why = self.forbidding(t.event, local) if t.controllable else []
+        why += [c for c in self.threatened(tuple(target)) if c not in why]
+        return (not why, why)
