@@ -7,12 +7,14 @@ from functools import lru_cache
 from importlib import resources
 from pathlib import Path
 
+from typing import Any, Sequence
+
 from lark import Lark, Token, Transformer, Tree, UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
 
-from synth.errors import InputError, Location, location_in
+from synth.errors import InputError, InputErrors, Location, location_in
 from synth.logic.expr import And, Const, Edge, Not, Or, Var
 
-__all__ = ["grammar_text", "parser", "syntax_error", "read_source", "ExprTransformer"]
+__all__ = ["grammar_text", "parser", "syntax_error", "read_source", "ExprTransformer", "Checker", "raise_all", "parse_tree"]
 
 # How terminals are shown to a user in "expected ..." lists.
 _TERMINAL_TEXT = {
@@ -159,3 +161,45 @@ class ExprTransformer(Transformer):
 
     def or_expr(self, items: list) -> Or:
         return Or(tuple(i for i in items if not isinstance(i, Token)))
+
+
+def raise_all(errors: Sequence[InputError]) -> None:
+    """Raise the errors of one file together (one :class:`InputError`, or :class:`InputErrors`)."""
+    if len(errors) == 1:
+        raise errors[0]
+    if errors:
+        raise InputErrors(errors)
+
+
+def parse_tree(grammar: str, source: str, file: str, transformer: Transformer) -> Any:
+    """Parse ``source`` with ``grammars/<grammar>.lark`` and transform it; a syntax error
+    becomes a located :class:`InputError`, and so does every error the transformer collected
+    in an ``errors`` list."""
+    p = parser(grammar)
+    try:
+        tree = p.parse(source)
+    except UnexpectedInput as err:
+        raise syntax_error(err, file, source, p) from None
+    result = transformer.transform(tree)
+    raise_all(getattr(transformer, "errors", ()))
+    return result
+
+
+class Checker:
+    """Base of the checkers of every language: collects each located error of a file,
+    so that a user sees all mistakes at once, then raises them together.
+
+    >>> c = Checker()
+    >>> c.fail("unknown variable 'x'", Location("a.g7", 1, 1, "x", 1), suggestions=("y",))
+    >>> len(c.errors)
+    1
+    """
+
+    def __init__(self) -> None:
+        self.errors: list[InputError] = []
+
+    def fail(self, message: str, location: Location | None, **details: Any) -> None:
+        self.errors.append(InputError(message, location, **details))
+
+    def raise_errors(self) -> None:
+        raise_all(self.errors)

@@ -40,7 +40,18 @@ __all__ = [
     "Monomial",
     "disjunctive_normal_form",
     "edge_text",
+    "renamed",
+    "NegatedEdge",
+    "NormalFormTooLarge",
 ]
+
+
+class NegatedEdge(ValueError):
+    """An edge under a negation: events are not levels, ``!↑x`` has no normal form."""
+
+
+class NormalFormTooLarge(ValueError):
+    """The disjunctive normal form would have more monomials than the limit."""
 
 
 def edge_text(rising: bool, name: str) -> str:
@@ -150,6 +161,23 @@ def names(e: Expr) -> Iterator[Var | Edge]:
             yield from names(a)
 
 
+def renamed(e: Expr, rename: Callable[[str], str]) -> Expr:
+    """``e`` with every variable and edge name passed through ``rename`` (locations kept).
+
+    >>> renamed(And((Var("A"), Edge(True, "b"))), str.upper).text()
+    'A & ↑B'
+    """
+    if isinstance(e, Var):
+        return Var(rename(e.name), e.loc)
+    if isinstance(e, Edge):
+        return Edge(e.rising, rename(e.name), e.loc)
+    if isinstance(e, Const):
+        return e
+    if isinstance(e, Not):
+        return Not(renamed(e.arg, rename), e.loc)
+    return type(e)(tuple(renamed(a, rename) for a in e.args), e.loc)
+
+
 # Methods attached here so that the dataclasses stay plain data.
 for _cls in (Var, Const, Edge, Not, And, Or):
     _cls.evaluate = evaluate  # type: ignore[attr-defined]
@@ -183,7 +211,7 @@ def disjunctive_normal_form(e: Expr, limit: int = 4096) -> list[Monomial]:
             return [frozenset({Literal(x.name, positive)})]
         if isinstance(x, Edge):
             if not positive:
-                raise ValueError("negated edge")
+                raise NegatedEdge(x.text())
             return [frozenset({Literal(x.name, x.rising, edge=True)})]
         if isinstance(x, Const):
             return [frozenset()] if x.value == positive else []
@@ -198,7 +226,7 @@ def disjunctive_normal_form(e: Expr, limit: int = 4096) -> list[Monomial]:
             m = frozenset().union(*combo)
             out.append(m)
             if len(out) > limit:
-                raise ValueError("expression too large for normal form")
+                raise NormalFormTooLarge(f"more than {limit} monomials")
         return out
 
     result: list[Monomial] = []

@@ -1,0 +1,310 @@
+r"""Checking the rules language: ``use`` files, models and instances resolved, then every
+name, ownership, precedence and constraint checked, all errors of a file reported together.
+
+Example
+-------
+>>> from synth.plant.rules_reader import rules_items
+>>> c = RulesChecker()
+>>> c.collect(rules_items("element E { sensor a = 0 }\nconstraint K: b = 0", "x.rules"), None)
+>>> c.check()
+>>> [e.message for e in c.errors]
+["constraint K uses undeclared variable 'b'"]
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+from typing import Mapping
+
+from synth.errors import InputError, Location, close_names
+from synth.logic.expr import Edge, Expr, NegatedEdge, NormalFormTooLarge, Var, disjunctive_normal_form, evaluate, names, renamed
+from synth.plant.rules import ORDER, Constraint, ElementSpec, Precedence, Rule, VarDecl
+from synth.plant.rules_reader import _Hold, _Inline, _Instance, _Model, _Use, _Vector, rules_items
+from synth.syntax import Checker
+
+__all__ = ["RulesChecker"]
+
+
+class RulesChecker(Checker):
+    """Resolves ``use``, models and instances, then checks names and ownership."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.models: dict[str, _Model] = {}
+        self.elements: list[ElementSpec] = []
+        self.constraints: list[Constraint] = []
+        self.holds: list[VarDecl] = []
+        self.top_free: list[VarDecl] = []
+        self.vectors: list[_Vector] = []
+        self.order: tuple[str, ...] = ()
+        self.loaded: set[Path] = set()
+
+    # ---- collection
+    def collect(self, items: list, base: Path | None) -> None:
+        for it in items:
+            if isinstance(it, _Use):
+                self.use(it, base)
+            elif isinstance(it, _Model):
+                if it.name in self.models:
+                    self.fail(
+                        f"model '{it.name}' is defined twice",
+                        it.loc,
+                        notes=(f"first defined at {self.models[it.name].loc}",),
+                    )
+                else:
+                    self.models[it.name] = it
+            elif isinstance(it, _Inline):
+                self.add_element(ElementSpec(it.name, it.body.decls, it.body.incoherences, it.body.rules, it.body.precedences, it.loc))
+            elif isinstance(it, _Instance):
+                self.instantiate(it)
+            elif isinstance(it, _Hold):
+                self.holds.extend(it.decls)
+            elif isinstance(it, tuple):  # top-level free inputs
+                self.top_free.extend(it)
+            elif isinstance(it, Constraint):
+                self.constraints.append(it)
+            elif isinstance(it, _Vector):
+                self.vectors.append(it)
+
+    def use(self, u: _Use, base: Path | None) -> None:
+        target = (base / u.path) if base is not None else Path(u.path)
+        try:
+            resolved = target.resolve()
+            if resolved in self.loaded:
+                return
+            source = target.read_text(encoding="utf-8-sig")
+        except OSError as exc:
+            self.fail(f"cannot read '{u.path}': {exc.strerror or exc}", u.loc)
+            return
+        except UnicodeDecodeError:
+            self.fail(f"'{u.path}' is not UTF-8 text", u.loc)
+            return
+        self.loaded.add(resolved)
+        try:
+            items = rules_items(source, str(target))
+        except InputError as err:
+            self.errors.append(err)
+            return
+        self.collect(items, target.parent)
+
+    def instantiate(self, inst: _Instance) -> None:
+        model = self.models.get(inst.model)
+        if model is None:
+            self.fail(
+                f"unknown model '{inst.model}' for element {inst.name}",
+                inst.model_loc,
+                suggestions=close_names(inst.model, self.models),
+                notes=("models are defined with `model NAME { ... }`, here or in a file named by `use`",),
+            )
+            return
+        declared = {d.name for d in model.body.decls}
+        mapping: dict[str, str] = {}
+        for old, new, old_loc, _ in inst.renaming:
+            if old not in declared:
+                self.fail(
+                    f"model '{model.name}' has no variable '{old}'",
+                    old_loc,
+                    suggestions=close_names(old, declared),
+                    expected=(", ".join(sorted(declared)),),
+                )
+                continue
+            if old in mapping:
+                self.fail(f"'{old}' is renamed twice in element {inst.name}", old_loc)
+                continue
+            mapping[old] = new
+        self.add_element(_rename(inst.name, model, mapping, inst.loc))
+
+    def add_element(self, e: ElementSpec) -> None:
+        for other in self.elements:
+            if other.name == e.name:
+                self.fail(f"element '{e.name}' is declared twice", e.loc, notes=(f"first declared at {other.loc}",))
+                return
+        self.elements.append(e)
+
+    # ---- checks
+    def check(self) -> None:
+        owner: dict[str, tuple[ElementSpec, VarDecl]] = {}
+        elements: list[ElementSpec] = []
+        for v in self.top_free:
+            elements.append(ElementSpec(v.name, (v,), loc=v.loc))
+        elements.extend(self.elements)
+        named: dict[str, ElementSpec] = {}
+        for e in elements:
+            if e.name in named and e.loc is not None:
+                self.fail(
+                    f"element '{e.name}' is declared twice",
+                    e.loc,
+                    notes=(f"first declared at {named[e.name].loc} (a top-level free input is an element of its own)",),
+                )
+            named.setdefault(e.name, e)
+        for e in elements:
+            for v in e.variables:
+                if v.name in owner:
+                    first_el, first = owner[v.name]
+                    where = "again" if first_el.name == e.name else f"by element {e.name}"
+                    self.fail(
+                        f"variable '{v.name}' is declared {where} but already belongs to element {first_el.name}",
+                        v.loc,
+                        notes=(f"{first_el.name} declares it at {first.loc}", "each variable belongs to exactly one element"),
+                    )
+                else:
+                    owner[v.name] = (e, v)
+        # outputs held constant
+        held: dict[str, VarDecl] = {}
+        for h in self.holds:
+            if h.name not in owner:
+                self.fail(f"hold: unknown order '{h.name}'", h.loc, suggestions=close_names(h.name, [n for n, (_, d) in owner.items() if d.kind == ORDER]))
+            elif owner[h.name][1].kind != ORDER:
+                self.fail(f"hold: '{h.name}' is an input of element {owner[h.name][0].name}; only orders can be held", h.loc)
+            else:
+                held[h.name] = h
+        final: list[ElementSpec] = []
+        for e in elements:
+            if any(v.name in held for v in e.variables):
+                e = replace(
+                    e,
+                    variables=tuple(
+                        replace(v, initial=held[v.name].initial, held=True) if v.name in held else v for v in e.variables
+                    ),
+                )
+            self.check_element(e, owner)
+            final.append(e)
+        self.elements = final
+        listed: dict[str, Location] = {}
+        for vec in self.vectors:
+            want_input = vec.kind == "inputs"
+            pool = [n for n, (_, d) in owner.items() if d.is_input == want_input]
+            for n, loc in vec.names:
+                if n in listed:
+                    self.fail(f"'{n}' is listed twice in the vectors", loc, notes=(f"first listed at {listed[n]}",))
+                elif n not in owner:
+                    self.fail(f"{vec.kind}: unknown variable '{n}'", loc, suggestions=close_names(n, pool))
+                elif owner[n][1].is_input != want_input:
+                    what = "an input" if owner[n][1].is_input else "an order"
+                    self.fail(f"{vec.kind}: '{n}' is {what} of element {owner[n][0].name}", loc)
+                else:
+                    listed[n] = loc
+        self.order = tuple(listed)
+        all_names = set(owner)
+        ids: dict[str, Constraint] = {}
+        for c in self.constraints:
+            if c.id in ids:
+                self.fail(f"constraint id '{c.id}' is used twice", c.loc, notes=(f"first used at {ids[c.id].loc}",))
+            ids[c.id] = c
+            try:
+                disjunctive_normal_form(c.forbidden)
+            except NegatedEdge:
+                self.fail(
+                    f"constraint {c.id}: an edge cannot be negated (or the constraint written = 1 around an edge)",
+                    c.loc,
+                    notes=("write the forbidden case as a conjunction, e.g. `↓AVANCER1 & !v11 = 0`",),
+                )
+            except NormalFormTooLarge:
+                self.fail(
+                    f"constraint {c.id} is too large once expanded into monomials (more than 4096)",
+                    c.loc,
+                    notes=("split it into several constraints",),
+                )
+            for n in names(c.expr):
+                if n.name not in all_names:
+                    what = "edge of an undeclared variable" if isinstance(n, Edge) else "undeclared variable"
+                    self.fail(f"constraint {c.id} uses {what} '{n.name}'", n.loc, suggestions=close_names(n.name, all_names))
+                elif isinstance(n, Edge) and owner[n.name][1].kind != ORDER:
+                    self.fail(
+                        f"constraint {c.id}: edges in constraints must be edges of orders; '{n.name}' is an input of element {owner[n.name][0].name}",
+                        n.loc,
+                        notes=("an edge restricts the matching controllable event; inputs are written as levels",),
+                    )
+
+    def check_element(self, e: ElementSpec, owner: Mapping[str, tuple[ElementSpec, VarDecl]]) -> None:
+        own = {v.name: v for v in e.variables}
+
+        def unknown(n: Var | Edge, role: str) -> None:
+            if n.name in owner and owner[n.name][0].name != e.name:
+                other = owner[n.name][0].name
+                self.fail(
+                    f"{role} of element {e.name} uses '{n.name}', which belongs to element {other}",
+                    n.loc,
+                    suggestions=close_names(n.name, own),
+                    notes=(f"an element's {role}s may only use its own variables: {', '.join(sorted(own))}",),
+                )
+            else:
+                self.fail(f"unknown variable '{n.name}' in element {e.name}", n.loc, suggestions=close_names(n.name, own))
+
+        def levels_only(x: Expr, role: str) -> None:
+            for n in names(x):
+                if isinstance(n, Edge):
+                    self.fail(f"an edge is not allowed in a {role}; write a level", n.loc)
+                elif n.name not in own:
+                    unknown(n, role)
+
+        for inc in e.incoherences:
+            levels_only(inc, "incoherence")
+        for r in e.rules:
+            c, q = r.cause, r.consequence
+            if c.name not in own:
+                unknown(c, "rule")
+            elif own[c.name].kind != ORDER:
+                self.fail(
+                    f"the cause of a rule must be an edge of one of {e.name}'s orders; '{c.name}' is an input",
+                    c.loc,
+                    suggestions=close_names(c.name, [v.name for v in e.orders]),
+                )
+            if q.name not in own:
+                if q.name in owner:
+                    other = owner[q.name][0].name
+                    self.fail(
+                        f"rule of element {e.name} produces {q.text()}, but {q.name} is a sensor of element {other}",
+                        q.loc,
+                        suggestions=close_names(q.name, [v.name for v in e.inputs]),
+                        notes=(f"a rule may only produce edges of its own element's sensors: {', '.join(v.name for v in e.inputs)}",),
+                    )
+                else:
+                    unknown(q, "rule")
+            elif own[q.name].kind == ORDER:
+                self.fail(
+                    f"the consequence of a rule must be an edge of a sensor of {e.name}; '{q.name}' is an order",
+                    q.loc,
+                    suggestions=close_names(q.name, [v.name for v in e.inputs]),
+                )
+            if r.guard is not None:
+                levels_only(r.guard, "guard")
+        for p in e.precedences:
+            for role, x in (("cause", p.cause), ("first", p.first), ("then", p.then)):
+                if x.name not in own:
+                    unknown(x, "precedence")
+                elif (own[x.name].kind == ORDER) != (role == "cause"):
+                    want = "an edge of one of its orders" if role == "cause" else "an edge of one of its sensors"
+                    self.fail(f"in a precedence of {e.name}, the {role} must be {want}; '{x.name}' is not", x.loc)
+        # the initial state must be coherent
+        init = {v.name: v.initial for v in e.variables}
+        for inc in e.incoherences:
+            if all(n.name in init for n in names(inc)) and evaluate(inc, init.__getitem__):
+                where = inc.loc or next((n.loc for n in names(inc)), e.loc)
+                self.fail(
+                    f"the initial state of element {e.name} is incoherent: {inc.text()} holds initially",
+                    where,
+                    notes=("initial values: " + ", ".join(f"{k}={int(v)}" for k, v in init.items()),),
+                )
+        if not e.variables:
+            self.fail(f"element {e.name} declares no variable", e.loc)
+
+
+def _rename(name: str, model: _Model, mapping: Mapping[str, str], loc: Location) -> ElementSpec:
+    def r(n: str) -> str:
+        return mapping.get(n, n)
+
+    def rx(x: Expr) -> Expr:
+        return renamed(x, r)
+
+    b = model.body
+    return ElementSpec(
+        name,
+        tuple(replace(d, name=r(d.name)) for d in b.decls),
+        tuple(rx(i) for i in b.incoherences),
+        tuple(Rule(rx(x.cause), rx(x.guard) if x.guard is not None else None, rx(x.consequence), x.loc) for x in b.rules),
+        tuple(Precedence(rx(p.cause), rx(p.first), rx(p.then), p.loc) for p in b.precedences),
+        loc,
+        model.name,
+    )
