@@ -1,0 +1,279 @@
+"""Checking the ``.g7`` language: names, steps, variables and orders, every error of a
+file collected and reported together.
+
+Example
+-------
+>>> from synth.grafcet.language_reader import grafcet_items
+>>> items = grafcet_items("grafcet G { initial step 0 transition 0 -> 9 when 1 }", "g.g7")
+>>> try:
+...     GrafcetChecker("g.g7", "", None, None).check(items)
+... except Exception as err:
+...     print(err.message)
+unknown step 9
+"""
+
+from __future__ import annotations
+
+import re
+from typing import Sequence
+
+from synth.errors import close_names, location_in
+from synth.grafcet.language import (
+    _SECONDS,
+    _TIMER_RE,
+    CONDITIONAL,
+    ON_EVENT,
+    STORED,
+    Action,
+    Grafcet,
+    PartialGrafcet,
+    Step,
+    Timer,
+    Transition,
+    step_key,
+)
+from synth.logic.expr import Edge, Expr, Var, names
+from synth.grafcet.language_reader import _Decl, _Graf, _Step, _StepRef, _Trans
+from synth.syntax import Checker
+
+__all__ = ["GrafcetChecker"]
+
+
+
+class GrafcetChecker(Checker):
+    """Names, steps, variables and orders; collects every error of the file."""
+
+    def __init__(self, file: str, source: str, plant_inputs: Sequence[str] | None, plant_outputs: Sequence[str] | None) -> None:
+        super().__init__()
+        self.file = file
+        self.source = source
+        self.plant_inputs = tuple(plant_inputs) if plant_inputs is not None else None
+        self.plant_outputs = tuple(plant_outputs) if plant_outputs is not None else None
+        self.steps: dict[str, tuple[_Step, str]] = {}
+        self.timers: dict[str, Timer] = {}
+
+    # ---- declarations
+    def declared(self, decls: list[_Decl], kind: str, plant: tuple[str, ...] | None) -> tuple[str, ...] | None:
+        names_: list[str] = []
+        for d in decls:
+            if d.kind != kind:
+                continue
+            for n, loc in d.names:
+                if n in names_:
+                    self.fail(f"{kind[:-1]} '{n}' is declared twice", loc)
+                    continue
+                if plant is not None and n not in plant:
+                    self.fail(
+                        f"'{n}' is declared as an {kind[:-1]} but the plant has no such {kind[:-1]}",
+                        loc,
+                        suggestions=close_names(n, plant),
+                    )
+                names_.append(n)
+        if plant is not None:
+            return plant
+        return tuple(names_) if any(d.kind == kind for d in decls) else None
+
+    # ---- the whole file
+    def check(self, items: list) -> Grafcet:
+        decls = [i for i in items if isinstance(i, _Decl)]
+        grafs = [i for i in items if isinstance(i, _Graf)]
+        inputs = self.declared(decls, "inputs", self.plant_inputs)
+        outputs = self.declared(decls, "outputs", self.plant_outputs)
+        if inputs is not None and outputs is not None:
+            for d in decls:
+                if d.kind == "inputs":
+                    for n, loc in d.names:
+                        if n in outputs:
+                            self.fail(f"'{n}' is declared both as an input and as an output", loc)
+        if not grafs:
+            self.fail(
+                "no grafcet in this file",
+                location_in(self.file, self.source, 1, 1),
+                notes=("write at least one partial grafcet: grafcet G1 { initial step 0 ... }",),
+            )
+            self.raise_errors()
+        # steps (unique across the whole file)
+        gnames: dict[str, _Graf] = {}
+        for g in grafs:
+            if g.name in gnames:
+                self.fail(f"partial grafcet '{g.name}' is defined twice", g.loc, notes=(f"first defined at {gnames[g.name].loc}",))
+            gnames.setdefault(g.name, g)
+            for s in g.steps:
+                if s.name in self.steps:
+                    first, where = self.steps[s.name]
+                    self.fail(
+                        f"step {s.name} is declared twice",
+                        s.loc,
+                        notes=(f"first declared at {first.loc} (grafcet {where}); step names are unique in the file",),
+                    )
+                else:
+                    self.steps[s.name] = (s, g.name)
+        step_vars = {"X" + n for n in self.steps}
+        if inputs is not None:
+            for n in inputs:
+                if n in step_vars:
+                    step = self.steps[n[1:]][0]
+                    self.fail(
+                        f"input '{n}' has the name of the step variable of step {n[1:]}; rename the input or the step",
+                        step.loc,
+                    )
+        # infer inputs/outputs when neither the file nor the caller gave them
+        if inputs is None:
+            inputs = self.infer_inputs(grafs, step_vars)
+        if outputs is None:
+            outputs = tuple(dict.fromkeys(a.order for g in grafs for s in g.steps for a in s.actions))
+        # transitions and expressions
+        built: list[PartialGrafcet] = []
+        for g in grafs:
+            labels: dict[str, _Trans] = {}
+            transitions: list[Transition] = []
+            for t in g.transitions:
+                if t.label is not None:
+                    if t.label in labels:
+                        self.fail(f"transition {t.label} is defined twice in grafcet {g.name}", t.label_loc, notes=(f"first defined at {labels[t.label].loc}",))
+                    labels.setdefault(t.label, t)
+                if not t.sources and not t.targets:
+                    self.fail("a transition needs at least one source or target step", t.loc)
+                for role, refs in (("source", t.sources), ("target", t.targets)):
+                    seen: set[str] = set()
+                    for r in refs:
+                        if r.name in seen:
+                            self.fail(f"step {r.name} is listed twice as a {role} of this transition", r.loc)
+                        seen.add(r.name)
+                        self.check_step_ref(r, g.name)
+                self.check_expr(t.receptivity, inputs, "receptivity", allow_edges=True)
+                transitions.append(
+                    Transition(t.label, tuple(r.name for r in t.sources), tuple(r.name for r in t.targets), t.receptivity, g.name, t.loc)
+                )
+            steps: list[Step] = []
+            for s in g.steps:
+                for a in s.actions:
+                    self.check_action(a, outputs, inputs)
+                steps.append(Step(s.name, g.name, s.initial, s.actions, s.loc))
+            if not any(s.initial for s in g.steps) and not any(not t.sources for t in g.transitions):
+                self.fail(
+                    f"partial grafcet {g.name} has no initial step",
+                    g.loc,
+                    notes=("mark one with `initial step N`, or give it a source transition (`transition -> N when ↑x`); "
+                           "otherwise its steps can never become active",),
+                )
+            built.append(PartialGrafcet(g.name, tuple(steps), tuple(transitions), g.loc))
+        self.check_stored_outputs(grafs)
+        self.raise_errors()
+        timers = tuple(sorted(self.timers.values(), key=lambda x: (step_key(x.step), x.seconds, x.id)))
+        return Grafcet(tuple(built), tuple(inputs), tuple(outputs), timers, self.file)
+
+    def infer_inputs(self, grafs: list[_Graf], step_vars: set[str]) -> tuple[str, ...]:
+        found: list[str] = []
+        exprs: list[Expr] = []
+        for g in grafs:
+            exprs.extend(t.receptivity for t in g.transitions)
+            exprs.extend(a.condition for s in g.steps for a in s.actions if a.condition is not None)
+        for e in exprs:
+            for n in names(e):
+                if n.name in step_vars or _TIMER_RE.match(n.name):
+                    continue
+                if isinstance(n, Var) and re.fullmatch(r"X[0-9]+", n.name):
+                    continue  # X of a missing step: reported by check_expr
+                if n.name not in found:
+                    found.append(n.name)
+        return tuple(found)
+
+    def check_step_ref(self, r: _StepRef, grafcet: str) -> None:
+        if r.name not in self.steps:
+            self.fail(
+                f"unknown step {r.name}",
+                r.loc,
+                suggestions=close_names(r.name, self.steps),
+                notes=("declare it with `step " + r.name + "` in grafcet " + grafcet,),
+            )
+            return
+        owner = self.steps[r.name][1]
+        if owner != grafcet:
+            self.fail(
+                f"step {r.name} belongs to grafcet {owner}; a transition links steps of its own grafcet",
+                r.loc,
+                notes=(f"to synchronise with {owner}, read its step variable X{r.name} in a receptivity",),
+            )
+
+    def check_expr(self, e: Expr, inputs: Sequence[str], role: str, allow_edges: bool) -> None:
+        known = set(inputs)
+        for n in names(e):
+            m = _TIMER_RE.match(n.name)
+            if m is not None:
+                step = m.group(3)
+                if isinstance(n, Edge):
+                    self.fail(f"an edge of a timer is not allowed; write the timer {n.name}", n.loc)
+                elif step not in self.steps:
+                    self.fail(
+                        f"timer {n.name} refers to step {step}, which does not exist",
+                        n.loc,
+                        suggestions=tuple(f"X{c}" for c in close_names(step, self.steps)),
+                    )
+                else:
+                    seconds = float(m.group(1)) * _SECONDS[m.group(2)]
+                    self.timers.setdefault(n.name, Timer(n.name, step, seconds, n.loc))
+                continue
+            if n.name.startswith("X") and n.name[1:] in self.steps and n.name not in known:
+                if isinstance(n, Edge):
+                    self.fail(
+                        f"edges of step variables are not supported: {n.text()}",
+                        n.loc,
+                        notes=("edges are input events; read the level X" + n.name[1:] + " instead",),
+                    )
+                continue
+            if n.name in known:
+                if isinstance(n, Edge) and not allow_edges:
+                    self.fail(
+                        f"an edge is not allowed in a {role}; write a level",
+                        n.loc,
+                        notes=("to act on an event, use a stored action: set ORDER on ↑x",),
+                    )
+                continue
+            step_vars = sorted("X" + s for s in self.steps)
+            if re.fullmatch(r"X[0-9]+", n.name):
+                self.fail(
+                    f"{n.name} refers to step {n.name[1:]}, which does not exist",
+                    n.loc,
+                    suggestions=close_names(n.name, step_vars),
+                    notes=("X<step> is the variable of a step: true while the step is active",),
+                )
+                continue
+            self.fail(
+                f"unknown variable '{n.name}'" + (" (not an input of the plant)" if self.plant_inputs is not None else ""),
+                n.loc,
+                suggestions=close_names(n.name, sorted(known) + step_vars),
+                notes=(("known inputs: " + ", ".join(inputs)) if inputs else "no input is declared",),
+            )
+
+    def check_action(self, a: Action, outputs: Sequence[str], inputs: Sequence[str]) -> None:
+        if a.order not in outputs:
+            source = "of the plant" if self.plant_outputs is not None else "declared"
+            self.fail(
+                f"'{a.order}' is not an output ({source})",
+                a.loc,
+                suggestions=close_names(a.order, outputs),
+                notes=("outputs: " + ", ".join(outputs),) if outputs else (),
+            )
+        if a.kind == CONDITIONAL and a.condition is not None:
+            self.check_expr(a.condition, inputs, "condition of an action", allow_edges=False)
+        if a.kind == STORED and a.when == ON_EVENT and a.condition is not None:
+            self.check_expr(a.condition, inputs, "event of a stored action", allow_edges=True)
+            if not any(isinstance(n, Edge) for n in names(a.condition)):
+                self.fail(
+                    f"the event of '{a.text()}' has no edge: it would never occur",
+                    a.condition.loc or next((n.loc for n in names(a.condition)), a.loc),
+                    notes=("write an input event such as ↑cp12 (possibly with a condition: ↑cp12 . v10)",),
+                )
+
+    def check_stored_outputs(self, grafs: list[_Graf]) -> None:
+        stored = {a.order for g in grafs for s in g.steps for a in s.actions if a.kind == STORED}
+        for g in grafs:
+            for s in g.steps:
+                for a in s.actions:
+                    if a.kind != STORED and a.order in stored:
+                        self.fail(
+                            f"output {a.order} is set/reset by stored actions and also assigned here",
+                            a.loc,
+                            notes=("an output is either assigned (continuous/conditional actions) or stored (set/reset), not both",),
+                        )
