@@ -16,17 +16,18 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from typing import Any, Callable, Iterator, Mapping, Sequence
+from typing import Callable, Iterator, Mapping, Sequence
 
 from synth.errors import InputError, Location, close_names
 from synth.output.files import write_atomic
 from synth.output.dot import ass_dot, orders_text as _orders_text
+from synth.output.summary import ass_json, ass_text
 from synth.output.html import write_svg
 from synth.grafcet.language import Grafcet, load_grafcet
-from synth.grafcet.ass import ASS, stable_situation_automaton
+from synth.grafcet.ass import stable_situation_automaton
 from synth.grafcet.machine import GrafcetMachine
 
-__all__ = ["register", "ass_text", "ass_json", "parse_events", "cmd_ass", "cmd_run"]
+__all__ = ["register", "parse_events", "cmd_ass", "cmd_run"]
 
 
 # --------------------------------------------------------------------------- loading
@@ -116,51 +117,6 @@ def parse_events(text: str, grafcet: Grafcet) -> list[tuple[str, tuple[str, bool
                        + (": " + ", ".join(timers) if timers else ""),),
             )
     return out
-
-
-# --------------------------------------------------------------------------- rendering
-
-
-def ass_text(ass: ASS, title: str = "") -> str:
-    """The ASS as a readable listing (pure function)."""
-    lines = []
-    head = f"ASS{' of ' + title if title else ''}: {len(ass.states)} stable situations, {len(ass.transitions)} transitions"
-    lines.append(head)
-    lines.append("inputs explored: " + (", ".join(ass.inputs) if ass.inputs else "none"))
-    if any(s.conditional for s in ass.states):
-        lines.append("(an order marked ? is emitted only under some input values: conditional action)")
-    for s in ass.states:
-        mark = "  (initial)" if s.id == ass.initial else ""
-        lines.append("")
-        lines.append(f"S{s.id}  {s.situation.text()}{mark}")
-        lines.append(f"    orders: {_orders_text(s.orders, s.conditional)}")
-        for t in ass.successors(s.id):
-            cond = "" if t.condition == "any" else f"  [{t.condition}]"
-            lines.append(f"    {t.event}{cond} -> S{t.target}")
-    return "\n".join(lines) + "\n"
-
-
-def ass_json(ass: ASS) -> dict[str, Any]:
-    """The ASS as JSON-ready data (pure function)."""
-    return {
-        "initial": ass.initial,
-        "inputs": list(ass.inputs),
-        "states": [
-            {
-                "id": s.id,
-                "situation": list(s.situation.steps),
-                "stored": list(s.situation.stored),
-                "elapsed": list(s.situation.elapsed),
-                "orders": list(s.orders),
-                "conditional_orders": list(s.conditional),
-            }
-            for s in ass.states
-        ],
-        "transitions": [
-            {"source": t.source, "event": t.event, "condition": t.condition, "target": t.target}
-            for t in ass.transitions
-        ],
-    }
 
 
 # --------------------------------------------------------------------------- commands

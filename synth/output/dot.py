@@ -11,13 +11,13 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Iterable, Mapping, Sequence
 
-from synth.plant.element import ElementAutomaton
-
-if TYPE_CHECKING:
+if TYPE_CHECKING:  # pragma: no cover
     from synth.grafcet.ass import ASS
+    from synth.plant.composition import Plant
+    from synth.plant.element import ElementAutomaton
     from synth.validation.sync import Sync
 
-__all__ = ["dot_graph", "dot_escape", "element_dot", "trace_dot", "sup_neighbourhood_dot", "aggregated_dot", "ass_dot", "orders_text"]
+__all__ = ["dot_graph", "dot_escape", "element_dot", "trace_dot", "sup_neighbourhood_dot", "aggregated_dot", "ass_dot", "orders_text", "plant_dot"]
 
 CONTROLLABLE_STYLE = {"color": "#1f5fa8", "fontcolor": "#1f5fa8"}
 UNCONTROLLABLE_STYLE = {"color": "#b03a2e", "fontcolor": "#b03a2e", "style": "dashed"}
@@ -57,7 +57,7 @@ def dot_graph(
     return "\n".join(out) + "\n"
 
 
-def element_dot(a: ElementAutomaton, highlight: Iterable[str] = (), current: int | None = None) -> str:
+def element_dot(a: "ElementAutomaton", highlight: Iterable[str] = (), current: int | None = None) -> str:
     """An element automaton; controllable edges solid blue, uncontrollable dashed red;
     transitions whose event is in ``highlight`` drawn thick orange; the local state
     ``current`` (e.g. the element's state in a blocking situation) filled."""
@@ -184,3 +184,18 @@ def ass_dot(ass: "ASS", title: str = "ASS") -> str:
         lines.append(f"  S{t.source} -> S{t.target} [label={_dot_string(label)}];")
     lines.append("}")
     return "\n".join(lines) + "\n"
+
+
+def plant_dot(p: "Plant") -> str:
+    """The whole plant automaton (small plants only: one node per state)."""
+    nodes = []
+    for code in range(p.size):
+        local = p.local(code)
+        nodes.append((str(code), p.label(local), {"peripheries": "2"} if local == p.initial else {}))
+    edges = []
+    for t, src, dst in p.transition_arrays():
+        style = CONTROLLABLE_STYLE if t.controllable else UNCONTROLLABLE_STYLE
+        for s, d in zip(src.tolist(), dst.tolist()):
+            edges.append((str(s), str(d), t.event, style))
+    edges.sort(key=lambda e: (int(e[0]), e[2]))
+    return dot_graph("plant", nodes, edges)

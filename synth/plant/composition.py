@@ -73,6 +73,21 @@ class Plant:
             self.outputs = tuple(v for e in elements for v in e.variables if v in e.orders)
         self.variables = self.inputs + self.outputs
 
+    def element(self, name: str) -> ElementAutomaton:
+        """The automaton of element ``name``; an unknown name is an error that lists the
+        close valid names."""
+        for a in self.elements:
+            if a.name == name:
+                return a
+        names = [a.name for a in self.elements]
+        hint = close_names(name, names)
+        where = self.rules.path if self.rules is not None else "the plant"
+        raise SynthError(
+            f"no element '{name}' in {where}"
+            + (f" (did you mean {' or '.join(hint)}?)" if hint else "")
+            + f"; elements: {', '.join(names)}"
+        )
+
     @property
     def warnings(self) -> tuple:
         """Warnings found while building the element automata (rules that never apply)."""
