@@ -16,16 +16,12 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from typing import Callable, Iterator, Mapping, Sequence
+from typing import TYPE_CHECKING, Callable, Iterator, Mapping, Sequence
 
 from synth.errors import InputError, Location, close_names
-from synth.output.files import write_atomic
-from synth.output.dot import ass_dot, orders_text as _orders_text
-from synth.output.summary import ass_json, ass_text
-from synth.output.html import write_svg
-from synth.grafcet.language import Grafcet, load_grafcet
-from synth.grafcet.ass import stable_situation_automaton
-from synth.grafcet.machine import GrafcetMachine
+
+if TYPE_CHECKING:  # pragma: no cover - the library is imported by the commands only (fast --help)
+    from synth.grafcet.language import Grafcet
 
 __all__ = ["register", "parse_events", "cmd_ass", "cmd_run"]
 
@@ -36,6 +32,8 @@ __all__ = ["register", "parse_events", "cmd_ass", "cmd_run"]
 def _load(args: argparse.Namespace) -> tuple[Grafcet, dict[str, bool], Callable[[Mapping[str, bool]], bool] | None]:
     """The Grafcet (checked against the plant if given), the initial input values, and
     the plant's test of admissible input vectors (None without a plant)."""
+    from synth.grafcet.language import load_grafcet
+
     initial: dict[str, bool] = {}
     admissible = None
     if args.plant:
@@ -123,6 +121,13 @@ def parse_events(text: str, grafcet: Grafcet) -> list[tuple[str, tuple[str, bool
 
 
 def cmd_ass(args: argparse.Namespace) -> int:
+    from synth.grafcet.ass import stable_situation_automaton
+    from synth.grafcet.machine import GrafcetMachine
+    from synth.output.dot import ass_dot
+    from synth.output.files import write_atomic
+    from synth.output.html import write_svg
+    from synth.output.summary import ass_json, ass_text
+
     grafcet, initial, admissible = _load(args)
     machine = GrafcetMachine(grafcet)
     ass = stable_situation_automaton(machine, initial_inputs=initial, admissible=admissible)
@@ -144,6 +149,9 @@ def _inputs_text(values: Mapping[str, bool], names: Sequence[str]) -> str:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
+    from synth.grafcet.machine import GrafcetMachine
+    from synth.output.dot import orders_text as _orders_text
+
     grafcet, inputs, _ = _load(args)
     machine = GrafcetMachine(grafcet)
     events = parse_events(args.events or "", grafcet)

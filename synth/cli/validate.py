@@ -9,11 +9,6 @@ from pathlib import Path
 
 from synth.cli.plant import print_warnings
 from synth.errors import SynthError
-from synth.output.files import write_atomic
-from synth.output.dot import dot_graph
-from synth.output.html import write_report
-from synth.validation.sync import stderr_progress
-from synth.validation.validate import reduced_controller, validate
 
 __all__ = ["register", "cmd_validate"]
 
@@ -37,6 +32,12 @@ def register(sub: "argparse._SubParsersAction") -> None:
 
 
 def cmd_validate(args: argparse.Namespace) -> int:
+    from synth.output.dot import dot_graph
+    from synth.output.files import write_atomic
+    from synth.output.html import write_report
+    from synth.validation.sync import stderr_progress
+    from synth.validation.validate import reduced_controller, validate
+
     if args.cor and Path(args.cor).suffix == ".dot":
         raise SynthError(f"--cor {args.cor}: the JSON file must not end in .dot, the DOT file is written beside it")
     show_progress = not args.quiet and sys.stderr.isatty()

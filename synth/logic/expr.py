@@ -24,7 +24,6 @@ from functools import reduce
 from itertools import product
 from typing import Any, Callable, Iterator, Union
 
-import numpy as np
 
 from synth.errors import Location
 
@@ -133,10 +132,16 @@ def _evaluate(e: Expr, value: Callable[[str], Any], edge: Callable[[Edge], Any])
         return edge(e)
     if isinstance(e, Not):
         r = _evaluate(e.arg, value, edge)
-        return (not r) if isinstance(r, bool) else np.logical_not(r)
+        if isinstance(r, bool):
+            return not r
+        import numpy as np  # arrays of values: numpy is loaded already
+
+        return np.logical_not(r)
     parts = [_evaluate(a, value, edge) for a in e.args]
     if all(isinstance(p, bool) for p in parts):
         return all(parts) if isinstance(e, And) else any(parts)
+    import numpy as np
+
     op = np.logical_and if isinstance(e, And) else np.logical_or
     return reduce(op, parts)
 
