@@ -11,7 +11,7 @@ from synth.grafcet.language import parse_grafcet
 from synth.grafcet.ass import stable_situation_automaton
 from synth.grafcet.language import load_grafcet
 from synth.grafcet.machine import GrafcetMachine, Situation
-from synth.logic.events import parse_event
+from synth.logic.events import EventKind, parse_event
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -30,11 +30,11 @@ class Sim:
 
     def __call__(self, event: str) -> Situation:
         e = parse_event(event)
-        if isinstance(e, str):
+        if e.kind is EventKind.TIMER:
             self.sit = self.m.fire_timer(self.sit, e, self.inputs)
         else:
             after = dict(self.inputs)
-            after[e[0]] = e[1]
+            after[e.name] = e.rising
             self.sit = self.m.react(self.sit, self.inputs, after)
             self.inputs = after
         return self.sit

@@ -10,11 +10,11 @@ from __future__ import annotations
 
 from collections import deque
 from dataclasses import dataclass, field
-from typing import Callable, Mapping, Sequence
+from typing import Callable, Mapping
 
 from synth.errors import LimitExceeded
 from synth.logic.cubes import Cubes, condition_text
-from synth.logic.expr import edge_text
+from synth.logic.events import Event, EventKind
 from synth.grafcet.machine import GrafcetMachine, Situation
 
 __all__ = ["ASSState", "ASSTransition", "ASS", "stable_situation_automaton", "MAX_INPUTS"]
@@ -40,7 +40,7 @@ class ASSTransition:
     """``source --event [condition]--> target`` (condition on the other inputs, ``any`` if none)."""
 
     source: int
-    event: str
+    event: Event
     condition: str
     target: int
 
@@ -136,12 +136,12 @@ def stable_situation_automaton(
     reached: list[int] = [1 << v0]
     pending: list[int] = [1 << v0]
     relevant: list[int] = []
-    timers: list[tuple[str, ...]] = []
-    labels: list[str] = [edge_text(r, n) for n in read for r in (True, False)]
+    timers: list[tuple[Event, ...]] = []
+    labels: list[Event] = [Event.edge(n, r) for n in read for r in (True, False)]
     # (situation, label) -> [(vectors covered, target)], from memoised runs
-    memo: dict[tuple[int, str], list[tuple[int, int]]] = {}
+    memo: dict[tuple[int, Event], list[tuple[int, int]]] = {}
     # (situation, label) -> {target: vectors before the event}
-    moves: dict[tuple[int, str], dict[int, int]] = {}
+    moves: dict[tuple[int, Event], dict[int, int]] = {}
     queue: deque[int] = deque([0])
     queued = {0}
 
@@ -162,9 +162,9 @@ def stable_situation_automaton(
 
     known(s0)
 
-    def classify(k: int, label: str, event: tuple[str, bool] | str, after: int) -> dict[int, int]:
+    def classify(k: int, event: Event, after: int) -> dict[int, int]:
         """Target situation of each vector of ``after`` (values once the event happened)."""
-        entries = memo.setdefault((k, label), [])
+        entries = memo.setdefault((k, event), [])
         out: dict[int, int] = {}
         rest = after
         for covered, target in entries:
@@ -175,7 +175,7 @@ def stable_situation_automaton(
         while rest:
             v = (rest & -rest).bit_length() - 1
             reader = _Reader(v, index, base)
-            if isinstance(event, str):
+            if event.kind is EventKind.TIMER:
                 result = machine.fire_timer_with_trace(sits[k], event, reader)[0]  # type: ignore[arg-type]
             else:
                 result = machine.react_event(sits[k], event, reader)[0]  # type: ignore[arg-type]
@@ -211,13 +211,13 @@ def stable_situation_automaton(
                     add(k, after)
                     continue
                 label = labels[2 * i + (0 if rising else 1)]
-                for target, vecs in classify(k, label, (n, rising), after).items():
+                for target, vecs in classify(k, label, after).items():
                     add(target, vecs)
                     if target != k:
                         m = moves.setdefault((k, label), {})
                         m[target] = m.get(target, 0) | cubes.flip(vecs, i)
         for t in timers[k]:
-            for target, vecs in classify(k, t, t, todo).items():
+            for target, vecs in classify(k, t, todo).items():
                 add(target, vecs)
                 if target != k:
                     m = moves.setdefault((k, t), {})

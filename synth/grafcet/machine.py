@@ -41,13 +41,12 @@ Example
 
 from __future__ import annotations
 
-from collections import deque
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Callable, Mapping, Sequence
 
-from synth.errors import InputError, LimitExceeded
+from synth.errors import InputError
 from synth.logic.events import Event
-from synth.logic.expr import And, Const, Edge, Expr, Not, Var, edge_text, names
+from synth.logic.expr import And, Const, Edge, Expr, Not, Var, names
 from synth.grafcet.language import (
     CONDITIONAL,
     CONTINUOUS,
@@ -95,7 +94,7 @@ class Situation:
 
 # --------------------------------------------------------------------------- compiled expressions
 
-_Fn = Callable[[Mapping[str, bool], frozenset[str], frozenset[str], "tuple[str, bool] | None"], bool]
+_Fn = Callable[[Mapping[str, bool], frozenset[str], frozenset[str], "Event | None"], bool]
 
 
 def _code(e: Expr, steps: set[str], timers: set[str]) -> str:
@@ -108,7 +107,7 @@ def _code(e: Expr, steps: set[str], timers: set[str]) -> str:
     if isinstance(e, Const):
         return "True" if e.value else "False"
     if isinstance(e, Edge):
-        return f"(E == {(e.name, e.rising)!r})"
+        return f"(E == {str(e.event)!r})"
     if isinstance(e, Not):
         return f"(not {_code(e.arg, steps, timers)})"
     op = " and " if isinstance(e, And) else " or "
@@ -156,6 +155,12 @@ class GrafcetMachine:
         self._rec = [_compile(t.receptivity, steps, timers) for t in self.transitions]
         self._enabled_cache: dict[frozenset[str], tuple[int, ...]] = {}
         self._rec_inputs = [frozenset(receptivity_inputs(t, self.inputs)) for t in self.transitions]
+        self._rec_steps = [
+            frozenset(n.name[1:] for n in names(t.receptivity)
+                      if isinstance(n, Var) and n.name[:1] == "X" and n.name[1:] in steps and n.name not in timers)
+            for t in self.transitions
+        ]
+        self._index = {t: i for i, t in enumerate(self.transitions)}
         self._steps = {s.name: s for s in grafcet.steps}
         self._cond: dict[tuple[str, int], _Fn] = {}
         for s in grafcet.steps:
@@ -191,13 +196,13 @@ class GrafcetMachine:
         changed = [n for n in self.inputs if bool(before[n]) != bool(after[n])]
         if len(changed) > 1:
             raise ValueError(f"one input changes per event, not {len(changed)}: {', '.join(changed)}")
-        event = (changed[0], bool(after[changed[0]])) if changed else None
+        event = Event.edge(changed[0], bool(after[changed[0]])) if changed else None
         return self.react_event(sit, event, after)
 
     def react_event(
-        self, sit: Situation, event: tuple[str, bool] | None, after: Mapping[str, bool]
+        self, sit: Situation, event: Event | None, after: Mapping[str, bool]
     ) -> tuple[Situation, tuple[tuple[Transition, ...], ...]]:
-        """The stable situation after input ``event`` (``("dcy", True)`` is ``↑dcy``),
+        """The stable situation after input ``event`` (an edge such as ``↑dcy``),
         ``after`` being the input values once it happened; with the rounds fired."""
         st = self._state(sit)
         if event is not None:
@@ -206,7 +211,7 @@ class GrafcetMachine:
         self._settle(st, after, event, rounds)
         return self._situation(st), tuple(rounds)
 
-    def timers(self, sit: Situation) -> tuple[str, ...]:
+    def timers(self, sit: Situation) -> tuple[Event, ...]:
         """Timer events that can occur now (sorted): the step is active, the timer has not
         elapsed, and no shorter timer of the same step is still running (timers of one
         step start together, so ``2s/X1`` always elapses before ``5s/X1``)."""
@@ -217,7 +222,7 @@ class GrafcetMachine:
             if running:
                 first = min(self._seconds[t] for t in running)
                 out += [t for t in running if self._seconds[t] == first]
-        return tuple(sorted(out))
+        return tuple(Event.timer(t) for t in sorted(out))
 
     def fire_timer(self, sit: Situation, timer: str, inputs: Mapping[str, bool]) -> Situation:
         """The stable situation after ``timer`` elapses (inputs unchanged)."""
@@ -260,6 +265,32 @@ class GrafcetMachine:
             if all(s in active for s in t.sources) and self._rec[i](inputs, active, elapsed, None)
         ]
 
+    def enabling_events(self, sit: Situation, t: Transition, inputs: Mapping[str, bool]) -> tuple[Event, ...]:
+        """The single input changes that would make ``t`` fireable in ``sit`` (inputs at
+        ``inputs``), in input-name order.
+
+        >>> from synth.grafcet.language import parse_grafcet
+        >>> m = GrafcetMachine(parse_grafcet("grafcet G { initial step 0 step 1 "
+        ...                    "transition 0 -> 1 when ↑a . !b }"))
+        >>> s0 = m.initial({"a": False, "b": False})
+        >>> m.enabling_events(s0, m.transitions[0], {"a": False, "b": False})
+        ('↑a',)
+        """
+        i = self._index[t]
+        active, elapsed = frozenset(sit.steps), frozenset(sit.elapsed)
+        out = []
+        for x in sorted(self._rec_inputs[i] & inputs.keys()):
+            after = dict(inputs)
+            after[x] = not inputs[x]
+            event = Event.edge(x, after[x])
+            if self._rec[i](after, active, elapsed, event):
+                out.append(event)
+        return tuple(out)
+
+    def waiting_steps(self, sit: Situation, t: Transition) -> tuple[str, ...]:
+        """Step variables read by ``t``'s receptivity whose step is not active in ``sit``."""
+        return tuple(sorted("X" + s for s in self._rec_steps[self._index[t]] if s not in sit.steps))
+
     def relevant_inputs(self, sit: Situation) -> frozenset[str]:
         """Inputs whose change may change ``sit``: read by an enabled transition or by an
         event action of an active step."""
@@ -298,7 +329,7 @@ class GrafcetMachine:
         st.stored |= sets
         st.stored -= resets
 
-    def _event_actions(self, st: _State, inputs: Mapping[str, bool], event: tuple[str, bool]) -> None:
+    def _event_actions(self, st: _State, inputs: Mapping[str, bool], event: Event) -> None:
         sets: set[str] = set()
         resets: set[str] = set()
         active, elapsed = frozenset(st.active), frozenset(st.elapsed)
@@ -313,7 +344,7 @@ class GrafcetMachine:
         self,
         st: _State,
         inputs: Mapping[str, bool],
-        event: tuple[str, bool] | None,
+        event: Event | None,
         rounds: list[tuple[Transition, ...]],
     ) -> None:
         """Search for stability, in place. Edges (``event``) hold in the first round only."""

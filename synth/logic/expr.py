@@ -26,6 +26,7 @@ from typing import Any, Callable, Iterator, Union
 
 
 from synth.errors import Location
+from synth.logic.events import Event
 
 __all__ = [
     "Expr",
@@ -53,9 +54,9 @@ class NormalFormTooLarge(ValueError):
     """The disjunctive normal form would have more monomials than the limit."""
 
 
-def edge_text(rising: bool, name: str) -> str:
-    """``↑name`` or ``↓name``."""
-    return ("↑" if rising else "↓") + name
+def edge_text(rising: bool, name: str) -> Event:
+    """The event ``↑name`` or ``↓name``."""
+    return Event.edge(name, rising)
 
 
 @dataclass(frozen=True)
@@ -88,8 +89,8 @@ class Edge:
         return edge_text(self.rising, self.name)
 
     @property
-    def event(self) -> str:
-        return self.text()
+    def event(self) -> Event:
+        return Event.edge(self.name, self.rising)
 
 
 @dataclass(frozen=True)

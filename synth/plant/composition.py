@@ -31,6 +31,7 @@ from typing import Callable, Iterator, Mapping
 import numpy as np
 
 from synth.errors import SynthError, close_names
+from synth.logic.events import Event
 from synth.logic.expr import Expr, evaluate
 from synth.plant.element import ElementAutomaton, element_automaton
 from synth.plant.rules import RuleSet
@@ -49,7 +50,7 @@ class LocalTransition:
     axis: int
     src: int
     dst: int
-    event: str
+    event: Event
     controllable: bool
 
 
@@ -103,7 +104,7 @@ class Plant:
         return tuple(out)
 
     @cached_property
-    def events(self) -> dict[str, bool]:
+    def events(self) -> dict[Event, bool]:
         """Every event of the plant and whether it is controllable, sorted by name."""
         return dict(sorted({t.event: t.controllable for t in self.transitions}.items()))
 

@@ -27,12 +27,15 @@ from __future__ import annotations
 
 from collections import deque
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
+from typing import Iterable
 
 import numpy as np
 
 from synth.errors import InputError
-from synth.logic.expr import edge_text, evaluate
+from synth.logic.events import Event
+from synth.logic.expr import evaluate
 from synth.plant.rules import ORDER, ElementSpec
 
 __all__ = ["ElementAutomaton", "element_automaton"]
@@ -79,13 +82,13 @@ class ElementAutomaton:
         i = self.variables.index(name)
         return ((self.codes >> i) & 1).astype(bool)
 
-    def event(self, t: int) -> str:
-        """Name of transition ``t``'s event, ``↑x`` or ``↓x`` (rising iff the target has x=1)."""
+    def event(self, t: int) -> Event:
+        """Transition ``t``'s event, ``↑x`` or ``↓x`` (rising iff the target has x=1)."""
         i = int(self.var[t])
         rising = bool((self.codes[self.dst[t]] >> i) & 1)
-        return edge_text(rising, self.variables[i])
+        return Event.edge(self.variables[i], rising)
 
-    def events(self) -> list[str]:
+    def events(self) -> list[Event]:
         return [self.event(t) for t in range(self.src.size)]
 
     def true_variables(self, k: int) -> tuple[str, ...]:
@@ -96,7 +99,12 @@ class ElementAutomaton:
         return "{" + ",".join(self.true_variables(k)) + "}"
 
     def uncontrollable_closure(self) -> np.ndarray:
-        """``R[k, j]``: local state j is reachable from k by uncontrollable transitions (k included)."""
+        """``R[k, j]``: local state j is reachable from k by uncontrollable transitions (k included).
+        Computed once per automaton."""
+        return self._closure
+
+    @cached_property
+    def _closure(self) -> np.ndarray:
         n = self.size
         reach = np.eye(n, dtype=bool)
         u = ~self.controllable
@@ -107,6 +115,29 @@ class ElementAutomaton:
             if np.array_equal(nxt, reach):
                 return reach
             reach = nxt
+
+    def is_true(self, k: int, name: str) -> bool:
+        """Value of variable ``name`` in local state ``k``."""
+        return bool((int(self.codes[k]) >> self.variables.index(name)) & 1)
+
+    def flipped(self, k: int, names: Iterable[str]) -> int | None:
+        """The local state equal to ``k`` but for ``names`` flipped, if it is a state
+        of the element (incoherent codes are not)."""
+        code = int(self.codes[k])
+        for name in names:
+            code ^= 1 << self.variables.index(name)
+        j = int(np.searchsorted(self.codes, code))
+        return j if j < self.size and int(self.codes[j]) == code else None
+
+    def drift(self, k: int) -> tuple[Event, ...]:
+        """Events the element can do from ``k`` on its own (uncontrollable moves only), sorted."""
+        reach = self._closure[k]
+        return tuple(sorted({self.event(t) for t in range(self.src.size)
+                             if not self.controllable[t] and reach[int(self.src[t])]}))
+
+    def produces(self, k: int, event: Event) -> bool:
+        """``event`` can occur from ``k`` without any order change (uncontrollable moves)."""
+        return event in self.drift(k)
 
 
 def element_automaton(e: ElementSpec) -> ElementAutomaton:

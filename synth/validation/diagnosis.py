@@ -1,4 +1,4 @@
-"""Diagnosis: the analysis the thesis leaves to a human (METHOD.md §7, lines 3360-3430).
+"""Diagnosis: the analysis the thesis leaves to a human (docs/method.md, diagnosis).
 
 For a blocking state: which receptivities are awaited; which sensor events would make
 each one true; which orders cause those events, through which rules of which element;
@@ -19,26 +19,39 @@ not which constraints forbid them. From that a verdict in plain words:
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from enum import StrEnum
 from itertools import combinations
 from typing import Any, Iterable, Sequence
 
-import numpy as np
-
+from synth.logic.events import Event
 from synth.plant.composition import Plant
-from synth.logic.expr import Var, edge_text, evaluate, names
-from synth.grafcet.language import Transition
+from synth.plant.element import ElementAutomaton
+from synth.plant.rules import VarKind
 from synth.validation.sync import Node, Prohibition, Sync
 
-__all__ = ["Cause", "Awaited", "Diagnosis", "diagnose", "diagnose_prohibition"]
+__all__ = ["Verdict", "Cause", "Awaited", "Diagnosis", "diagnose", "diagnose_prohibition"]
+
+
+class Verdict(StrEnum):
+    """The verdict on a blocking state, most specific first (the cascade's order)."""
+
+    DEAD_END = "dead_end"
+    PROHIBITED_ORDER = "prohibited_order"
+    ELEMENT_MODEL = "element_model"
+    MISSING_ORDER = "missing_order"
+    TRAP = "trap"
+    UNPRODUCIBLE_EVENT = "unproducible_event"
+    WAITING = "waiting"
+    UNKNOWN = "unknown"
 
 
 @dataclass(frozen=True)
 class Cause:
     """How an awaited sensor event could happen, seen from its element."""
 
-    event: str
+    event: Event
     element: str | None
-    changes: tuple[str, ...] = ()  # order changes needed (↑AVANCER2)
+    changes: tuple[Event, ...] = ()  # order changes needed (↑AVANCER2)
     rules: tuple[str, ...] = ()  # rules producing the event
     emitted: bool = False  # the situation asks for those changes
     authorised: bool = True  # SUP allows them here
@@ -65,7 +78,7 @@ class Awaited:
     transition: str
     grafcet: str
     receptivity: str
-    events: tuple[str, ...]  # input events that would make it true (one event each)
+    events: tuple[Event, ...]  # input events that would make it true (one event each)
     steps: tuple[str, ...] = ()  # step variables it waits on, not active
     causes: tuple[Cause, ...] = ()
     sources: tuple[str, ...] = ()  # the transition's source steps
@@ -84,7 +97,7 @@ class Awaited:
 
 @dataclass(frozen=True)
 class Diagnosis:
-    verdict: str
+    verdict: Verdict
     summary: str
     awaited: tuple[Awaited, ...] = ()
     details: tuple[str, ...] = field(default=())
@@ -98,86 +111,26 @@ class Diagnosis:
         }
 
 
-def _value_fn(sync: Sync, node: Node, inputs: dict[str, bool]):
-    sit = node.situation
-    active = {f"X{s}" for s in sit.steps}
-    elapsed = set(sit.elapsed)
-
-    def value(name: str) -> bool:
-        if name in inputs:
-            return inputs[name]
-        if name in elapsed:
-            return True
-        return name in active
-
-    return value
-
-
-def _awaited_events(sync: Sync, node: Node, t: Transition) -> tuple[tuple[str, ...], tuple[str, ...]]:
-    """Input events (single input changes) that make ``t``'s receptivity true, and the
-    step variables it reads that are not active."""
-    inputs = sync.inputs(node.plant)
-    used = sorted({n.name for n in names(t.receptivity) if n.name in inputs})
-    events = []
-    for x in used:
-        after = dict(inputs)
-        after[x] = not inputs[x]
-        rising = after[x]
-        val = _value_fn(sync, node, after)
-        ok = evaluate(t.receptivity, val, lambda e: e.name == x and e.rising == rising)
-        if ok:
-            events.append(edge_text(rising, x))
-    active = {f"X{s}" for s in node.situation.steps}
-    steps = tuple(
-        sorted({n.name for n in names(t.receptivity) if isinstance(n, Var) and n.name.startswith("X")
-                and n.name not in inputs and "/" not in n.name and n.name not in active})
-    )
-    return tuple(events), steps
-
-
-def _element_cause(sync: Sync, node: Node, event: str) -> Cause:
+def _element_cause(sync: Sync, node: Node, event: Event) -> Cause:
+    """How ``event`` (an edge of a plant variable) could happen from ``node``: the fewest
+    order changes after which its element produces it on its own, and whether the
+    situation asks for them and SUP allows them here."""
     p: Plant = sync.plant
-    name = event[1:]
-    rising = event[0] == "↑"
-    if name not in p.owner:
+    if event.name not in p.owner:
         return Cause(event, None)
-    axis = p.owner[name]
+    axis = p.owner[event.name]
     a = p.elements[axis]
     spec = a.spec
-    decl = spec.variable(name)
-    if decl is not None and decl.kind == "free":
+    decl = spec.variable(event.name)
+    if decl is not None and decl.kind == VarKind.FREE:
         return Cause(event, a.name, producible_now=True, free=True)
-    rules = tuple(r.text() for r in spec.rules if r.consequence.name == name and r.consequence.rising == rising)
+    rules = tuple(r.text() for r in spec.rules if r.consequence.event == event)
     k = node.plant[axis]
-    code = int(a.codes[k])
-    bit = {v: i for i, v in enumerate(a.variables)}
-    orders = [v.name for v in spec.orders if not v.held]
-    closure = a.uncontrollable_closure()
-    ev_trans = [t for t in range(a.src.size) if not a.controllable[t] and a.event(t) == event]
-
-    def producible_from(local_code: int) -> bool:
-        hits = np.nonzero(a.codes == local_code)[0]
-        if hits.size == 0:
-            return False
-        reach = closure[int(hits[0])]
-        return any(reach[int(a.src[t])] for t in ev_trans)
-
-    now = producible_from(code)
-    best: tuple[str, ...] | None = None
-    for n_changes in range(1, len(orders) + 1):
-        for subset in combinations(orders, n_changes):
-            c = code
-            for o in subset:
-                c ^= 1 << bit[o]
-            if producible_from(c):
-                best = tuple(edge_text(bool((c >> bit[o]) & 1), o) for o in subset)
-                break
-        if best is not None:
-            break
+    now = a.produces(k, event)
+    best = _fewest_changes(a, k, event, [v.name for v in spec.orders if not v.held])
     if best is None:
         return Cause(event, a.name, (), rules, producible_now=now)
-    wanted = node.emitted
-    emitted = all((ch[0] == "↑") == (ch[1:] in wanted) for ch in best)
+    emitted = all(ch.rising == (ch.name in node.emitted) for ch in best)
     constraints: list[str] = []
     authorised = True
     proh = {pr.event: pr for pr in node.proh}
@@ -193,6 +146,17 @@ def _element_cause(sync: Sync, node: Node, event: str) -> Cause:
                     authorised = False
                     constraints += [c for c in why if c not in constraints]
     return Cause(event, a.name, best, rules, emitted, authorised, tuple(constraints), now)
+
+
+def _fewest_changes(a: ElementAutomaton, k: int, event: Event, orders: Sequence[str]) -> tuple[Event, ...] | None:
+    """The smallest set of order changes (first in ``orders`` order) after which element
+    ``a``, in local state ``k``, produces ``event`` by itself; None if none does."""
+    for n_changes in range(1, len(orders) + 1):
+        for subset in combinations(orders, n_changes):
+            j = a.flipped(k, subset)
+            if j is not None and a.produces(j, event):
+                return tuple(Event.edge(o, a.is_true(j, o)) for o in subset)
+    return None
 
 
 def _emitting_steps(sync: Sync, node: Node, order: str) -> tuple[str, ...]:
@@ -219,8 +183,11 @@ def diagnose(sync: Sync, node_index: int, *, expert: bool = False, component: Se
     terminal component it belongs to (the states it can still move between)."""
     node = sync.nodes[node_index]
     awaited: list[Awaited] = []
-    for t in sync.machine.awaited(node.situation):
-        events, steps = _awaited_events(sync, node, t)
+    machine = sync.machine
+    inputs = sync.inputs(node.plant)
+    for t in machine.awaited(node.situation):
+        events = machine.enabling_events(node.situation, t, inputs)
+        steps = machine.waiting_steps(node.situation, t)
         causes = tuple(_element_cause(sync, node, e) for e in events)
         awaited.append(Awaited(t.name, t.grafcet, t.receptivity.text(), events, steps, causes, tuple(t.sources)))
     details = []
@@ -232,7 +199,7 @@ def diagnose(sync: Sync, node_index: int, *, expert: bool = False, component: Se
         details.append(f"transition {a.transition} of {a.grafcet} awaits {a.receptivity}: it becomes true with {' or '.join(a.events)}")
         for c in a.causes:
             if c.element is None:
-                details.append(f"  {c.event}: no plant element drives {c.event[1:]}")
+                details.append(f"  {c.event}: no plant element drives {c.event.name}")
                 continue
             if c.free:
                 details.append(f"  {c.event}: an operator input, it may change at any time")
@@ -252,12 +219,12 @@ def diagnose(sync: Sync, node_index: int, *, expert: bool = False, component: Se
 
 def _verdict(
     sync: Sync, node: Node, awaited: list[Awaited], expert: bool, component: Sequence[int]
-) -> tuple[str, str]:
+) -> tuple[Verdict, str]:
     p = sync.plant
     if not awaited:
         steps = ", ".join(f"X{s}" for s in node.situation.steps)
         return (
-            "dead_end",
+            Verdict.DEAD_END,
             f"no transition leaves the active steps {{{steps}}}: the Grafcet stops here and never returns "
             "to its initial situation",
         )
@@ -269,7 +236,7 @@ def _verdict(
 
     def by_rule(c: Cause) -> str:
         """The element, and its first rule producing the event whose cause is a needed change."""
-        spec = p.elements[p.owner[c.event[1:]]].spec
+        spec = p.elements[p.owner[c.event.name]].spec
         causing = [r.text() for r in spec.rules if r.cause.text() in c.changes and r.consequence.text() == c.event]
         rules = causing or list(c.rules)
         return f"element {c.element}" + (f", rule {rules[0]}" if rules else "")
@@ -277,7 +244,7 @@ def _verdict(
     # 1. an order the awaited event needs is emitted but prohibited by SUP
     for a, c in items:
         if c.changes and c.emitted and not c.authorised:
-            order = c.changes[0][1:]
+            order = c.changes[0].name
             steps = _emitting_steps(sync, node, order)
             where = f" in step {', '.join(steps)}" if steps else ""
             who = (
@@ -286,7 +253,7 @@ def _verdict(
                 else "wrong control or over-strict constraint"
             )
             return (
-                "prohibited_order",
+                Verdict.PROHIBITED_ORDER,
                 f"order {order}{where} prohibited by {_named(sync, c.constraints)}: {context(a)}, "
                 f"which needs {c.event}, caused by {order} ({by_rule(c)}); SUP forbids {c.changes[0]} here: {who}",
             )
@@ -294,7 +261,7 @@ def _verdict(
     if node.proh and expert:
         pr = node.proh[0]
         return (
-            "prohibited_order",
+            Verdict.PROHIBITED_ORDER,
             f"order {pr.order} prohibited by {_named(sync, pr.constraints)}: the trusted Grafcet emits it "
             f"and SUP forbids {pr.event} here, so the constraint is over-strict",
         )
@@ -303,18 +270,16 @@ def _verdict(
         for a, c in items:
             if c.element is None or c.producible_now:
                 continue
-            axis = p.owner[c.event[1:]]
+            axis = p.owner[c.event.name]
             el = p.elements[axis]
             own_orders = [o for o in el.variables if o in el.orders]
             emitted_here = [o for o in own_orders if o in node.emitted]
             if emitted_here and not any(pr.order in own_orders for pr in node.proh):
                 state = el.state_label(node.plant[axis])
-                reach = el.uncontrollable_closure()[node.plant[axis]]
-                moves = sorted({el.event(t) for t in range(el.src.size)
-                                if not el.controllable[t] and reach[int(el.src[t])]})
+                moves = el.drift(node.plant[axis])
                 drift = f"; under these orders it only does {', '.join(moves)}" if moves else "; under these orders it does not move"
                 return (
-                    "element_model",
+                    Verdict.ELEMENT_MODEL,
                     f"element {c.element} cannot produce the awaited {c.event}: {', '.join(emitted_here)} "
                     f"{'is' if len(emitted_here) == 1 else 'are'} emitted and authorised, {c.element} is in {state}, "
                     f"and no rule of {c.element} produces {c.event} there: an occurrence rule is missing or its guard "
@@ -324,18 +289,18 @@ def _verdict(
     for a, c in items:
         if c.changes and not c.emitted:
             ch = c.changes[0]
-            order = ch[1:]
+            order = ch.name
             steps = a.sources
             step_text = f" in step {', '.join(steps)}" if steps else ""
             sup = "SUP authorises it here" if c.authorised else f"SUP forbids it here ({_named(sync, c.constraints)})"
-            if ch[0] == "↑":
+            if ch.rising:
                 return (
-                    "missing_order",
+                    Verdict.MISSING_ORDER,
                     f"missing order {order}{step_text}: {context(a)}, which needs {c.event}; "
                     f"only {order} causes {c.event} ({by_rule(c)}) and {sup}",
                 )
             return (
-                "missing_order",
+                Verdict.MISSING_ORDER,
                 f"order {order} must be released{step_text}: {context(a)}, which needs {c.event}; "
                 f"{c.event} only follows {ch} ({by_rule(c)}) and {sup}",
             )
@@ -344,7 +309,7 @@ def _verdict(
         sits = sorted({sync.nodes[i].situation for i in component} or {node.situation})
         events = sorted({c.event for _, c in free})
         return (
-            "trap",
+            Verdict.TRAP,
             f"the Grafcet keeps evolving on operator inputs ({', '.join(events)}) between "
             f"{', '.join(s.text() for s in sits)} but can never return to its initial situation: "
             f"a loop with no way out ({context(free[0][0])})",
@@ -354,25 +319,25 @@ def _verdict(
         if not c.changes and not c.rules:
             owner = f"element {c.element}" if c.element else "no element"
             return (
-                "unproducible_event",
+                Verdict.UNPRODUCIBLE_EVENT,
                 f"awaited event {c.event} can never occur: {context(a)} and {owner} has no rule producing {c.event}",
             )
     for a, c in items:
         if not c.changes:
             return (
-                "unproducible_event",
+                Verdict.UNPRODUCIBLE_EVENT,
                 f"awaited event {c.event} cannot occur from the current state of element {c.element}: {context(a)}",
             )
     if node.proh:
         pr = node.proh[0]
         return (
-            "prohibited_order",
+            Verdict.PROHIBITED_ORDER,
             f"order {pr.order} prohibited by {_named(sync, pr.constraints)}: the situation emits it and SUP forbids {pr.event}",
         )
     waits = sorted({s for a in awaited for s in a.steps})
     if waits:
-        return ("waiting", f"the situation only waits on steps {', '.join(waits)}, which can no longer become active")
-    return ("unknown", "no awaited receptivity can become true and no order change is prohibited")
+        return (Verdict.WAITING, f"the situation only waits on steps {', '.join(waits)}, which can no longer become active")
+    return (Verdict.UNKNOWN, "no awaited receptivity can become true and no order change is prohibited")
 
 
 def diagnose_prohibition(sync: Sync, node_index: int, pr: Prohibition) -> str:
@@ -381,7 +346,7 @@ def diagnose_prohibition(sync: Sync, node_index: int, pr: Prohibition) -> str:
     order = pr.order
     steps = _emitting_steps(sync, node, order)
     where = f" by step {', '.join(steps)}" if steps else ""
-    verb = "emitted" if pr.event[0] == "↑" else "released"
+    verb = "emitted" if pr.event.rising else "released"
     return (
         f"order {order} {verb}{where} in situation {node.situation.text()} is prohibited by "
         f"{_named(sync, pr.constraints)}: SUP forbids {pr.event} there"

@@ -1,4 +1,4 @@
-"""SYNC: the Grafcet's stable situations running against SUP (METHOD.md §6).
+"""SYNC: the Grafcet's stable situations running against SUP (docs/method.md, SYNC).
 
 A SYNC state pairs a plant state of SUP with a stable situation. In a situation the
 controller wants the orders it emits: the controllable transitions that change Z one
@@ -34,10 +34,12 @@ from collections import deque
 from dataclasses import dataclass, field
 from typing import Callable, Sequence
 
-from synth.plant.composition import LocalTransition, Plant
 from synth.errors import LimitExceeded
-from synth.plant.rules import Constraint
+from synth.grafcet.language import Transition
 from synth.grafcet.machine import GrafcetMachine, Situation
+from synth.logic.events import Event
+from synth.plant.composition import LocalTransition, Plant
+from synth.plant.rules import Constraint
 from synth.sup.constraints import CompiledConstraints
 
 __all__ = ["Prohibition", "Node", "Edge", "Conflict", "Sync", "synchronous_product", "region"]
@@ -49,12 +51,12 @@ Local = tuple[int, ...]
 class Prohibition:
     """An order change the situation asks for and SUP refuses: ``event`` is ``↑Z``/``↓Z``."""
 
-    event: str
+    event: Event
     constraints: tuple[str, ...]
 
     @property
     def order(self) -> str:
-        return self.event[1:]
+        return self.event.name
 
 
 @dataclass(frozen=True)
@@ -71,7 +73,7 @@ class Node:
 @dataclass(frozen=True)
 class Edge:
     source: int
-    event: str  # ↑v11, ↓dcy, 2s/X101
+    event: Event  # ↑v11, ↓dcy, 2s/X101
     target: int
 
 
@@ -81,36 +83,41 @@ class Conflict:
     receptivities were true at once): every branch became active."""
 
     node: int  # the aggregated state the event left
-    event: str
+    event: Event
     step: str
     transitions: tuple[str, ...]
 
 
-@dataclass
+@dataclass(frozen=True)
 class Sync:
-    """The aggregated view of SYNC, explored from the initial state."""
+    """The aggregated view of SYNC, explored from the initial state (fully built:
+    successors and predecessors are indexed on construction)."""
 
     plant: Plant
     oracle: CompiledConstraints
     machine: GrafcetMachine
-    nodes: list[Node] = field(default_factory=list)
-    edges: list[Edge] = field(default_factory=list)
+    nodes: tuple[Node, ...] = ()
+    edges: tuple[Edge, ...] = ()
     initial: tuple[int, ...] = ()  # the initial region may settle in several plant states
-    conflicts: list["Conflict"] = field(default_factory=list)
+    conflicts: tuple[Conflict, ...] = ()
     sync_states: int = 0  # SYNC states (all region members)
+    _out: tuple[list[Edge], ...] = field(init=False, repr=False, compare=False)
+    _in: tuple[list[Edge], ...] = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        out: tuple[list[Edge], ...] = tuple([] for _ in self.nodes)
+        into: tuple[list[Edge], ...] = tuple([] for _ in self.nodes)
+        for e in self.edges:
+            out[e.source].append(e)
+            into[e.target].append(e)
+        object.__setattr__(self, "_out", out)
+        object.__setattr__(self, "_in", into)
 
     def successors(self, i: int) -> list[Edge]:
         return self._out[i]
 
     def predecessors(self, i: int) -> list[Edge]:
         return self._in[i]
-
-    def index(self) -> None:
-        self._out: list[list[Edge]] = [[] for _ in self.nodes]
-        self._in: list[list[Edge]] = [[] for _ in self.nodes]
-        for e in self.edges:
-            self._out[e.source].append(e)
-            self._in[e.target].append(e)
 
     def inputs(self, local: Local) -> dict[str, bool]:
         val = self.plant.valuation(local)
@@ -124,7 +131,7 @@ def _order_moves(p: Plant) -> dict[str, list[LocalTransition]]:
     moves: dict[str, list[LocalTransition]] = {}
     for t in p.transitions:
         if t.controllable:
-            moves.setdefault(t.event[1:], []).append(t)
+            moves.setdefault(t.event.name, []).append(t)
     return moves
 
 
@@ -184,7 +191,13 @@ def synchronous_product(
 ) -> Sync:
     """Explore SYNC from (initial plant state, initial situation), aggregated per region."""
     oracle = CompiledConstraints(p, constraints)
-    sync = Sync(p, oracle, machine)
+    nodes: list[Node] = []
+    edges: list[Edge] = []
+    conflicts: list[Conflict] = []
+
+    def inputs(local: Local) -> dict[str, bool]:
+        val = p.valuation(local)
+        return {n: val[n] for n in machine.inputs if n in val}
     moves = _order_moves(p)
     uncontrollable = [t for t in p.transitions if not t.controllable]
     index: dict[tuple[Situation, Local], int] = {}
@@ -194,7 +207,7 @@ def synchronous_product(
     def enter(sit: Situation, entry: Local) -> list[int]:
         key = (sit, entry)
         if key not in region_cache:
-            wanted = machine.orders(sit, sync.inputs(entry))
+            wanted = machine.orders(sit, inputs(entry))
             members, settled = region(p, oracle, entry, wanted, moves)
             sync_seen.update((sit, m) for m in members)
             region_cache[key] = settled
@@ -202,13 +215,13 @@ def synchronous_product(
         for q, proh in region_cache[key]:
             nk = (sit, q)
             if nk not in index:
-                wanted = machine.orders(sit, sync.inputs(q))
+                wanted = machine.orders(sit, inputs(q))
                 val = p.valuation(q)
                 ords = tuple(sorted(o for o in wanted if val.get(o, False)))
-                index[nk] = len(sync.nodes)
-                sync.nodes.append(Node(sit, q, frozenset(wanted), ords, proh))
+                index[nk] = len(nodes)
+                nodes.append(Node(sit, q, frozenset(wanted), ords, proh))
                 queue.append(index[nk])
-                if max_states is not None and len(sync.nodes) > max_states:
+                if max_states is not None and len(nodes) > max_states:
                     raise LimitExceeded(
                         f"more than {max_states} aggregated states; raise --max-states or simplify the model"
                     )
@@ -217,7 +230,7 @@ def synchronous_product(
 
     seen_conflicts: set[tuple[str, tuple[str, ...]]] = set()
 
-    def note_conflicts(i: int, event: str, rounds) -> None:
+    def note_conflicts(i: int, event: Event, rounds: Sequence[Sequence[Transition]]) -> None:
         for fired in rounds:
             by_step: dict[str, list[str]] = {}
             for tr in fired:
@@ -226,20 +239,19 @@ def synchronous_product(
             for st, names in by_step.items():
                 if len(names) > 1 and (st, tuple(names)) not in seen_conflicts:
                     seen_conflicts.add((st, tuple(names)))
-                    sync.conflicts.append(Conflict(i, event, st, tuple(names)))
+                    conflicts.append(Conflict(i, event, st, tuple(names)))
 
     queue: deque[int] = deque()
     if not oracle.kept(p.initial):
-        sync.index()
-        return sync
-    sit0 = machine.initial(sync.inputs(p.initial))
-    sync.initial = tuple(enter(sit0, p.initial))
+        return Sync(p, oracle, machine)
+    sit0 = machine.initial(inputs(p.initial))
+    initial = tuple(enter(sit0, p.initial))
     last = time.monotonic()
     while queue:
         i = queue.popleft()
-        node = sync.nodes[i]
+        node = nodes[i]
         cur = node.plant
-        before = sync.inputs(cur)
+        before = inputs(cur)
         for t in uncontrollable:
             if t.src != cur[t.axis]:
                 continue
@@ -248,22 +260,20 @@ def synchronous_product(
             n = tuple(nxt)
             if not oracle.kept(n):  # cannot happen from a SUP state; kept for safety
                 continue
-            after = sync.inputs(n)
+            after = inputs(n)
             sit, rounds = machine.react_with_trace(node.situation, before, after)
             note_conflicts(i, t.event, rounds)
             for j in enter(sit, n):
-                sync.edges.append(Edge(i, t.event, j))
+                edges.append(Edge(i, t.event, j))
         for timer in machine.timers(node.situation):
             sit, rounds = machine.fire_timer_with_trace(node.situation, timer, before)
             note_conflicts(i, timer, rounds)
             for j in enter(sit, cur):
-                sync.edges.append(Edge(i, timer, j))
+                edges.append(Edge(i, timer, j))
         if progress is not None and time.monotonic() - last > 0.5:
-            progress(len(sync.nodes), len(queue))
+            progress(len(nodes), len(queue))
             last = time.monotonic()
-    sync.sync_states = len(sync_seen)
-    sync.index()
-    return sync
+    return Sync(p, oracle, machine, tuple(nodes), tuple(edges), initial, tuple(conflicts), len(sync_seen))
 
 
 def stderr_progress(nodes: int, pending: int) -> None:  # pragma: no cover - terminal only
