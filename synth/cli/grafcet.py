@@ -16,14 +16,13 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from typing import TYPE_CHECKING, Callable, Iterator, Mapping, Sequence
+from typing import TYPE_CHECKING, Callable, Mapping
 
-from synth.errors import InputError, Location, close_names
 
 if TYPE_CHECKING:  # pragma: no cover - the library is imported by the commands only (fast --help)
     from synth.grafcet.language import Grafcet
 
-__all__ = ["register", "parse_events", "cmd_ass", "cmd_run"]
+__all__ = ["register", "cmd_ass", "cmd_run"]
 
 
 # --------------------------------------------------------------------------- loading
@@ -48,73 +47,10 @@ def _load(args: argparse.Namespace) -> tuple[Grafcet, dict[str, bool], Callable[
         grafcet = load_grafcet(args.file)
     initial = {n: initial.get(n, False) for n in grafcet.inputs}
     if args.initial:
-        initial.update(_parse_initial(args.initial, grafcet.inputs))
+        from synth.grafcet.simulation import parse_initial
+
+        initial.update(parse_initial(args.initial, grafcet.inputs))
     return grafcet, initial, admissible
-
-
-def _comma_items(text: str) -> Iterator[tuple[str, int]]:
-    """The non-empty comma-separated items of an option's text, with their 1-based columns.
-
-    >>> list(_comma_items("a, b,,c"))
-    [('a', 1), ('b', 4), ('c', 7)]
-    """
-    col = 1
-    for part in text.split(","):
-        item = part.strip()
-        start = col + (len(part) - len(part.lstrip()))
-        col += len(part) + 1
-        if item:
-            yield item, start
-
-
-def _parse_initial(text: str, inputs: Sequence[str]) -> dict[str, bool]:
-    """``"v10=1, v20=1"`` (or ``"v10, v20"``) → values; errors point into the option text."""
-    out: dict[str, bool] = {}
-    for item, start in _comma_items(text):
-        name, _, value = item.partition("=")
-        name = name.strip()
-        loc = Location("--initial", 1, start, text, max(1, len(name)))
-        if name not in inputs:
-            raise InputError(f"unknown input '{name}'", loc, suggestions=close_names(name, inputs))
-        if value.strip() not in ("", "0", "1"):
-            raise InputError(f"the value of {name} must be 0 or 1", loc)
-        out[name] = value.strip() != "0"
-    return out
-
-
-def parse_events(text: str, grafcet: Grafcet) -> list[tuple[str, tuple[str, bool] | str, Location]]:
-    """``"↑dcy, ^cp12, 2s/X101, _v10"`` → ``[(text, event, location), ...]``.
-
-    An input event is ``(name, rising)``; a timer event is its id. Unknown names are
-    :class:`InputError` located in the option text, with suggestions.
-    """
-    out: list[tuple[str, tuple[str, bool] | str, Location]] = []
-    timers = [t.id for t in grafcet.timers]
-    for item, start in _comma_items(text):
-        loc = Location("--events", 1, start, text, len(item))
-        if item[0] in "↑^↓_":
-            rising = item[0] in "↑^"
-            name = item[1:].strip()
-            if name not in grafcet.inputs:
-                raise InputError(
-                    f"unknown input '{name}' in event {item}",
-                    Location("--events", 1, start + 1, text, max(1, len(name))),
-                    suggestions=tuple(item[0] + c for c in close_names(name, grafcet.inputs)),
-                    notes=("inputs: " + ", ".join(grafcet.inputs),) if grafcet.inputs else (),
-                )
-            out.append((("↑" if rising else "↓") + name, (name, rising), loc))
-        elif item in timers:
-            out.append((item, item, loc))
-        else:
-            hint = close_names(item, timers + ["↑" + i for i in grafcet.inputs] + ["↓" + i for i in grafcet.inputs])
-            raise InputError(
-                f"unknown event '{item}'",
-                loc,
-                suggestions=hint,
-                notes=("an event is ↑x / ^x (rising), ↓x / _x (falling) of an input, or a timer of the Grafcet"
-                       + (": " + ", ".join(timers) if timers else ""),),
-            )
-    return out
 
 
 # --------------------------------------------------------------------------- commands
@@ -143,54 +79,13 @@ def cmd_ass(args: argparse.Namespace) -> int:
     return 0
 
 
-def _inputs_text(values: Mapping[str, bool], names: Sequence[str]) -> str:
-    ones = [n for n in names if values[n]]
-    return ", ".join(ones) if ones else "-"
-
-
 def cmd_run(args: argparse.Namespace) -> int:
-    from synth.grafcet.machine import GrafcetMachine
-    from synth.output.dot import orders_text as _orders_text
+    from synth.grafcet.simulation import parse_events, simulate
+    from synth.output.summary import run_text
 
     grafcet, inputs, _ = _load(args)
-    machine = GrafcetMachine(grafcet)
-    events = parse_events(args.events or "", grafcet)
-    sit = machine.initial(inputs)
-    rows: list[tuple[str, str, str, str]] = [("initial", sit.text(), _orders_text(sorted(machine.orders(sit, inputs), key=grafcet.outputs.index)), "")]
-    for text, event, loc in events:
-        if isinstance(event, str):
-            if event not in machine.timers(sit):
-                step = next(t.step for t in grafcet.timers if t.id == event)
-                if event in sit.elapsed:
-                    why = "it has already elapsed"
-                elif step not in sit.steps:
-                    why = f"step {step} is not active"
-                else:
-                    why = f"a shorter timer of step {step} must elapse first ({', '.join(machine.timers(sit))})"
-                raise InputError(f"timer {event} cannot elapse now: {why}", loc, notes=(f"situation: {sit.text()}",))
-            sit, rounds = machine.fire_timer_with_trace(sit, event, inputs)
-        else:
-            name, rising = event
-            if inputs[name] == rising:
-                raise InputError(
-                    f"{text} cannot happen: {name} is already {int(rising)}", loc,
-                    notes=("inputs at 1 now: " + _inputs_text(inputs, grafcet.inputs),),
-                )
-            after = dict(inputs)
-            after[name] = rising
-            sit, rounds = machine.react_with_trace(sit, inputs, after)
-            inputs = after
-        fired = "; ".join(", ".join(t.name for t in r) for r in rounds)
-        orders = sorted(machine.orders(sit, inputs), key=grafcet.outputs.index)
-        rows.append((text, sit.text(), _orders_text(orders), fired))
-    w_event = max(len(r[0]) for r in rows)
-    w_sit = max(len(r[1]) for r in rows)
-    out = sys.stdout
-    for i, (ev, s, orders, fired) in enumerate(rows):
-        line = f"{i:<3}{ev:<{w_event}}  {s:<{w_sit}}  orders: {orders}"
-        if fired:
-            line += f"   fired: {fired}"
-        out.write(line.rstrip() + "\n")
+    rows = simulate(grafcet, inputs, parse_events(args.events or "", grafcet))
+    sys.stdout.write(run_text(rows))
     return 0
 
 

@@ -24,12 +24,13 @@ S1  {X1}
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any, Mapping
+from typing import TYPE_CHECKING, Any, Mapping, Sequence
 
 from synth.output.dot import orders_text
 
 if TYPE_CHECKING:  # pragma: no cover
     from synth.grafcet.ass import ASS
+    from synth.grafcet.simulation import SimulationStep
     from synth.plant.composition import Plant
     from synth.plant.element import ElementAutomaton
     from synth.plant.rules import RuleSet
@@ -44,6 +45,7 @@ __all__ = [
     "sup_text",
     "ass_json",
     "ass_text",
+    "run_text",
 ]
 
 
@@ -192,3 +194,17 @@ def ass_json(ass: "ASS") -> dict[str, Any]:
             for t in ass.transitions
         ],
     }
+
+
+def run_text(rows: "Sequence[SimulationStep]") -> str:
+    """``synth run``'s table: number, event, stable situation, orders, transitions fired."""
+    cells = [(r.event, r.situation.text(), orders_text(r.orders), "; ".join(", ".join(f) for f in r.fired)) for r in rows]
+    w_event = max(len(c[0]) for c in cells)
+    w_sit = max(len(c[1]) for c in cells)
+    out = []
+    for i, (ev, sit, orders, fired) in enumerate(cells):
+        line = f"{i:<3}{ev:<{w_event}}  {sit:<{w_sit}}  orders: {orders}"
+        if fired:
+            line += f"   fired: {fired}"
+        out.append(line.rstrip() + "\n")
+    return "".join(out)
