@@ -39,6 +39,7 @@ ROOT = Path(__file__).resolve().parent.parent
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
+from synth.logic.events import Event
 from synth.logic.expr import Edge, evaluate, names  # noqa: E402
 from synth.output.faudes import element_generator, generator_text  # noqa: E402
 from synth.plant.element import element_automaton  # noqa: E402
@@ -59,12 +60,12 @@ def constraint_observer(rs: RuleSet, c: Constraint) -> tuple[str, set[str]]:
         if owner is None:
             raise ValueError(f"constraint {c.id}: unknown variable {v}")
         decls[v] = owner.variable(v)
-    events: dict[str, bool] = {}
+    events: dict[Event, bool] = {}
     for v in variables:
         if not decls[v].held:
             ctrl = decls[v].kind == ORDER
-            events["↑" + v] = ctrl
-            events["↓" + v] = ctrl
+            events[Event.rise(v)] = ctrl
+            events[Event.fall(v)] = ctrl
     events = dict(sorted(events.items()))
     ev_index = {e: i for i, e in enumerate(events)}
     states = []
@@ -86,7 +87,7 @@ def constraint_observer(rs: RuleSet, c: Constraint) -> tuple[str, set[str]]:
             if t in number:
                 src.append(number[s])
                 dst.append(number[t])
-                ev.append(ev_index[("↑" if t[j] else "↓") + v])
+                ev.append(ev_index[Event.edge(v, t[j])])
     init = tuple(decls[v].initial for v in variables)
     arr = lambda xs: np.asarray(xs, dtype=np.int64)  # noqa: E731
     text = generator_text(f"obs_{c.id}", len(states), number.get(init), events, arr(src), arr(ev), arr(dst))

@@ -32,45 +32,41 @@ def register(sub: "argparse._SubParsersAction") -> None:
 
 
 def cmd_validate(args: argparse.Namespace) -> int:
-    from synth.output.dot import dot_graph
     from synth.output.files import write_atomic
     from synth.output.html import write_report
-    from synth.validation.sync import stderr_progress
+    from synth.output.progress import clear_progress, tty_progress
+    from synth.output.result import cor_dot, cor_json, validation_json, validation_text
     from synth.validation.validate import reduced_controller, validate
 
     if args.cor and Path(args.cor).suffix == ".dot":
         raise SynthError(f"--cor {args.cor}: the JSON file must not end in .dot, the DOT file is written beside it")
-    show_progress = not args.quiet and sys.stderr.isatty()
+    show = tty_progress(not args.quiet and sys.stderr.isatty())
     result = validate(
         args.grafcet,
         args.plant,
         expert=args.expert,
         max_states=args.max_states,
-        progress=stderr_progress if show_progress else None,
+        progress=None if show is None else lambda n, pending: show(f"exploring SYNC: {n} aggregated states, {pending} to visit"),
     )
-    if show_progress:
-        sys.stderr.write("\r\033[K")
+    clear_progress(show)
     print_warnings(result.plant)
     if args.cor:
-        cor = reduced_controller(result)
+        cor = cor_json(result, reduced_controller(result))
         path = Path(args.cor)
         write_atomic(path, json.dumps(cor, indent=2, ensure_ascii=False) + "\n")
-        nodes = [(str(s["id"]), "{" + ", ".join(s["situation"]) + "}\n" + ", ".join(s["orders"]), {"shape": "box"})
-                 for s in cor["states"]]
-        edges = [(str(t["source"]), str(t["target"]), t["event"], {}) for t in cor["transitions"]]
-        write_atomic(path.with_suffix(".dot"), dot_graph("COR", nodes, edges))
+        write_atomic(path.with_suffix(".dot"), cor_dot(cor))
     report_path = None
     if args.report is not None:
         directory = args.report or str(Path("reports") / Path(args.grafcet).stem)
         report_path = write_report(directory, result)
     if args.json:
-        data = result.as_json()
+        data = validation_json(result)
         if report_path is not None:
             data["report"] = str(report_path)
         json.dump(data, sys.stdout, indent=2, ensure_ascii=False)
         sys.stdout.write("\n")
     else:
-        print(result.text())
+        print(validation_text(result))
         if report_path is not None:
             print(f"\nreport: {report_path}")
         if args.cor:

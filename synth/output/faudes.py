@@ -17,6 +17,8 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from synth.logic.events import Event
+
 import numpy as np
 
 from synth.plant.composition import Plant
@@ -28,9 +30,9 @@ if TYPE_CHECKING:
 __all__ = ["faudes_event", "generator_text", "plant_generator", "supervisor_generator", "element_generator"]
 
 
-def faudes_event(event: str) -> str:
+def faudes_event(event: Event) -> str:
     """``↑AVANCER1`` → ``AVANCER1_up``; ``↓v10`` → ``v10_down``."""
-    return event[1:] + ("_up" if event[0] == "↑" else "_down")
+    return event.name + ("_up" if event.rising else "_down")
 
 
 def generator_text(

@@ -65,8 +65,9 @@ code, .mono { font-family: Menlo, Consolas, monospace; } .figure { overflow-x: a
 def report_html(v: "Validation") -> str:
     """The self-contained HTML report of a validation (inline SVG made by Graphviz)."""
     from synth.output.dot import aggregated_dot, element_dot, sup_neighbourhood_dot, trace_dot
+    from synth.output.result import prohibited_json, validation_json
 
-    data = v.as_json()
+    data = validation_json(v)
     a = v.analysis
     verdict = data["verdict"]
     parts = [
@@ -129,7 +130,7 @@ def report_html(v: "Validation") -> str:
         ]
     for k, i in enumerate(a.prohibited, 1):
         tr = a.traces[i]
-        items = v.prohibited_data(i)
+        items = prohibited_json(v, i)
         parts += [
             f'<div class="problem"><h2>Prohibited orders {k}: situation {_esc(v.sync.nodes[i].situation.text())}</h2>',
             _state_table(items[0]) if items else "",

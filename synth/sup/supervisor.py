@@ -25,7 +25,7 @@ held in numpy arrays: the work is linear in SUP's transitions, not in the plant.
 Example
 -------
 >>> from synth.plant.rules import load_rules
->>> from synth.plant.composition import plant
+>>> from synth.plant.composition import plant, _plants
 >>> rs = load_rules(_plants("tri_annex.rules"))
 >>> sup = supremal_controllable(plant(rs), rs.constraints)
 >>> sup.size > 0, sup.size < sup.plant.size
@@ -33,16 +33,15 @@ Example
 """
 from __future__ import annotations
 
-from collections import deque
 from functools import cached_property
 from typing import Callable, Iterable, Iterator, Sequence
 
 import numpy as np
 
 from synth.errors import LimitExceeded
-from synth.plant.composition import LocalTransition, Plant, _plants
+from synth.plant.composition import LocalTransition, Plant
 from synth.plant.rules import Constraint
-from synth.sup.constraints import GRID_LIMIT, CompiledConstraints, _closed, _holds, _product
+from synth.sup.constraints import GRID_LIMIT, CompiledConstraints, _holds, _product
 
 __all__ = ["Supervisor", "supremal_controllable"]
 

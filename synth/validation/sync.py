@@ -28,7 +28,6 @@ Example
 
 from __future__ import annotations
 
-import sys
 import time
 from collections import deque
 from dataclasses import dataclass, field
@@ -274,9 +273,3 @@ def synchronous_product(
             progress(len(nodes), len(queue))
             last = time.monotonic()
     return Sync(p, oracle, machine, tuple(nodes), tuple(edges), initial, tuple(conflicts), len(sync_seen))
-
-
-def stderr_progress(nodes: int, pending: int) -> None:  # pragma: no cover - terminal only
-    sys.stderr.write(f"\rexploring SYNC: {nodes} aggregated states, {pending} to visit ")
-    sys.stderr.flush()
-
