@@ -1,4 +1,4 @@
-"""Every ``--json`` output of the plant, SUP and ASS commands validates against its shipped
+"""Every ``--json`` output of the plant, SUP, ASS and validate commands validates against its shipped
 schema, for every bundled plant and Grafcet; and a schema does reject drift."""
 
 from __future__ import annotations
@@ -47,6 +47,39 @@ def test_sup_why_json(capsys, state):
 def test_ass_json(capsys, g7):
     plant = ["--plant", str(ROOT / "plants/tri.rules")] if g7.startswith("tri") else []
     assert_valid("ass", _json(capsys, "ass", str(ROOT / "grafcets" / g7), *plant, "--json"))
+
+
+VALIDATE_CASES = [
+    ("grafcets/tri.g7", "plants/tri.rules"),
+    ("grafcets/tri_missing_order.g7", "plants/tri.rules"),
+    ("grafcets/tri.g7", "plants/tri_missing_rule.rules", "--expert"),
+    ("grafcets/tri.g7", "plants/tri_overstrict.rules"),
+    ("grafcets/tri.g7", "plants/tri_overstrict.rules", "--expert"),
+    ("tests/data/or_conflict.g7", "plants/tri.rules"),
+]
+
+
+@pytest.mark.parametrize("case", VALIDATE_CASES, ids=lambda c: " ".join(Path(x).name for x in c))
+def test_validate_json(capsys, tmp_path, case):
+    g7, rules, *flags = case
+    argv = ["validate", str(ROOT / g7), "--plant", str(ROOT / rules), *flags, "--json", "--report", str(tmp_path)]
+    code = main(argv)
+    data = json.loads(capsys.readouterr().out)
+    assert code == (0 if data["verdict"] == "pass" else 1)
+    assert data["report"].endswith("index.html")
+    assert_valid("validate", data)
+
+
+def test_validate_schema_rejects_unknown_verdicts(capsys):
+    main(["validate", str(ROOT / "grafcets/tri_missing_order.g7"), "--plant", str(ROOT / "plants/tri.rules"), "--json"])
+    data = json.loads(capsys.readouterr().out)
+    data["blocking"][0]["diagnosis"]["verdict"] = "blocked"
+    with pytest.raises(jsonschema.ValidationError):
+        assert_valid("validate", data)
+    data["blocking"][0]["diagnosis"]["verdict"] = "missing_order"
+    data["blocking"][0]["trace_states"][0]["extra"] = []
+    with pytest.raises(jsonschema.ValidationError):
+        assert_valid("validate", data)
 
 
 def test_schema_rejects_drift(capsys):

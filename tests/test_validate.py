@@ -15,6 +15,7 @@ from synth.sup.supervisor import supremal_controllable
 from synth.validation.sync import synchronous_product
 
 from conftest import ROOT
+from schemas import assert_valid
 
 G = ROOT / "grafcets"
 P = ROOT / "plants"
@@ -24,7 +25,9 @@ MISSING_TRACE = ["↑dcy", "↑cp12", "2s/X101", "↓v10", "↑v11"]
 def _json(cli, *args):
     code, out, err = cli("validate", *args, "--json")
     assert "Traceback" not in err
-    return code, json.loads(out)
+    data = json.loads(out)
+    assert_valid("validate", data)
+    return code, data
 
 
 def test_tri_passes(cli):
