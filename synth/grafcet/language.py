@@ -33,13 +33,16 @@ import re
 from dataclasses import dataclass, field
 from enum import StrEnum
 from pathlib import Path
-from typing import Iterator, Sequence
+from typing import Collection, Iterator, Sequence
 
 from synth.errors import Location
 from synth.logic.expr import Expr, Var, names
 from synth.syntax import read_source
 
 __all__ = [
+    "STEP_PREFIX",
+    "step_variable",
+    "step_of",
     "ActionKind",
     "StoredWhen",
     "CONTINUOUS",
@@ -83,6 +86,25 @@ ON_ACTIVATION, ON_DEACTIVATION, ON_EVENT = StoredWhen.ACTIVATION, StoredWhen.DEA
 
 _TIMER_RE = re.compile(r"^([0-9]+(?:\.[0-9]+)?)(ms|s|min|h)/X([A-Za-z0-9_]+)$")
 _SECONDS = {"ms": 0.001, "s": 1.0, "min": 60.0, "h": 3600.0}
+
+
+STEP_PREFIX = "X"  # the step variable of step 12 is X12 (IEC 60848)
+
+
+def step_variable(step: str) -> str:
+    """The name of ``step``'s step variable: ``step_variable("12") == "X12"``."""
+    return STEP_PREFIX + step
+
+
+def step_of(name: str, steps: Collection[str]) -> str | None:
+    """The step whose variable ``name`` is, if it is one of ``steps``.
+
+    >>> step_of("X12", {"12", "3"}), step_of("Xa", {"12"})
+    ('12', None)
+    """
+    if name.startswith(STEP_PREFIX) and name[len(STEP_PREFIX):] in steps:
+        return name[len(STEP_PREFIX):]
+    return None
 
 
 def step_key(name: str) -> tuple[int, int, str]:
@@ -143,7 +165,7 @@ class Step:
     @property
     def variable(self) -> str:
         """The step variable's name, ``X12``."""
-        return "X" + self.name
+        return step_variable(self.name)
 
 
 @dataclass(frozen=True)

@@ -31,6 +31,8 @@ from synth.grafcet.language import (
     Timer,
     Transition,
     step_key,
+    step_of,
+    step_variable,
 )
 from synth.logic.expr import Edge, Expr, Var, names
 from synth.grafcet.language_reader import _Decl, _Graf, _Step, _StepRef, _Trans
@@ -108,14 +110,14 @@ class GrafcetChecker(Checker):
                     )
                 else:
                     self.steps[s.name] = (s, g.name)
-        step_vars = {"X" + n for n in self.steps}
+        step_vars = {step_variable(n) for n in self.steps}
         if inputs is not None:
             for n in inputs:
-                if n in step_vars:
-                    step = self.steps[n[1:]][0]
+                clash = step_of(n, self.steps)
+                if clash is not None:
                     self.fail(
-                        f"input '{n}' has the name of the step variable of step {n[1:]}; rename the input or the step",
-                        step.loc,
+                        f"input '{n}' has the name of the step variable of step {clash}; rename the input or the step",
+                        self.steps[clash][0].loc,
                     )
         # infer inputs/outputs when neither the file nor the caller gave them
         if inputs is None:
@@ -208,18 +210,19 @@ class GrafcetChecker(Checker):
                     self.fail(
                         f"timer {n.name} refers to step {step}, which does not exist",
                         n.loc,
-                        suggestions=tuple(f"X{c}" for c in close_names(step, self.steps)),
+                        suggestions=tuple(step_variable(c) for c in close_names(step, self.steps)),
                     )
                 else:
                     seconds = float(m.group(1)) * _SECONDS[m.group(2)]
                     self.timers.setdefault(n.name, Timer(n.name, step, seconds, n.loc))
                 continue
-            if n.name.startswith("X") and n.name[1:] in self.steps and n.name not in known:
+            step_var_of = step_of(n.name, self.steps)
+            if step_var_of is not None and n.name not in known:
                 if isinstance(n, Edge):
                     self.fail(
                         f"edges of step variables are not supported: {n.text()}",
                         n.loc,
-                        notes=("edges are input events; read the level X" + n.name[1:] + " instead",),
+                        notes=(f"edges are input events; read the level {n.name} instead",),
                     )
                 continue
             if n.name in known:
@@ -230,7 +233,7 @@ class GrafcetChecker(Checker):
                         notes=("to act on an event, use a stored action: set ORDER on ↑x",),
                     )
                 continue
-            step_vars = sorted("X" + s for s in self.steps)
+            step_vars = sorted(step_variable(s) for s in self.steps)
             if re.fullmatch(r"X[0-9]+", n.name):
                 self.fail(
                     f"{n.name} refers to step {n.name[1:]}, which does not exist",

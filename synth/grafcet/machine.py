@@ -58,6 +58,8 @@ from synth.grafcet.language import (
     Transition,
     receptivity_inputs,
     step_key,
+    step_of,
+    step_variable,
 )
 
 __all__ = ["Situation", "GrafcetMachine"]
@@ -80,7 +82,7 @@ class Situation:
     elapsed: tuple[str, ...] = ()
 
     def text(self) -> str:
-        out = "{" + ", ".join("X" + s for s in self.steps) + "}"
+        out = "{" + ", ".join(self.step_variables) + "}"
         if self.stored:
             out += " stored{" + ", ".join(self.stored) + "}"
         if self.elapsed:
@@ -89,7 +91,7 @@ class Situation:
 
     @property
     def step_variables(self) -> tuple[str, ...]:
-        return tuple("X" + s for s in self.steps)
+        return tuple(step_variable(s) for s in self.steps)
 
 
 # --------------------------------------------------------------------------- compiled expressions
@@ -101,8 +103,9 @@ def _code(e: Expr, steps: set[str], timers: set[str]) -> str:
     if isinstance(e, Var):
         if e.name in timers:
             return f"({e.name!r} in T)"
-        if e.name.startswith("X") and e.name[1:] in steps:
-            return f"({e.name[1:]!r} in A)"
+        step = step_of(e.name, steps)
+        if step is not None:
+            return f"({step!r} in A)"
         return f"I[{e.name!r}]"
     if isinstance(e, Const):
         return "True" if e.value else "False"
@@ -156,8 +159,8 @@ class GrafcetMachine:
         self._enabled_cache: dict[frozenset[str], tuple[int, ...]] = {}
         self._rec_inputs = [frozenset(receptivity_inputs(t, self.inputs)) for t in self.transitions]
         self._rec_steps = [
-            frozenset(n.name[1:] for n in names(t.receptivity)
-                      if isinstance(n, Var) and n.name[:1] == "X" and n.name[1:] in steps and n.name not in timers)
+            frozenset(step_of(n.name, steps) for n in names(t.receptivity)
+                      if isinstance(n, Var) and n.name not in timers and step_of(n.name, steps) is not None)
             for t in self.transitions
         ]
         self._index = {t: i for i, t in enumerate(self.transitions)}
@@ -289,7 +292,7 @@ class GrafcetMachine:
 
     def waiting_steps(self, sit: Situation, t: Transition) -> tuple[str, ...]:
         """Step variables read by ``t``'s receptivity whose step is not active in ``sit``."""
-        return tuple(sorted("X" + s for s in self._rec_steps[self._index[t]] if s not in sit.steps))
+        return tuple(sorted(step_variable(s) for s in self._rec_steps[self._index[t]] if s not in sit.steps))
 
     def relevant_inputs(self, sit: Situation) -> frozenset[str]:
         """Inputs whose change may change ``sit``: read by an enabled transition or by an

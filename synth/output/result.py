@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
+from synth.grafcet.language import step_variable
 from synth.output.dot import dot_graph
 from synth.validation.diagnosis import diagnose_prohibition
 
@@ -17,7 +18,7 @@ __all__ = ["state_json", "prohibited_json", "validation_json", "validation_text"
 
 
 def _steps(steps: tuple[str, ...]) -> list[str]:
-    return [f"X{s}" for s in steps]
+    return [step_variable(s) for s in steps]
 
 
 def state_json(v: Validation, i: int) -> dict[str, Any]:
@@ -84,7 +85,7 @@ def validation_json(v: Validation) -> dict[str, Any]:
         "unreached_steps": v.unreached_steps,
         "conflicts": [
             {
-                "step": f"X{c.step}",
+                "step": step_variable(c.step),
                 "transitions": list(c.transitions),
                 "event": c.event,
                 "situation": _steps(v.sync.nodes[c.node].situation.steps),

@@ -1,4 +1,4 @@
-"""Asynchronous composition of element automata: the plant (METHOD.md §2).
+"""Asynchronous composition of element automata: the plant (docs/method.md, plant).
 
 The plant is never built transition by transition. A global state is the tuple of
 the elements' local states, stored as a position in an N-dimensional numpy grid of

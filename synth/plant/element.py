@@ -1,4 +1,4 @@
-"""Element automata: the boolean-state automaton of one plant element (METHOD.md §2).
+"""Element automata: the boolean-state automaton of one plant element (docs/method.md, plant).
 
 Construction (thesis lines 2470-2520), state-based reading of the rules:
 

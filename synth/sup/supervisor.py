@@ -1,4 +1,4 @@
-"""SUP: the maximal admissible plant behaviour under the constraints (METHOD.md §4).
+"""SUP: the maximal admissible plant behaviour under the constraints (docs/method.md, SUP).
 
 Tajer's algorithm (thesis figure 2.4):
 

@@ -222,7 +222,7 @@ def _verdict(
 ) -> tuple[Verdict, str]:
     p = sync.plant
     if not awaited:
-        steps = ", ".join(f"X{s}" for s in node.situation.steps)
+        steps = ", ".join(node.situation.step_variables)
         return (
             Verdict.DEAD_END,
             f"no transition leaves the active steps {{{steps}}}: the Grafcet stops here and never returns "

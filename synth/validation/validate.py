@@ -37,7 +37,7 @@ class Validation:
     def unreached_steps(self) -> list[str]:
         """Steps active in no stable situation SYNC reaches: dead code under this plant."""
         active = {st for n in self.sync.nodes for st in n.situation.steps}
-        return [f"X{s.name}" for s in self.grafcet.steps if s.name not in active]
+        return [s.variable for s in self.grafcet.steps if s.name not in active]
 
     @property
     def stats(self) -> dict[str, int]:
