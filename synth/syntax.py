@@ -12,9 +12,9 @@ from typing import Any, Sequence
 from lark import Lark, Token, Transformer, Tree, UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
 
 from synth.errors import InputError, InputErrors, Location, location_in
-from synth.logic.expr import And, Const, Edge, Not, Or, Var
+from synth.logic.expr import And, Const, Edge, Expr, Not, Or, Var
 
-__all__ = ["grammar_text", "parser", "syntax_error", "read_source", "ExprTransformer", "Checker", "raise_all", "parse_tree"]
+__all__ = ["grammar_text", "parser", "syntax_error", "read_source", "ExprTransformer", "Checker", "raise_all", "parse_tree", "parse_expression"]
 
 # How terminals are shown to a user in "expected ..." lists.
 _TERMINAL_TEXT = {
@@ -58,9 +58,9 @@ def grammar_text(name: str) -> str:
 
 
 @lru_cache(maxsize=None)
-def parser(name: str) -> Lark:
-    """A cached LALR parser for ``grammars/<name>.lark`` (positions propagated)."""
-    options = dict(parser="lalr", propagate_positions=True, maybe_placeholders=True)
+def parser(name: str, start: str = "start") -> Lark:
+    """A cached LALR parser for ``grammars/<name>.lark`` from rule ``start`` (positions propagated)."""
+    options = dict(parser="lalr", propagate_positions=True, maybe_placeholders=True, start=start)
     text = grammar_text(name)
     try:  # lark caches the compiled LALR tables in the temporary folder, keyed by grammar and options
         return Lark(text, cache=True, **options)
@@ -183,6 +183,21 @@ def parse_tree(grammar: str, source: str, file: str, transformer: Transformer) -
     result = transformer.transform(tree)
     raise_all(getattr(transformer, "errors", ()))
     return result
+
+
+def parse_expression(source: str, file: str) -> Expr:
+    """One Boolean expression in the rules syntax (a command-line condition such as
+    ``--home "X0 & v10"``), its names located in ``file`` (the option's name).
+
+    >>> parse_expression("X0 & !v10", "--home").text()
+    'X0 & !v10'
+    """
+    p = parser("rules", "expr")
+    try:
+        tree = p.parse(source)
+    except UnexpectedInput as err:
+        raise syntax_error(err, file, source, p) from None
+    return ExprTransformer(file, source).transform(tree)
 
 
 class Checker:

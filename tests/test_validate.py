@@ -230,14 +230,16 @@ TWO = (
 
 def test_initial_region_settling_in_two_states(cli, tmp_path):
     """SUP lets the initial situation set A or B, not both: two initial aggregated states,
-    each with its own prohibition; traces start from either."""
+    each with its own prohibition; traces start from either. Where A was set, the
+    prohibited B holds the Grafcet in step 0 for ever: blocking at the initial state."""
     g, r = _small(tmp_path, TWO, "grafcet G { initial step 0: A, B   step 1   transition 0 -> 1 when b }\n")
     code, data = _json(cli, g, "--plant", r)
     assert code == 1
     assert sorted((p["order"], p["trace"]) for p in data["prohibited"]) == [("A", []), ("B", [])]
-    (b,) = data["blocking"]
-    assert b["trace"] == ["↑b", "↓b"]
-    assert b["diagnosis"]["verdict"] == "dead_end"
+    held, dead = data["blocking"]
+    assert (held["trace"], held["Z"], held["diagnosis"]["verdict"]) == ([], {"A": 1, "B": 0}, "prohibited_order")
+    assert dead["trace"] == ["↑b", "↓b"]
+    assert dead["diagnosis"]["verdict"] == "dead_end"
 
 
 def test_trap_on_operator_inputs(cli, tmp_path):

@@ -24,10 +24,11 @@ from __future__ import annotations
 
 from collections import deque
 from dataclasses import dataclass
+from typing import Iterable
 
 from synth.validation.sync import Sync
 
-__all__ = ["Trace", "Analysis", "analyse", "coreachable", "shortest_paths", "strongly_connected_components"]
+__all__ = ["Trace", "Analysis", "analyse", "coreachable", "held_nodes", "shortest_paths", "strongly_connected_components"]
 
 
 @dataclass(frozen=True)
@@ -43,9 +44,12 @@ class Analysis:
     blocking: tuple[int, ...]  # first state of each terminal component, by trace length
     traces: dict[int, Trace]
     no_return: dict[int, int]  # blocking node -> first node of its trace that cannot come back
-    coreachable: frozenset[int]
+    coreachable: frozenset[int]  # nodes from which a home state is reachable
     prohibited: tuple[int, ...]  # first node meeting each (steps, prohibited event)
     components: dict[int, tuple[int, ...]]  # blocking node -> members of its terminal component
+    homes: frozenset[int] = frozenset()  # the home (marked) states
+    held: frozenset[int] = frozenset()  # nodes whose active steps can never change again
+    never_starts: bool = False  # no reachable situation has other active steps than the initial one
 
 
 def coreachable(sync: Sync, targets: set[int]) -> set[int]:
@@ -133,27 +137,56 @@ def strongly_connected_components(nodes: list[int], succ: dict[int, list[int]]) 
     return out
 
 
-def analyse(sync: Sync) -> Analysis:
-    """Blocking states, their shortest traces and points of no return; prohibited orders."""
+def held_nodes(sync: Sync) -> set[int]:
+    """Nodes from which no node with other active steps is reachable: whatever the plant
+    and the operator do, the Grafcet stays in these steps for ever.
+
+    A node can change steps iff it reaches a node with an edge to other steps."""
+    changers = {e.source for e in sync.edges if sync.nodes[e.source].situation.steps != sync.nodes[e.target].situation.steps}
+    movable = coreachable(sync, changers)
+    return {i for i in range(len(sync.nodes)) if i not in movable}
+
+
+def analyse(sync: Sync, homes: Iterable[int] | None = None) -> Analysis:
+    """Blocking states, their shortest traces and points of no return; prohibited orders.
+
+    ``homes`` are the home (marked) states; by default the initial aggregated states
+    (the initial situation with its settled initial plant state). A state is blocking
+    when no home state is reachable from it; a state with a prohibited order in which
+    the Grafcet is held for ever is blocking too, even if it is a home.
+    """
     if not sync.nodes:
         return Analysis((), {}, {}, frozenset(), (), {})
-    initial_steps = sync.nodes[0].situation
-    homes = {i for i, n in enumerate(sync.nodes) if n.situation == initial_steps}
-    back = coreachable(sync, homes)
+    home = set(sync.initial if homes is None else homes)
+    back = coreachable(sync, home)
     dist, parent = shortest_paths(sync)
     stuck = [i for i in range(len(sync.nodes)) if i not in back]
     succ = {i: sorted({e.target for e in sync.successors(i)}) for i in stuck}
     blocking: list[int] = []
     components: dict[int, tuple[int, ...]] = {}
+    held = held_nodes(sync)
+    # a prohibited order holding the Grafcet in its steps for ever: blocking, home or not,
+    # once per set of steps, at the nearest such state
+    by_steps: dict[tuple[str, ...], list[int]] = {}
+    for i in sorted(held, key=lambda i: (dist.get(i, 1 << 30), i)):
+        if sync.nodes[i].proh:
+            by_steps.setdefault(sync.nodes[i].situation.steps, []).append(i)
+    for members in by_steps.values():
+        blocking.append(members[0])
+        components[members[0]] = tuple(sorted(members))
     for comp in strongly_connected_components(stuck, succ):
         if any(s not in comp for i in comp for s in succ[i]):
             continue  # not terminal
+        if all(sync.nodes[i].situation.steps in by_steps for i in comp):
+            continue  # held by a prohibited order, reported above
         entry = min(comp, key=lambda i: (dist.get(i, 1 << 30), i))
         blocking.append(entry)
         components[entry] = tuple(sorted(comp))
     blocking.sort(key=lambda i: (dist.get(i, 1 << 30), i))
     traces = {b: _trace(parent, b) for b in blocking}
-    no_return = {b: next(n for n in traces[b].nodes if n not in back) for b in blocking}
+    no_return = {b: next((n for n in traces[b].nodes if n not in back), b) for b in blocking}
+    first_steps = sync.nodes[sync.initial[0]].situation.steps if sync.initial else ()
+    never_starts = bool(sync.initial) and all(n.situation.steps == first_steps for n in sync.nodes)
     seen: set[tuple] = set()
     prohibited: list[int] = []
     for i in sorted(dist, key=lambda i: (dist[i], i)):
@@ -166,4 +199,5 @@ def analyse(sync: Sync) -> Analysis:
                     prohibited.append(i)
     for i in prohibited + [c.node for c in sync.conflicts]:
         traces.setdefault(i, _trace(parent, i))
-    return Analysis(tuple(blocking), traces, no_return, frozenset(back), tuple(prohibited), components)
+    return Analysis(tuple(blocking), traces, no_return, frozenset(back), tuple(prohibited), components,
+                    frozenset(home), frozenset(held), never_starts)
