@@ -61,6 +61,15 @@ CASES = {
         "order A must be released in step 2: transition 2->0 of G awaits !a, which needs ↓a; ↓a only follows ↓A "
         "(element EA, rule ↓A -> ↓a) and SUP authorises it here",
     ),
+    "livelock": (
+        GO + EA,
+        "grafcet G { initial step 0 step 1: A step 2 "
+        "transition 0 -> 1 when ↑go transition 1 -> 2 when a transition 2 -> 1 when !a }",
+        False, ["↑go"], Verdict.LIVELOCK,
+        "the Grafcet keeps running through {X1} → {X2} and never returns to a home state: transition 1->2 of G "
+        "awaits a, and ↑a occurs with the orders as they are (element EA); if this loop is the intended cycle, "
+        'declare its home with --home "X1"',
+    ),
     "trap": (
         "free dcy = 0\n" + EA,
         "grafcet G { initial step 0  step 1  step 2: A "
@@ -98,7 +107,22 @@ CASES = {
 
 
 def test_every_verdict_has_a_case():
-    assert {c[4] for c in CASES.values()} == set(Verdict)
+    assert {c[4] for c in CASES.values()} == set(Verdict) - {Verdict.NEVER_STARTS}
+
+
+def test_never_starts(tmp_path):
+    """Not the verdict of a blocking state but of the whole Grafcet, with the verdict on
+    its initial situation as the cause."""
+    (tmp_path / "p.rules").write_text(EA)
+    (tmp_path / "g.g7").write_text("grafcet G { initial step 0 step 1: A transition 0 -> 1 when a }")
+    v = validate(tmp_path / "g.g7", tmp_path / "p.rules")
+    assert v.analysis.blocking == () and not v.passed
+    d = v.never_starts
+    assert (d.verdict, d.cause) == (Verdict.NEVER_STARTS, Verdict.MISSING_ORDER)
+    assert d.summary == (
+        "the Grafcet never leaves its initial steps {X0}: missing order A in step 0: transition 0->1 of G awaits a, "
+        "which needs ↑a; only A causes ↑a (element EA, rule ↑A -> ↑a) and SUP authorises it here"
+    )
 
 
 @pytest.mark.parametrize("name", CASES)

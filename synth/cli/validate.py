@@ -21,6 +21,9 @@ def register(sub: "argparse._SubParsersAction") -> None:
     )
     v.add_argument("grafcet", metavar="GRAFCET.g7", help="the control program")
     v.add_argument("--plant", metavar="RULES", required=True, help="the plant (.rules, with its constraints)")
+    v.add_argument("--home", metavar="EXPR", action="append", default=[],
+                   help='a home state: a condition on step variables and E/Z names, e.g. "X1" or "X0 & v10" '
+                        "(repeatable; the initial state is always a home)")
     v.add_argument("--expert", action="store_true", help="the Grafcet is trusted: blame element models and constraints")
     v.add_argument("--report", metavar="DIR", nargs="?", const="", default=None,
                    help="write DIR/index.html (default reports/<grafcet name>)")
@@ -45,6 +48,7 @@ def cmd_validate(args: argparse.Namespace) -> int:
         args.grafcet,
         args.plant,
         expert=args.expert,
+        homes=args.home,
         max_states=args.max_states,
         progress=None if show is None else lambda n, pending: show(f"exploring SYNC: {n} aggregated states, {pending} to visit"),
     )

@@ -78,6 +78,8 @@ def validation_json(v: Validation) -> dict[str, Any]:
         "grafcet": v.grafcet.path,
         "plant": v.rules.path,
         "sup_empty": v.sup_empty,
+        "homes": list(v.homes),
+        "never_starts": v.never_starts.as_dict() if v.never_starts is not None else None,
         "stats": v.stats,
         "constraints": {c.id: c.label for c in v.rules.constraints},
         "blocking": blocking,
@@ -108,6 +110,12 @@ def validation_text(v: Validation) -> str:
     ]
     if v.sup_empty:
         lines.append("SUP is empty: the initial plant state is illegal, defended or weakly defended")
+    if v.never_starts is not None:
+        d = v.never_starts
+        lines.append(f"never starts [{d.cause}]: {d.summary}")
+        lines += [f"    {x}" for x in d.details]
+    if v.homes:
+        lines.append(f"home states: the initial state and where {' or '.join(v.homes)} holds")
     for c in v.sync.conflicts:
         lines.append(
             f"warning: transitions {', '.join(c.transitions)} leaving step {c.step} fired together on {c.event} "
@@ -127,7 +135,8 @@ def validation_text(v: Validation) -> str:
             after = tr.events[: tr.nodes.index(nr)]
             lines.append(
                 f"  no return since {v.sync.nodes[nr].situation.text()} (after {' '.join(after) or 'the start'}):"
-                " from there the initial situation can no longer be reached"
+                + (" from there no home state can be reached" if v.homes
+                   else " from there the initial situation can no longer be reached")
             )
         d = v.diagnoses[b]
         lines.append(f"  diagnosis [{d.verdict}]: {d.summary}")

@@ -5,12 +5,16 @@ each one true; which orders cause those events, through which rules of which ele
 whether the situation emits those orders and whether SUP authorises them there, and if
 not which constraints forbid them. From that a verdict in plain words:
 
+- ``never_starts``: the Grafcet never leaves its initial steps (with the verdict on
+  the initial situation as its ``cause``);
 - ``missing_order``: an order that would cause the awaited event is not emitted;
 - ``prohibited_order``: it is emitted but SUP forbids it (wrong control, or over-strict
   constraint; in expert mode the Grafcet is trusted, so the constraint is blamed);
 - ``element_model`` (expert mode): the orders are emitted and authorised, yet the
   element's rules never produce the awaited event from its current state;
 - ``unproducible_event``: no rule of any element produces the awaited event;
+- ``livelock``: the awaited event comes with the orders as they are: the Grafcet keeps
+  running in a loop of situations that never meets a home state (``--home``);
 - ``trap``: the Grafcet still moves on operator inputs, in a closed loop of situations;
 - ``dead_end``: no transition leaves the active steps;
 - ``waiting``: the situation only waits on other steps (see the other grafcets' verdicts).
@@ -23,20 +27,23 @@ from enum import StrEnum
 from itertools import combinations
 from typing import Any, Iterable, Sequence
 
+from synth.grafcet.language import step_variable
 from synth.logic.events import Event
 from synth.plant.composition import Plant
 from synth.plant.element import ElementAutomaton
 from synth.plant.rules import VarKind
 from synth.validation.sync import Node, Prohibition, Sync
 
-__all__ = ["Verdict", "Cause", "Awaited", "Diagnosis", "diagnose", "diagnose_prohibition"]
+__all__ = ["Verdict", "Cause", "Awaited", "Diagnosis", "diagnose", "diagnose_never_starts", "diagnose_prohibition"]
 
 
 class Verdict(StrEnum):
     """The verdict on a blocking state, most specific first (the cascade's order)."""
 
+    NEVER_STARTS = "never_starts"
     DEAD_END = "dead_end"
     PROHIBITED_ORDER = "prohibited_order"
+    LIVELOCK = "livelock"
     ELEMENT_MODEL = "element_model"
     MISSING_ORDER = "missing_order"
     TRAP = "trap"
@@ -101,14 +108,18 @@ class Diagnosis:
     summary: str
     awaited: tuple[Awaited, ...] = ()
     details: tuple[str, ...] = field(default=())
+    cause: Verdict | None = None  # for never_starts: the verdict on the initial situation
 
     def as_dict(self) -> dict[str, Any]:
-        return {
+        d: dict[str, Any] = {
             "verdict": self.verdict,
             "summary": self.summary,
             "awaited": [a.as_dict() for a in self.awaited],
             "details": list(self.details),
         }
+        if self.cause is not None:
+            d["cause"] = self.cause
+        return d
 
 
 def _element_cause(sync: Sync, node: Node, event: Event) -> Cause:
@@ -126,10 +137,11 @@ def _element_cause(sync: Sync, node: Node, event: Event) -> Cause:
         return Cause(event, a.name, producible_now=True, free=True)
     rules = tuple(r.text() for r in spec.rules if r.consequence.event == event)
     k = node.plant[axis]
-    now = a.produces(k, event)
+    if a.produces(k, event):  # no order change needed: it happens with the orders as they are
+        return Cause(event, a.name, (), rules, emitted=True, authorised=True, producible_now=True)
     best = _fewest_changes(a, k, event, [v.name for v in spec.orders if not v.held])
     if best is None:
-        return Cause(event, a.name, (), rules, producible_now=now)
+        return Cause(event, a.name, (), rules)
     emitted = all(ch.rising == (ch.name in node.emitted) for ch in best)
     constraints: list[str] = []
     authorised = True
@@ -145,7 +157,7 @@ def _element_cause(sync: Sync, node: Node, event: Event) -> Cause:
                 if not ok:
                     authorised = False
                     constraints += [c for c in why if c not in constraints]
-    return Cause(event, a.name, best, rules, emitted, authorised, tuple(constraints), now)
+    return Cause(event, a.name, best, rules, emitted, authorised, tuple(constraints))
 
 
 def _fewest_changes(a: ElementAutomaton, k: int, event: Event, orders: Sequence[str]) -> tuple[Event, ...] | None:
@@ -205,7 +217,9 @@ def diagnose(sync: Sync, node_index: int, *, expert: bool = False, component: Se
                 details.append(f"  {c.event}: an operator input, it may change at any time")
                 continue
             rules = "; ".join(c.rules) if c.rules else "no rule"
-            if c.changes:
+            if c.producible_now:
+                details.append(f"  {c.event} (element {c.element}) occurs with the orders as they are; rules: {rules}")
+            elif c.changes:
                 state = "emitted" if c.emitted else "not emitted"
                 sup = "authorised by SUP" if c.authorised else f"prohibited by {_named(sync, c.constraints)}"
                 details.append(f"  {c.event} (element {c.element}) needs {', '.join(c.changes)}: {state}, {sup}; rules: {rules}")
@@ -256,6 +270,18 @@ def _verdict(
                 Verdict.PROHIBITED_ORDER,
                 f"order {order}{where} prohibited by {_named(sync, c.constraints)}: {context(a)}, "
                 f"which needs {c.event}, caused by {order} ({by_rule(c)}); SUP forbids {c.changes[0]} here: {who}",
+            )
+    # the awaited event comes by itself: the Grafcet moves on, in a loop that never meets a home
+    for a, c in items:
+        if c.producible_now:
+            sits = sorted({sync.nodes[i].situation.steps for i in component} or {node.situation.steps})
+            loop = " → ".join("{" + ", ".join(step_variable(x) for x in steps) + "}" for steps in sits)
+            home = " & ".join(step_variable(x) for x in node.situation.steps)
+            return (
+                Verdict.LIVELOCK,
+                f"the Grafcet keeps running through {loop} and never returns to a home state: {context(a)}, "
+                f"and {c.event} occurs with the orders as they are (element {c.element}); if this loop is the "
+                f'intended cycle, declare its home with --home "{home}"',
             )
     # prohibited orders of the situation that nothing above explained
     if node.proh and expert:
@@ -338,6 +364,22 @@ def _verdict(
     if waits:
         return (Verdict.WAITING, f"the situation only waits on steps {', '.join(waits)}, which can no longer become active")
     return (Verdict.UNKNOWN, "no awaited receptivity can become true and no order change is prohibited")
+
+
+def diagnose_never_starts(sync: Sync, *, expert: bool = False) -> Diagnosis:
+    """The diagnosis of a Grafcet that never leaves its initial steps: what the first
+    initial aggregated state awaits, and why it does not come (timers of the initial
+    steps play no part: the state diagnosed is the one before any elapses)."""
+    first = sync.initial[0]
+    d = diagnose(sync, first, expert=expert, component=range(len(sync.nodes)))
+    steps = ", ".join(sync.nodes[first].situation.step_variables)
+    return Diagnosis(
+        Verdict.NEVER_STARTS,
+        f"the Grafcet never leaves its initial steps {{{steps}}}: {d.summary}",
+        d.awaited,
+        d.details,
+        cause=d.verdict,
+    )
 
 
 def diagnose_prohibition(sync: Sync, node_index: int, pr: Prohibition) -> str:

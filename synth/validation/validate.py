@@ -8,18 +8,21 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable
+from typing import Callable, Sequence
 
 from synth.validation.analysis import Analysis, analyse
 from synth.plant.composition import Plant, plant
-from synth.validation.diagnosis import Diagnosis, diagnose
+from synth.errors import InputError, close_names
+from synth.logic.expr import Edge as ExprEdge, Expr, evaluate, names
+from synth.syntax import parse_expression
+from synth.validation.diagnosis import Diagnosis, diagnose, diagnose_never_starts
 from synth.grafcet.language import Grafcet, load_grafcet
 from synth.plant.rules import RuleSet, load_rules
 from synth.grafcet.machine import GrafcetMachine
 from synth.sup.constraints import CompiledConstraints
 from synth.validation.sync import Edge, Sync, synchronous_product
 
-__all__ = ["Validation", "ReducedController", "validate", "reduced_controller"]
+__all__ = ["Validation", "ReducedController", "validate", "home_conditions", "home_states", "reduced_controller"]
 
 
 @dataclass(frozen=True)
@@ -32,6 +35,8 @@ class Validation:
     diagnoses: dict[int, Diagnosis]
     expert: bool
     sup_empty: bool
+    homes: tuple[str, ...] = ()  # the --home conditions, as written
+    never_starts: Diagnosis | None = None
 
     @property
     def unreached_steps(self) -> list[str]:
@@ -50,26 +55,64 @@ class Validation:
 
     @property
     def passed(self) -> bool:
-        return not self.sup_empty and not self.analysis.blocking and not self.analysis.prohibited
+        return (not self.sup_empty and not self.analysis.blocking and not self.analysis.prohibited
+                and self.never_starts is None)
+
+def home_conditions(texts: Sequence[str], p: Plant, g: Grafcet) -> tuple[Expr, ...]:
+    """``--home`` conditions read and checked: names are step variables or plant
+    variables (E and Z), no edges; errors are located in the option text."""
+    known = [s.variable for s in g.steps] + list(p.inputs) + list(p.outputs)
+    out = []
+    for text in texts:
+        e = parse_expression(text, "--home")
+        for n in names(e):
+            if isinstance(n, ExprEdge):
+                raise InputError(f"an edge is not a state: {n.text()}", n.loc,
+                                 notes=("a home state is a condition on levels, e.g. --home \"X1 & v10\"",))
+            if n.name not in known:
+                raise InputError(f"unknown name '{n.name}' in --home", n.loc, suggestions=close_names(n.name, known),
+                                 notes=("a home condition reads step variables (X1) and plant variables (E, Z)",))
+        out.append(e)
+    return tuple(out)
+
+
+def home_states(sync: Sync, conditions: Sequence[Expr]) -> frozenset[int]:
+    """The home states: the initial aggregated states, and every state where one of
+    ``conditions`` holds (read on its active steps and its plant values)."""
+    homes = set(sync.initial)
+    for i, n in enumerate(sync.nodes):
+        val = sync.plant.valuation(n.plant)
+        steps = set(n.situation.step_variables)
+
+        def value(name: str) -> bool:
+            return name in steps if name not in val else val[name]
+
+        if any(evaluate(c, value) for c in conditions):
+            homes.add(i)
+    return frozenset(homes)
+
 
 def validate(
     grafcet_path: str | Path,
     rules_path: str | Path,
     *,
     expert: bool = False,
+    homes: Sequence[str] = (),
     max_states: int | None = None,
     progress: Callable[[int, int], None] | None = None,
 ) -> Validation:
-    """Run the whole method on a Grafcet and a plant."""
+    """Run the whole method on a Grafcet and a plant; ``homes`` are ``--home`` conditions."""
     rs = load_rules(rules_path)
     p = plant(rs)
     g = load_grafcet(grafcet_path, inputs=p.inputs, outputs=p.outputs)
+    conditions = home_conditions(homes, p, g)
     machine = GrafcetMachine(g)
     sup_empty = not CompiledConstraints(p, rs.constraints).kept(p.initial)
     sync = synchronous_product(p, rs.constraints, machine, max_states=max_states, progress=progress)
-    analysis = analyse(sync)
+    analysis = analyse(sync, home_states(sync, conditions))
     diagnoses = {b: diagnose(sync, b, expert=expert, component=analysis.components[b]) for b in analysis.blocking}
-    return Validation(rs, p, g, sync, analysis, diagnoses, expert, sup_empty)
+    never = diagnose_never_starts(sync, expert=expert) if analysis.never_starts else None
+    return Validation(rs, p, g, sync, analysis, diagnoses, expert, sup_empty, tuple(homes), never)
 
 
 @dataclass(frozen=True)
