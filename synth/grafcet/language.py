@@ -30,6 +30,7 @@ Example
 from __future__ import annotations
 
 import re
+from fractions import Fraction
 from dataclasses import dataclass, field
 from enum import StrEnum
 from pathlib import Path
@@ -85,7 +86,16 @@ CONTINUOUS, CONDITIONAL, STORED = ActionKind.CONTINUOUS, ActionKind.CONDITIONAL,
 ON_ACTIVATION, ON_DEACTIVATION, ON_EVENT = StoredWhen.ACTIVATION, StoredWhen.DEACTIVATION, StoredWhen.EVENT
 
 _TIMER_RE = re.compile(r"^([0-9]+(?:\.[0-9]+)?)(ms|s|min|h)/X([A-Za-z0-9_]+)$")
-_SECONDS = {"ms": 0.001, "s": 1.0, "min": 60.0, "h": 3600.0}
+_SECONDS = {"ms": Fraction(1, 1000), "s": Fraction(1), "min": Fraction(60), "h": Fraction(3600)}
+
+
+def duration_seconds(number: str, unit: str) -> Fraction:
+    """A duration as an exact number of seconds, so that equal durations compare equal.
+
+    >>> duration_seconds("700", "ms") == duration_seconds("0.7", "s"), duration_seconds("2", "min")
+    (True, Fraction(120, 1))
+    """
+    return Fraction(number) * _SECONDS[unit]
 
 
 STEP_PREFIX = "X"  # the step variable of step 12 is X12 (IEC 60848)
@@ -174,7 +184,7 @@ class Timer:
 
     id: str
     step: str
-    seconds: float
+    seconds: Fraction  # exact: 700ms and 0.7s are the same duration
     loc: Location | None = field(default=None, compare=False)
 
 

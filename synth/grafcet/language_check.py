@@ -19,7 +19,6 @@ from typing import Sequence
 
 from synth.errors import close_names, location_in
 from synth.grafcet.language import (
-    _SECONDS,
     _TIMER_RE,
     CONDITIONAL,
     ON_EVENT,
@@ -30,6 +29,7 @@ from synth.grafcet.language import (
     Step,
     Timer,
     Transition,
+    duration_seconds,
     step_key,
     step_of,
     step_variable,
@@ -213,7 +213,7 @@ class GrafcetChecker(Checker):
                         suggestions=tuple(step_variable(c) for c in close_names(step, self.steps)),
                     )
                 else:
-                    seconds = float(m.group(1)) * _SECONDS[m.group(2)]
+                    seconds = duration_seconds(m.group(1), m.group(2))
                     self.timers.setdefault(n.name, Timer(n.name, step, seconds, n.loc))
                 continue
             step_var_of = step_of(n.name, self.steps)

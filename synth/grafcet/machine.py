@@ -153,8 +153,14 @@ class GrafcetMachine:
         self._timer_step = {t.id: t.step for t in grafcet.timers}
         self._seconds = {t.id: t.seconds for t in grafcet.timers}
         self._timers_of_step: dict[str, tuple[str, ...]] = {}
+        # timers of one step with equal durations (2s/X1, 2000ms/X1) elapse at the same
+        # instant: one event, named after the first of them (grafcet.timers order)
+        self._same_instant: dict[str, tuple[str, ...]] = {}
         for t in grafcet.timers:
             self._timers_of_step[t.step] = self._timers_of_step.get(t.step, ()) + (t.id,)
+            self._same_instant[t.id] = tuple(
+                u.id for u in grafcet.timers if u.step == t.step and u.seconds == t.seconds
+            )
         self._rec = [_compile(t.receptivity, steps, timers) for t in self.transitions]
         self._enabled_cache: dict[frozenset[str], tuple[int, ...]] = {}
         self._rec_inputs = [frozenset(receptivity_inputs(t, self.inputs)) for t in self.transitions]
@@ -217,15 +223,27 @@ class GrafcetMachine:
     def timers(self, sit: Situation) -> tuple[Event, ...]:
         """Timer events that can occur now (sorted): the step is active, the timer has not
         elapsed, and no shorter timer of the same step is still running (timers of one
-        step start together, so ``2s/X1`` always elapses before ``5s/X1``)."""
+        step start together, so ``2s/X1`` always elapses before ``5s/X1``). Timers of
+        equal duration are one event, named by :meth:`timer_event`."""
         done = set(sit.elapsed)
         out = []
         for s in sit.steps:
             running = [t for t in self._timers_of_step.get(s, ()) if t not in done]
             if running:
                 first = min(self._seconds[t] for t in running)
-                out += [t for t in running if self._seconds[t] == first]
+                out += [t for t in running if self._seconds[t] == first and self.timer_event(t) == t]
         return tuple(Event.timer(t) for t in sorted(out))
+
+    def timer_event(self, timer: str) -> Event:
+        """The event of ``timer``: itself, or the first timer of its step with the same duration.
+
+        >>> from synth.grafcet.language import parse_grafcet
+        >>> m = GrafcetMachine(parse_grafcet("grafcet G { initial step 0 step 1 step 2 "
+        ...     "transition 0 -> 1 when 2s/X0  transition 0 -> 2 when 2000ms/X0 }"))
+        >>> m.timer_event("2s/X0"), m.timer_event("2000ms/X0")
+        ('2000ms/X0', '2000ms/X0')
+        """
+        return Event.timer(self._same_instant[timer][0])
 
     def fire_timer(self, sit: Situation, timer: str, inputs: Mapping[str, bool]) -> Situation:
         """The stable situation after ``timer`` elapses (inputs unchanged)."""
@@ -234,10 +252,10 @@ class GrafcetMachine:
     def fire_timer_with_trace(
         self, sit: Situation, timer: str, inputs: Mapping[str, bool]
     ) -> tuple[Situation, tuple[tuple[Transition, ...], ...]]:
-        if timer not in self.timers(sit):
+        if self.timer_event(timer) not in self.timers(sit):
             raise ValueError(f"timer {timer} is not running in {sit.text()}")
         st = self._state(sit)
-        st.elapsed.add(timer)
+        st.elapsed.update(self._same_instant[timer])
         rounds: list[tuple[Transition, ...]] = []
         self._settle(st, inputs, None, rounds)
         return self._situation(st), tuple(rounds)

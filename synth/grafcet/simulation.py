@@ -119,7 +119,7 @@ def simulate(grafcet: Grafcet, inputs: Mapping[str, bool], events: Sequence[tupl
     rows = [SimulationStep("initial", sit, ordered(sit), ())]
     for event, loc in events:
         if event.kind is EventKind.TIMER:
-            if event not in machine.timers(sit):
+            if machine.timer_event(event) not in machine.timers(sit):
                 step = next(t.step for t in grafcet.timers if t.id == event)
                 if event in sit.elapsed:
                     why = "it has already elapsed"
