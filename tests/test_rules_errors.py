@@ -129,3 +129,18 @@ def test_constraint_too_large(cli, tmp_path):
     text = f"element EA {{ orders {decl_a} }}\nelement EB {{ orders {decl_b} }}\nconstraint C1 \"pairs\": {big} = 1\n"
     err = _run(cli, tmp_path, text)
     assert "constraint C1 is too large once expanded" in err
+
+
+@pytest.mark.parametrize("text,where,name", [
+    ("element E { order A = 0  sensor a = 0  free b = 0  ↑A -> ↑a  ↓A -> ↓a  ↑A -> ↑b }\n", "1:79", "b"),
+    ("free dcy = 0\nelement E { order A = 0  sensor a = 0  ↑A -> ↑a  ↑A -> ↑dcy }\n", "2:57", "dcy"),
+])
+def test_rule_producing_a_free_input_is_an_error(cli, tmp_path, text, where, name):
+    """Decision (docs/rules.md): free inputs are the operator's; a rule that produces one
+    is bad input, not a rule that silently never applies."""
+    err = _run(cli, tmp_path, text)
+    assert err.splitlines()[0] == (
+        f"bad.rules:{where}: error: rule of element E produces ↑{name}, but {name} is a free input: "
+        "an operator changes it at any time, no rule produces it"
+    )
+    assert err.splitlines()[3] == f"  = note: declare {name} as a sensor of E if the element drives it"

@@ -19,7 +19,7 @@ from typing import Mapping
 
 from synth.errors import InputError, Location, close_names
 from synth.logic.expr import Edge, Expr, NegatedEdge, NormalFormTooLarge, Var, disjunctive_normal_form, evaluate, names, renamed
-from synth.plant.rules import ORDER, Constraint, ElementSpec, Precedence, Rule, VarDecl
+from synth.plant.rules import ORDER, Constraint, ElementSpec, Precedence, Rule, VarDecl, VarKind
 from synth.plant.rules_reader import _Hold, _Inline, _Instance, _Model, _Use, _Vector, rules_items
 from synth.syntax import Checker
 
@@ -251,7 +251,15 @@ class RulesChecker(Checker):
                     c.loc,
                     suggestions=close_names(c.name, [v.name for v in e.orders]),
                 )
-            if q.name not in own:
+            decl = own[q.name] if q.name in own else owner[q.name][1] if q.name in owner else None
+            if decl is not None and decl.kind == VarKind.FREE:
+                self.fail(
+                    f"rule of element {e.name} produces {q.text()}, but {q.name} is a free input: "
+                    "an operator changes it at any time, no rule produces it",
+                    q.loc,
+                    notes=(f"declare {q.name} as a sensor of {e.name} if the element drives it",),
+                )
+            elif q.name not in own:
                 if q.name in owner:
                     other = owner[q.name][0].name
                     self.fail(
