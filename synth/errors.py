@@ -34,6 +34,7 @@ __all__ = [
     "LimitExceeded",
     "close_names",
     "location_in",
+    "source_lines",
 ]
 
 
@@ -83,7 +84,9 @@ class InputError(SynthError):
         if loc is not None and loc.text:
             number = str(loc.line)
             pad = " " * len(number)
-            text = loc.text.rstrip("\n").expandtabs(1)
+            # one visible character per control character, so the caret stays aligned
+            text = "".join(c if c >= " " or c == "\t" else chr(0x2400 + ord(c)) for c in loc.text.rstrip("\n"))
+            text = text.expandtabs(1)
             lines.append(f"  {number} | {text}")
             width = max(1, loc.width)
             lines.append(f"  {pad} | " + " " * (loc.column - 1) + "^" + "~" * (width - 1))
@@ -130,8 +133,19 @@ def close_names(name: str, candidates: Iterable[str], n: int = 3) -> tuple[str, 
     return tuple(lowered[h] for h in hits)
 
 
+def source_lines(source: str) -> list[str]:
+    """The lines of ``source`` as the parsers number them: split at ``\\n`` only (a
+    ``\\r`` before it is dropped); ``\\r``, ``\\f`` and other control characters
+    inside a line stay in it.
+
+    >>> source_lines("a\\r\\nb\\fc\\n")
+    ['a', 'b\\x0cc', '']
+    """
+    return [line[:-1] if line.endswith("\r") else line for line in source.split("\n")]
+
+
 def location_in(file: str, source: str, line: int, column: int, width: int = 1) -> Location:
     """A :class:`Location` whose ``text`` is taken from ``source``."""
-    lines = source.splitlines()
+    lines = source_lines(source)
     text = lines[line - 1] if 0 < line <= len(lines) else ""
     return Location(file, line, column, text, width)

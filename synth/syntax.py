@@ -11,7 +11,7 @@ from typing import Any, Sequence
 
 from lark import Lark, Token, Transformer, Tree, UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
 
-from synth.errors import InputError, InputErrors, Location, location_in
+from synth.errors import InputError, InputErrors, Location, location_in, source_lines
 from synth.logic.expr import And, Const, Edge, Expr, Not, Or, Var
 
 __all__ = ["grammar_text", "parser", "syntax_error", "read_source", "ExprTransformer", "Checker", "raise_all", "parse_tree", "parse_expression"]
@@ -87,7 +87,7 @@ def syntax_error(err: UnexpectedInput, file: str, source: str, p: Lark) -> Input
     if isinstance(err, UnexpectedEOF) or (
         isinstance(err, UnexpectedToken) and err.token.type == "$END"
     ):
-        lines = source.splitlines() or [""]
+        lines = source_lines(source)
         line = len(lines)
         column = len(lines[-1]) + 1
         found = "end of file"
@@ -97,8 +97,19 @@ def syntax_error(err: UnexpectedInput, file: str, source: str, p: Lark) -> Input
         found = f"'{err.token}'"
         width = max(1, len(str(err.token)))
         expected = err.accepts or err.expected
+        history = getattr(err, "token_history", None) or ()
+        prev = history[-1] if history else None
+        if prev is not None and prev.end_line is not None and prev.end_line < line:
+            # the line ended too early (a missing ')' or operand): point where it is missing
+            line, column = prev.end_line, prev.end_column or 1
+            found = f"end of line after '{prev}'"
+            width = 1
     elif isinstance(err, UnexpectedCharacters):
-        found = f"character '{source[err.pos_in_stream]}'" if err.pos_in_stream < len(source) else "end of file"
+        if err.pos_in_stream < len(source):
+            char = source[err.pos_in_stream]
+            found = f"character '{char}'" if char.isprintable() else f"control character U+{ord(char):04X}"
+        else:
+            found = "end of file"
         width = 1
         expected = err.allowed or set()
     else:  # pragma: no cover - lark has no other kinds
@@ -114,11 +125,21 @@ def syntax_error(err: UnexpectedInput, file: str, source: str, p: Lark) -> Input
 def read_source(path: str | Path) -> str:
     """The text of a user file; an unreadable or non-UTF-8 file is an :class:`InputError`."""
     try:
-        return Path(path).read_text(encoding="utf-8-sig")  # a byte-order mark is dropped
+        data = Path(path).read_bytes()
     except OSError as exc:
         raise InputError(f"cannot read '{path}': {exc.strerror or exc}", None) from None
-    except UnicodeDecodeError:
-        raise InputError(f"'{path}' is not UTF-8 text", None) from None
+    try:
+        return data.decode("utf-8-sig")  # a byte-order mark is dropped
+    except UnicodeDecodeError as exc:
+        start = data.rfind(b"\n", 0, exc.start) + 1
+        line = data.count(b"\n", 0, exc.start) + 1
+        text = data[start:].split(b"\n", 1)[0].decode("utf-8", errors="replace")
+        column = len(data[start:exc.start].decode("utf-8", errors="replace")) + 1
+        raise InputError(
+            f"not UTF-8 text: byte 0x{data[exc.start]:02x} cannot start or continue a character",
+            Location(str(path), line, column, text, 1),
+            notes=("save the file as UTF-8 (synth reads ↑, ↓ and accented names in UTF-8)",),
+        ) from None
 
 
 class ExprTransformer(Transformer):

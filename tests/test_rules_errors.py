@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import shutil
 from pathlib import Path
 
 import pytest
@@ -144,3 +145,73 @@ def test_rule_producing_a_free_input_is_an_error(cli, tmp_path, text, where, nam
         "an operator changes it at any time, no rule produces it"
     )
     assert err.splitlines()[3] == f"  = note: declare {name} as a sensor of E if the element drives it"
+
+
+def test_typo_in_an_instantiation_is_reported_at_the_typo(cli, tmp_path):
+    (tmp_path / "lib").mkdir()
+    shutil.copy(ROOT / "plants/lib/double_acting.rules", tmp_path / "lib")
+    shutil.copy(ROOT / "plants/lib/single_acting.rules", tmp_path / "lib")
+    shutil.copy(ROOT / "plants/lib/conveyor.rules", tmp_path / "lib")
+    text = (ROOT / "plants/tri.rules").read_text().replace("AVANCER=AVANCER2, RECULER", "AVANCER=AVANCR2, RECULER")
+    lines = _run(cli, tmp_path, text).splitlines()
+    assert lines == [
+        "bad.rules:12:36: error: element V2 renames AVANCER to 'AVANCR2', which the file never uses; "
+        "the vectors and constraints use 'AVANCER2' (lines 4, 18, 21)",
+        "  12 | element V2 = double_acting(AVANCER=AVANCR2, RECULER=RECULER2, v0=v20, v1=v21)",
+        "     |                                    ^~~~~~~",
+        "  = did you mean AVANCER2?",
+    ]
+
+
+def test_missing_parenthesis_is_reported_where_it_is_missing(cli, tmp_path):
+    text = "element V = m(A=B\nconstraint K \"k\": B = 0\n"
+    lines = _run(cli, tmp_path, text).splitlines()
+    assert lines[:3] == [
+        "bad.rules:1:18: error: syntax error: unexpected end of line after 'B'",
+        "  1 | element V = m(A=B",
+        "    |                  ^",
+    ]
+    assert lines[3].startswith("  = expected ") and ")" in lines[3]
+
+
+@pytest.mark.parametrize("sep", ["\f", "\r"])
+def test_control_characters_do_not_shift_line_numbers(cli, tmp_path, sep):
+    text = f"free dcy = 0\nelement E {{{sep} order A = 0  sensor a = 0  ↑A -> ↑a  ↓A -> ↓b }}\n"
+    lines = _run(cli, tmp_path, text).splitlines()
+    shown = chr(0x2400 + ord(sep))
+    assert lines[:3] == [
+        "bad.rules:2:58: error: unknown variable 'b' in element E",
+        f"  2 | element E {{{shown} order A = 0  sensor a = 0  ↑A -> ↑a  ↓A -> ↓b }}",
+        "    |                                                          ^",
+    ]
+
+
+@pytest.mark.parametrize("sep", ["\x0b", "\x1c"])
+def test_other_control_characters_are_named(cli, tmp_path, sep):
+    text = f"free dcy = 0\nelement E {{{sep} order A = 0 }}\n"
+    lines = _run(cli, tmp_path, text).splitlines()
+    assert lines[:3] == [
+        f"bad.rules:2:12: error: syntax error: unexpected control character U+{ord(sep):04X}",
+        f"  2 | element E {{{chr(0x2400 + ord(sep))} order A = 0 }}",
+        "    |            ^",
+    ]
+
+
+def test_crlf_files_read_like_lf_files(cli, tmp_path):
+    text = "free dcy = 0\r\nelement E { order A = 0  sensor a = 0  ↑A -> ↑a  ↓A -> ↓b }\r\n"
+    lines = _run(cli, tmp_path, text).splitlines()
+    assert lines[0] == "bad.rules:2:57: error: unknown variable 'b' in element E"
+    assert lines[1] == "  2 | element E { order A = 0  sensor a = 0  ↑A -> ↑a  ↓A -> ↓b }"
+
+
+def test_non_utf8_file_points_at_the_first_bad_byte(cli, tmp_path):
+    f = tmp_path / "bad.rules"
+    f.write_bytes("free dcy = 0\n# caf\xe9 ↑\nelement E { order A = 0 }\n".encode("latin-1", errors="replace"))
+    code, out, err = cli("sup", f)
+    assert code == 2 and "Traceback" not in err
+    lines = err.replace(str(f), "bad.rules").splitlines()
+    assert lines[:3] == [
+        "bad.rules:2:6: error: not UTF-8 text: byte 0xe9 cannot start or continue a character",
+        "  2 | # caf\ufffd ?",
+        "    |      ^",
+    ]

@@ -39,6 +39,10 @@ class RulesChecker(Checker):
         self.vectors: list[_Vector] = []
         self.order: tuple[str, ...] = ()
         self.loaded: set[Path] = set()
+        # new names given by instance renamings: name -> (element, model variable, location)
+        self.renamed: dict[str, tuple[str, str, Location]] = {}
+        # uses of names no element declares, in vectors and constraints: (name, error)
+        self.unknown_uses: list[tuple[str, InputError]] = []
 
     # ---- collection
     def collect(self, items: list, base: Path | None) -> None:
@@ -100,7 +104,8 @@ class RulesChecker(Checker):
             return
         declared = {d.name for d in model.body.decls}
         mapping: dict[str, str] = {}
-        for old, new, old_loc, _ in inst.renaming:
+        for old, new, old_loc, new_loc in inst.renaming:
+            self.renamed.setdefault(new, (inst.name, old, new_loc))
             if old not in declared:
                 self.fail(
                     f"model '{model.name}' has no variable '{old}'",
@@ -179,7 +184,7 @@ class RulesChecker(Checker):
                 if n in listed:
                     self.fail(f"'{n}' is listed twice in the vectors", loc, notes=(f"first listed at {listed[n]}",))
                 elif n not in owner:
-                    self.fail(f"{vec.kind}: unknown variable '{n}'", loc, suggestions=close_names(n, pool))
+                    self.unknown_use(n, f"{vec.kind}: unknown variable '{n}'", loc, close_names(n, pool))
                 elif owner[n][1].is_input != want_input:
                     what = "an input" if owner[n][1].is_input else "an order"
                     self.fail(f"{vec.kind}: '{n}' is {what} of element {owner[n][0].name}", loc)
@@ -209,13 +214,45 @@ class RulesChecker(Checker):
             for n in names(c.expr):
                 if n.name not in all_names:
                     what = "edge of an undeclared variable" if isinstance(n, Edge) else "undeclared variable"
-                    self.fail(f"constraint {c.id} uses {what} '{n.name}'", n.loc, suggestions=close_names(n.name, all_names))
+                    self.unknown_use(n.name, f"constraint {c.id} uses {what} '{n.name}'", n.loc, close_names(n.name, all_names))
                 elif isinstance(n, Edge) and owner[n.name][1].kind != ORDER:
                     self.fail(
                         f"constraint {c.id}: edges in constraints must be edges of orders; '{n.name}' is an input of element {owner[n.name][0].name}",
                         n.loc,
                         notes=("an edge restricts the matching controllable event; inputs are written as levels",),
                     )
+
+        self.blame_renamings()
+
+    def unknown_use(self, name: str, message: str, loc: Location | None, suggestions: tuple[str, ...]) -> None:
+        self.unknown_uses.append((name, InputError(message, loc, suggestions=suggestions)))
+
+    def blame_renamings(self) -> None:
+        """Unknown names reported at their cause: when an instance renames a variable to a
+        name the file never uses and the unknown name is close to it (``AVANCER=AVANCR2``
+        while the vectors and constraints say ``AVANCER2``), one error at the renaming
+        replaces the errors at every use."""
+        used = {n for n, _ in self.unknown_uses}
+        referenced = {n for vec in self.vectors for n, _ in vec.names}
+        referenced |= {n.name for c in self.constraints for n in names(c.expr)}
+        blamed: dict[str, str] = {}
+        for new, (element, old, loc) in sorted(self.renamed.items(), key=lambda kv: str(kv[1][2])):
+            if new in referenced:
+                continue
+            typo_of = [u for u in sorted(used) if u not in blamed and close_names(u, [new])]
+            if not typo_of:
+                continue
+            u = typo_of[0]
+            uses = [e for n, e in self.unknown_uses if n == u]
+            lines = [str(e.location.line) for e in uses if e.location is not None]
+            self.fail(
+                f"element {element} renames {old} to '{new}', which the file never uses; "
+                f"the vectors and constraints use '{u}' (line{'s' if len(lines) > 1 else ''} {', '.join(lines)})",
+                loc,
+                suggestions=(u,),
+            )
+            blamed[u] = new
+        self.errors.extend(e for n, e in self.unknown_uses if n not in blamed)
 
     def check_element(self, e: ElementSpec, owner: Mapping[str, tuple[ElementSpec, VarDecl]]) -> None:
         own = {v.name: v for v in e.variables}
