@@ -210,3 +210,19 @@ def test_sparse_sup_equals_plain_tajer(seed):
     states, transitions = _plain_tajer(p, rs.constraints)
     assert {p.local(int(c)) for c in sup.states} == states
     assert sup.count_transitions() == transitions
+
+
+def test_why_weakly_defended_names_each_uncontrollable_event_and_the_constraint(cli, tmp_path):
+    """``sup --why`` on a weakly defended state: the path, event by event, and the violated
+    constraint with its label (issue 10, item 6)."""
+    text = (ROOT / "plants" / "tri_annex.rules").read_text().replace('use "lib/', f'use "{ROOT}/plants/lib/')
+    kept = [l for l in text.splitlines() if not l.startswith("constraint") or l.split()[1] in {"A1", "A2", "A3", "A4", "A5"}]
+    rules = tmp_path / "annex_1_5.rules"
+    rules.write_text("\n".join(kept) + "\n")
+    code, out, _ = cli("sup", rules, "--why", "TAPIS,v10,v20,v30,v40,AVANCER1,AVANCER3")
+    assert code == 0
+    label = next(l for l in kept if l.startswith("constraint A3")).split('"')[1]
+    assert out.strip() == (
+        "{v10,v20,v30,v40,TAPIS,AVANCER1,AVANCER3} is weakly defended: the uncontrollable path ↓v10 ↑v11 "
+        f'leads to a state violating A3 "{label}"'
+    )

@@ -15,13 +15,24 @@ from __future__ import annotations
 
 from collections import deque
 from dataclasses import dataclass
+from enum import StrEnum
 from typing import Iterable
 
 import numpy as np
 
 from synth.sup.supervisor import Supervisor
 
-__all__ = ["Explanation", "explain"]
+__all__ = ["Status", "Explanation", "explain"]
+
+
+class Status(StrEnum):
+    """Where a plant state stands with respect to SUP."""
+
+    ILLEGAL = "illegal"  # it violates a constraint
+    DEFENDED = "defended"  # one uncontrollable event leads to an illegal state
+    WEAKLY_DEFENDED = "weakly_defended"  # an uncontrollable path leads to a defended state
+    KEPT = "kept"  # in SUP
+    UNREACHABLE = "unreachable"  # legal, not defended, but not reachable in SUP
 
 
 @dataclass(frozen=True)
@@ -29,7 +40,7 @@ class Explanation:
     """Why a state is kept in or removed from SUP."""
 
     state: str
-    status: str  # illegal | defended | weakly_defended | kept | unreachable
+    status: Status
     constraints: tuple[str, ...] = ()
     path: tuple[str, ...] = ()  # uncontrollable events leading to the violation
     forbidden: tuple[tuple[str, tuple[str, ...]], ...] = ()  # (event, constraint ids) cut from here
@@ -50,16 +61,16 @@ class Explanation:
             return ", ".join(f'{i} "{labels[i]}"' if labels.get(i) else i for i in ids)
 
         s = self.state
-        if self.status == "illegal":
+        if self.status is Status.ILLEGAL:
             return f"{s} is illegal: it violates {named(self.constraints)}"
-        if self.status == "defended":
+        if self.status is Status.DEFENDED:
             return f"{s} is defended: the uncontrollable event {self.path[0]} leads to a state violating {named(self.constraints)}"
-        if self.status == "weakly_defended":
+        if self.status is Status.WEAKLY_DEFENDED:
             return (
                 f"{s} is weakly defended: the uncontrollable path {' '.join(self.path)} leads to a state "
                 f"violating {named(self.constraints)}"
             )
-        head = f"{s} is kept in SUP" if self.status == "kept" else f"{s} is legal and not defended, but unreachable in SUP"
+        head = f"{s} is kept in SUP" if self.status is Status.KEPT else f"{s} is legal and not defended, but unreachable in SUP"
         if not self.forbidden:
             return head + "; no controllable event is forbidden there"
         lines = [head + "; forbidden controllable events from it:"]
@@ -74,7 +85,7 @@ def explain(sup: Supervisor, local: tuple[int, ...]) -> Explanation:
     label = p.label(local)
     violated = sup.violated(local)
     if violated:
-        return Explanation(label, "illegal", tuple(violated))
+        return Explanation(label, Status.ILLEGAL, tuple(violated))
     if not sup.kept(local):
         # breadth-first search over uncontrollable moves to the nearest violation
         parent: dict[tuple[int, ...], tuple[tuple[int, ...], str] | None] = {local: None}
@@ -89,7 +100,7 @@ def explain(sup: Supervisor, local: tuple[int, ...]) -> Explanation:
                     path.append(ev)
                     node = prev
                 path.reverse()
-                status = "defended" if len(path) == 1 else "weakly_defended"
+                status = Status.DEFENDED if len(path) == 1 else Status.WEAKLY_DEFENDED
                 return Explanation(label, status, tuple(sup.violated(cur)), tuple(path))
             for t, nxt in p.successors(cur):
                 if not t.controllable and nxt not in parent:
@@ -103,5 +114,5 @@ def explain(sup: Supervisor, local: tuple[int, ...]) -> Explanation:
             if not ok:
                 forbidden.append((t.event, tuple(why)))
     inside = bool(sup.contains(np.array([p.index(local)], dtype=np.int64))[0])
-    status = "kept" if inside else "unreachable"
+    status = Status.KEPT if inside else Status.UNREACHABLE
     return Explanation(label, status, (), (), tuple(forbidden))
