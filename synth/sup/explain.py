@@ -7,7 +7,7 @@ Example
 >>> from synth.sup.supervisor import supremal_controllable
 >>> rs = load_rules(_plants("tri_annex.rules"))
 >>> sup = supremal_controllable(plant(rs), rs.constraints)
->>> explain(sup, sup.plant.initial).status
+>>> explain(sup, sup.plant.initial).status.value
 'kept'
 """
 
