@@ -1,13 +1,56 @@
 #!/usr/bin/env bash
-# Installs what synth needs on a fresh machine: Graphviz's dot (Debian) and the
-# package with its test dependencies (pip). Safe to run again.
+# Set-up on a fresh machine (stock Debian 12 included): a project virtual environment
+# .venv with synth and its test dependencies, Graphviz's dot from Debian when missing,
+# and, with SYNTH_SETUP_BROWSER=1 (CI), Debian's chromium for the report's browser test.
+# Writes nothing outside .venv (and Debian's packages). Safe to run again.
+#
+# Environment:
+#   SYNTH_PYTHON        the Python to build the venv from (default: python3)
+#   SYNTH_VENV          where the venv goes (default: .venv in the repository)
+#   SYNTH_SKIP_APT=1    never call apt-get (tests, machines without root)
+#   SYNTH_SETUP_BROWSER=1  also install chromium (the browser test)
+#   SYNTH_PIP_ARGS      extra pip arguments (e.g. --no-deps for an offline re-install)
+#   SYNTH_VENV_ARGS     extra venv arguments (e.g. --system-site-packages)
 set -euo pipefail
 cd "$(dirname "$0")/.."
-if ! command -v dot >/dev/null 2>&1; then
-  echo "== installing Graphviz (dot)" >&2
+PYTHON="${SYNTH_PYTHON:-python3}"
+VENV="${SYNTH_VENV:-.venv}"
+
+apt_install() {  # apt_install PACKAGE...: Debian packages, as root or through sudo
+  if [ "${SYNTH_SKIP_APT:-0}" = 1 ] || ! command -v apt-get >/dev/null 2>&1; then
+    echo "== please install: $* (no apt-get here)" >&2
+    return 1
+  fi
+  local sudo=""
+  if [ "$(id -u)" != 0 ]; then
+    if command -v sudo >/dev/null 2>&1; then sudo="sudo"; else
+      echo "== please install as root: apt-get install $*" >&2; return 1; fi
+  fi
+  echo "== installing $* (Debian)" >&2
   export DEBIAN_FRONTEND=noninteractive
-  apt-get update -qq >&2
-  apt-get install -y -qq graphviz >/dev/null
+  $sudo apt-get update -qq >&2 || true
+  $sudo apt-get install -y -qq "$@" >/dev/null
+}
+
+if ! command -v dot >/dev/null 2>&1; then
+  apt_install graphviz || echo "== warning: no Graphviz: reports are written without drawings" >&2
 fi
-echo "== installing synth" >&2
-python3 -m pip install --quiet --disable-pip-version-check ".[test]" >&2
+if [ "${SYNTH_SETUP_BROWSER:-0}" = 1 ] && ! command -v chromium >/dev/null 2>&1; then
+  apt_install chromium || echo "== warning: no chromium: the browser test will be skipped" >&2
+fi
+
+# the venv: python3 -m venv needs Debian's python3-venv (ensurepip) on stock Debian
+if [ ! -x "$VENV/bin/python" ]; then
+  if ! "$PYTHON" -m venv --help >/dev/null 2>&1 || ! "$PYTHON" -c "import ensurepip" >/dev/null 2>&1; then
+    ver="$("$PYTHON" -c 'import sys; print(f"{sys.version_info[0]}.{sys.version_info[1]}")')"
+    apt_install "python${ver}-venv" || apt_install python3-venv
+  fi
+  echo "== creating the virtual environment $VENV" >&2
+  rm -rf "$VENV"
+  # shellcheck disable=SC2086
+  "$PYTHON" -m venv ${SYNTH_VENV_ARGS:-} "$VENV"
+fi
+echo "== installing synth into $VENV" >&2
+# shellcheck disable=SC2086
+"$VENV/bin/python" -m pip install --quiet --disable-pip-version-check ${SYNTH_PIP_ARGS:-} -e ".[test]" >&2
+echo "== ready: $VENV/bin/synth (or: export PATH=\"$(cd "$VENV" && pwd)/bin:\$PATH\")" >&2

@@ -1,4 +1,4 @@
-"""Command line: ``synth plant``, ``synth sup``, ``synth ass``, ``synth run``, ``synth validate``.
+"""Command line: ``synth plant``, ``synth sup``, ``synth ass``, ``synth run``, ``synth validate``, ``synth lib``.
 
 Exit codes: 0 pass, 1 the model fails validation, 2 bad input (reported as
 ``file:line:col: message`` with a caret, never a traceback).
@@ -12,7 +12,7 @@ from typing import Callable, Sequence
 
 from synth.errors import InputError, InputErrors, LimitExceeded, ModelError, SynthError
 
-__all__ = ["main", "entry", "build_parser"]
+__all__ = ["main", "entry", "build_parser", "version"]
 
 EXIT_PASS, EXIT_FAIL, EXIT_INPUT = 0, 1, 2
 
@@ -23,15 +23,39 @@ class _Parser(argparse.ArgumentParser):
         self.exit(EXIT_INPUT, f"{self.prog}: error: {message}\n")
 
 
+class _Version(argparse.Action):
+    """``--version``, the version read only when asked (``--help`` stays fast)."""
+
+    def __call__(self, parser: argparse.ArgumentParser, *args: object) -> None:
+        sys.stdout.write(f"synth {version()}\n")
+        parser.exit(0)
+
+
 def build_parser() -> argparse.ArgumentParser:
-    from synth.cli import grafcet as cli_grafcet, plant as cli_plant, validate as cli_validate
+    from synth.cli import grafcet as cli_grafcet, lib as cli_lib, plant as cli_plant, validate as cli_validate
 
     p = _Parser(prog="synth", description="Validate a Grafcet against a rule-based plant model and its safety constraints.")
+    p.add_argument("--version", action=_Version, nargs=0, help="print synth's version and exit")
     sub = p.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
-    for module in (cli_plant, cli_grafcet, cli_validate):
+    for module in (cli_plant, cli_grafcet, cli_validate, cli_lib):
         module.register(sub)
     return p
+
+
+def version() -> str:
+    """The installed distribution's version (the source tree's pyproject when not installed)."""
+    from importlib import metadata
+
+    try:
+        return metadata.version("synth")
+    except metadata.PackageNotFoundError:  # pragma: no cover - a bare source tree
+        import re
+        from pathlib import Path
+
+        text = (Path(__file__).resolve().parents[2] / "pyproject.toml").read_text(encoding="utf-8")
+        found = re.search(r'^version = "([^"]+)"', text, re.M)
+        return found.group(1) if found else "unknown"
 
 
 def main(argv: Sequence[str] | None = None) -> int:

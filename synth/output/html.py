@@ -53,7 +53,17 @@ def _template(name: str):
     return env.get_template(name)
 
 
+MISSING_DOT_NOTE = ("drawing missing: Graphviz's dot program is not installed (Debian: apt-get install graphviz); "
+                    "its DOT text follows")
+
+
 def _inline_svg(dot_text: str) -> str:
+    """The drawing inline; without Graphviz, a note and the DOT text (folded away)."""
+    if not dot_available():
+        from markupsafe import escape
+
+        return (f'<div class="figure missing"><p class="note">{escape(MISSING_DOT_NOTE)}</p>'
+                f"<details><summary>DOT</summary><pre>{escape(dot_text)}</pre></details></div>")
     text = svg(dot_text)
     start = text.find("<svg")
     return f'<div class="figure">{text[start:] if start >= 0 else text}</div>'

@@ -30,7 +30,10 @@ from synth.output.dot import orders_text
 
 if TYPE_CHECKING:  # pragma: no cover
     from synth.grafcet.ass import ASS
+    from pathlib import Path
+
     from synth.grafcet.simulation import SimulationStep
+    from synth.plant.library import LibraryModel
     from synth.plant.composition import Plant
     from synth.plant.element import ElementAutomaton
     from synth.plant.rules import RuleSet
@@ -46,6 +49,8 @@ __all__ = [
     "ass_json",
     "ass_text",
     "run_text",
+    "library_json",
+    "library_text",
 ]
 
 
@@ -208,3 +213,28 @@ def run_text(rows: "Sequence[SimulationStep]") -> str:
             line += f"   fired: {fired}"
         out.append(line.rstrip() + "\n")
     return "".join(out)
+
+
+def library_json(models: "Sequence[LibraryModel]") -> list[dict[str, Any]]:
+    """``synth lib --json``: one object per model."""
+    return [
+        {"model": m.name, "use": m.use, "orders": list(m.orders), "sensors": list(m.sensors),
+         "initial": {n: int(v) for n, v in m.initial}, "summary": m.summary}
+        for m in models
+    ]
+
+
+def library_text(models: "Sequence[LibraryModel]", where: "Path") -> str:
+    """``synth lib``: each model with its orders, sensors (initial values) and use line."""
+    lines = [f"element library: {where}"]
+    for m in models:
+        init = dict(m.initial)
+        lines += [
+            "",
+            f"{m.name}  ({m.use})" + (f"  {m.summary}" if m.summary else ""),
+            "  orders:  " + (", ".join(f"{o} = {int(init[o])}" for o in m.orders) or "-"),
+            "  sensors: " + (", ".join(f"{x} = {int(init[x])}" for x in m.sensors) or "-"),
+            f'  use "{m.use}"   element NAME = {m.name}('
+            + ", ".join(f"{v}={v}1" for v in m.orders + m.sensors) + ")",
+        ]
+    return "\n".join(lines) + "\n"

@@ -20,6 +20,7 @@ from typing import Mapping
 from synth.errors import InputError, Location, close_names
 from synth.logic.expr import Edge, Expr, NegatedEdge, NormalFormTooLarge, Var, disjunctive_normal_form, evaluate, names, renamed
 from synth.plant.rules import ORDER, Constraint, ElementSpec, Precedence, Rule, VarDecl, VarKind
+from synth.plant.library import library_file
 from synth.plant.rules_reader import _Hold, _Inline, _Instance, _Model, _Use, _Vector, rules_items
 from synth.syntax import Checker
 
@@ -72,7 +73,7 @@ class RulesChecker(Checker):
                 self.vectors.append(it)
 
     def use(self, u: _Use, base: Path | None) -> None:
-        target = (base / u.path) if base is not None else Path(u.path)
+        target = library_file(u.path, base)
         try:
             resolved = target.resolve()
             if resolved in self.loaded:

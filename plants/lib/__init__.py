@@ -1,0 +1,1 @@
+"""The element library shipped with synth: models for ``use "lib/NAME.rules"`` (``synth lib`` lists them)."""

@@ -1,0 +1,123 @@
+"""A newcomer's first hour (issue 13): the set-up script on a Python that refuses
+system-wide installs, a wheel that carries the element library, no Graphviz, the
+version and the library listing."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import pytest
+
+from conftest import ROOT
+from synth.cli.main import main
+
+
+def _run(argv: list[str], **kw) -> subprocess.CompletedProcess:
+    return subprocess.run(argv, capture_output=True, text=True, timeout=600, **kw)
+
+
+@pytest.mark.slow
+def test_setup_uses_a_venv_when_the_system_python_refuses_installs(tmp_path):
+    """Debian 12's python3 refuses ``pip install`` (PEP 668, ``externally-managed-environment``).
+    The stand-in below does the same for any ``-m pip`` outside a venv; set-up must still
+    succeed, because it installs into its own virtual environment only."""
+    fake = tmp_path / "python3"
+    fake.write_text(textwrap.dedent(f"""\
+        #!/bin/sh
+        for a in "$@"; do
+          if [ "$a" = pip ]; then
+            echo "error: externally-managed-environment" >&2; exit 1
+          fi
+        done
+        exec {sys.executable} "$@"
+        """))
+    fake.chmod(0o755)
+    assert _run([str(fake), "-m", "pip", "--version"]).returncode == 1
+    venv = tmp_path / "venv"
+    env = dict(os.environ, SYNTH_PYTHON=str(fake), SYNTH_VENV=str(venv), SYNTH_SKIP_APT="1",
+               SYNTH_VENV_ARGS="--system-site-packages", SYNTH_PIP_ARGS="--no-deps")
+    r = _run(["bash", str(ROOT / "scripts/setup.sh")], env=env)
+    assert r.returncode == 0, r.stderr
+    assert f"ready: {venv}/bin/synth" in r.stderr
+    r = _run([str(venv / "bin/synth"), "--version"])
+    assert r.returncode == 0 and r.stdout.startswith("synth ")
+
+
+@pytest.mark.slow
+def test_installed_wheel_validates_a_lone_copy_of_tri_rules(tmp_path):
+    """The element library ships in the wheel: ``use "lib/…"`` resolves from the installed
+    package when nothing is beside the file."""
+    wheels = tmp_path / "wheels"
+    r = _run([sys.executable, "-m", "pip", "wheel", "-q", "--no-deps", "--no-build-isolation", "-w", str(wheels), str(ROOT)])
+    assert r.returncode == 0, r.stderr
+    venv = tmp_path / "venv"
+    assert _run([sys.executable, "-m", "venv", "--system-site-packages", "--without-pip", str(venv)]).returncode == 0
+    (wheel,) = wheels.glob("synth-*.whl")
+    r = _run([sys.executable, "-m", "pip", "--python", str(venv / "bin/python"), "install", "-q", "--no-deps",
+              "--force-reinstall", str(wheel)])
+    assert r.returncode == 0, r.stderr
+    work = tmp_path / "empty"
+    work.mkdir()
+    shutil.copy(ROOT / "plants/tri.rules", work)
+    shutil.copy(ROOT / "grafcets/tri.g7", work)
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    r = _run([str(venv / "bin/synth"), "validate", "tri.g7", "--plant", "tri.rules"], cwd=work, env=env)
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert r.stdout.startswith("PASS: 0 blocking situation(s)")
+    r = _run([str(venv / "bin/python"), "-c", "import synth; print(synth.__file__)"], cwd=work, env=env)
+    assert str(venv) in r.stdout  # the installed copy ran, not the source tree
+
+
+def test_report_without_graphviz_still_answers(tmp_path):
+    """No ``dot`` on the PATH: the verdict, the diagnosis and the exit code are the same,
+    and the report says where drawings are missing."""
+    bin_dir = tmp_path / "bin"
+    bin_dir.mkdir()
+    (bin_dir / "python3").symlink_to(sys.executable)
+    env = dict(os.environ, PATH=str(bin_dir), PYTHONPATH=str(ROOT))
+    out = tmp_path / "rep"
+    r = _run([str(bin_dir / "python3"), "-m", "synth", "validate", str(ROOT / "grafcets/tri_missing_order.g7"),
+              "--plant", str(ROOT / "plants/tri.rules"), "--report", str(out)], env=env, cwd=tmp_path)
+    assert r.returncode == 1, r.stderr
+    assert "diagnosis [missing_order]: missing order AVANCER2 in step 103" in r.stdout
+    html = (out / "index.html").read_text()
+    assert "drawing missing: Graphviz&#39;s dot program is not installed" in html
+    assert "<svg" not in html
+
+
+def test_version(capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["--version"])
+    assert exc.value.code == 0
+    assert capsys.readouterr().out == "synth 0.1.0\n"
+
+
+def test_lib_lists_models_with_orders_and_sensors(capsys):
+    assert main(["lib", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert [(m["model"], m["use"], m["orders"], m["sensors"]) for m in data] == [
+        ("conveyor", "lib/conveyor.rules", ["TAPIS"], ["small", "large"]),
+        ("double_acting", "lib/double_acting.rules", ["AVANCER", "RECULER"], ["v0", "v1"]),
+        ("single_acting", "lib/single_acting.rules", ["AVANCER"], ["v0", "v1"]),
+    ]
+    assert data[1]["initial"] == {"AVANCER": 0, "RECULER": 0, "v0": 1, "v1": 0}
+    assert main(["lib"]) == 0
+    out = capsys.readouterr().out
+    assert "  orders:  AVANCER = 0, RECULER = 0\n  sensors: v0 = 1, v1 = 0\n" in out
+
+
+def test_use_lib_resolves_beside_the_file_first(tmp_path):
+    """A ``lib/`` folder beside the file wins over the installed library."""
+    from synth.plant.library import library_file
+
+    (tmp_path / "lib").mkdir()
+    mine = tmp_path / "lib" / "double_acting.rules"
+    mine.write_text("model double_acting { orders A = 0 }\n")
+    assert library_file("lib/double_acting.rules", tmp_path) == mine
+    assert library_file("lib/double_acting.rules", tmp_path / "nowhere").parent.name in ("lib", "library")
