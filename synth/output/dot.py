@@ -13,11 +13,12 @@ from typing import TYPE_CHECKING, Iterable, Mapping, Sequence
 
 if TYPE_CHECKING:  # pragma: no cover
     from synth.grafcet.ass import ASS
+    from synth.grafcet.language import Grafcet
     from synth.plant.composition import Plant
     from synth.plant.element import ElementAutomaton
     from synth.validation.sync import Sync
 
-__all__ = ["dot_graph", "dot_escape", "element_dot", "trace_dot", "sup_neighbourhood_dot", "aggregated_dot", "ass_dot", "orders_text", "plant_dot"]
+__all__ = ["dot_graph", "dot_escape", "element_dot", "trace_dot", "sup_neighbourhood_dot", "aggregated_dot", "ass_dot", "orders_text", "plant_dot", "grafcet_dot", "true_names"]
 
 CONTROLLABLE_STYLE = {"color": "#1f5fa8", "fontcolor": "#1f5fa8"}
 UNCONTROLLABLE_STYLE = {"color": "#b03a2e", "fontcolor": "#b03a2e", "style": "dashed"}
@@ -82,6 +83,34 @@ def _vector_text(names: Iterable[str], values: Mapping[str, bool]) -> str:
     return "[" + "".join("1" if values[n] else "0" for n in names) + "]"
 
 
+def true_names(names: Iterable[str], values: Mapping[str, bool]) -> str:
+    """The variables that are true, by name (``v10 cp12``), ``-`` for none."""
+    return " ".join(n for n in names if values[n]) or "-"
+
+
+def grafcet_dot(g: "Grafcet") -> str:
+    """The Grafcet as a chart: steps (initial ones double) with their actions, each
+    transition a bar labelled with its receptivity. Step nodes are named ``step_<name>``
+    so that a page can mark the active steps."""
+    nodes: list[tuple[str, str, Mapping[str, str]]] = []
+    edges: list[tuple[str, str, str, Mapping[str, str]]] = []
+    for step in g.steps:
+        label = step.variable + ("\n" + "\n".join(a.text() for a in step.actions) if step.actions else "")
+        attrs = {"shape": "box", "style": "filled", "fillcolor": "#ffffff"}
+        if step.initial:
+            attrs["peripheries"] = "2"
+        nodes.append((f"step_{step.name}", label, attrs))
+    for k, t in enumerate(g.transitions):
+        bar = f"t{k}"
+        nodes.append((bar, "", {"shape": "rect", "height": "0.04", "width": "0.5", "style": "filled",
+                                "fillcolor": "#222222", "xlabel": f"{t.name}: {t.receptivity.text()}"}))
+        for src in t.sources:
+            edges.append((f"step_{src}", bar, "", {"arrowhead": "none"}))
+        for dst in t.targets:
+            edges.append((bar, f"step_{dst}", "", {}))
+    return dot_graph(g.path or "grafcet", nodes, edges, rankdir="TB")
+
+
 def trace_dot(sync: "Sync", nodes: Iterable[int], events: Iterable[str], blocking: int | None = None) -> str:
     """A trace of the aggregated automaton drawn like the thesis's figure 2.10: each state
     with Sit, ORD, PROH, E and Z; the blocking state in red with a double border."""
@@ -95,7 +124,7 @@ def trace_dot(sync: "Sync", nodes: Iterable[int], events: Iterable[str], blockin
         label = (
             f"{k}: Sit={n.situation.text()}\n"
             f"ORD={{{', '.join(n.ord)}}}  PROH={{{proh}}}\n"
-            f"E={_vector_text(p.inputs, val)}  Z={_vector_text(p.outputs, val)}"
+            f"E: {true_names(p.inputs, val)}\nZ: {true_names(p.outputs, val)}"
         )
         attrs = {"shape": "box", "style": "rounded"}
         if k == 0:
@@ -106,8 +135,6 @@ def trace_dot(sync: "Sync", nodes: Iterable[int], events: Iterable[str], blockin
             attrs.update({"color": "#e67e22"})
         out_nodes.append((f"n{k}", label, attrs))
     edges = [(f"n{k}", f"n{k + 1}", ev, dict(UNCONTROLLABLE_STYLE)) for k, ev in enumerate(events)]
-    legend = "E = [" + ", ".join(p.inputs) + "]\nZ = [" + ", ".join(p.outputs) + "]"
-    out_nodes.append(("legend", legend, {"shape": "note", "fontsize": "9"}))
     return dot_graph("trace", out_nodes, edges, rankdir="TB")
 
 
@@ -145,13 +172,15 @@ def aggregated_dot(sync: "Sync", keep: Iterable[int] | None = None, blocking: It
     nodes = []
     for i in chosen:
         n = sync.nodes[i]
-        e, z = p.vectors(n.plant)
+        val = p.valuation(n.plant)
         attrs = {"shape": "box", "style": "rounded"}
         if i == 0:
             attrs["peripheries"] = "2"
         if i in bad:
             attrs.update({"color": "#c0392b", "penwidth": "2"})
-        nodes.append((f"q{i}", f"q{i}: {n.situation.text()}\nORD={{{', '.join(n.ord)}}}\nE={e} Z={z}", attrs))
+        label = (f"q{i}: {n.situation.text()}\nORD={{{', '.join(n.ord)}}}\n"
+                 f"E: {true_names(p.inputs, val)}\nZ: {true_names(p.outputs, val)}")
+        nodes.append((f"q{i}", label, attrs))
     edges = [
         (f"q{e.source}", f"q{e.target}", e.event, dict(UNCONTROLLABLE_STYLE))
         for e in sync.edges

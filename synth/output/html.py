@@ -69,17 +69,36 @@ def _inline_svg(dot_text: str) -> str:
     return f'<div class="figure">{text[start:] if start >= 0 else text}</div>'
 
 
+def _walk_step(event: str, state: dict) -> dict:
+    """One trace step for the page's state panel: names of the true variables."""
+    return {
+        "event": event,
+        "situation": state["situation"],
+        "E": [k for k, x in state["E"].items() if x],
+        "Z": [k for k, x in state["Z"].items() if x],
+        "ord": state["ord"],
+        "proh": ", ".join(f"{p['order']} ({', '.join(p['constraints'])})" for p in state["proh"]),
+        "stored": state["stored"],
+        "elapsed": state["elapsed"],
+    }
+
+
 def report_html(v: "Validation") -> str:
-    """The self-contained HTML report of a validation (inline SVG made by Graphviz)."""
+    """The self-contained HTML report of a validation (inline SVG made by Graphviz; no
+    network requests): the problems first, each trace step clickable to show its state
+    and the Grafcet's active steps, then what was checked, a legend and the drawings."""
     from markupsafe import Markup
 
-    from synth.output.dot import aggregated_dot, element_dot, sup_neighbourhood_dot, trace_dot
+    from synth.output.dot import aggregated_dot, element_dot, grafcet_dot, sup_neighbourhood_dot, trace_dot
     from synth.output.result import prohibited_json, validation_json
 
     data = validation_json(v)
     a = v.analysis
+    chart = grafcet_dot(v.grafcet)
+    chart_svg = Markup(_inline_svg(chart))
     blocking = []
-    for b, item in zip(a.blocking, data["blocking"]):
+    walks: dict[str, list[dict]] = {}
+    for k, (b, item) in enumerate(zip(a.blocking, data["blocking"]), 1):
         d = v.diagnoses[b]
         tr = a.traces[b]
         names, events = _involved(v, b, d)
@@ -90,11 +109,14 @@ def report_html(v: "Validation") -> str:
             here = v.sync.nodes[b].plant[axis]
             elements.append({"name": name, "state": el.state_label(here),
                              "svg": Markup(_inline_svg(element_dot(el, highlight=events, current=here)))})
+        steps = [_walk_step(ev, st) for ev, st in zip(["initial"] + list(tr.events), item["trace_states"])]
+        walks[f"b{k}"] = steps
         blocking.append({
             "situation": v.sync.nodes[b].situation.text(),
             "item": item,
-            "trace": tr.events,
+            "steps": steps,
             "diagnosis": d,
+            "grafcet_svg": chart_svg,
             "trace_svg": Markup(_inline_svg(trace_dot(v.sync, tr.nodes, tr.events, blocking=b))),
             "elements": elements,
             "sup_svg": Markup(_inline_svg(sup_neighbourhood_dot(v.sync, v.sync.nodes[b].plant))),
@@ -108,7 +130,12 @@ def report_html(v: "Validation") -> str:
             "trace": tr.events,
             "trace_svg": Markup(_inline_svg(trace_dot(v.sync, tr.nodes, tr.events, blocking=None))),
         })
-    aggregated = Markup(_inline_svg(aggregated_dot(v.sync, blocking=a.blocking))) if len(v.sync.nodes) <= 120 else None
+    keep = None
+    if a.blocking:  # the part that leads to the blocking states
+        keep = {n for b in a.blocking for n in a.traces[b].nodes} | {n for b in a.blocking for n in a.components[b]}
+    shown = len(keep) if keep is not None else len(v.sync.nodes)
+    aggregated = Markup(_inline_svg(aggregated_dot(v.sync, keep=keep, blocking=a.blocking))) if shown <= 120 else None
+    steps_total = len(v.grafcet.steps)
     return _template("report.html.j2").render(
         grafcet_name=Path(v.grafcet.path).name,
         data=data,
@@ -116,6 +143,11 @@ def report_html(v: "Validation") -> str:
         blocking=blocking,
         prohibited=prohibited,
         aggregated_svg=aggregated,
+        aggregated_cut=keep is not None,
+        situations=len({n.situation for n in v.sync.nodes}),
+        steps_covered=steps_total - len(data["unreached_steps"]),
+        steps_total=steps_total,
+        walks=walks,
         state_table=_state_table,
     )
 

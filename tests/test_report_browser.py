@@ -1,0 +1,96 @@
+"""The HTML report opened in a real browser (headless Chromium from Debian, driven by
+Playwright): no JavaScript error, no horizontal overflow, the blocking section and its
+trace on the first screen, and a click on a trace step updates the state panel and the
+Grafcet's active steps. Screenshots are saved in the test's temporary folder."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import pytest
+
+from conftest import ROOT
+from synth.cli.main import main
+
+CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
+playwright = pytest.importorskip("playwright.sync_api")
+
+pytestmark = pytest.mark.skipif(CHROMIUM is None, reason="Debian's chromium is not installed (setup.sh installs it for CI)")
+
+
+def _report(tmp_path: Path, g7: str, rules: str, *flags: str) -> Path:
+    out = tmp_path / Path(g7).stem
+    main(["validate", str(ROOT / g7), "--plant", str(ROOT / rules), "--report", str(out), *flags])
+    return out / "index.html"
+
+
+@pytest.fixture(scope="module")
+def browser():
+    with playwright.sync_playwright() as p:
+        b = p.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox"])
+        yield b
+        b.close()
+
+
+def _open(browser, path: Path, errors: list[str]):
+    page = browser.new_page(viewport={"width": 1280, "height": 900})
+    page.on("pageerror", lambda e: errors.append(str(e)))
+    page.on("console", lambda m: errors.append(m.text) if m.type == "error" else None)
+    requests: list[str] = []
+    page.on("request", lambda r: requests.append(r.url))
+    page.goto(path.as_uri())
+    assert all(u.startswith("file:") for u in requests), requests  # one self-contained file
+    return page
+
+
+def _no_horizontal_overflow(page) -> None:
+    assert page.evaluate("document.documentElement.scrollWidth <= window.innerWidth")
+
+
+def test_blocking_report_in_a_browser(browser, tmp_path, capsys):
+    path = _report(tmp_path, "grafcets/tri_missing_order.g7", "plants/tri.rules")
+    capsys.readouterr()
+    errors: list[str] = []
+    page = _open(browser, path, errors)
+    page.screenshot(path=str(tmp_path / "missing_order_first_screen.png"))
+    _no_horizontal_overflow(page)
+    height = page.evaluate("window.innerHeight")
+    for selector in ("#blocking-1 h2", "#blocking-1 .diag", "#trace-1"):
+        box = page.locator(selector).bounding_box()
+        assert box is not None and box["y"] < height, selector
+    panel = page.locator("#panel-b1")
+    assert "X1, X103, X200, X300" in panel.inner_text()  # the blocking state first
+    buttons = page.locator("#trace-1 button")
+    assert [buttons.nth(i).inner_text() for i in range(buttons.count())] == [
+        "initial", "↑dcy", "↑cp12", "2s/X101", "↓v10", "↑v11"]
+    buttons.nth(0).click()
+    text = panel.inner_text()
+    assert "X0, X100, X200, X300" in text and "initial" in text
+    fills = page.evaluate("""() => Array.from(document.querySelectorAll('#grafcet-b1 g.node'))
+        .filter(g => g.querySelector('title').textContent.startsWith('step_'))
+        .filter(g => g.querySelector('polygon').getAttribute('fill') === '#f9d71c')
+        .map(g => g.querySelector('title').textContent).sort()""")
+    assert fills == ["step_0", "step_100", "step_200", "step_300"]
+    buttons.nth(2).click()
+    assert "↑cp12" in panel.inner_text() and "TAPIS" in panel.inner_text()
+    page.screenshot(path=str(tmp_path / "missing_order_step_2.png"), full_page=True)
+    assert errors == []
+
+
+@pytest.mark.parametrize("case", [
+    ("grafcets/tri.g7", "plants/tri.rules"),
+    ("grafcets/tri.g7", "plants/tri_overstrict.rules"),
+    ("grafcets/tri.g7", "plants/tri_missing_rule.rules", "--expert"),
+])
+def test_other_reports_open_cleanly(browser, tmp_path, capsys, case):
+    path = _report(tmp_path, *case)
+    capsys.readouterr()
+    errors: list[str] = []
+    page = _open(browser, path, errors)
+    _no_horizontal_overflow(page)
+    page.screenshot(path=str(tmp_path / "report.png"), full_page=True)
+    assert errors == []
+    if case[1] == "plants/tri.rules":
+        assert "What was checked" in page.inner_text("#checked")
+        assert "Prohibited orders met: none" in page.inner_text("#checked")
