@@ -82,6 +82,14 @@ def test_validate_schema_rejects_unknown_verdicts(capsys):
         assert_valid("validate", data)
 
 
+def test_lib_json(capsys):
+    data = _json(capsys, "lib", "--json")
+    assert_valid("lib", data)
+    data[0]["initial"]["TAPIS"] = 2
+    with pytest.raises(jsonschema.ValidationError):
+        assert_valid("lib", data)
+
+
 def test_schema_rejects_drift(capsys):
     data = _json(capsys, "plant", str(ROOT / "plants/tri_annex.rules"), "--json")
     data["elements"][0]["unexpected"] = 1
