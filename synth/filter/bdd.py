@@ -151,12 +151,13 @@ class Engine:
         if u == self.false:
             return None
         cube: Cube = {}
-        while u != self.true:
+        while u != self.true:  # cofactors by let: dd.cudd's low/high ignore complement edges
             name = self._outer[u.var]
-            if u.low != self.false:
-                cube[name], u = False, u.low
+            low = self.bdd.let({u.var: False}, u)
+            if low != self.false:
+                cube[name], u = False, low
             else:
-                cube[name], u = True, u.high
+                cube[name], u = True, self.bdd.let({u.var: True}, u)
         return self.ordered(cube)
 
     def expanded(self, cube: Cube, upper: Function) -> Cube:
@@ -173,6 +174,13 @@ class Engine:
         """A prime implicant of ``u`` (a counterexample no literal of which can be dropped)."""
         c = self.path_cube(u)
         return None if c is None else self.expanded(c, u)
+
+    def witness(self, u: Function, care: Function | None = None) -> Cube | None:
+        """A prime implicant of ``u`` within ``care``: a cube meeting ``u & care`` whose
+        every valuation in ``care`` is in ``u``; ``None`` when ``u & care`` is false."""
+        care = self.true if care is None else care
+        c = self.path_cube(u & care)
+        return None if c is None else self.expanded(c, u | ~care)
 
     def ordered(self, cube: Mapping[str, bool]) -> Cube:
         return dict(sorted(cube.items(), key=lambda kv: self.level(kv[0])))

@@ -1,0 +1,248 @@
+"""Algebraic synthesis of a filter (004 §2.2, §3.2) in its relational form: the admissible
+set ``S(O,Y) = A ∧ ¬F`` is narrowed by each criterion in order —
+``Max(c)``: ``S := S ∧ (c ↔ ∃O.(S∧c))``, ``Min(c)``: ``S := S ∧ (c ↔ ∀O.(¬S∨c))`` —
+and when S is functional each output is ``∃O.(S ∧ o)``, printed minimised over the
+care set (the assumptions where a safe vector exists).
+
+The criteria, in order: the CSc priorities as leading ``Min`` criteria (004 eq. 24),
+unless the file states its own ``minimize``/``maximize`` criteria; then the file's
+criteria; ``maximize sim`` expands to one ``Max(R_o·o + !R_o·!o)`` per output, and every
+output without one gets it at the end, in ``outputs`` order.
+
+Example (004 eqs. 4-13)
+-------
+>>> from synth.filter.language_check import parse_filter
+>>> f = parse_filter('''inputs i1
+... outputs O1, O2
+... safety K: O1 & O2
+... maximize i1 & O1
+... minimize O1
+... maximize O2''', "x.filter")
+>>> s = synthesis(f)
+>>> s.functional, s.equations
+(True, {'O1': 'i1', 'O2': '!i1'})
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Sequence
+
+from synth.errors import InputError
+from synth.filter.bdd import Cube, Function, cube_text
+from synth.filter.language import Criterion, Filter, Sense, SimCriterion, pre_name, request_name
+from synth.filter.model import FilterFunctions, equation_functions, functions
+from synth.logic.expr import And, Const, Edge, Expr, Not, Or, Var
+
+__all__ = ["Applied", "Synthesis", "synthesis", "criteria", "priority_criteria", "requested", "sim_expr",
+           "differences"]
+
+
+def sim_expr(output: str) -> Expr:
+    """``R_o & o | !R_o & !o``, the similarity of 004 eq. (25)."""
+    r, o = Var(request_name(output)), Var(output)
+    return Or((And((r, o)), And((Not(r), Not(o)))))
+
+
+def requested(e: Expr, outputs: Sequence[str]) -> Expr:
+    """``e`` with each output at t replaced by its request (past values kept), e.g.
+    ``↑A4`` becomes ``!A4^-1 & R_A4``: the condition under which the request violates ``e``.
+
+    >>> requested(And((Edge(True, "A4"), Var("C"))), ["A4"]).text()
+    '!A4^-1 & R_A4 & C'
+    """
+    if isinstance(e, Var):
+        return Var(request_name(e.name), e.loc) if e.name in outputs else e
+    if isinstance(e, Edge):
+        if e.name not in outputs:
+            return e
+        before, now = Var(pre_name(e.name)), Var(request_name(e.name))
+        return And((Not(before), now)) if e.rising else And((before, Not(now)))
+    if isinstance(e, Const):
+        return e
+    if isinstance(e, Not):
+        return Not(requested(e.arg, outputs), e.loc)
+    args = []
+    for a in e.args:  # flatten the And an edge became
+        r = requested(a, outputs)
+        args.extend(r.args if isinstance(r, type(e)) and not isinstance(a, type(e)) else (r,))
+    return type(e)(tuple(args), e.loc)
+
+
+def priority_criteria(f: Filter) -> list[Criterion]:
+    """One ``Min`` per CSc with a priority (004 eq. 24): when the requests violate it,
+    minimise ``!L`` for ``keep L``, or the forced outputs being off their values."""
+    found = []
+    for s in f.combined:
+        if not s.has_priority:
+            continue
+        when = requested(s.expr, f.outputs)
+        if s.keep is not None:
+            bad: Expr = Not(s.keep)
+        else:
+            offs = tuple(Not(Var(c.output)) if c.value else Var(c.output) for c in s.forced)
+            bad = offs[0] if len(offs) == 1 else Or(offs)
+        found.append(Criterion(Sense.MIN, And((when, bad)), s.loc, f"priority of {s.id}"))
+    return found
+
+
+def criteria(f: Filter, order: Sequence[str] | None = None) -> list[Criterion]:
+    """The criteria of ``f`` in the order they are applied (``order``: the Sim order)."""
+    stated = [c for c in f.criteria if isinstance(c, Criterion)]
+    out: list[Criterion] = [] if stated else priority_criteria(f)
+    sims: list[str] = []
+    sim_at = None
+    for c in f.criteria:
+        if isinstance(c, SimCriterion):
+            sim_at = len(out) if sim_at is None else sim_at
+            sims += c.outputs
+            if order is None:
+                out += [Criterion(Sense.MAX, sim_expr(o), c.loc, f"sim {o}") for o in c.outputs]
+        else:
+            line = f"line {c.loc.line}" if c.loc else "file"
+            out.append(Criterion(c.sense, c.expr, c.loc, line))
+    if order is not None:
+        unknown = [o for o in order if o not in f.outputs]
+        if unknown:
+            raise InputError(f"--order: '{unknown[0]}' is not an output of {f.file}", None,
+                             expected=f.outputs)
+        sims = list(dict.fromkeys(order))
+        at = len(out) if sim_at is None else sim_at
+        out[at:at] = [Criterion(Sense.MAX, sim_expr(o), None, f"sim {o}") for o in sims]
+    out += [Criterion(Sense.MAX, sim_expr(o), None, f"sim {o}") for o in f.outputs if o not in sims]
+    return out
+
+
+@dataclass(frozen=True)
+class Applied:
+    """A criterion as applied: did it narrow the admissible set?"""
+
+    criterion: Criterion
+    effect: bool
+
+    def text(self) -> str:
+        return f"{self.criterion.sense.value} {self.criterion.expr.text()}  ({self.criterion.origin})"
+
+
+@dataclass
+class Synthesis:
+    """The outcome of ``solve``: equations in filter syntax, and why it may have failed."""
+
+    functions: FilterFunctions
+    admissible: Function
+    care: Function
+    applied: list[Applied]
+    equations: dict[str, str] = field(default_factory=dict)
+    free: dict[str, Cube] = field(default_factory=dict)  # output -> Y witness with two choices
+    inconsistent: Cube | None = None
+    inconsistent_text: str = ""
+    notes: list[str] = field(default_factory=list)
+
+    @property
+    def functional(self) -> bool:
+        return not self.free
+
+    @property
+    def consistent(self) -> bool:
+        return self.inconsistent is None
+
+    @property
+    def warnings(self) -> list[str]:
+        return [f"criterion {i} has no effect: {a.text()}" for i, a in enumerate(self.applied, 1) if not a.effect]
+
+    def output(self, o: str) -> Function:
+        """The synthesised output ``o`` as a function of Y."""
+        m = self.functions
+        return m.engine.exists(m.outputs, self.admissible & m.engine.var(o))
+
+    def as_dict(self) -> dict[str, Any]:
+        return {
+            "functional": self.functional,
+            "consistent": self.consistent,
+            "equations": dict(self.equations),
+            "warnings": self.warnings,
+            "notes": list(self.notes),
+            "criteria": [{"sense": a.criterion.sense.value, "expression": a.criterion.expr.text(),
+                          "origin": a.criterion.origin, "effect": a.effect} for a in self.applied],
+            "free": {o: {n: int(v) for n, v in c.items()} for o, c in self.free.items()},
+            "inconsistent": None if self.inconsistent is None else {
+                "counterexample": {n: int(v) for n, v in self.inconsistent.items()},
+                "expression": self.inconsistent_text},
+        }
+
+    def text(self) -> str:
+        lines = [f"equation {o} = {t}" for o, t in self.equations.items()]
+        for o, c in self.free.items():
+            lines.append(f"not functional: {o} is free when {cube_text(c)}")
+        if self.inconsistent is not None:
+            lines.append(f"inconsistent: no safe output vector when {cube_text(self.inconsistent)}"
+                         + (f" (wherever {self.inconsistent_text})" if self.inconsistent_text != cube_text(
+                             self.inconsistent) else ""))
+        return "\n".join(lines) + "\n"
+
+
+def synthesis(f: Filter | FilterFunctions, order: Sequence[str] | None = None) -> Synthesis:
+    """Solve the filter's constraints with its criteria (the relational semantics of 004)."""
+    m = f if isinstance(f, FilterFunctions) else functions(f)
+    e, outs = m.engine, m.outputs
+    admissible = m.assumed & ~m.forbidden
+    applied = []
+    for c in criteria(m.filter, order):
+        u = e.expr(c.expr)
+        if c.sense is Sense.MAX:
+            best = e.exists(outs, admissible & u)
+        else:
+            best = e.forall(outs, ~admissible | u)
+        narrowed = admissible & u.equiv(best)
+        applied.append(Applied(c, narrowed != admissible))
+        admissible = narrowed
+    care = e.exists(outs, admissible)
+    result = Synthesis(m, admissible, care, applied)
+    stated = any(isinstance(c, Criterion) for c in m.filter.criteria)
+    if stated and any(s.has_priority for s in m.filter.combined):
+        result.notes.append("the file states its criteria: the priorities of the combined constraints are not "
+                            "translated into criteria")
+    for s in m.filter.combined:
+        if not s.has_priority:
+            result.notes.append(f"{s.id} has no priority: the criteria order decides how it is relieved")
+    stuck = m.assumed & ~care
+    if stuck != e.false:
+        result.inconsistent = e.witness(stuck, m.assumed)
+        result.inconsistent_text = e.text(stuck, stuck | ~m.assumed)
+    for o in outs:
+        one = e.exists(outs, admissible & e.var(o))
+        zero = e.exists(outs, admissible & ~e.var(o))
+        if (one & zero) != e.false:
+            result.free[o] = e.minimal_cube(one & zero)
+        else:
+            result.equations[o] = e.text(one, one | ~care)
+    return result
+
+
+def differences(s: Synthesis) -> list[str]:
+    """How the file's ``equation`` lines differ from the synthesis, on the care set: the
+    printed terms that give 1 where the synthesis gives 0, and where no printed term
+    gives the synthesis's 1."""
+    m = s.functions
+    e, f = m.engine, m.filter
+    if not f.equations:
+        return []
+    printed = equation_functions(m)
+    lines = []
+    for q in f.equations:
+        if q.output in s.free:
+            continue
+        mine, theirs = s.output(q.output), printed[q.output]
+        if ((mine ^ theirs) & s.care) == e.false:
+            continue
+        terms = q.expr.args if isinstance(q.expr, Or) else (q.expr,)
+        for t in terms:
+            extra = e.let(printed, e.expr(t)) & ~mine
+            if (extra & s.care) != e.false:
+                lines.append(f"{q.output}: the printed term {t.text()} gives 1 where the synthesis gives 0, "
+                             f"e.g. when {cube_text(e.witness(extra, s.care))}")
+        missing = mine & ~theirs
+        if (missing & s.care) != e.false:
+            lines.append(f"{q.output}: the synthesis gives 1 where no printed term does, "
+                         f"e.g. when {cube_text(e.witness(missing, s.care))}")
+    return lines
