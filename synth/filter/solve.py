@@ -34,8 +34,11 @@ from synth.filter.language import Criterion, Filter, Sense, SimCriterion, pre_na
 from synth.filter.model import FilterFunctions, equation_functions, functions
 from synth.logic.expr import And, Const, Edge, Expr, Not, Or, Var
 
-__all__ = ["Applied", "Synthesis", "synthesis", "criteria", "priority_criteria", "requested", "sim_expr",
+__all__ = ["IMPLICIT", "Applied", "Synthesis", "synthesis", "criteria", "priority_criteria", "requested", "sim_expr",
            "differences"]
+
+
+IMPLICIT = "implicit"
 
 
 def sim_expr(output: str) -> Expr:
@@ -109,19 +112,29 @@ def criteria(f: Filter, order: Sequence[str] | None = None) -> list[Criterion]:
         sims = list(dict.fromkeys(order))
         at = len(out) if sim_at is None else sim_at
         out[at:at] = [Criterion(Sense.MAX, sim_expr(o), None, f"sim {o}") for o in sims]
-    out += [Criterion(Sense.MAX, sim_expr(o), None, f"sim {o}") for o in f.outputs if o not in sims]
+    out += [Criterion(Sense.MAX, sim_expr(o), None, f"{IMPLICIT} sim {o}") for o in f.outputs if o not in sims]
     return out
 
 
 @dataclass(frozen=True)
 class Applied:
-    """A criterion as applied: did it narrow the admissible set?"""
+    """A criterion as applied: does it narrow the admissible set where it stands
+    (``narrows``), and would the final filter differ without it (``effect``)?"""
 
     criterion: Criterion
+    narrows: bool
     effect: bool
+
+    @property
+    def implicit(self) -> bool:
+        return self.criterion.origin.startswith(IMPLICIT)
 
     def text(self) -> str:
         return f"{self.criterion.sense.value} {self.criterion.expr.text()}  ({self.criterion.origin})"
+
+    def warning(self, number: int) -> str:
+        why = "it removes no solution" if not self.narrows else "the criteria after it give the same filter without it"
+        return f"criterion {number} has no effect ({why}): {self.text()}"
 
 
 @dataclass
@@ -148,7 +161,7 @@ class Synthesis:
 
     @property
     def warnings(self) -> list[str]:
-        return [f"criterion {i} has no effect: {a.text()}" for i, a in enumerate(self.applied, 1) if not a.effect]
+        return [a.warning(i) for i, a in enumerate(self.applied, 1) if not a.effect and not a.implicit]
 
     def output(self, o: str) -> Function:
         """The synthesised output ``o`` as a function of Y."""
@@ -163,7 +176,7 @@ class Synthesis:
             "warnings": self.warnings,
             "notes": list(self.notes),
             "criteria": [{"sense": a.criterion.sense.value, "expression": a.criterion.expr.text(),
-                          "origin": a.criterion.origin, "effect": a.effect} for a in self.applied],
+                          "origin": a.criterion.origin, "narrows": a.narrows, "effect": a.effect} for a in self.applied],
             "free": {o: {n: int(v) for n, v in c.items()} for o, c in self.free.items()},
             "inconsistent": None if self.inconsistent is None else {
                 "counterexample": {n: int(v) for n, v in self.inconsistent.items()},
@@ -185,17 +198,27 @@ def synthesis(f: Filter | FilterFunctions, order: Sequence[str] | None = None) -
     """Solve the filter's constraints with its criteria (the relational semantics of 004)."""
     m = f if isinstance(f, FilterFunctions) else functions(f)
     e, outs = m.engine, m.outputs
-    admissible = m.assumed & ~m.forbidden
-    applied = []
-    for c in criteria(m.filter, order):
-        u = e.expr(c.expr)
+    steps = [(c, e.expr(c.expr)) for c in criteria(m.filter, order)]
+
+    def narrowed(admissible: Function, c: Criterion, u: Function) -> Function:
         if c.sense is Sense.MAX:
             best = e.exists(outs, admissible & u)
         else:
             best = e.forall(outs, ~admissible | u)
-        narrowed = admissible & u.equiv(best)
-        applied.append(Applied(c, narrowed != admissible))
-        admissible = narrowed
+        return admissible & u.equiv(best)
+
+    states = [m.assumed & ~m.forbidden]
+    for c, u in steps:
+        states.append(narrowed(states[-1], c, u))
+    admissible = states[-1]
+    applied = []
+    for i, (c, u) in enumerate(steps):
+        narrows = states[i + 1] != states[i]
+        without = states[i]
+        if narrows:  # the same filter without it?
+            for later, v in steps[i + 1:]:
+                without = narrowed(without, later, v)
+        applied.append(Applied(c, narrows, narrows and without != admissible))
     care = e.exists(outs, admissible)
     result = Synthesis(m, admissible, care, applied)
     stated = any(isinstance(c, Criterion) for c in m.filter.criteria)
