@@ -119,7 +119,7 @@ class Coherence:
 
 
 def _judged(m: FilterFunctions, prop: Property, subject: str, parts: Sequence[tuple[tuple[str, ...], str, Function]],
-            domain: Function, edge: bool = False) -> Finding:
+            domain: Function, edge: bool = False, outside: str = "outside the assumptions") -> Finding:
     """The status of ``OR parts ≡ 0``: literally, then within ``domain``."""
     e = m.engine
     literal = e.disjunction(u for _, _, u in parts)
@@ -133,7 +133,7 @@ def _judged(m: FilterFunctions, prop: Property, subject: str, parts: Sequence[tu
     if literal == e.false:
         return Finding(prop, subject, Status.HOLDS)
     only = cube_text(e.minimal_cube(literal))
-    return Finding(prop, subject, Status.ASSUMED, detail=f"fails outside the assumptions, e.g. when {only}")
+    return Finding(prop, subject, Status.ASSUMED, detail=f"fails only {outside}, e.g. when {only}")
 
 
 def _p1(m: FilterFunctions, o: str) -> Finding:
@@ -191,11 +191,12 @@ def _consistency(m: FilterFunctions) -> Finding:
 def _equations(m: FilterFunctions) -> list[Finding]:
     e = m.engine
     implemented = equation_functions(m)
+    safe = m.assumed & e.exists(m.outputs, ~m.forbidden)
     found = []
     for ident, u in m.constraint.items():
         now = e.let(implemented, u)
         found.append(_judged(m, Property.EQUATION, ident, [((ident,), f"the equations violate {ident}", now)],
-                             m.assumed))
+                             safe, outside="outside the assumptions or where no output vector is safe"))
     return found
 
 

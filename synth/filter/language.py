@@ -155,6 +155,7 @@ class SimCriterion:
 
     outputs: tuple[str, ...]
     loc: Location | None = field(default=None, compare=False)
+    locs: tuple[Location, ...] = field(default=(), compare=False)  # one per output
 
 
 @dataclass(frozen=True)

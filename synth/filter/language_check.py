@@ -207,12 +207,12 @@ class _FilterChecker(Checker):
 
     def sim(self, c: SimCriterion, simmed: set[str]) -> SimCriterion | None:
         outs = self.of_kind(VarKind.OUTPUT)
-        for o in c.outputs:
+        for o, loc in zip(c.outputs, c.locs or (c.loc,) * len(c.outputs)):
             if o not in outs:
-                self.fail(f"maximize sim: '{o}' is not an output", c.loc, suggestions=close_names(o, outs))
+                self.fail(f"maximize sim: '{o}' is not an output", loc, suggestions=close_names(o, outs))
                 return None
             if o in simmed:
-                self.fail(f"output '{o}' has two sim criteria", c.loc)
+                self.fail(f"output '{o}' has two sim criteria", loc)
                 return None
             simmed.add(o)
         return c

@@ -105,7 +105,7 @@ class _ToFilter(ExprTransformer):
         return Criterion(Sense.MAX, e, _first_loc(e))
 
     def maximize_sim(self, items: list) -> SimCriterion:
-        return SimCriterion(tuple(str(n) for n in items), self._loc(items[0]))
+        return SimCriterion(tuple(str(n) for n in items), self._loc(items[0]), tuple(self._loc(n) for n in items))
 
     def equation(self, items: list) -> Equation:
         name, e = items

@@ -256,7 +256,7 @@ def differences(s: Synthesis) -> list[str]:
         if q.output in s.free:
             continue
         mine, theirs = s.output(q.output), printed[q.output]
-        if ((mine ^ theirs) & s.care) == e.false:
+        if (~mine.equiv(theirs) & s.care) == e.false:
             continue
         terms = q.expr.args if isinstance(q.expr, Or) else (q.expr,)
         for t in terms:
