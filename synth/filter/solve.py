@@ -81,7 +81,7 @@ def priority_criteria(f: Filter) -> list[Criterion]:
             continue
         when = requested(s.expr, f.outputs)
         if s.keep is not None:
-            bad: Expr = Not(s.keep)
+            bad: Expr = s.keep.arg if isinstance(s.keep, Not) else Not(s.keep)
         else:
             offs = tuple(Not(Var(c.output)) if c.value else Var(c.output) for c in s.forced)
             bad = offs[0] if len(offs) == 1 else Or(offs)
