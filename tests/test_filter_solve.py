@@ -179,12 +179,17 @@ def test_not_functional_reports_free_outputs(cli, tmp_path):
     f = tmp_path / "free.filter"
     f.write_text("inputs i\noutputs o1, o2\nsafety K: o1 & o2 & i\nmaximize o1 | o2\n")
     s = synthesis(load_filter(f))
-    assert s.functional  # implicit sims decide
+    assert s.functional  # no `maximize sim` line: a Sim per output, implicitly, decides
+    assert s.warnings == []  # the implicit ones are never reported
     f.write_text("inputs i\noutputs o1, o2\nsafety K: o1 & o2 & i\nmaximize sim o1\n")
     s = synthesis(load_filter(f))
-    assert s.functional and s.equations["o2"] == "R_o2 & (!R_o1 | !i)"
-    s = synthesis(functions(load_filter(f)), order=["o1"])
-    assert s.functional
+    assert not s.functional and s.equations == {"o1": "R_o1"}
+    assert s.free == {"o2": {"R_o1": False}}
+    code, out, _ = cli("filter", "solve", f, "--json")
+    data = json.loads(out)
+    assert code == 1 and data["functional"] is False and data["free"] == {"o2": {"R_o1": 0}}
+    code, out, _ = cli("filter", "solve", f)
+    assert "not functional: o2 is free when !R_o1" in out
 
 
 def test_no_solution_exit_1(cli, tmp_path):

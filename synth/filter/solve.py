@@ -6,8 +6,8 @@ care set (the assumptions where a safe vector exists).
 
 The criteria, in order: the CSc priorities as leading ``Min`` criteria (004 eq. 24),
 unless the file states its own ``minimize``/``maximize`` criteria; then the file's
-criteria; ``maximize sim`` expands to one ``Max(R_o·o + !R_o·!o)`` per output, and every
-output without one gets it at the end, in ``outputs`` order.
+criteria; ``maximize sim`` expands to one ``Max(R_o·o + !R_o·!o)`` per output named. A
+file without any ``maximize sim`` line gets one per output at the end, in ``outputs`` order.
 
 Example (004 eqs. 4-13)
 -------
@@ -90,29 +90,29 @@ def priority_criteria(f: Filter) -> list[Criterion]:
 
 
 def criteria(f: Filter, order: Sequence[str] | None = None) -> list[Criterion]:
-    """The criteria of ``f`` in the order they are applied (``order``: the Sim order)."""
+    """The criteria of ``f`` in the order they are applied. ``order`` reorders the Sim
+    criteria: the outputs it names first, the others after them in their own order."""
     stated = [c for c in f.criteria if isinstance(c, Criterion)]
     out: list[Criterion] = [] if stated else priority_criteria(f)
-    sims: list[str] = []
-    sim_at = None
-    for c in f.criteria:
-        if isinstance(c, SimCriterion):
-            sim_at = len(out) if sim_at is None else sim_at
-            sims += c.outputs
-            if order is None:
-                out += [Criterion(Sense.MAX, sim_expr(o), c.loc, f"sim {o}") for o in c.outputs]
-        else:
-            line = f"line {c.loc.line}" if c.loc else "file"
-            out.append(Criterion(c.sense, c.expr, c.loc, line))
+    sims = [o for c in f.criteria if isinstance(c, SimCriterion) for o in c.outputs]
+    implicit = not sims
+    if implicit:  # no `maximize sim` line: every output, in `outputs` order, after the rest
+        sims = list(f.outputs)
     if order is not None:
         unknown = [o for o in order if o not in f.outputs]
         if unknown:
-            raise InputError(f"--order: '{unknown[0]}' is not an output of {f.file}", None,
-                             expected=f.outputs)
-        sims = list(dict.fromkeys(order))
-        at = len(out) if sim_at is None else sim_at
-        out[at:at] = [Criterion(Sense.MAX, sim_expr(o), None, f"sim {o}") for o in sims]
-    out += [Criterion(Sense.MAX, sim_expr(o), None, f"{IMPLICIT} sim {o}") for o in f.outputs if o not in sims]
+            raise InputError(f"--order: '{unknown[0]}' is not an output of {f.file}", None, expected=f.outputs)
+        sims = [o for o in dict.fromkeys(order) if o in sims] + [o for o in sims if o not in order]
+    pending = list(sims)
+    for c in f.criteria:
+        if isinstance(c, SimCriterion):  # the file's sims, in the (re)ordered sequence
+            count, pending = len(c.outputs), pending
+            out += [Criterion(Sense.MAX, sim_expr(o), c.loc, f"sim {o}") for o in pending[:count]]
+            pending = pending[count:]
+        else:
+            out.append(Criterion(c.sense, c.expr, c.loc, f"line {c.loc.line}" if c.loc else "file"))
+    origin = f"{IMPLICIT} sim" if implicit else "sim"
+    out += [Criterion(Sense.MAX, sim_expr(o), None, f"{origin} {o}") for o in pending]
     return out
 
 
