@@ -200,3 +200,20 @@ def test_no_solution_exit_1(cli, tmp_path):
     assert code == 1 and data["consistent"] is False
     assert data["inconsistent"]["counterexample"] == {"i": 1}
     assert data["equations"] == {"o": "R_o"}  # on the care set !i
+
+
+def test_tri_chained_equations_as_004_prints_them():
+    """The text output: an evaluation order where an equation may use earlier outputs;
+    pasted back into the file, `check` finds them safe and equal to the synthesis."""
+    from synth.filter.coherence import Property, Status, coherence
+    from synth.filter.solve import differences
+
+    s = _tri()
+    assert list(s.chained) == ["A5", "A6", "A1", "A0", "A3", "A2", "A4"]
+    assert s.chained["A0"] == "R_A0 & !P01 & (!C0 | A1)"  # as printed in (30)
+    assert s.chained["A4"] == "A4^-1 & (A2 | A3) | R_A4 & !A2 & !A3"
+    text = TRI + "".join(f"equation {o} = {t}\n" for o, t in s.chained.items())
+    f = parse_filter(text, "chained.filter")
+    found = [x for x in coherence(f).findings if x.property is Property.EQUATION]
+    assert len(found) == 13 and all(x.status in (Status.HOLDS, Status.ASSUMED) for x in found)
+    assert differences(synthesis(f)) == []

@@ -34,7 +34,7 @@ from synth.filter.language import Criterion, Filter, Sense, SimCriterion, pre_na
 from synth.filter.model import FilterFunctions, equation_functions, functions
 from synth.logic.expr import And, Const, Edge, Expr, Not, Or, Var
 
-__all__ = ["IMPLICIT", "Applied", "Synthesis", "synthesis", "criteria", "priority_criteria", "requested", "sim_expr",
+__all__ = ["IMPLICIT", "Applied", "Synthesis", "synthesis", "chained_equations", "criteria", "priority_criteria", "requested", "sim_expr",
            "differences"]
 
 
@@ -146,6 +146,7 @@ class Synthesis:
     care: Function
     applied: list[Applied]
     equations: dict[str, str] = field(default_factory=dict)
+    chained: dict[str, str] = field(default_factory=dict)  # evaluation order; may use earlier outputs
     free: dict[str, Cube] = field(default_factory=dict)  # output -> Y witness with two choices
     inconsistent: Cube | None = None
     inconsistent_text: str = ""
@@ -173,6 +174,7 @@ class Synthesis:
             "functional": self.functional,
             "consistent": self.consistent,
             "equations": dict(self.equations),
+            "chained": {"order": list(self.chained), "equations": dict(self.chained)},
             "warnings": self.warnings,
             "notes": list(self.notes),
             "criteria": [{"sense": a.criterion.sense.value, "expression": a.criterion.expr.text(),
@@ -184,7 +186,7 @@ class Synthesis:
         }
 
     def text(self) -> str:
-        lines = [f"equation {o} = {t}" for o, t in self.equations.items()]
+        lines = [f"equation {o} = {t}" for o, t in self.chained.items()]
         for o, c in self.free.items():
             lines.append(f"not functional: {o} is free when {cube_text(c)}")
         if self.inconsistent is not None:
@@ -239,7 +241,25 @@ def synthesis(f: Filter | FilterFunctions, order: Sequence[str] | None = None) -
             result.free[o] = e.minimal_cube(one & zero)
         else:
             result.equations[o] = e.text(one, one | ~care)
+    result.chained = chained_equations(result)
     return result
+
+
+def chained_equations(s: Synthesis) -> dict[str, str]:
+    """The equations in an evaluation order where each may use the outputs computed before
+    it, as 004's (30) does (``A0 = R_A0 & !P01 & (!C0 | A1)``): outputs with the shortest
+    equations first; each keeps its Y-only text unless using earlier outputs is shorter."""
+    m = s.functions
+    e = m.engine
+    order = sorted(s.equations, key=lambda o: (len(s.equations[o]), m.outputs.index(o)))
+    chained: dict[str, str] = {}
+    agree = e.true  # the earlier outputs equal their functions
+    for o in order:
+        f = s.output(o)
+        text = e.text(f & agree & s.care, f | ~agree | ~s.care)
+        chained[o] = text if len(text) < len(s.equations[o]) else s.equations[o]
+        agree &= e.var(o).equiv(f)
+    return chained
 
 
 def differences(s: Synthesis) -> list[str]:
