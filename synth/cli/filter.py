@@ -8,6 +8,10 @@ from __future__ import annotations
 
 import argparse
 import sys
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from synth.filter.language import Filter
 
 __all__ = ["register"]
 
@@ -29,7 +33,8 @@ def register(sub: "argparse._SubParsersAction") -> None:
     s.set_defaults(handler=cmd_solve)
 
 
-def _warnings(f) -> None:
+def _warnings(f: "Filter") -> None:
+    """The file's warnings (a relief on a simple constraint), on stderr."""
     for w in f.warnings:
         print(w.render(), file=sys.stderr)
 
