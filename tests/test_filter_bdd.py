@@ -106,3 +106,22 @@ def test_let_exists_forall_support():
     assert e.text(e.forall(["a"], u)) == "c"
     assert e.text(e.let({"a": "d"}, u)) == "b & d | c"
     assert e.value(u, {"a": True, "b": True, "c": False})
+
+
+def test_pure_python_backend_gives_the_same_filter(monkeypatch):
+    """Without the CUDD extension synth falls back to dd.autoref: same equations, same checks."""
+    from dd import autoref
+
+    from conftest import ROOT
+    from synth.filter import bdd
+    from synth.filter.coherence import coherence
+    from synth.filter.language_check import load_filter
+    from synth.filter.solve import synthesis
+
+    f = load_filter(ROOT / "plants" / "tri.filter")
+    cudd_solve, cudd_check = synthesis(f), coherence(f)
+    monkeypatch.setattr(bdd, "_backend", autoref)
+    assert type(Engine().bdd).__module__ == "dd.autoref"
+    python_solve, python_check = synthesis(f), coherence(f)
+    assert python_solve.equations == cudd_solve.equations and python_solve.chained == cudd_solve.chained
+    assert python_check.as_dict() == cudd_check.as_dict()

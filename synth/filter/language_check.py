@@ -11,6 +11,7 @@ Example
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from synth.errors import InputError, Location, close_names, location_in
 from synth.filter.language import (
@@ -30,6 +31,9 @@ from synth.filter.language import (
 from synth.filter.language_reader import Use, Vector, filter_items
 from synth.logic.expr import And, Edge, Expr, Not, Or, Var, names
 from synth.syntax import Checker, read_source
+
+if TYPE_CHECKING:
+    from synth.filter.bdd import Engine
 
 __all__ = ["parse_filter", "load_filter", "output_polarities"]
 
@@ -65,6 +69,7 @@ class _FilterChecker(Checker):
         self.declared: dict[str, Declared] = {}
         self.warnings: list[InputError] = []
         self.plant: str | None = None
+        self.engine: "Engine | None" = None
 
     # ---- declarations
     def declare(self, name: str, kind: VarKind, loc: Location | None, grafcet: str | None = None) -> None:
@@ -187,7 +192,9 @@ class _FilterChecker(Checker):
     def relieving(self, s: Safety, forced: tuple[Forcing, ...]) -> tuple[Forcing, ...] | None:
         from synth.filter.bdd import Engine
 
-        engine = Engine()
+        if self.engine is None:  # one manager for the file: creating one costs ~10 ms
+            self.engine = Engine()
+        engine = self.engine
         u = engine.expr(s.expr)
         if engine.let({f.output: f.value for f in forced}, u) != engine.false:
             values = ", ".join(f"{f.output}={int(f.value)}" for f in forced)

@@ -15,7 +15,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from synth.filter.bdd import Engine, Function
-from synth.filter.language import Filter, base_name, pre_name
+from synth.filter.language import Criterion, Filter, base_name, pre_name
 from synth.logic.expr import Var, names
 
 __all__ = ["FilterFunctions", "functions", "variable_order", "edge_rule", "equation_functions"]
@@ -28,7 +28,9 @@ def variable_order(f: Filter) -> list[str]:
     for x in (*f.observer_names, *f.inputs):
         order += [pre_name(x), x]
     order += [pre_name(o) for o in f.outputs]
-    mentioned = [v.name for s in f.safeties for v in names(s.expr) if isinstance(v, Var)]
+    exprs = [s.expr for s in f.safeties] + [a.expr for a in f.assumptions] + [q.expr for q in f.equations]
+    exprs += [c.expr for c in f.criteria if isinstance(c, Criterion)]
+    mentioned = [v.name for e in exprs for v in names(e) if isinstance(v, Var)]
     order += [n for n in mentioned if n not in order and base_name(n) not in f.outputs]
     return order + list(f.outputs)
 
