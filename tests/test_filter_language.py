@@ -146,3 +146,12 @@ def test_use_plant(tmp_path):
     f = load_filter(tmp_path / "p.filter")
     assert "AVANCER3" in f.outputs and "v11" in f.inputs
     assert f.safeties[0].forced[0].output == "AVANCER3"
+
+
+def test_observers_and_criteria_are_kept():
+    f = parse_filter(HEAD + 'observer P01, X31 = grafcet "obs.g7"\nsafety S: X31 & A0\n'
+                     "minimize R_A0 & A1\nmaximize sim A1\n", "x.filter")
+    assert [(d.name, d.grafcet) for d in f.observers] == [("P01", None), ("X31", "obs.g7")]
+    assert f.requests == ("R_A0", "R_A1")
+    assert [type(c).__name__ for c in f.criteria] == ["Criterion", "SimCriterion"]
+    assert f.criteria[0].expr.text() == "R_A0 & A1" and f.criteria[0].loc.line == 5

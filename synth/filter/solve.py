@@ -106,9 +106,8 @@ def criteria(f: Filter, order: Sequence[str] | None = None) -> list[Criterion]:
     pending = list(sims)
     for c in f.criteria:
         if isinstance(c, SimCriterion):  # the file's sims, in the (re)ordered sequence
-            count, pending = len(c.outputs), pending
-            out += [Criterion(Sense.MAX, sim_expr(o), c.loc, f"sim {o}") for o in pending[:count]]
-            pending = pending[count:]
+            here, pending = pending[: len(c.outputs)], pending[len(c.outputs):]
+            out += [Criterion(Sense.MAX, sim_expr(o), c.loc, f"sim {o}") for o in here]
         else:
             out.append(Criterion(c.sense, c.expr, c.loc, f"line {c.loc.line}" if c.loc else "file"))
     origin = f"{IMPLICIT} sim" if implicit else "sim"
