@@ -1,0 +1,287 @@
+"""The Boolean engine of the filter: BDDs (``dd.cudd`` when importable, else ``dd.autoref``)
+over filter names, the shared expression AST translated into them, minimal cubes for
+counterexamples, and a BDD printed back as a readable expression in filter syntax
+(an irredundant sum of prime implicants, Minato–Morreale ISOP then expansion, with
+edges recognised and common literals factored out).
+
+Variables keep the filter's names (``A2``, ``A2^-1``, ``R_A2``); the manager uses
+internal names ``v0``, ``v1``, … in a fixed order (no dynamic reordering, so every
+printed result is deterministic).
+
+Example
+-------
+>>> from synth.logic.expr import And, Edge, Var
+>>> e = Engine(["C6^-1", "C6", "A1"])
+>>> u = e.expr(And((Edge(True, "C6"), Var("A1"))))
+>>> e.text(u)
+'↑C6 & A1'
+>>> e.minimal_cube(u | e.var("A1"))
+{'A1': True}
+"""
+
+from __future__ import annotations
+
+from functools import reduce
+from typing import Any, Iterable, Mapping, Sequence
+
+from synth.filter.language import PRE_SUFFIX, pre_name
+from synth.logic.expr import And, Const, Edge, Expr, Not, Var
+
+try:  # CUDD when the extension is built, the pure-Python manager otherwise
+    from dd import cudd as _backend
+except ImportError:  # pragma: no cover - depends on the installation
+    from dd import autoref as _backend  # type: ignore[no-redef]
+
+__all__ = ["Engine", "Function", "Cube", "cube_text", "BACKEND"]
+
+BACKEND: str = _backend.__name__
+Function = Any  # a dd Function of the active backend
+Cube = dict[str, bool]  # filter name -> value
+
+
+def cube_text(cube: Mapping[str, bool]) -> str:
+    """A cube in filter syntax, ``1`` when empty.
+
+    >>> cube_text({"C4": True, "C5": False})
+    'C4 & !C5'
+    """
+    return " & ".join(n if v else "!" + n for n, v in cube.items()) or "1"
+
+
+class Engine:
+    """A BDD manager whose variables are filter names, in a fixed order (``order`` first,
+    any other name is appended when first used)."""
+
+    def __init__(self, order: Iterable[str] = ()) -> None:
+        self.bdd = _backend.BDD()
+        self.bdd.configure(reordering=False)
+        self._inner: dict[str, str] = {}
+        self._outer: dict[str, str] = {}
+        for n in order:
+            self.declare(n)
+
+    # ---- variables
+    def declare(self, name: str) -> str:
+        """The internal name of ``name``, declared if new."""
+        inner = self._inner.get(name)
+        if inner is None:
+            inner = f"v{len(self._inner)}"
+            self.bdd.declare(inner)
+            self._inner[name] = inner
+            self._outer[inner] = name
+        return inner
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """Every declared name, in the variable order."""
+        return tuple(self._inner)
+
+    @property
+    def true(self) -> Function:
+        return self.bdd.true
+
+    @property
+    def false(self) -> Function:
+        return self.bdd.false
+
+    def var(self, name: str) -> Function:
+        return self.bdd.var(self.declare(name))
+
+    def level(self, name: str) -> int:
+        return self.bdd.level_of_var(self.declare(name))
+
+    # ---- translation
+    def expr(self, e: Expr) -> Function:
+        """The BDD of an expression; ``↑x`` is ``!x^-1 & x`` and ``↓x`` is ``x^-1 & !x``."""
+        if isinstance(e, Var):
+            return self.var(e.name)
+        if isinstance(e, Const):
+            return self.true if e.value else self.false
+        if isinstance(e, Edge):
+            now, before = self.var(e.name), self.var(pre_name(e.name))
+            return (~before & now) if e.rising else (before & ~now)
+        if isinstance(e, Not):
+            return ~self.expr(e.arg)
+        parts = [self.expr(a) for a in e.args]
+        if isinstance(e, And):
+            return reduce(lambda a, b: a & b, parts, self.true)
+        return reduce(lambda a, b: a | b, parts, self.false)
+
+    def conjunction(self, parts: Iterable[Function]) -> Function:
+        return reduce(lambda a, b: a & b, parts, self.true)
+
+    def disjunction(self, parts: Iterable[Function]) -> Function:
+        return reduce(lambda a, b: a | b, parts, self.false)
+
+    # ---- operations on filter names
+    def let(self, values: Mapping[str, bool | str | Function], u: Function) -> Function:
+        """``u`` with names replaced by constants, other names, or functions."""
+        inner: dict[str, Any] = {}
+        for n, v in values.items():
+            inner[self.declare(n)] = self.var(v) if isinstance(v, str) else v
+        return self.bdd.let(inner, u) if inner else u
+
+    def exists(self, names: Iterable[str], u: Function) -> Function:
+        vs = [self.declare(n) for n in names]
+        return self.bdd.exist(vs, u) if vs else u
+
+    def forall(self, names: Iterable[str], u: Function) -> Function:
+        vs = [self.declare(n) for n in names]
+        return self.bdd.forall(vs, u) if vs else u
+
+    def support(self, u: Function) -> list[str]:
+        """The names ``u`` depends on, in variable order."""
+        inner = self.bdd.support(u)
+        return [n for n, i in self._inner.items() if i in inner]
+
+    def cube(self, values: Mapping[str, bool]) -> Function:
+        return self.conjunction(self.var(n) if v else ~self.var(n) for n, v in values.items())
+
+    def implies(self, a: Function, b: Function) -> bool:
+        return (a & ~b) == self.false
+
+    def value(self, u: Function, point: Mapping[str, bool]) -> bool:
+        """``u`` at a valuation of (at least) its support."""
+        r = self.let({n: point[n] for n in self.support(u)}, u)
+        return r == self.true
+
+    # ---- cubes
+    def path_cube(self, u: Function) -> Cube | None:
+        """One path to 1 of ``u``, preferring the 0 branch; ``None`` when ``u`` is false."""
+        if u == self.false:
+            return None
+        cube: Cube = {}
+        while u != self.true:  # cofactors by let: dd.cudd's low/high ignore complement edges
+            name = self._outer[u.var]
+            low = self.bdd.let({u.var: False}, u)
+            if low != self.false:
+                cube[name], u = False, low
+            else:
+                cube[name], u = True, self.bdd.let({u.var: True}, u)
+        return self.ordered(cube)
+
+    def expanded(self, cube: Cube, upper: Function) -> Cube:
+        """``cube`` (implying ``upper``) with literals dropped, in variable order, while it
+        still implies ``upper``: a prime implicant of ``upper``."""
+        kept = dict(cube)
+        for n in list(cube):
+            trial = {m: v for m, v in kept.items() if m != n}
+            if self.implies(self.cube(trial), upper):
+                kept = trial
+        return kept
+
+    def minimal_cube(self, u: Function) -> Cube | None:
+        """A prime implicant of ``u`` (a counterexample no literal of which can be dropped)."""
+        c = self.path_cube(u)
+        return None if c is None else self.expanded(c, u)
+
+    def witness(self, u: Function, care: Function | None = None) -> Cube | None:
+        """A prime implicant of ``u`` within ``care``: a cube meeting ``u & care`` whose
+        every valuation in ``care`` is in ``u``; ``None`` when ``u & care`` is false."""
+        care = self.true if care is None else care
+        c = self.path_cube(u & care)
+        return None if c is None else self.expanded(c, u | ~care)
+
+    def ordered(self, cube: Mapping[str, bool]) -> Cube:
+        return dict(sorted(cube.items(), key=lambda kv: self.level(kv[0])))
+
+    # ---- covers
+    def _isop(self, lower: Function, upper: Function, memo: dict) -> tuple[list[Cube], Function]:
+        if lower == self.false:
+            return [], self.false
+        if upper == self.true:
+            return [{}], self.true
+        key = (lower, upper)
+        if key in memo:
+            return memo[key]
+        levels = [self.bdd.level_of_var(f.var) for f in (lower, upper) if f.var is not None]
+        inner = self.bdd.var_at_level(min(levels))
+        x = self.bdd.var(inner)
+        l0, l1 = self.bdd.let({inner: False}, lower), self.bdd.let({inner: True}, lower)
+        u0, u1 = self.bdd.let({inner: False}, upper), self.bdd.let({inner: True}, upper)
+        c0, f0 = self._isop(l0 & ~u1, u0, memo)
+        c1, f1 = self._isop(l1 & ~u0, u1, memo)
+        cd, fd = self._isop((l0 & ~f0) | (l1 & ~f1), u0 & u1, memo)
+        name = self._outer[inner]
+        cover = [{name: False, **c} for c in c0] + [{name: True, **c} for c in c1] + cd
+        result = (cover, (~x & f0) | (x & f1) | fd)
+        memo[key] = result
+        return result
+
+    def cover(self, lower: Function, upper: Function | None = None) -> list[Cube]:
+        """An irredundant cover of prime implicants of some function between ``lower`` and
+        ``upper`` (``upper`` defaults to ``lower``; the gap is the don't-care set)."""
+        upper = lower if upper is None else upper
+        cubes, _ = self._isop(lower, upper, {})
+        primes: list[Cube] = []
+        for c in (self.expanded(self.ordered(c), upper) for c in cubes):
+            if c not in primes:
+                primes.append(c)
+        i = 0
+        while i < len(primes):  # drop a cube the others already cover
+            others = self.disjunction(self.cube(c) for j, c in enumerate(primes) if j != i)
+            if self.implies(lower, others):
+                del primes[i]
+            else:
+                i += 1
+        return primes
+
+    def text(self, lower: Function, upper: Function | None = None) -> str:
+        """``u`` (or some function between ``lower`` and ``upper``) in filter syntax."""
+        if lower == self.false:
+            return "0"
+        cubes = self.cover(lower, upper)
+        if cubes == [{}]:
+            return "1"
+        order = {n: i for i, n in enumerate(self.names)}
+        return _factored([_literals(c, order) for c in cubes], top=True)
+
+
+# ---- printing a cover: literals with edges recognised, then greedy factoring
+_Lit = tuple[int, str]  # (sort key, text)
+
+
+def _literals(cube: Cube, order: Mapping[str, int]) -> list[_Lit]:
+    lits: list[_Lit] = []
+    done: set[str] = set()
+    for n, v in cube.items():
+        if n in done:
+            continue
+        if n.endswith(PRE_SUFFIX):
+            now = n[: -len(PRE_SUFFIX)]
+            if now in cube and cube[now] != v:  # !x^-1 & x is ↑x, x^-1 & !x is ↓x
+                done.update((n, now))
+                lits.append((order.get(now, 0), ("↓" if v else "↑") + now))
+                continue
+        elif pre_name(n) in cube and cube[pre_name(n)] != v:
+            continue  # printed with its past value above
+        done.add(n)
+        lits.append((order.get(n, 0), n if v else "!" + n))
+    return sorted(lits)
+
+
+def _factored(terms: Sequence[list[_Lit]], top: bool = False) -> str:
+    """Greedy algebraic factoring: take out the literal common to most terms."""
+    terms = [t for t in terms]
+    if any(not t for t in terms):
+        return "1"
+    counts: dict[_Lit, int] = {}
+    for t in terms:
+        for lit in t:
+            counts[lit] = counts.get(lit, 0) + 1
+    best = min(counts, key=lambda lit: (-counts[lit], lit)) if counts else None
+    if best is None or counts[best] < 2:
+        texts = [" & ".join(text for _, text in t) for t in terms]
+        out = " | ".join(texts)
+        return out if top or len(terms) == 1 else f"({out})"
+    inner = [[lit for lit in t if lit != best] for t in terms if best in t]
+    rest = [t for t in terms if best not in t]
+    if any(not t for t in inner):  # x | x & y: cannot happen in an irredundant cover
+        factored = best[1]
+    else:
+        sub = _factored(inner)
+        factored = f"{best[1]} & {sub}" if len(inner) > 1 else best[1] + " & " + sub
+    if not rest:
+        return factored
+    out = factored + " | " + _factored(rest, top=True)
+    return out if top else f"({out})"

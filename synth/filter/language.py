@@ -1,0 +1,202 @@
+"""The ``.filter`` language as plain frozen data: declarations, safety constraints with
+their relief, assumptions, criteria and (optional) equations to check.
+
+Expressions are the shared :mod:`synth.logic.expr` AST. The previous cycle's value of
+``x`` (written ``x^-1`` or ``pre(x)``) is the variable named ``x^-1``; the request of an
+output ``o`` is the variable ``R_o``. An edge ``↑x`` stands for ``!x^-1 & x``.
+
+Example
+-------
+>>> pre_name("A2"), request_name("A2"), base_name("A2^-1")
+('A2^-1', 'R_A2', 'A2')
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from enum import StrEnum
+
+from synth.errors import InputError, Location
+from synth.logic.expr import Expr
+
+__all__ = [
+    "PRE_SUFFIX",
+    "REQUEST_PREFIX",
+    "pre_name",
+    "request_name",
+    "base_name",
+    "is_pre",
+    "VarKind",
+    "ConstraintKind",
+    "Sense",
+    "Declared",
+    "Forcing",
+    "Safety",
+    "Assumption",
+    "Criterion",
+    "SimCriterion",
+    "Equation",
+    "Filter",
+]
+
+PRE_SUFFIX = "^-1"
+REQUEST_PREFIX = "R_"
+
+
+def pre_name(name: str) -> str:
+    """The variable holding ``name`` at the previous cycle."""
+    return name + PRE_SUFFIX
+
+
+def request_name(output: str) -> str:
+    """The request ``R_o`` of output ``o`` (the program's order, 000's g1)."""
+    return REQUEST_PREFIX + output
+
+
+def is_pre(name: str) -> bool:
+    """Whether ``name`` is a previous-cycle value ``x^-1``."""
+    return name.endswith(PRE_SUFFIX)
+
+
+def base_name(name: str) -> str:
+    """``x`` for ``x^-1``, ``name`` itself otherwise."""
+    return name[: -len(PRE_SUFFIX)] if is_pre(name) else name
+
+
+class VarKind(StrEnum):
+    """What a declared name is. Only outputs at t are controllable; the rest is Y."""
+
+    INPUT = "input"
+    OUTPUT = "output"
+    OBSERVER = "observer"
+    REQUEST = "request"
+
+
+class ConstraintKind(StrEnum):
+    """CSs (one output at t) or CSc (two or more), after 000 eqs. (1)-(2)."""
+
+    SIMPLE = "simple"
+    COMBINED = "combined"
+
+
+class Sense(StrEnum):
+    """The direction of an optimisation criterion (004 §2.2)."""
+
+    MIN = "minimize"
+    MAX = "maximize"
+
+
+@dataclass(frozen=True)
+class Declared:
+    """A declared name; ``grafcet`` is the file of an observer computed from a Grafcet."""
+
+    name: str
+    kind: VarKind
+    loc: Location | None = field(default=None, compare=False)
+    grafcet: str | None = None
+
+
+@dataclass(frozen=True)
+class Forcing:
+    """``o=v`` in a ``force`` list: relieving the constraint sets output ``o`` to ``v``."""
+
+    output: str
+    value: bool
+    loc: Location | None = field(default=None, compare=False)
+
+
+@dataclass(frozen=True)
+class Safety:
+    """``safety ID "label": EXPR [keep L | force o=v, ...]``: EXPR must be 0 after every cycle.
+
+    ``outputs`` are the outputs at t the expression mentions (edges of an output count),
+    in text order; ``forced`` is the relief as a column of 000's MC0/MC1 (empty when the
+    constraint gives none, or is simple)."""
+
+    id: str
+    label: str
+    expr: Expr
+    loc: Location | None = field(default=None, compare=False)
+    keep: Expr | None = None
+    force: tuple[Forcing, ...] = ()
+    outputs: tuple[str, ...] = ()
+    forced: tuple[Forcing, ...] = ()
+
+    @property
+    def kind(self) -> ConstraintKind:
+        return ConstraintKind.SIMPLE if len(self.outputs) == 1 else ConstraintKind.COMBINED
+
+    @property
+    def has_priority(self) -> bool:
+        return self.keep is not None or bool(self.force)
+
+
+@dataclass(frozen=True)
+class Assumption:
+    """``assume EXPR``: EXPR is true on every reachable valuation of Y."""
+
+    expr: Expr
+    loc: Location | None = field(default=None, compare=False)
+
+
+@dataclass(frozen=True)
+class Criterion:
+    """``minimize EXPR`` / ``maximize EXPR``; ``origin`` says where it comes from (for reports)."""
+
+    sense: Sense
+    expr: Expr
+    loc: Location | None = field(default=None, compare=False)
+    origin: str = ""
+
+
+@dataclass(frozen=True)
+class SimCriterion:
+    """``maximize sim o1, o2, ...``: one ``Max(R_o·o + !R_o·!o)`` per output, in this order."""
+
+    outputs: tuple[str, ...]
+    loc: Location | None = field(default=None, compare=False)
+    locs: tuple[Location, ...] = field(default=(), compare=False)  # one per output
+
+
+@dataclass(frozen=True)
+class Equation:
+    """``equation o = EXPR``: a proposed implementation of output ``o`` that ``check`` verifies."""
+
+    output: str
+    expr: Expr
+    loc: Location | None = field(default=None, compare=False)
+
+
+@dataclass(frozen=True)
+class Filter:
+    """A checked ``.filter`` file. ``criteria`` keeps the file's order, sims included."""
+
+    file: str
+    inputs: tuple[str, ...]
+    outputs: tuple[str, ...]
+    observers: tuple[Declared, ...] = ()
+    assumptions: tuple[Assumption, ...] = ()
+    safeties: tuple[Safety, ...] = ()
+    criteria: tuple[Criterion | SimCriterion, ...] = ()
+    equations: tuple[Equation, ...] = ()
+    plant: str | None = None
+    warnings: tuple[InputError, ...] = ()
+
+    @property
+    def requests(self) -> tuple[str, ...]:
+        return tuple(request_name(o) for o in self.outputs)
+
+    @property
+    def observer_names(self) -> tuple[str, ...]:
+        return tuple(d.name for d in self.observers)
+
+    @property
+    def simple(self) -> tuple[Safety, ...]:
+        return tuple(s for s in self.safeties if s.kind is ConstraintKind.SIMPLE)
+
+    @property
+    def combined(self) -> tuple[Safety, ...]:
+        return tuple(s for s in self.safeties if s.kind is ConstraintKind.COMBINED)
+
+    def safety(self, ident: str) -> Safety:
+        return next(s for s in self.safeties if s.id == ident)

@@ -1,0 +1,296 @@
+"""Checking a filter file: names resolved, constraints classified (CSs / CSc), reliefs
+turned into forced values, every mistake located; ``load_filter`` / ``parse_filter``.
+
+Example
+-------
+>>> f = parse_filter('outputs O1, O2\\ninputs i1\\nsafety K1: O1 & O2 keep O1\\nsafety S1: i1 & O1', "x.filter")
+>>> [(s.id, s.kind.value, [(c.output, c.value) for c in s.forced]) for s in f.safeties]
+[('K1', 'combined', [('O2', False)]), ('S1', 'simple', [])]
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from synth.errors import InputError, Location, close_names, location_in
+from synth.filter.language import (
+    Assumption,
+    ConstraintKind,
+    Criterion,
+    Declared,
+    Equation,
+    Filter,
+    Forcing,
+    Safety,
+    SimCriterion,
+    VarKind,
+    base_name,
+    request_name,
+)
+from synth.filter.language_reader import Use, Vector, filter_items
+from synth.logic.expr import And, Edge, Expr, Not, Or, Var, names
+from synth.syntax import Checker, read_source
+
+if TYPE_CHECKING:
+    from synth.filter.bdd import Engine
+
+__all__ = ["parse_filter", "load_filter", "output_polarities"]
+
+
+def output_polarities(e: Expr, outputs: set[str] | frozenset[str]) -> dict[str, set[bool]]:
+    """For each output at t in ``e`` (text order), the polarities it occurs with
+    (``True``: the expression grows with the output; ``↑o`` counts as ``o``, ``↓o`` as ``!o``).
+
+    >>> output_polarities(Not(And((Var("a"), Edge(False, "b")))), {"a", "b"})
+    {'a': {False}, 'b': {True}}
+    """
+    found: dict[str, set[bool]] = {}
+
+    def walk(x: Expr, positive: bool) -> None:
+        if isinstance(x, Var) and x.name in outputs:
+            found.setdefault(x.name, set()).add(positive)
+        elif isinstance(x, Edge) and x.name in outputs:
+            found.setdefault(x.name, set()).add(x.rising == positive)
+        elif isinstance(x, Not):
+            walk(x.arg, not positive)
+        elif isinstance(x, (And, Or)):
+            for a in x.args:
+                walk(a, positive)
+
+    walk(e, True)
+    return found
+
+
+class _FilterChecker(Checker):
+    def __init__(self, file: str, source: str, base: Path | None) -> None:
+        super().__init__()
+        self.file, self.source, self.base = file, source, base
+        self.declared: dict[str, Declared] = {}
+        self.warnings: list[InputError] = []
+        self.plant: str | None = None
+        self.engine: "Engine | None" = None
+
+    # ---- declarations
+    def declare(self, name: str, kind: VarKind, loc: Location | None, grafcet: str | None = None) -> None:
+        if name in self.declared:
+            first = self.declared[name]
+            if first.kind is kind and loc is None:  # a plant's vector repeated in the filter
+                return
+            where = f" at {first.loc}" if first.loc else " by the plant"
+            self.fail(f"'{name}' is declared twice", loc, notes=(f"first declared as {first.kind.value}{where}",))
+            return
+        self.declared[name] = Declared(name, kind, loc, grafcet)
+
+    def use(self, u: Use) -> None:
+        from synth.plant.rules import load_rules
+
+        if self.plant is not None:
+            self.fail("a filter uses at most one plant", u.loc)
+            return
+        target = (self.base / u.path) if self.base is not None else Path(u.path)
+        if not target.is_file():
+            self.fail(f"cannot read '{u.path}': no such file", u.loc)
+            return
+        rs = load_rules(target)
+        self.plant = str(target)
+        for kind, vector in ((VarKind.INPUT, rs.inputs), (VarKind.OUTPUT, rs.outputs)):
+            for n in vector:
+                if n not in self.declared:
+                    self.declared[n] = Declared(n, kind, None)
+
+    def of_kind(self, kind: VarKind) -> tuple[str, ...]:
+        return tuple(n for n, d in self.declared.items() if d.kind is kind)
+
+    # ---- expressions
+    def known(self, e: Expr, what: str) -> bool:
+        ok = True
+        for v in names(e):
+            base = base_name(v.name) if isinstance(v, Var) else v.name
+            if base not in self.declared:
+                self.fail(
+                    f"unknown variable '{base}' in {what}",
+                    v.loc,
+                    suggestions=close_names(base, self.declared),
+                )
+                ok = False
+        return ok
+
+    def outputs_at_t(self, e: Expr) -> tuple[str, ...]:
+        outs = self.of_kind(VarKind.OUTPUT)
+        seen: list[str] = []
+        for v in names(e):
+            if v.name in outs and v.name not in seen:
+                seen.append(v.name)
+        return tuple(seen)
+
+    # ---- statements
+    def safety(self, s: Safety, ids: dict[str, Safety]) -> Safety | None:
+        if s.id in ids:
+            self.fail(f"constraint '{s.id}' is declared twice", s.loc, notes=(f"first declared at {ids[s.id].loc}",))
+            return None
+        ids[s.id] = s
+        if not self.known(s.expr, f"constraint {s.id}"):
+            return None
+        outs = self.outputs_at_t(s.expr)
+        if not outs:
+            self.fail(
+                f"constraint {s.id} does not involve an output at t",
+                s.loc,
+                notes=("a safety constraint names an output or its edge; past values x^-1 are read-only",),
+            )
+            return None
+        s = Safety(s.id, s.label, s.expr, s.loc, s.keep, s.force, outs)
+        if s.kind is ConstraintKind.SIMPLE:
+            if s.has_priority:
+                self.warnings.append(InputError(
+                    f"{s.id} is a simple constraint (output {outs[0]}): its relief is implied, keep/force is ignored",
+                    s.loc, severity="warning"))
+            return s
+        forced = self.forced(s)
+        if forced is None:
+            return None
+        return Safety(s.id, s.label, s.expr, s.loc, s.keep, s.force, outs, forced)
+
+    def forced(self, s: Safety) -> tuple[Forcing, ...] | None:
+        if s.force:
+            seen: set[str] = set()
+            for f in s.force:
+                if f.output not in s.outputs:
+                    self.fail(f"force: '{f.output}' is not an output of {s.id}", f.loc, expected=s.outputs,
+                              suggestions=close_names(f.output, s.outputs))
+                    return None
+                if f.output in seen:
+                    self.fail(f"'{f.output}' is forced twice in {s.id}", f.loc)
+                    return None
+                seen.add(f.output)
+            return self.relieving(s, s.force)
+        if s.keep is None:
+            return ()
+        kept: list[str] = []
+        for v in names(s.keep):
+            if v.name not in s.outputs:
+                self.fail(f"keep: '{v.name}' is not an output of {s.id} at t", v.loc, expected=s.outputs,
+                          suggestions=close_names(v.name, s.outputs))
+                return None
+            kept.append(v.name)
+        polarity = output_polarities(s.expr, set(s.outputs))
+        forced: list[Forcing] = []
+        for o in s.outputs:
+            if o in kept:
+                continue
+            if len(polarity[o]) > 1:
+                self.fail(f"keep: cannot tell the value to force on '{o}' in {s.id}, it occurs both negated and not",
+                          s.loc, notes=(f"write the relief as `force {o}=0` or `force {o}=1`",))
+                return None
+            forced.append(Forcing(o, not next(iter(polarity[o])), s.keep.loc if hasattr(s.keep, "loc") else None))
+        if not forced:
+            self.fail(f"keep: {s.id} keeps every output, nothing is left to force", s.loc)
+            return None
+        return self.relieving(s, tuple(forced))
+
+    def relieving(self, s: Safety, forced: tuple[Forcing, ...]) -> tuple[Forcing, ...] | None:
+        from synth.filter.bdd import Engine
+
+        if self.engine is None:  # one manager for the file: creating one costs ~10 ms
+            self.engine = Engine()
+        engine = self.engine
+        u = engine.expr(s.expr)
+        if engine.let({f.output: f.value for f in forced}, u) != engine.false:
+            values = ", ".join(f"{f.output}={int(f.value)}" for f in forced)
+            self.fail(f"the relief of {s.id} does not make it false: {values} leaves it satisfiable", s.loc)
+            return None
+        return forced
+
+    def assumption(self, a: Assumption) -> Assumption | None:
+        if not self.known(a.expr, "an assumption"):
+            return None
+        for o in self.outputs_at_t(a.expr):
+            loc = next(v.loc for v in names(a.expr) if v.name == o)
+            self.fail(f"an assumption cannot use the output '{o}' at t", loc,
+                      notes=("assumptions describe the read-only variables; a condition on outputs is a `safety`",))
+            return None
+        return a
+
+    def sim(self, c: SimCriterion, simmed: set[str]) -> SimCriterion | None:
+        outs = self.of_kind(VarKind.OUTPUT)
+        for o, loc in zip(c.outputs, c.locs or (c.loc,) * len(c.outputs)):
+            if o not in outs:
+                self.fail(f"maximize sim: '{o}' is not an output", loc, suggestions=close_names(o, outs))
+                return None
+            if o in simmed:
+                self.fail(f"output '{o}' has two sim criteria", loc)
+                return None
+            simmed.add(o)
+        return c
+
+    def equation(self, q: Equation, done: dict[str, Equation]) -> Equation | None:
+        outs = self.of_kind(VarKind.OUTPUT)
+        if q.output not in outs:
+            self.fail(f"equation: '{q.output}' is not an output", q.loc, suggestions=close_names(q.output, outs))
+            return None
+        if q.output in done:
+            self.fail(f"output '{q.output}' has two equations", q.loc, notes=(f"first at {done[q.output].loc}",))
+            return None
+        done[q.output] = q
+        return q if self.known(q.expr, f"the equation of {q.output}") else None
+
+    def check(self, items: list) -> Filter:
+        for it in items:
+            if isinstance(it, Use):
+                self.use(it)
+        for it in items:
+            if isinstance(it, Vector):
+                for n, loc in it.names:
+                    self.declare(n, it.kind, loc)
+            elif isinstance(it, Declared):
+                self.declare(it.name, it.kind, it.loc, it.grafcet)
+        outputs = self.of_kind(VarKind.OUTPUT)
+        for o in outputs:
+            r = request_name(o)
+            if r in self.declared:
+                self.fail(f"'{r}' is the implicit request of output {o}; it cannot be declared", self.declared[r].loc)
+            else:
+                self.declared[r] = Declared(r, VarKind.REQUEST, None)
+        if not outputs:
+            self.fail("no outputs declared", location_in(self.file, self.source, 1, 1),
+                      notes=("declare them with `outputs A0, A1, ...` or `use` a plant",))
+        ids: dict[str, Safety] = {}
+        simmed: set[str] = set()
+        eqs: dict[str, Equation] = {}
+        safeties, assumptions, criteria, equations = [], [], [], []
+        for it in items:
+            if isinstance(it, Safety):
+                safeties.append(self.safety(it, ids))
+            elif isinstance(it, Assumption):
+                assumptions.append(self.assumption(it))
+            elif isinstance(it, Criterion):
+                criteria.append(it if self.known(it.expr, "a criterion") else None)
+            elif isinstance(it, SimCriterion):
+                criteria.append(self.sim(it, simmed))
+            elif isinstance(it, Equation):
+                equations.append(self.equation(it, eqs))
+        self.raise_errors()
+        return Filter(
+            self.file,
+            self.of_kind(VarKind.INPUT),
+            outputs,
+            tuple(d for d in self.declared.values() if d.kind is VarKind.OBSERVER),
+            tuple(assumptions),
+            tuple(safeties),
+            tuple(criteria),
+            tuple(equations),
+            self.plant,
+            tuple(self.warnings),
+        )
+
+
+def parse_filter(source: str, file: str = "<filter>", base: Path | None = None) -> Filter:
+    """Parse and check filter text; ``base`` is the folder ``use`` paths are relative to."""
+    items = filter_items(source, file)
+    return _FilterChecker(file, source, base).check(items)
+
+
+def load_filter(path: str | Path) -> Filter:
+    """Read, parse and check a ``.filter`` file."""
+    return parse_filter(read_source(path), str(path), Path(path).parent)

@@ -1,0 +1,290 @@
+"""Algebraic synthesis of a filter (004 §2.2, §3.2) in its relational form: the admissible
+set ``S(O,Y) = A ∧ ¬F`` is narrowed by each criterion in order —
+``Max(c)``: ``S := S ∧ (c ↔ ∃O.(S∧c))``, ``Min(c)``: ``S := S ∧ (c ↔ ∀O.(¬S∨c))`` —
+and when S is functional each output is ``∃O.(S ∧ o)``, printed minimised over the
+care set (the assumptions where a safe vector exists).
+
+The criteria, in order: the CSc priorities as leading ``Min`` criteria (004 eq. 24),
+unless the file states its own ``minimize``/``maximize`` criteria; then the file's
+criteria; ``maximize sim`` expands to one ``Max(R_o·o + !R_o·!o)`` per output named. A
+file without any ``maximize sim`` line gets one per output at the end, in ``outputs`` order.
+
+Example (004 eqs. 4-13)
+-------
+>>> from synth.filter.language_check import parse_filter
+>>> f = parse_filter('''inputs i1
+... outputs O1, O2
+... safety K: O1 & O2
+... maximize i1 & O1
+... minimize O1
+... maximize O2''', "x.filter")
+>>> s = synthesis(f)
+>>> s.functional, s.equations
+(True, {'O1': 'i1', 'O2': '!i1'})
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Sequence
+
+from synth.errors import InputError
+from synth.filter.bdd import Cube, Function, cube_text
+from synth.filter.language import Criterion, Filter, Sense, SimCriterion, pre_name, request_name
+from synth.filter.model import FilterFunctions, equation_functions, functions
+from synth.logic.expr import And, Const, Edge, Expr, Not, Or, Var
+
+__all__ = ["IMPLICIT", "Applied", "Synthesis", "synthesis", "chained_equations", "criteria", "priority_criteria", "requested", "sim_expr",
+           "differences"]
+
+
+IMPLICIT = "implicit"
+
+
+def sim_expr(output: str) -> Expr:
+    """``R_o & o | !R_o & !o``, the similarity of 004 eq. (25)."""
+    r, o = Var(request_name(output)), Var(output)
+    return Or((And((r, o)), And((Not(r), Not(o)))))
+
+
+def requested(e: Expr, outputs: Sequence[str]) -> Expr:
+    """``e`` with each output at t replaced by its request (past values kept), e.g.
+    ``↑A4`` becomes ``!A4^-1 & R_A4``: the condition under which the request violates ``e``.
+
+    >>> requested(And((Edge(True, "A4"), Var("C"))), ["A4"]).text()
+    '!A4^-1 & R_A4 & C'
+    """
+    if isinstance(e, Var):
+        return Var(request_name(e.name), e.loc) if e.name in outputs else e
+    if isinstance(e, Edge):
+        if e.name not in outputs:
+            return e
+        before, now = Var(pre_name(e.name)), Var(request_name(e.name))
+        return And((Not(before), now)) if e.rising else And((before, Not(now)))
+    if isinstance(e, Const):
+        return e
+    if isinstance(e, Not):
+        return Not(requested(e.arg, outputs), e.loc)
+    args = []
+    for a in e.args:  # flatten the And an edge became
+        r = requested(a, outputs)
+        args.extend(r.args if isinstance(r, type(e)) and not isinstance(a, type(e)) else (r,))
+    return type(e)(tuple(args), e.loc)
+
+
+def priority_criteria(f: Filter) -> list[Criterion]:
+    """One ``Min`` per CSc with a priority (004 eq. 24): when the requests violate it,
+    minimise ``!L`` for ``keep L``, or the forced outputs being off their values."""
+    found = []
+    for s in f.combined:
+        if not s.has_priority:
+            continue
+        when = requested(s.expr, f.outputs)
+        if s.keep is not None:
+            bad: Expr = s.keep.arg if isinstance(s.keep, Not) else Not(s.keep)
+        else:
+            offs = tuple(Not(Var(c.output)) if c.value else Var(c.output) for c in s.forced)
+            bad = offs[0] if len(offs) == 1 else Or(offs)
+        found.append(Criterion(Sense.MIN, And((when, bad)), s.loc, f"priority of {s.id}"))
+    return found
+
+
+def criteria(f: Filter, order: Sequence[str] | None = None) -> list[Criterion]:
+    """The criteria of ``f`` in the order they are applied. ``order`` reorders the Sim
+    criteria: the outputs it names first, the others after them in their own order."""
+    stated = [c for c in f.criteria if isinstance(c, Criterion)]
+    out: list[Criterion] = [] if stated else priority_criteria(f)
+    sims = [o for c in f.criteria if isinstance(c, SimCriterion) for o in c.outputs]
+    implicit = not sims
+    if implicit:  # no `maximize sim` line: every output, in `outputs` order, after the rest
+        sims = list(f.outputs)
+    if order is not None:
+        unknown = [o for o in order if o not in f.outputs]
+        if unknown:
+            raise InputError(f"--order: '{unknown[0]}' is not an output of {f.file}", None, expected=f.outputs)
+        sims = [o for o in dict.fromkeys(order) if o in sims] + [o for o in sims if o not in order]
+    pending = list(sims)
+    for c in f.criteria:
+        if isinstance(c, SimCriterion):  # the file's sims, in the (re)ordered sequence
+            here, pending = pending[: len(c.outputs)], pending[len(c.outputs):]
+            out += [Criterion(Sense.MAX, sim_expr(o), c.loc, f"sim {o}") for o in here]
+        else:
+            out.append(Criterion(c.sense, c.expr, c.loc, f"line {c.loc.line}" if c.loc else "file"))
+    origin = f"{IMPLICIT} sim" if implicit else "sim"
+    out += [Criterion(Sense.MAX, sim_expr(o), None, f"{origin} {o}") for o in pending]
+    return out
+
+
+@dataclass(frozen=True)
+class Applied:
+    """A criterion as applied: does it narrow the admissible set where it stands
+    (``narrows``), and would the final filter differ without it (``effect``)?"""
+
+    criterion: Criterion
+    narrows: bool
+    effect: bool
+
+    @property
+    def implicit(self) -> bool:
+        return self.criterion.origin.startswith(IMPLICIT)
+
+    def text(self) -> str:
+        return f"{self.criterion.sense.value} {self.criterion.expr.text()}  ({self.criterion.origin})"
+
+    def warning(self, number: int) -> str:
+        why = "it removes no solution" if not self.narrows else "the criteria after it give the same filter without it"
+        return f"criterion {number} has no effect ({why}): {self.text()}"
+
+
+@dataclass
+class Synthesis:
+    """The outcome of ``solve``: equations in filter syntax, and why it may have failed."""
+
+    functions: FilterFunctions
+    admissible: Function
+    care: Function
+    applied: list[Applied]
+    equations: dict[str, str] = field(default_factory=dict)
+    chained: dict[str, str] = field(default_factory=dict)  # evaluation order; may use earlier outputs
+    free: dict[str, Cube] = field(default_factory=dict)  # output -> Y witness with two choices
+    inconsistent: Cube | None = None
+    inconsistent_text: str = ""
+    notes: list[str] = field(default_factory=list)
+
+    @property
+    def functional(self) -> bool:
+        return not self.free
+
+    @property
+    def consistent(self) -> bool:
+        return self.inconsistent is None
+
+    @property
+    def warnings(self) -> list[str]:
+        return [a.warning(i) for i, a in enumerate(self.applied, 1) if not a.effect and not a.implicit]
+
+    def output(self, o: str) -> Function:
+        """The synthesised output ``o`` as a function of Y."""
+        m = self.functions
+        return m.engine.exists(m.outputs, self.admissible & m.engine.var(o))
+
+    def as_dict(self) -> dict[str, Any]:
+        return {
+            "functional": self.functional,
+            "consistent": self.consistent,
+            "equations": dict(self.equations),
+            "chained": {"order": list(self.chained), "equations": dict(self.chained)},
+            "warnings": self.warnings,
+            "notes": list(self.notes),
+            "criteria": [{"sense": a.criterion.sense.value, "expression": a.criterion.expr.text(),
+                          "origin": a.criterion.origin, "narrows": a.narrows, "effect": a.effect} for a in self.applied],
+            "free": {o: {n: int(v) for n, v in c.items()} for o, c in self.free.items()},
+            "inconsistent": None if self.inconsistent is None else {
+                "counterexample": {n: int(v) for n, v in self.inconsistent.items()},
+                "expression": self.inconsistent_text},
+        }
+
+    def text(self) -> str:
+        lines = [f"equation {o} = {t}" for o, t in self.chained.items()]
+        for o, c in self.free.items():
+            lines.append(f"not functional: {o} is free when {cube_text(c)}")
+        if self.inconsistent is not None:
+            lines.append(f"inconsistent: no safe output vector when {cube_text(self.inconsistent)}"
+                         + (f" (wherever {self.inconsistent_text})" if self.inconsistent_text != cube_text(
+                             self.inconsistent) else ""))
+        return "\n".join(lines) + "\n"
+
+
+def synthesis(f: Filter | FilterFunctions, order: Sequence[str] | None = None) -> Synthesis:
+    """Solve the filter's constraints with its criteria (the relational semantics of 004)."""
+    m = f if isinstance(f, FilterFunctions) else functions(f)
+    e, outs = m.engine, m.outputs
+    steps = [(c, e.expr(c.expr)) for c in criteria(m.filter, order)]
+
+    def narrowed(admissible: Function, c: Criterion, u: Function) -> Function:
+        if c.sense is Sense.MAX:
+            best = e.exists(outs, admissible & u)
+        else:
+            best = e.forall(outs, ~admissible | u)
+        return admissible & u.equiv(best)
+
+    states = [m.assumed & ~m.forbidden]
+    for c, u in steps:
+        states.append(narrowed(states[-1], c, u))
+    admissible = states[-1]
+    applied = []
+    for i, (c, u) in enumerate(steps):
+        narrows = states[i + 1] != states[i]
+        without = states[i]
+        if narrows:  # the same filter without it?
+            for later, v in steps[i + 1:]:
+                without = narrowed(without, later, v)
+        applied.append(Applied(c, narrows, narrows and without != admissible))
+    care = e.exists(outs, admissible)
+    result = Synthesis(m, admissible, care, applied)
+    stated = any(isinstance(c, Criterion) for c in m.filter.criteria)
+    if stated and any(s.has_priority for s in m.filter.combined):
+        result.notes.append("the file states its criteria: the priorities of the combined constraints are not "
+                            "translated into criteria")
+    for s in m.filter.combined:
+        if not s.has_priority:
+            result.notes.append(f"{s.id} has no priority: the criteria order decides how it is relieved")
+    stuck = m.assumed & ~care
+    if stuck != e.false:
+        result.inconsistent = e.witness(stuck, m.assumed)
+        result.inconsistent_text = e.text(stuck, stuck | ~m.assumed)
+    for o in outs:
+        one = e.exists(outs, admissible & e.var(o))
+        zero = e.exists(outs, admissible & ~e.var(o))
+        if (one & zero) != e.false:
+            result.free[o] = e.minimal_cube(one & zero)
+        else:
+            result.equations[o] = e.text(one, one | ~care)
+    result.chained = chained_equations(result)
+    return result
+
+
+def chained_equations(s: Synthesis) -> dict[str, str]:
+    """The equations in an evaluation order where each may use the outputs computed before
+    it, as 004's (30) does (``A0 = R_A0 & !P01 & (!C0 | A1)``): outputs with the shortest
+    equations first; each keeps its Y-only text unless using earlier outputs is shorter."""
+    m = s.functions
+    e = m.engine
+    order = sorted(s.equations, key=lambda o: (len(s.equations[o]), m.outputs.index(o)))
+    chained: dict[str, str] = {}
+    agree = e.true  # the earlier outputs equal their functions
+    for o in order:
+        f = s.output(o)
+        text = e.text(f & agree & s.care, f | ~agree | ~s.care)
+        chained[o] = text if len(text) < len(s.equations[o]) else s.equations[o]
+        agree &= e.var(o).equiv(f)
+    return chained
+
+
+def differences(s: Synthesis) -> list[str]:
+    """How the file's ``equation`` lines differ from the synthesis, on the care set: the
+    printed terms that give 1 where the synthesis gives 0, and where no printed term
+    gives the synthesis's 1."""
+    m = s.functions
+    e, f = m.engine, m.filter
+    if not f.equations:
+        return []
+    printed = equation_functions(m)
+    lines = []
+    for q in f.equations:
+        if q.output in s.free:
+            continue
+        mine, theirs = s.output(q.output), printed[q.output]
+        if (~mine.equiv(theirs) & s.care) == e.false:
+            continue
+        terms = q.expr.args if isinstance(q.expr, Or) else (q.expr,)
+        for t in terms:
+            extra = e.let(printed, e.expr(t)) & ~mine
+            if (extra & s.care) != e.false:
+                lines.append(f"{q.output}: the printed term {t.text()} gives 1 where the synthesis gives 0, "
+                             f"e.g. when {cube_text(e.witness(extra, s.care))}")
+        missing = mine & ~theirs
+        if (missing & s.care) != e.false:
+            lines.append(f"{q.output}: the synthesis gives 1 where no printed term does, "
+                         f"e.g. when {cube_text(e.witness(missing, s.care))}")
+    return lines
