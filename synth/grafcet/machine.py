@@ -150,7 +150,6 @@ class GrafcetMachine:
         self.transitions: tuple[Transition, ...] = grafcet.transitions
         steps = {s.name for s in grafcet.steps}
         timers = {t.id for t in grafcet.timers}
-        self._timer_step = {t.id: t.step for t in grafcet.timers}
         self._seconds = {t.id: t.seconds for t in grafcet.timers}
         self._timers_of_step: dict[str, tuple[str, ...]] = {}
         # timers of one step with equal durations (2s/X1, 2000ms/X1) elapse at the same

@@ -71,13 +71,16 @@ def _inline_svg(dot_text: str) -> str:
 
 def _walk_step(event: str, state: dict) -> dict:
     """One trace step for the page's state panel: names of the true variables."""
+    from synth.output.result import state_names
+
+    true_e, true_z, proh = state_names(state)
     return {
         "event": event,
         "situation": state["situation"],
-        "E": [k for k, x in state["E"].items() if x],
-        "Z": [k for k, x in state["Z"].items() if x],
+        "E": true_e,
+        "Z": true_z,
         "ord": state["ord"],
-        "proh": ", ".join(f"{p['order']} ({', '.join(p['constraints'])})" for p in state["proh"]),
+        "proh": proh,
         "stored": state["stored"],
         "elapsed": state["elapsed"],
     }
@@ -156,10 +159,11 @@ def _state_table(item: dict):
     """Sit, E, Z, ORD and PROH of one state, as an HTML table."""
     from markupsafe import Markup, escape
 
-    e = " ".join(k for k, x in item["E"].items() if x) or "-"
-    z = " ".join(k for k, x in item["Z"].items() if x) or "-"
-    proh = ", ".join(f"{p['order']} ({', '.join(p['constraints'])})" for p in item["proh"]) or "-"
-    rows = [("Sit", ", ".join(item["situation"])), ("E (true)", e), ("Z (true)", z), ("ORD", ", ".join(item["ord"]) or "-"), ("PROH", proh)]
+    from synth.output.result import state_names
+
+    true_e, true_z, proh = state_names(item)
+    rows = [("Sit", ", ".join(item["situation"])), ("E (true)", " ".join(true_e) or "-"),
+            ("Z (true)", " ".join(true_z) or "-"), ("ORD", ", ".join(item["ord"]) or "-"), ("PROH", proh or "-")]
     return Markup("<table>" + "".join(f"<tr><th>{k}</th><td class='mono'>{escape(val)}</td></tr>" for k, val in rows) + "</table>")
 
 

@@ -14,7 +14,7 @@ from synth.validation.diagnosis import diagnose_prohibition
 if TYPE_CHECKING:  # pragma: no cover
     from synth.validation.validate import ReducedController, Validation
 
-__all__ = ["state_json", "prohibited_json", "validation_json", "validation_text", "cor_json", "cor_dot"]
+__all__ = ["state_json", "state_names", "prohibited_json", "validation_json", "validation_text", "cor_json", "cor_dot"]
 
 
 def _steps(steps: tuple[str, ...]) -> list[str]:
@@ -34,6 +34,15 @@ def state_json(v: Validation, i: int) -> dict[str, Any]:
         "ord": list(n.ord),
         "proh": [{"order": p.order, "event": p.event, "constraints": list(p.constraints)} for p in n.proh],
     }
+
+
+def state_names(state: dict[str, Any]) -> tuple[list[str], list[str], str]:
+    """What a reader sees of a :func:`state_json` state: the true inputs, the true
+    outputs (by name) and the PROH text (``AVANCER1 (C2_1, C2_6)``, empty for none)."""
+    true_e = [k for k, x in state["E"].items() if x]
+    true_z = [k for k, x in state["Z"].items() if x]
+    proh = ", ".join(f"{p['order']} ({', '.join(p['constraints'])})" for p in state["proh"])
+    return true_e, true_z, proh
 
 
 def prohibited_json(v: Validation, i: int) -> list[dict[str, Any]]:
@@ -151,14 +160,12 @@ def validation_text(v: Validation) -> str:
 def _problem_lines(v: Validation, title: str, i: int) -> list[str]:
     d = state_json(v, i)
     n = v.sync.nodes[i]
-    true_e = [k for k, x in d["E"].items() if x] or ["-"]
-    true_z = [k for k, x in d["Z"].items() if x] or ["-"]
-    proh = ", ".join(f"{p['order']} ({', '.join(p['constraints'])})" for p in d["proh"]) or "-"
+    true_e, true_z, proh = state_names(d)
     return [
         f"{title}: situation {n.situation.text()}",
-        f"  E: {' '.join(true_e)}",
-        f"  Z: {' '.join(true_z)}",
-        f"  ORD: {', '.join(d['ord']) or '-'}   PROH: {proh}",
+        f"  E: {' '.join(true_e) or '-'}",
+        f"  Z: {' '.join(true_z) or '-'}",
+        f"  ORD: {', '.join(d['ord']) or '-'}   PROH: {proh or '-'}",
         f"  trace: {' '.join(v.analysis.traces[i].events) or '(initial state)'}",
     ]
 

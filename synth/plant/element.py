@@ -16,7 +16,8 @@ Only the states reachable from the initial state are kept.
 Example
 -------
 >>> from synth.plant.rules import parse_rules
->>> rs = parse_rules(open(_library("double_acting.rules")).read() +
+>>> from synth.plant.library import library_dir
+>>> rs = parse_rules(open(library_dir() / "double_acting.rules").read() +
 ...     "element V1 = double_acting(AVANCER=AVANCER1, RECULER=RECULER1, v0=v10, v1=v11)")
 >>> a = element_automaton(rs.elements[0])
 >>> a.size, a.count(controllable=True), a.count(controllable=False)
@@ -28,7 +29,6 @@ from __future__ import annotations
 from collections import deque
 from dataclasses import dataclass
 from functools import cached_property
-from pathlib import Path
 from typing import Iterable
 
 import numpy as np
@@ -41,10 +41,6 @@ from synth.plant.rules import ORDER, ElementSpec
 __all__ = ["ElementAutomaton", "element_automaton"]
 
 MAX_ELEMENT_VARIABLES = 20
-
-
-def _library(name: str) -> str:
-    return str(Path(__file__).resolve().parents[2] / "plants" / "lib" / name)
 
 
 @dataclass(frozen=True, eq=False)

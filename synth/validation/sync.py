@@ -119,11 +119,16 @@ class Sync:
         return self._in[i]
 
     def inputs(self, local: Local) -> dict[str, bool]:
-        val = self.plant.valuation(local)
-        return {n: val[n] for n in self.machine.inputs if n in val}
+        """The Grafcet's inputs in plant state ``local``."""
+        return _grafcet_inputs(self.plant, self.machine, local)
 
     def vectors(self, i: int) -> tuple[str, str]:
         return self.plant.vectors(self.nodes[i].plant)
+
+
+def _grafcet_inputs(p: Plant, machine: GrafcetMachine, local: Local) -> dict[str, bool]:
+    val = p.valuation(local)
+    return {n: val[n] for n in machine.inputs if n in val}
 
 
 def _order_moves(p: Plant) -> dict[str, list[LocalTransition]]:
@@ -195,8 +200,7 @@ def synchronous_product(
     conflicts: list[Conflict] = []
 
     def inputs(local: Local) -> dict[str, bool]:
-        val = p.valuation(local)
-        return {n: val[n] for n in machine.inputs if n in val}
+        return _grafcet_inputs(p, machine, local)
     moves = _order_moves(p)
     uncontrollable = [t for t in p.transitions if not t.controllable]
     index: dict[tuple[Situation, Local], int] = {}

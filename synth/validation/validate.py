@@ -80,7 +80,7 @@ def home_states(sync: Sync, conditions: Sequence[Expr]) -> frozenset[int]:
     """The home states: the initial aggregated states, and every state where one of
     ``conditions`` holds (read on its active steps and its plant values)."""
     homes = set(sync.initial)
-    for i, n in enumerate(sync.nodes):
+    for i, n in enumerate(sync.nodes if conditions else ()):
         val = sync.plant.valuation(n.plant)
         steps = set(n.situation.step_variables)
 
