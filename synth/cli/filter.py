@@ -31,6 +31,21 @@ def register(sub: "argparse._SubParsersAction") -> None:
     s.add_argument("--json", action="store_true", help="print JSON instead of text")
     s.add_argument("--order", metavar="O1,O2,...", help="the order of the Sim criteria (default: the file's)")
     s.set_defaults(handler=cmd_solve)
+    register_st(commands)
+
+
+def register_st(commands: "argparse._SubParsersAction") -> None:
+    t = commands.add_parser("st", help="the filter as an IEC 61131-3 FUNCTION_BLOCK (Structured Text)")
+    t.add_argument("filter", metavar="F.filter", help="the .filter file")
+    t.add_argument("--algorithm", choices=("algebraic", "loop"), default="algebraic",
+                   help="the synthesised equations (default) or the detection/correction loop")
+    t.add_argument("--mode", choices=("supervisor", "blocking"), default="supervisor",
+                   help="pass the requests on (default), or latch and fold them after a violation until Ack")
+    t.add_argument("-o", "--output", metavar="FB.st", help="write the block to this file (default: standard output)")
+    t.add_argument("--xml", action="store_true", help="write PLCopen TC6 XML instead of Structured Text")
+    t.add_argument("--name", metavar="NAME", help="the block is FB_NAME_Filter (default: the file's stem)")
+    t.add_argument("--order", metavar="O1,O2,...", help="the order of the Sim criteria (algebraic)")
+    t.set_defaults(handler=cmd_st)
 
 
 def _warnings(f: "Filter") -> None:
@@ -79,3 +94,26 @@ def cmd_solve(args: argparse.Namespace) -> int:
         for w in s.warnings:
             print(f"warning: {w}", file=sys.stderr)
     return 0 if s.functional and s.consistent else 1
+
+
+def cmd_st(args: argparse.Namespace) -> int:
+    from synth.codegen.filter_st import filter_block
+    from synth.filter.language_check import load_filter
+    from synth.output.files import write_atomic
+
+    f = load_filter(args.filter)
+    _warnings(f)
+    order = [o.strip() for o in args.order.split(",") if o.strip()] if args.order else None
+    block = filter_block(f, args.algorithm, args.mode, args.name, order)
+    for n in block.notes:
+        print(f"note: {n}", file=sys.stderr)
+    text = block.text
+    if args.xml:
+        from synth.codegen.plcopen import st_project_xml
+
+        text = st_project_xml([(block.name, "functionBlock", block.text)], args.filter)
+    if args.output:
+        write_atomic(args.output, text)
+    else:
+        sys.stdout.write(text)
+    return 0
