@@ -217,14 +217,18 @@ class Engine:
         for c in (self.expanded(self.ordered(c), upper) for c in cubes):
             if c not in primes:
                 primes.append(c)
-        i = 0
-        while i < len(primes):  # drop a cube the others already cover
-            others = self.disjunction(self.cube(c) for j, c in enumerate(primes) if j != i)
-            if self.implies(lower, others):
-                del primes[i]
-            else:
-                i += 1
-        return primes
+        # drop, in order, each cube the others (the kept ones before it, all after it) cover
+        functions = [self.cube(c) for c in primes]
+        after = [self.false] * (len(primes) + 1)
+        for i in range(len(primes) - 1, -1, -1):
+            after[i] = functions[i] | after[i + 1]
+        kept: list[Cube] = []
+        before = self.false
+        for i, c in enumerate(primes):
+            if not self.implies(lower, before | after[i + 1]):
+                kept.append(c)
+                before |= functions[i]
+        return kept
 
     def text(self, lower: Function, upper: Function | None = None) -> str:
         """``u`` (or some function between ``lower`` and ``upper``) in filter syntax."""
