@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from synth.filter.language import Filter
 
-__all__ = ["register"]
+__all__ = ["register", "register_run", "register_verify", "register_from_rules"]
 
 
 def register(sub: "argparse._SubParsersAction") -> None:
@@ -31,6 +31,9 @@ def register(sub: "argparse._SubParsersAction") -> None:
     s.add_argument("--json", action="store_true", help="print JSON instead of text")
     s.add_argument("--order", metavar="O1,O2,...", help="the order of the Sim criteria (default: the file's)")
     s.set_defaults(handler=cmd_solve)
+
+    register_run(commands)
+    register_from_rules(commands)
 
 
 def _warnings(f: "Filter") -> None:
@@ -79,3 +82,60 @@ def cmd_solve(args: argparse.Namespace) -> int:
         for w in s.warnings:
             print(f"warning: {w}", file=sys.stderr)
     return 0 if s.functional and s.consistent else 1
+
+
+# --------------------------------------------------------------------------- run / verify / from-rules
+
+
+def _algorithm_mode(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--algorithm", choices=("algebraic", "loop"), default="algebraic",
+                   help="the solve equations (default) or the correction loop of FILTER.md §1.4")
+    p.add_argument("--mode", choices=("supervisor", "blocking"), default="supervisor",
+                   help="supervisor (default): g1 = R; blocking: g1 = 0 after a violation until Ack")
+
+
+def register_run(commands: "argparse._SubParsersAction") -> None:
+    r = commands.add_parser("run", help="evaluate the filter cycle by cycle on a CSV trace")
+    r.add_argument("filter", metavar="F.filter", help="the .filter file")
+    r.add_argument("--trace", metavar="CYCLES.csv", required=True,
+                   help="header: the inputs, observers and requests R_o (and Ack); one line of 0/1 per cycle")
+    _algorithm_mode(r)
+    r.add_argument("--json", action="store_true", help="print JSON instead of text")
+    r.set_defaults(handler=cmd_run)
+
+
+def cmd_run(args: argparse.Namespace) -> int:
+    from synth.cli.plant import print_json
+    from synth.filter.cycle import Algorithm, FilterCycle, Mode
+    from synth.filter.language_check import load_filter
+    from synth.filter.run import load_trace, run, run_json, run_text
+
+    f = load_filter(args.filter)
+    _warnings(f)
+    cycle = FilterCycle(f, Algorithm(args.algorithm), Mode(args.mode))
+    rows = load_trace(args.trace, cycle.reads)
+    results = run(cycle, rows)
+    if args.json:
+        data = run_json(cycle, rows, results)
+        print_json({"file": args.filter, "trace": args.trace, **data})
+    else:
+        sys.stdout.write(run_text(cycle, rows, results))
+    return 0 if not any(r.fallback or r.outside_care for r in results) else 1
+
+
+def register_from_rules(commands: "argparse._SubParsersAction") -> None:
+    g = commands.add_parser("from-rules", help="write a .filter skeleton from a rules file's constraints")
+    g.add_argument("rules", metavar="P.rules", help="the plant's rules file")
+    g.add_argument("-o", "--output", metavar="F.filter", required=True, help="the filter file to write")
+    g.set_defaults(handler=cmd_from_rules)
+
+
+def cmd_from_rules(args: argparse.Namespace) -> int:
+    from synth.filter.from_rules import write_skeleton
+
+    sk = write_skeleton(args.rules, args.output)
+    for c in sk.constraints:
+        what = {"simple": "CSs", "combined": "CSc (no priority)", "skipped": "skipped: no order"}[c.kind]
+        print(f"{c.id}: {what}" + (f" on {', '.join(c.outputs)}" if c.outputs else ""))
+    print(f"wrote {args.output}")
+    return 0
