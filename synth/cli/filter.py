@@ -33,6 +33,7 @@ def register(sub: "argparse._SubParsersAction") -> None:
     s.set_defaults(handler=cmd_solve)
 
     register_run(commands)
+    register_verify(commands)
     register_from_rules(commands)
 
 
@@ -138,4 +139,45 @@ def cmd_from_rules(args: argparse.Namespace) -> int:
         what = {"simple": "CSs", "combined": "CSc (no priority)", "skipped": "skipped: no order"}[c.kind]
         print(f"{c.id}: {what}" + (f" on {', '.join(c.outputs)}" if c.outputs else ""))
     print(f"wrote {args.output}")
+    return 0
+
+
+def register_verify(commands: "argparse._SubParsersAction") -> None:
+    v = commands.add_parser("verify", help="explore the filter in closed loop with the plant (FILTER.md §3.4)")
+    v.add_argument("filter", metavar="F.filter", help="the .filter file")
+    v.add_argument("--plant", metavar="P.rules", required=True, help="the plant's rules file")
+    source = v.add_mutually_exclusive_group(required=True)
+    source.add_argument("--grafcet", metavar="G.g7", help="the requests are this Grafcet's orders")
+    source.add_argument("--any-control", action="store_true", help="the requests are any vector, every cycle")
+    _algorithm_mode(v)
+    v.add_argument("--atomic-outputs", action="store_true",
+                   help="write the changed outputs in one plant step (default: falls, then rises, in output order)")
+    v.add_argument("--strict", action="store_true",
+                   help="a violation before the PLC writes its outputs also makes the loop unsafe")
+    v.add_argument("--max-states", type=int, default=1_000_000, metavar="N",
+                   help="stop the exploration after N states (default 1000000)")
+    v.add_argument("--json", action="store_true", help="print JSON instead of text")
+    v.set_defaults(handler=cmd_verify)
+
+
+def cmd_verify(args: argparse.Namespace) -> int:
+    from synth.cli.plant import print_json
+    from synth.filter.closed_loop import verification_json, verification_text, verify
+    from synth.filter.cycle import Algorithm, Mode
+    from synth.filter.language_check import load_filter
+
+    f = load_filter(args.filter)
+    _warnings(f)
+    v = verify(f, args.plant, args.grafcet, any_control=args.any_control, algorithm=Algorithm(args.algorithm),
+               mode=Mode(args.mode), atomic=args.atomic_outputs, strict=args.strict, max_states=args.max_states)
+    if args.json:
+        print_json(verification_json(v))
+    else:
+        sys.stdout.write(verification_text(v))
+    if not (v.safe and v.coherent):
+        return 1
+    if not v.complete:
+        print(f"stopped: the exploration reached --max-states {args.max_states} before covering every "
+              "reachable state; nothing wrong was found in the explored part", file=sys.stderr)
+        return 2
     return 0
