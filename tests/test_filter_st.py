@@ -1,6 +1,6 @@
-"""``synth filter st``: every bundled filter becomes a FUNCTION_BLOCK that blark parses and
-that, run by the ST interpreter, computes what ``solve`` computed (algebraic) or what
-FILTER.md §1.4 specifies (loop)."""
+"""``synth filter st``: run by the ST interpreter, the block computes what ``solve`` computed
+(algebraic) or what FILTER.md §1.4 specifies (loop). That blark parses every bundled filter's
+blocks is the business of ``test_filter_st_cycle.py``."""
 
 from __future__ import annotations
 
@@ -16,40 +16,9 @@ from synth.errors import InputError, ModelError
 from synth.filter.language import pre_name
 from synth.filter.language_check import load_filter, parse_filter
 from synth.filter.solve import requested, synthesis
+from st_blocks import interpreted
 
 ROOT = Path(__file__).resolve().parent.parent
-FILTERS = sorted((ROOT / "plants").glob("*.filter"))
-
-
-_MODULES: dict[str, object] = {}
-
-
-def _module(text: str, file: str):
-    """The interpreted block, parsed once per text (blark's Earley parser takes ~1 s per block)."""
-    if text not in _MODULES:
-        _MODULES[text] = load_st(text, file)
-    return _MODULES[text]
-
-
-def _loop_ready(f) -> bool:
-    return all(s.forced for s in f.combined)
-
-
-@pytest.mark.parametrize("path", FILTERS, ids=lambda p: p.stem)
-def test_every_bundled_filter_gives_blocks_blark_parses(path: Path) -> None:
-    f = load_filter(path)
-    made = 0
-    for algorithm in ("algebraic", "loop"):
-        if algorithm == "loop" and not _loop_ready(f):
-            continue
-        if algorithm == "algebraic" and not synthesis(f).functional:
-            continue
-        for mode in ("supervisor", "blocking"):
-            block = filter_block(f, algorithm, mode)
-            module = _module(block.text, f"{path.stem}_{algorithm}_{mode}.st")  # blark parses it
-            assert list(module.pous) == [block.name]
-            made += 1
-    assert made >= 2
 
 
 def _reference_cycle(s, f, point: dict[str, bool]) -> dict[str, bool]:
@@ -94,8 +63,8 @@ def _random_run(f, fb, cycles: int, seed: int, blocking: bool = False):
 @pytest.mark.parametrize("mode", ["supervisor", "blocking"])
 def test_algebraic_block_computes_the_synthesised_equations(name: str, mode: str) -> None:
     f = load_filter(ROOT / "plants" / f"{name}.filter")
-    block = filter_block(f, "algebraic", mode)
-    fb = _module(block.text, f"{name}.st").instance(block.name)
+    block, module = interpreted(name, "algebraic", mode)
+    fb = module.instance(block.name)
     compared = 0
     for n, got, expected in _random_run(f, fb, 300, seed=len(name), blocking=mode == "blocking"):
         assert got == expected, f"cycle {n}"
@@ -114,8 +83,8 @@ def test_a_flipped_operator_in_the_block_is_caught() -> None:
 
 def _loop_outputs(name: str, requests: tuple[int, ...], mode: str = "supervisor") -> tuple[tuple[int, ...], bool]:
     f = load_filter(ROOT / "plants" / f"{name}.filter")
-    block = filter_block(f, "loop", mode)
-    fb = _module(block.text, f"{name}.st").instance(block.name)
+    block, module = interpreted(name, "loop", mode)
+    fb = module.instance(block.name)
     fb.cycle({f"R_{o}": bool(v) for o, v in zip(f.outputs, requests)})
     return tuple(int(fb[o]) for o in f.outputs), fb["Fallback"]
 
