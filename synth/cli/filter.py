@@ -108,13 +108,15 @@ def cmd_st(args: argparse.Namespace) -> int:
     block = filter_block(f, args.algorithm, args.mode, args.name, order)
     for n in block.notes:
         print(f"note: {n}", file=sys.stderr)
-    text = block.text
+    text: str | bytes = block.text
     if args.xml:
         from synth.codegen.plcopen import st_project_xml
 
-        text = st_project_xml([(block.name, "functionBlock", block.text)], args.filter)
+        text = st_project_xml(block.text, name=block.name, comment=f"safety logic filter from {args.filter}")
     if args.output:
         write_atomic(args.output, text)
+    elif isinstance(text, bytes):
+        sys.stdout.buffer.write(text)
     else:
         sys.stdout.write(text)
     return 0
