@@ -84,6 +84,7 @@ class TraceRow:
     requests: tuple[str, ...]
     orders: tuple[str, ...]
     note: str = ""
+    ran: bool = True  # False: the plant's event only, the PLC has not run yet
 
 
 @dataclass(frozen=True)
@@ -460,7 +461,7 @@ def verify(f: Filter, rules_path: str, grafcet: str | None = None, *, any_contro
                     elif kind == "refused":
                         ids = ()
                     findings[kind] = (int(origin_e[i]), events[int(event_e[i])], int(oid[i]),
-                                      int(final[i]) if kind == "violation" else int(post_e[i]), ids)
+                                      int(final[i]) if final_ok[i] else int(post_e[i]), ids)
         if pr.machine is not None:
             req = np.array([o.requests for o in outcomes], dtype=bool).reshape(len(outcomes), len(pr.orders))[oid]
             dist = (req != targets).sum(axis=1)
@@ -507,17 +508,14 @@ def verify(f: Filter, rules_path: str, grafcet: str | None = None, *, any_contro
     for kind, (pk, ev, g, code, ids) in findings.items():
         rows = trace(pk)
         if g < 0:  # the plant's event alone
-            rows.append(TraceRow(ev, pr.label(code), rows[-1].situation, (), (), "before the PLC writes"))
+            rows.append(TraceRow(ev, pr.label(code), rows[-1].situation, (), (), "before the PLC writes", False))
         else:
             oc = outcomes[g]
             note = {"violation": "", "edge": "output event forbidden", "refused": "output change refused",
                     "fallback": "fallback", "outside_care": "outside the care set",
                     "transient": "an intermediate state of the write violates a constraint"}[kind]
             sit = aux_list[oc.aux][2]
-            shown = code if kind == "violation" else code
-            rows.append(_row(pr, oc, ev, shown, sit, note))
-            if kind == "transient" and not ids:
-                ids = ()
+            rows.append(_row(pr, oc, ev, code, sit, note))
         result[kind] = Finding(kind, ids, tuple(rows), len(counts[kind]))
     if "violation" in first_node and "violation" not in result:
         result["violation"] = Finding("violation", pr.violated(p.initial_index), tuple(trace(key0)),
@@ -607,7 +605,7 @@ def trace_text(rows: Sequence[TraceRow]) -> str:
         line = f"{i:<3}{r.event:<{w_event}}  {r.state:<{w_state}}"
         if w_sit:
             line += f"  {r.situation:<{w_sit}}"
-        if i or r.requests or r.orders:
+        if i and r.ran:
             line += f"  requests: {_names(r.requests)}  orders: {_names(r.orders)}"
         if r.note:
             line += f"   {r.note}"
@@ -660,5 +658,6 @@ def verification_json(v: Verification) -> dict[str, Any]:
         "corrected": v.corrected, "max_distance": v.max_distance, "seconds": round(v.seconds, 3),
         "findings": {k: {"count": f.count, "constraints": list(f.constraints), "trace": [
             {"event": r.event, "state": r.state, "situation": r.situation, "requests": list(r.requests),
-             "orders": list(r.orders), "note": r.note} for r in f.trace]} for k, f in v.findings.items()},
+             "orders": list(r.orders), "note": r.note, "plc_ran": r.ran} for r in f.trace]}
+                     for k, f in v.findings.items()},
     }
