@@ -11,6 +11,7 @@ import random
 import pytest
 
 from conftest import ROOT
+from schemas import assert_valid
 from synth.errors import InputError
 from synth.filter.cycle import ACK, Algorithm, FilterCycle, Memory, Mode
 from synth.filter.language_check import load_filter, parse_filter
@@ -151,6 +152,7 @@ def test_cli_run_loop_c(cli):
     ]
     code, out, _ = cli("filter", "run", PLANTS / "loop_c.filter", "--trace", DATA / "loop_c.csv", "--json")
     data = json.loads(out)
+    assert_valid("filter_run", data)
     assert code == 0 and data["coherent"] and data["algorithm"] == "algebraic"
     # cycle 2: the priority of K2 (o2:=1) is a leading Min criterion, so o1 gives way
     assert [c["outputs"] for c in data["cycles"]] == [{"o1": 1, "o2": 0, "o3": 0}, {"o1": 0, "o2": 1, "o3": 1},

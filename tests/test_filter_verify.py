@@ -14,6 +14,7 @@ from itertools import product
 import pytest
 
 from conftest import ROOT
+from schemas import assert_valid
 from synth.errors import InputError
 from synth.filter.closed_loop import trace_text, verify
 from synth.filter.cycle import Algorithm, FilterCycle, Memory, Mode
@@ -69,6 +70,7 @@ def test_dropped_constraint_is_found(cli, tri_filter, tmp_path):
     unsafe.write_text("".join(line for line in text.splitlines(True) if "C2_6" not in line))
     code, out, _ = cli("filter", "verify", unsafe, "--plant", TRI, "--any-control", "--json")
     data = json.loads(out)
+    assert_valid("filter_verify", data)
     assert (code, data["safe"], data["coherent"]) == (1, False, True)
     found = data["findings"]["violation"]
     assert (found["constraints"], found["count"]) == (["C2_6"], 1152)
@@ -128,6 +130,11 @@ def test_grafcet_requests(cli, tmp_path):
     assert (v.safe, v.coherent, v.states, v.cycles, v.corrected, v.max_distance) == (True, True, 4, 8, 2, 1)
     code, text, _ = cli("filter", "verify", out, "--plant", DATA / "two.rules", "--grafcet", DATA / "two.g7")
     assert code == 0 and "transparency: 2 of 8 cycles correct the requests, largest Hamming distance 1" in text
+    code, text, _ = cli("filter", "verify", out, "--plant", DATA / "two.rules", "--grafcet", DATA / "two.g7", "--json")
+    data = json.loads(text)
+    assert_valid("filter_verify", data)
+    assert (data["corrected"], data["max_distance"], data["findings"]["transient"]["trace"][0]["situation"]) == (
+        2, 1, "{X0}")
     code, text, _ = cli("filter", "verify", tmp_path / "no.filter", "--plant", DATA / "two.rules", "--any-control")
     assert code == 2
 

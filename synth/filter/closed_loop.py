@@ -171,6 +171,8 @@ class _Product:
         self.orders = p.outputs
         self.passthrough = tuple(o for o in p.outputs if o not in f.outputs)
         self.ynames = tuple(dict.fromkeys([*f.inputs, *(self.grafcet.inputs if self.grafcet else ())]))
+        if len(self.ynames) > 40:
+            raise LimitExceeded(f"{len(self.ynames)} inputs are read; verify codes an input vector in 40 bits")
         self.toggle: dict[str, np.ndarray] = {}
         self.uncontrollable: list[tuple[str, np.ndarray]] = []
         for t, src, dst in p.transition_arrays():
