@@ -154,6 +154,9 @@ def test_bad_input_and_limit(cli, tmp_path):
     assert code == 2 and f"{f}:3:10: error: observer X1 has no value in verify" in err
     with pytest.raises(SystemExit):
         cli("filter", "verify", f, "--plant", DATA / "two.rules")
+    code, _, err = cli("filter", "verify", DATA / "two_no_edge.filter", "--plant", DATA / "two.rules",
+                       "--any-control", "--algorithm", "loop")
+    assert code == 2 and "K is a combined constraint without priority" in err
     code, out, err = cli("filter", "verify", DATA / "three_cycle.filter", "--plant", DATA / "three.rules",
                          "--any-control", "--max-states", "2")
     assert code == 2 and "STOPPED at the state limit" in out
