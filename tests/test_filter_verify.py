@@ -17,7 +17,7 @@ from conftest import ROOT
 from schemas import assert_valid
 from synth.errors import InputError
 from synth.filter.closed_loop import trace_text, verify
-from synth.filter.cycle import Algorithm, FilterCycle, Memory, Mode
+from synth.filter.cycle import Algorithm, FilterCycle, Mode
 from synth.filter.from_rules import skeleton
 from synth.filter.language_check import load_filter, parse_filter
 from synth.logic.events import Event
@@ -160,6 +160,9 @@ def test_bad_input_and_limit(cli, tmp_path):
     code, out, err = cli("filter", "verify", DATA / "three_cycle.filter", "--plant", DATA / "three.rules",
                          "--any-control", "--max-states", "2")
     assert code == 2 and "STOPPED at the state limit" in out
+    code, out, _ = cli("filter", "verify", DATA / "three_cycle.filter", "--plant", DATA / "three.rules",
+                       "--any-control", "--max-states", "4")  # exactly the reachable states: complete
+    assert code == 0 and out.splitlines()[1].startswith("explored 4 states (4 plant states), 16 cycles in ")
     assert err.splitlines()[-1].startswith("stopped: the exploration reached --max-states 2")
 
 

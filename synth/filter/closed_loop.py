@@ -53,7 +53,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from synth.errors import InputError, LimitExceeded
-from synth.filter.cycle import ACK, Algorithm, FilterCycle, Mode
+from synth.filter.cycle import ACK, Algorithm, FilterCycle, Memory, Mode
 from synth.filter.language import Filter
 from synth.logic.events import Event
 
@@ -284,7 +284,6 @@ def verify(f: Filter, rules_path: str, grafcet: str | None = None, *, any_contro
         previous = [False] * len(cyc.remembered)
         for i, v in zip(pr.used_index, mem_used):
             previous[i] = v
-        from synth.filter.cycle import Memory
 
         lanes = cyc.lanes(Memory(tuple(previous), blocked), fixed, free)
         n = lanes.count
@@ -483,6 +482,9 @@ def verify(f: Filter, rules_path: str, grafcet: str | None = None, *, any_contro
         uk, first = uk[fresh], first[fresh]
         new_keys = []
         for k, fi in zip(uk.tolist(), first.tolist()):
+            if len(seen_keys) >= max_states:
+                complete = False
+                break
             seen_keys.add(k)
             seen_array(k // size)[k % size] = True
             e_i = int(src_entry[fi])
@@ -490,9 +492,6 @@ def verify(f: Filter, rules_path: str, grafcet: str | None = None, *, any_contro
             new_keys.append(k)
             if pr.outside_sup[k % size]:
                 outside_sup_codes.add(k % size)
-            if len(seen_keys) >= max_states:
-                complete = False
-                break
         if not complete:
             break
         frontier = np.array(new_keys, dtype=np.int64)
