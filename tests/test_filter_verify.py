@@ -80,6 +80,24 @@ def test_dropped_constraint_is_found(cli, tri_filter, tmp_path):
     ]
 
 
+def test_require_sup(cli, tmp_path):
+    """--require-sup: a node from which uncontrollable events alone reach a violation fails.
+    On two.rules, {s} is reached before any write, and from {} the plant can make ↑s."""
+    out = tmp_path / "two.filter"
+    out.write_text(skeleton(DATA / "two.rules", out).text)
+    v = verify(load_filter(out), str(DATA / "two.rules"), any_control=True, require_sup=True)
+    assert (v.safe, v.outside_sup) == (False, 1)
+    found = v.findings["outside_sup"]
+    assert (found.constraints, found.count) == (("K",), 1)
+    assert trace_text(found.trace).splitlines() == [
+        "0  initial  {}   outside SUP: uncontrollable events can lead to K"]
+    code, text, _ = cli("filter", "verify", out, "--plant", DATA / "two.rules", "--any-control", "--require-sup",
+                        "--json")
+    data = json.loads(text)
+    assert_valid("filter_verify", data)
+    assert code == 1 and data["findings"]["outside_sup"]["count"] == 1
+
+
 def test_edge_constraint_and_trace_text():
     v = verify(load_filter(DATA / "two_no_edge.filter"), str(DATA / "two.rules"), any_control=True)
     assert not v.safe and set(v.findings) == {"edge", "transient"}

@@ -24,7 +24,8 @@ Verdicts, over everything reachable:
   in a violating state the filter could not prevent (the PLC is synchronous, the plant
   asynchronous): such *transient* states — and the intermediate states of an ordered
   write — are counted and shown but fail the verdict only with ``strict=True``. Nodes
-  outside SUP (a violation reachable by uncontrollable events alone) are counted;
+  outside SUP (a violation reachable by uncontrollable events alone) are counted, and
+  fail the verdict only with ``require_sup=True``;
 - (b) *coherent*: the loop never falls back and the algebraic filter never meets a Y
   outside its care set;
 - (c) with a Grafcet: the cycles where O ≠ R and the largest Hamming distance.
@@ -46,6 +47,7 @@ Example
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from dataclasses import dataclass, field
 from typing import Any, Sequence
@@ -70,6 +72,7 @@ FINDINGS = {
     "fallback": "the loop falls back",
     "outside_care": "Y is outside the care set of the algebraic filter",
     "transient": "a plant state violates a constraint before the PLC writes its outputs",
+    "outside_sup": "uncontrollable events alone can lead from a state to a violation (it is not in SUP)",
 }
 
 
@@ -121,7 +124,7 @@ class Verification:
 
     @property
     def safe(self) -> bool:
-        bad = {"violation", "edge", "refused"} | ({"transient"} if self.strict else set())
+        bad = {"violation", "edge", "refused", "outside_sup"} | ({"transient"} if self.strict else set())
         return not any(k in self.findings for k in bad)
 
     @property
@@ -227,7 +230,7 @@ class _Outcome:
 
 def verify(f: Filter, rules_path: str, grafcet: str | None = None, *, any_control: bool = False,
            algorithm: Algorithm = Algorithm.ALGEBRAIC, mode: Mode = Mode.SUPERVISOR, atomic: bool = False,
-           strict: bool = False, max_states: int = 1_000_000) -> Verification:
+           strict: bool = False, require_sup: bool = False, max_states: int = 1_000_000) -> Verification:
     """Explore the closed loop (see the module docstring)."""
     if (grafcet is None) == (not any_control):
         raise InputError("verify needs a request source: --grafcet G.g7 or --any-control (one of them)", None)
@@ -235,10 +238,13 @@ def verify(f: Filter, rules_path: str, grafcet: str | None = None, *, any_contro
     pr = _Product(f, rules_path, grafcet, Algorithm(algorithm), Mode(mode), atomic)
     ex = _Explorer(pr, max_states)
     ex.run()
+    findings = ex.findings()
+    if not require_sup:
+        findings.pop("outside_sup", None)
     return Verification(
         f.file, rules_path, grafcet if grafcet is not None else "any control", pr.cycle.algorithm, pr.cycle.mode,
         atomic, strict, len(ex.seen_keys), len({k % pr.size for k in ex.seen_keys}), ex.cycles, ex.complete,
-        time.perf_counter() - started, len(ex.outside_sup), ex.findings(), ex.corrected, ex.max_distance)
+        time.perf_counter() - started, len(ex.outside_sup), findings, ex.corrected, ex.max_distance)
 
 
 _NOTES = {"violation": "", "edge": "output event forbidden", "refused": "output change refused",
@@ -274,6 +280,7 @@ class _Explorer:
         self.first: dict[str, tuple[int, str, int, int, tuple[str, ...]]] = {}  # kind -> (node, event, outcome, code, ids)
         self.counts: dict[str, set[int]] = {k: set() for k in FINDINGS}
         self.outside_sup: set[int] = set()
+        self.first_outside_sup: int | None = None
         self.cycles = self.corrected = self.max_distance = 0
         self.complete = True
         p = pr.plant
@@ -306,6 +313,7 @@ class _Explorer:
         self.seen_array(key // self.size)[code] = True
         if self.pr.outside_sup[code]:
             self.outside_sup.add(code)
+            self.first_outside_sup = key if self.first_outside_sup is None else self.first_outside_sup
 
     def record(self, kind: str, mask: np.ndarray, where: np.ndarray, node: np.ndarray, event: np.ndarray,
                oid: np.ndarray | None, shown: np.ndarray, ids: Any = ()) -> None:
@@ -553,6 +561,13 @@ class _Explorer:
                 oc = self.outcomes[g]
                 rows.append(_row(self.pr, oc, ev, code, self.aux_list[oc.aux][2], _NOTES[kind]))
             out[kind] = Finding(kind, ids, tuple(rows), len(self.counts[kind]))
+        if self.first_outside_sup is not None:
+            key = self.first_outside_sup
+            rows = self.trace(key)
+            ids = tuple(self.pr.cc.threatened(self.pr.plant.local(key % self.size)))
+            rows[-1] = dataclasses.replace(rows[-1], note="; ".join(
+                n for n in (rows[-1].note, "outside SUP: uncontrollable events can lead to " + ", ".join(ids)) if n))
+            out["outside_sup"] = Finding("outside_sup", ids, tuple(rows), len(self.outside_sup))
         return {k: out[k] for k in FINDINGS if k in out}
 
 
@@ -651,7 +666,7 @@ def verification_text(v: Verification) -> str:
              f"({v.algorithm.value}, {v.mode.value}, {'atomic outputs' if v.atomic else 'ordered outputs'})",
              f"explored {v.states} states ({v.plant_states} plant states), {v.cycles} cycles"
              f" in {v.seconds:.2f} s" + ("" if v.complete else " -- STOPPED at the state limit")]
-    for kind in ("violation", "edge", "refused"):
+    for kind in ("violation", "edge", "refused", "outside_sup"):
         if kind in v.findings:
             fd = v.findings[kind]
             lines.append(f"unsafe: {FINDINGS[kind]} ({fd.count} plant states)"
@@ -664,8 +679,9 @@ def verification_text(v: Verification) -> str:
         lines.append(f"{'unsafe' if v.strict else 'transient'}: {fd.count} plant states violate a constraint "
                      "between the plant's event and the end of the write"
                      + (f" ({', '.join(fd.constraints)})" if fd.constraints else ""))
-    lines.append(f"outside SUP: {v.outside_sup} explored plant states can reach a violation by "
-                 "uncontrollable events alone")
+    if "outside_sup" not in v.findings:
+        lines.append(f"outside SUP: {v.outside_sup} explored plant states can reach a violation by "
+                     "uncontrollable events alone")
     for kind in ("fallback", "outside_care"):
         if kind in v.findings:
             lines.append(f"incoherent: {FINDINGS[kind]} ({v.findings[kind].count} plant states)")
