@@ -262,3 +262,20 @@ def test_blocking_mode_latch_in_the_state(tri_filter):
     plain = verify(f, str(DATA / "two.rules"), any_control=True)
     blocking = verify(f, str(DATA / "two.rules"), any_control=True, mode=Mode.BLOCKING)
     assert blocking.safe and blocking.states > plain.states
+
+
+def test_held_orders(tmp_path):
+    """`hold TAPIS = 1` (tri_annex.rules): the request of a held order is its held value; a
+    filter that switches it off meets a plant with no event ↓TAPIS (refused)."""
+    annex = ROOT / "plants" / "tri_annex.rules"
+    out = tmp_path / "annex.filter"
+    out.write_text(skeleton(annex, out).text)
+    v = verify(load_filter(out), str(annex), any_control=True)
+    assert (v.safe, v.coherent, v.states, v.cycles) == (True, True, 2199, 174035)
+    held = tmp_path / "held.filter"
+    held.write_text(f'use "{annex.as_posix()}"\nsafety H "stop the conveyor on a small box": TAPIS & cp11\n')
+    v = verify(load_filter(held), str(annex), any_control=True)
+    assert not v.safe and v.findings["refused"].count == 5184
+    assert _rows(v.findings["refused"]) == [
+        ("initial", "{v10,v20,v30,v40,TAPIS}", (), (), ""),
+        ("↑cp11", "{v10,v20,v30,v40,cp11,TAPIS}", ("TAPIS",), (), "requests violate H; output change refused")]

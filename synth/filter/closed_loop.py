@@ -13,7 +13,8 @@ Grafcet situation). One **PLC cycle** from a node:
    first, then rises, each in the plant's output order** (an order is released before
    another is taken); with ``atomic=True`` all at once (one step, no intermediate state).
 
-Plant orders the filter does not declare are passed through (O = R for them).
+Plant orders the filter does not declare are passed through (O = R for them); an order
+the rules ``hold`` is requested at its held value.
 
 Verdicts, over everything reachable:
 
@@ -173,6 +174,7 @@ class _Product:
         self.val = {v: np.broadcast_to(p.values(v), shape).ravel().copy() for v in p.variables}
         self.orders = p.outputs
         self.passthrough = tuple(o for o in p.outputs if o not in f.outputs)
+        self.held = {v.name: v.initial for v in rs.variables if v.held}  # requested at their held value
         self.ynames = tuple(dict.fromkeys([*f.inputs, *(self.grafcet.inputs if self.grafcet else ())]))
         if len(self.ynames) > 40:
             raise LimitExceeded(f"{len(self.ynames)} inputs are read; verify codes an input vector in 40 bits")
@@ -345,10 +347,13 @@ class _Explorer:
             for st in pr.grafcet.steps:
                 fixed[f"X{st.name}"] = st.name in sit.steps
             orders = pr.machine.orders(sit, {n: values[n] for n in pr.grafcet.inputs})
-            fixed.update({r: o in orders for o, r in zip(cyc.outputs, cyc.requests)})
-            passed = {o: o in orders for o in pr.passthrough}
+            fixed.update({r: pr.held.get(o, o in orders) for o, r in zip(cyc.outputs, cyc.requests)})
+            passed = {o: pr.held.get(o, o in orders) for o in pr.passthrough}
         else:
-            free = [*cyc.requests, *pr.passthrough]
+            fixed.update({r: pr.held[o] for o, r in zip(cyc.outputs, cyc.requests) if o in pr.held})
+            passed = {o: pr.held[o] for o in pr.passthrough if o in pr.held}
+            free = [r for o, r in zip(cyc.outputs, cyc.requests) if o not in pr.held]
+            free += [o for o in pr.passthrough if o not in pr.held]
         if cyc.mode is Mode.BLOCKING:
             free.append(ACK)
         previous = [False] * len(cyc.remembered)
@@ -358,7 +363,7 @@ class _Explorer:
         n = lanes.count
         out = {o: _unpack(m, n) for o, m in zip(cyc.outputs, lanes.outputs)}
         for o in pr.passthrough:
-            out[o] = np.full(n, passed[o]) if sit is not None else _unpack(_lane_bits(free.index(o), n), n)
+            out[o] = np.full(n, passed[o]) if o in passed else _unpack(_lane_bits(free.index(o), n), n)
         columns = [out[o] for o in pr.orders] + [_unpack(lanes.previous[i], n) for i in pr.used_index]
         columns += [_unpack(m, n) for m in (lanes.blocked, lanes.fallback, lanes.outside_care)]
         _, firsts = np.unique(np.stack(columns, axis=1), axis=0, return_index=True)
