@@ -49,16 +49,16 @@ def test_receptivities_edges_and_simultaneous_firing():
       transition 0 -> 1, 2 when ↑go . (a + !b)
       transition 1, 2 -> 0 when ↓go }""")
     lines = _lines(text)
-    assert "RE_go := go AND NOT Prev_go;" in lines
-    assert "FE_go := NOT go AND Prev_go;" in lines
-    assert "Fire[1] := X0 AND RE_go AND (a OR NOT b); (* 0->1,2: 0 -> 1, 2 when ↑go & (a | !b) *)" in lines
-    assert "Fire[2] := X1 AND X2 AND FE_go; (* 1,2->0: 1, 2 -> 0 when ↓go *)" in lines
+    assert "_RE_go := go AND NOT _Prev_go;" in lines
+    assert "_FE_go := NOT go AND _Prev_go;" in lines
+    assert "_Fire[1] := X0 AND _RE_go AND (a OR NOT b); (* 0->1,2: 0 -> 1, 2 when ↑go & (a | !b) *)" in lines
+    assert "_Fire[2] := X1 AND X2 AND _FE_go; (* 1,2->0: 1, 2 -> 0 when ↓go *)" in lines
     # rule 5: a step deactivated and activated at once stays active
-    assert "Leave[1] := Fire[1] AND NOT Fire[2];" in lines
-    assert "Enter[1] := Fire[2] AND NOT X0;" in lines
-    assert "X0 := (X0 AND NOT Leave[1]) OR Enter[1];" in lines
+    assert "_Leave[1] := _Fire[1] AND NOT _Fire[2];" in lines
+    assert "_Enter[1] := _Fire[2] AND NOT X0;" in lines
+    assert "X0 := (X0 AND NOT _Leave[1]) OR _Enter[1];" in lines
     # edges hold in the first round of the search for stability only
-    assert lines.index("RE_go := FALSE;") > lines.index("WHILE Fired DO")
+    assert lines.index("_RE_go := FALSE;") > lines.index("WHILE _Fired DO")
 
 
 def test_continuous_conditional_and_stored_actions():
@@ -68,27 +68,27 @@ def test_continuous_conditional_and_stored_actions():
     lines = _lines(text)
     assert "A := NOT Unstable AND (X1 AND NOT h);" in lines
     assert "L := NOT Unstable AND X1;" in lines
-    assert "M := NOT Unstable AND Mem_M;" in lines
-    assert "Mem_M := Mem_M OR (X3 AND RE_p);" in lines  # the event action, before the evolution
+    assert "M := NOT Unstable AND _Mem_M;" in lines
+    assert "_Mem_M := _Mem_M OR (X3 AND _RE_p);" in lines  # the event action, before the evolution
     # one round: deactivation phase, then activation phase
-    assert lines.index("Mem_M := Mem_M AND NOT (Leave[3]);") < lines.index("Mem_M := Mem_M OR Enter[3];")
+    assert lines.index("_Mem_M := _Mem_M AND NOT (_Leave[3]);") < lines.index("_Mem_M := _Mem_M OR _Enter[3];")
 
 
 def test_timers_are_ton_instances_restarted_when_their_step_is_left():
     text = _st("grafcet G { initial step 0 step 1: H transition 0 -> 1 when ↑s transition 1 -> 0 when 3s/X1 }")
     lines = _lines(text)
-    assert "Tmr1 : TON; (* 3s/X1 *)" in lines
-    assert lines.count("Tmr1(IN := X1, PT := T#3s);") == 2  # start of the cycle and end of the cycle
-    assert "TE1 := Tmr1.Q;" in lines
-    assert "Fire[2] := X1 AND TE1; (* 1->0: 1 -> 0 when 3s/X1 *)" in lines
-    assert "Tmr1(IN := FALSE, PT := T#3s);" in lines
+    assert "_Tmr1 : TON; (* 3s/X1 *)" in lines
+    assert lines.count("_Tmr1(IN := X1, PT := T#3s);") == 2  # start of the cycle and end of the cycle
+    assert "_TE1 := _Tmr1.Q;" in lines
+    assert "_Fire[2] := X1 AND _TE1; (* 1->0: 1 -> 0 when 3s/X1 *)" in lines
+    assert "_Tmr1(IN := FALSE, PT := T#3s);" in lines
 
 
 def test_bounded_search_for_stability_with_an_error_flag():
     lines = _lines(_st("grafcet G { initial step 0 step 1 transition 0 -> 1 when a transition 1 -> 0 when a }",
                        max_rounds=7))
-    assert "MAX_ROUNDS : INT := 7;" in lines
-    assert lines[lines.index("IF Rounds > MAX_ROUNDS THEN") + 1] == "Unstable := TRUE;"
+    assert "_MAX_ROUNDS : INT := 7;" in lines
+    assert lines[lines.index("IF _Rounds > _MAX_ROUNDS THEN") + 1] == "Unstable := TRUE;"
 
 
 def test_names_differing_in_case_only_are_renamed_and_listed():
