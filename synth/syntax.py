@@ -206,19 +206,20 @@ def parse_tree(grammar: str, source: str, file: str, transformer: Transformer) -
     return result
 
 
-def parse_expression(source: str, file: str) -> Expr:
-    """One Boolean expression in the rules syntax (a command-line condition such as
-    ``--home "X0 & v10"``), its names located in ``file`` (the option's name).
+def parse_expression(source: str, file: str, grammar: str = "rules", transformer: Transformer | None = None) -> Expr:
+    """One Boolean expression in the syntax of ``grammars/<grammar>.lark`` (default: the
+    rules syntax, as for a command-line condition such as ``--home "X0 & v10"``), its names
+    located in ``file`` (the option's name).
 
     >>> parse_expression("X0 & !v10", "--home").text()
     'X0 & !v10'
     """
-    p = parser("rules", "expr")
+    p = parser(grammar, "expr")
     try:
         tree = p.parse(source)
     except UnexpectedInput as err:
         raise syntax_error(err, file, source, p) from None
-    return ExprTransformer(file, source).transform(tree)
+    return (transformer or ExprTransformer(file, source)).transform(tree)
 
 
 class Checker:

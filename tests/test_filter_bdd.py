@@ -125,3 +125,13 @@ def test_pure_python_backend_gives_the_same_filter(monkeypatch):
     python_solve, python_check = synthesis(f), coherence(f)
     assert python_solve.equations == cudd_solve.equations and python_solve.chained == cudd_solve.chained
     assert python_check.as_dict() == cudd_check.as_dict()
+
+
+def test_dd_loads_without_networkx_and_leaves_it_importable() -> None:
+    import subprocess
+    import sys
+
+    code = ("import sys; import synth.filter.bdd as b; loaded = 'networkx' in sys.modules; "
+            "import networkx; print(b.BACKEND, loaded, networkx.__name__)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
+    assert out[1:] == ["False", "networkx"] and out[0] in ("dd.cudd", "dd.autoref")

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from synth.filter.language import Filter
 
-__all__ = ["register"]
+__all__ = ["register", "register_run", "register_verify", "register_from_rules"]
 
 
 def register(sub: "argparse._SubParsersAction") -> None:
@@ -31,6 +31,22 @@ def register(sub: "argparse._SubParsersAction") -> None:
     s.add_argument("--json", action="store_true", help="print JSON instead of text")
     s.add_argument("--order", metavar="O1,O2,...", help="the order of the Sim criteria (default: the file's)")
     s.set_defaults(handler=cmd_solve)
+    register_st(commands)
+
+
+def register_st(commands: "argparse._SubParsersAction") -> None:
+    t = commands.add_parser("st", help="the filter as an IEC 61131-3 FUNCTION_BLOCK (Structured Text)")
+    t.add_argument("filter", metavar="F.filter", help="the .filter file")
+    _algorithm_mode(t)
+    t.add_argument("-o", "--output", metavar="FB.st", help="write the block to this file (default: standard output)")
+    t.add_argument("--xml", action="store_true", help="write PLCopen TC6 XML instead of Structured Text")
+    t.add_argument("--name", metavar="NAME", help="the block is FB_NAME_Filter (default: the file's stem)")
+    t.add_argument("--order", metavar="O1,O2,...", help="the order of the Sim criteria (algebraic)")
+    t.set_defaults(handler=cmd_st)
+
+    register_run(commands)
+    register_verify(commands)
+    register_from_rules(commands)
 
 
 def _warnings(f: "Filter") -> None:
@@ -79,3 +95,126 @@ def cmd_solve(args: argparse.Namespace) -> int:
         for w in s.warnings:
             print(f"warning: {w}", file=sys.stderr)
     return 0 if s.functional and s.consistent else 1
+
+
+def cmd_st(args: argparse.Namespace) -> int:
+    from synth.codegen.filter_st import filter_block
+    from synth.filter.language_check import load_filter
+    from synth.output.files import write_atomic
+
+    f = load_filter(args.filter)
+    _warnings(f)
+    order = [o.strip() for o in args.order.split(",") if o.strip()] if args.order else None
+    block = filter_block(f, args.algorithm, args.mode, args.name, order)
+    for n in block.notes:
+        print(f"note: {n}", file=sys.stderr)
+    text: str | bytes = block.text
+    if args.xml:
+        from synth.codegen.plcopen import st_project_xml
+
+        text = st_project_xml(block.text, name=block.name, comment=f"safety logic filter from {args.filter}")
+    if args.output:
+        write_atomic(args.output, text)
+    elif isinstance(text, bytes):
+        sys.stdout.buffer.write(text)
+    else:
+        sys.stdout.write(text)
+    return 0
+
+
+# --------------------------------------------------------------------------- run / verify / from-rules
+
+
+def _algorithm_mode(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--algorithm", choices=("algebraic", "loop"), default="algebraic",
+                   help="the solve equations (default) or the correction loop of FILTER.md §1.4")
+    p.add_argument("--mode", choices=("supervisor", "blocking"), default="supervisor",
+                   help="supervisor (default): g1 = R; blocking: g1 = 0 after a violation until Ack")
+
+
+def register_run(commands: "argparse._SubParsersAction") -> None:
+    r = commands.add_parser("run", help="evaluate the filter cycle by cycle on a CSV trace")
+    r.add_argument("filter", metavar="F.filter", help="the .filter file")
+    r.add_argument("--trace", metavar="CYCLES.csv", required=True,
+                   help="header: the inputs, observers and requests R_o (and Ack); one line of 0/1 per cycle")
+    _algorithm_mode(r)
+    r.add_argument("--json", action="store_true", help="print JSON instead of text")
+    r.set_defaults(handler=cmd_run)
+
+
+def cmd_run(args: argparse.Namespace) -> int:
+    from synth.cli.plant import print_json
+    from synth.filter.cycle import Algorithm, FilterCycle, Mode
+    from synth.filter.language_check import load_filter
+    from synth.filter.run import load_trace, run, run_json, run_text
+
+    f = load_filter(args.filter)
+    _warnings(f)
+    cycle = FilterCycle(f, Algorithm(args.algorithm), Mode(args.mode))
+    rows = load_trace(args.trace, cycle.reads)
+    results = run(cycle, rows)
+    if args.json:
+        data = run_json(cycle, rows, results)
+        print_json({"file": args.filter, "trace": args.trace, **data})
+    else:
+        sys.stdout.write(run_text(cycle, rows, results))
+    return 0 if not any(r.fallback or r.outside_care for r in results) else 1
+
+
+def register_from_rules(commands: "argparse._SubParsersAction") -> None:
+    g = commands.add_parser("from-rules", help="write a .filter skeleton from a rules file's constraints")
+    g.add_argument("rules", metavar="P.rules", help="the plant's rules file")
+    g.add_argument("-o", "--output", metavar="F.filter", required=True, help="the filter file to write")
+    g.set_defaults(handler=cmd_from_rules)
+
+
+def cmd_from_rules(args: argparse.Namespace) -> int:
+    from synth.filter.from_rules import write_skeleton
+
+    sk = write_skeleton(args.rules, args.output)
+    for c in sk.constraints:
+        what = {"simple": "CSs", "combined": "CSc (no priority)", "skipped": "skipped: no order"}[c.kind]
+        print(f"{c.id}: {what}" + (f" on {', '.join(c.outputs)}" if c.outputs else ""))
+    print(f"wrote {args.output}")
+    return 0
+
+
+def register_verify(commands: "argparse._SubParsersAction") -> None:
+    v = commands.add_parser("verify", help="explore the filter in closed loop with the plant (FILTER.md §3.4)")
+    v.add_argument("filter", metavar="F.filter", help="the .filter file")
+    v.add_argument("--plant", metavar="P.rules", required=True, help="the plant's rules file")
+    source = v.add_mutually_exclusive_group(required=True)
+    source.add_argument("--grafcet", metavar="G.g7", help="the requests are this Grafcet's orders")
+    source.add_argument("--any-control", action="store_true", help="the requests are any vector, every cycle")
+    _algorithm_mode(v)
+    v.add_argument("--atomic-outputs", action="store_true",
+                   help="write the changed outputs in one plant step (default: falls, then rises, in output order)")
+    v.add_argument("--strict", action="store_true",
+                   help="a violation before the PLC writes its outputs also makes the loop unsafe")
+    v.add_argument("--max-states", type=int, default=1_000_000, metavar="N",
+                   help="stop the exploration after N states (default 1000000)")
+    v.add_argument("--json", action="store_true", help="print JSON instead of text")
+    v.set_defaults(handler=cmd_verify)
+
+
+def cmd_verify(args: argparse.Namespace) -> int:
+    from synth.cli.plant import print_json
+    from synth.filter.closed_loop import verification_json, verification_text, verify
+    from synth.filter.cycle import Algorithm, Mode
+    from synth.filter.language_check import load_filter
+
+    f = load_filter(args.filter)
+    _warnings(f)
+    v = verify(f, args.plant, args.grafcet, any_control=args.any_control, algorithm=Algorithm(args.algorithm),
+               mode=Mode(args.mode), atomic=args.atomic_outputs, strict=args.strict, max_states=args.max_states)
+    if args.json:
+        print_json(verification_json(v))
+    else:
+        sys.stdout.write(verification_text(v))
+    if not (v.safe and v.coherent):
+        return 1
+    if not v.complete:
+        print(f"stopped: the exploration reached --max-states {args.max_states} before covering every "
+              "reachable state; nothing wrong was found in the explored part", file=sys.stderr)
+        return 2
+    return 0

@@ -12,6 +12,7 @@ import sys
 from typing import Callable, Sequence
 
 from synth.errors import InputError, InputErrors, LimitExceeded, ModelError, SynthError
+from synth.version import version
 
 __all__ = ["main", "entry", "build_parser", "version"]
 
@@ -44,19 +45,6 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
-def version() -> str:
-    """The installed distribution's version (the source tree's pyproject when not installed)."""
-    from importlib import metadata
-
-    try:
-        return metadata.version("synth")
-    except metadata.PackageNotFoundError:  # pragma: no cover - a bare source tree
-        import re
-        from pathlib import Path
-
-        text = (Path(__file__).resolve().parents[2] / "pyproject.toml").read_text(encoding="utf-8")
-        found = re.search(r'^version = "([^"]+)"', text, re.M)
-        return found.group(1) if found else "unknown"
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -33,7 +33,7 @@ from synth.filter.language import (
 from synth.logic.expr import Expr, Var
 from synth.syntax import ExprTransformer, parse_tree
 
-__all__ = ["filter_items", "Use", "Vector"]
+__all__ = ["filter_items", "filter_expression", "Use", "Vector"]
 
 
 @dataclass(frozen=True)
@@ -132,3 +132,15 @@ def _first_loc(e: Expr) -> Location | None:
 def filter_items(source: str, file: str) -> list:
     """The top-level items of a filter text, in file order (observer lists flattened)."""
     return parse_tree("filter", source, file, _ToFilter(file, source))
+
+
+def filter_expression(source: str, file: str) -> Expr:
+    """One expression in filter syntax (``x^-1``, edges of any variable), e.g. an equation
+    ``synth filter solve`` printed.
+
+    >>> filter_expression("R_A0 & !A1^-1 | ↑C6", "eq").text()
+    'R_A0 & !A1^-1 | ↑C6'
+    """
+    from synth.syntax import parse_expression
+
+    return parse_expression(source, file, "filter", _ToFilter(file, source))

@@ -1,0 +1,149 @@
+"""Writing IEC 61131-3 Structured Text: expressions, identifiers, declarations, the header.
+
+One place for what every generated POU shares (the Grafcet program and the safety filter
+block), so that the same Boolean expression always becomes the same ST text.
+
+Example
+-------
+>>> from synth.logic.expr import And, Edge, Not, Or, Var
+>>> st_expression(Or((And((Var("a"), Not(Var("b^-1")))), Edge(True, "c"))), past_name)
+'a AND NOT b_1 OR c AND NOT c_1'
+>>> st_identifier_problem("IN"), st_identifier_problem("a__b"), st_identifier_problem("V1")
+('IN is a reserved word of IEC 61131-3', 'a__b has two underscores in a row', None)
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from typing import Callable, Iterable, Sequence
+
+from synth.logic.expr import And, Const, Edge, Expr, Not, Or, Var
+
+__all__ = [
+    "PAST_SUFFIX",
+    "past_name",
+    "st_expression",
+    "st_identifier_problem",
+    "Declaration",
+    "var_block",
+    "header",
+    "indent",
+]
+
+PAST_SUFFIX = "_1"
+_PRE = "^-1"
+
+# IEC 61131-3 keywords and the standard function blocks/functions a variable may not shadow.
+_RESERVED = frozenset("""
+ABS ACOS ACTION ADD AND ANY ARRAY ASIN AT ATAN BOOL BY BYTE CASE CONCAT CONFIGURATION CONSTANT
+COS CTD CTU CTUD DATE DATE_AND_TIME DELETE DINT DIV DO DT DWORD ELSE ELSIF EN ENO END_ACTION
+END_CASE END_CONFIGURATION END_FOR END_FUNCTION END_FUNCTION_BLOCK END_IF END_PROGRAM END_REPEAT
+END_RESOURCE END_STEP END_STRUCT END_TRANSITION END_TYPE END_VAR END_WHILE EQ EXIT EXP EXPT
+F_EDGE F_TRIG FALSE FIND FOR FROM FUNCTION FUNCTION_BLOCK GE GT IF IN INITIAL_STEP INSERT INT
+INTERVAL LD LE LEFT LEN LIMIT LINT LN LOG LREAL LT LWORD MAX MID MIN MOD MOVE MUL MUX NE NOT OF
+ON OR PROGRAM PT Q R R_EDGE R_TRIG READ_ONLY READ_WRITE REAL REPEAT REPLACE RESOURCE RETAIN RETURN
+RIGHT ROL ROR RS S SEL SHL SHR SIN SINT SQRT SR STEP STRING STRUCT SUB TAN TASK THEN TIME
+TIME_OF_DAY TO TOD TOF TON TP TRANSITION TRUE TRUNC TYPE UDINT UINT ULINT UNTIL USINT VAR
+VAR_ACCESS VAR_CONFIG VAR_EXTERNAL VAR_GLOBAL VAR_IN_OUT VAR_INPUT VAR_OUTPUT VAR_TEMP WHILE WITH
+WORD WSTRING XOR
+""".split())
+_IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
+
+
+def past_name(name: str) -> str:
+    """The ST variable of a name as synth writes it: ``x^-1`` (the previous cycle's value) is ``x_1``."""
+    return name[: -len(_PRE)] + PAST_SUFFIX if name.endswith(_PRE) else name
+
+
+def st_identifier_problem(name: str) -> str | None:
+    """Why ``name`` cannot be an IEC 61131-3 identifier, or ``None`` when it can."""
+    if not _IDENTIFIER.match(name):
+        return f"{name} is not an IEC 61131-3 identifier (letters, digits and _ only)"
+    if name.upper() in _RESERVED:
+        return f"{name} is a reserved word of IEC 61131-3"
+    if "__" in name:
+        return f"{name} has two underscores in a row"
+    if name.endswith("_"):
+        return f"{name} ends with an underscore"
+    return None
+
+
+def _edge_default(e: Edge, name: Callable[[str], str]) -> str:
+    now, before = name(e.name), name(e.name + _PRE)
+    return f"{now} AND NOT {before}" if e.rising else f"NOT {now} AND {before}"
+
+
+def st_expression(
+    e: Expr,
+    name: Callable[[str], str] = past_name,
+    edge: Callable[[Edge], str] | None = None,
+) -> str:
+    """``e`` in ST, with the fewest parentheses (``NOT`` binds tighter than ``AND``, which
+    binds tighter than ``OR``). ``name`` maps synth names to ST variables; an edge is
+    ``x AND NOT x_1`` (``↑x``) unless ``edge`` says otherwise."""
+
+    def level(x: Expr) -> int:  # 3 atom, 2 NOT, 1 AND, 0 OR
+        if isinstance(x, Or):
+            return 0
+        if isinstance(x, (And, Edge)):
+            return 1
+        if isinstance(x, Not):
+            return 2
+        return 3
+
+    def go(x: Expr, context: int) -> str:
+        if isinstance(x, Var):
+            text = name(x.name)
+        elif isinstance(x, Const):
+            text = "TRUE" if x.value else "FALSE"
+        elif isinstance(x, Edge):
+            text = edge(x) if edge is not None else _edge_default(x, name)
+        elif isinstance(x, Not):
+            text = "NOT " + go(x.arg, 2)
+        elif isinstance(x, And):
+            text = " AND ".join(go(a, 1) for a in x.args)
+        else:
+            text = " OR ".join(go(a, 0) for a in x.args)
+        return f"({text})" if level(x) < context else text
+
+    return go(e, 0)
+
+
+@dataclass(frozen=True)
+class Declaration:
+    """One variable line: ``name : TYPE [:= init]; (* comment *)``."""
+
+    name: str
+    type: str = "BOOL"
+    init: str | None = None
+    comment: str = ""
+
+    def text(self) -> str:
+        init = f" := {self.init}" if self.init is not None else ""
+        comment = f" (* {self.comment} *)" if self.comment else ""
+        return f"{self.name} : {self.type}{init};{comment}"
+
+
+def var_block(keyword: str, declarations: Sequence[Declaration]) -> list[str]:
+    """``VAR_INPUT … END_VAR`` (empty list when there is nothing to declare)."""
+    if not declarations:
+        return []
+    return [keyword, *indent([d.text() for d in declarations]), "END_VAR"]
+
+
+def indent(lines: Iterable[str], level: int = 1) -> list[str]:
+    """Lines indented by four spaces per level (empty lines stay empty)."""
+    pad = "    " * level
+    return [pad + line if line else line for line in lines]
+
+
+def header(what: str, files: Sequence[str], details: Sequence[str] = ()) -> list[str]:
+    """The comment that opens every generated file: which synth and which files made it.
+    Nothing in it depends on the time of day, so the same input gives the same bytes."""
+    from synth.version import version
+
+    lines = [f"(* {what}, generated by synth {version()} from {', '.join(files)}."]
+    lines += [f"   {d}" for d in details]
+    lines[-1] += " *)"
+    return lines

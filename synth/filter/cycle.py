@@ -1,0 +1,303 @@
+"""One PLC cycle of a filter, evaluated in Python: the reference semantics that
+``synth filter run`` and ``synth filter verify`` use and that the Structured Text
+generator reproduces.
+
+Semantics (docs/filter.md, "One PLC cycle"):
+
+- *memory*: the previous cycle's value ``x^-1`` of every input, observer and output
+  of the filter (and of a request, when the file reads ``R_o^-1``), all FALSE
+  initially, stored at the end of the cycle (the inputs read, the outputs produced);
+  ``↑x`` is ``x & !x^-1`` and ``↓x`` is ``!x & x^-1``;
+- :attr:`Mode.SUPERVISOR`: the effective requests are ``g1 = R``.
+  :attr:`Mode.BLOCKING` adds the input ``Ack`` and a latch ``Blocked``: at the start of
+  the cycle ``IF Ack THEN Blocked := FALSE``; if the raw requests violate a constraint
+  (``O := R`` with the current Y and memory) then ``Blocked := TRUE``; ``g1 = R & !Blocked``;
+- :attr:`Algorithm.ALGEBRAIC`: ``O`` is given by the equations ``synth filter solve``
+  prints (on the care set they are the synthesis; ``outside_care`` says when the
+  cycle's Y is not in it, i.e. breaks an assumption or admits no safe vector);
+- :attr:`Algorithm.LOOP`: the specified loop of FILTER.md §1.4 (fc0/fc1 accumulate, at
+  most Ncsc+1 iterations, ``Fallback`` when a combined constraint is still violated);
+  ``literal=True`` runs the published code instead (fc reset at each iteration, final
+  test ``Cpt > Ncsc``), to show its two defects.
+
+Every function (constraints, fs0/fs1, equations, care set) is taken from the filter's
+BDDs as a cover of cubes. A cycle is evaluated on *lanes*: each value is a Python int
+whose bit ``j`` is the value in lane ``j``, so :meth:`FilterCycle.lanes` evaluates the
+cycle for every valuation of some names at once (``verify --any-control`` uses it for
+the 2^|O| request vectors); :meth:`FilterCycle.step` is one lane.
+
+Example (FILTER.md §1.4, example A)
+-------
+>>> from synth.filter.language_check import parse_filter
+>>> f = parse_filter("outputs o1, o2\\nsafety K: o1 & o2 keep o1", "a.filter")
+>>> c = FilterCycle(f, Algorithm.LOOP)
+>>> r, memory = c.step(c.initial(), {"R_o1": True, "R_o2": True})
+>>> r.outputs, r.iterations, r.fallback, r.corrections
+((True, False), ((True, True), (True, False)), False, ('o2',))
+>>> FilterCycle(f, Algorithm.LOOP, literal=True).step(c.initial(), {"R_o1": True, "R_o2": True})[0].outputs
+(False, False)
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import StrEnum
+from typing import Iterable, Mapping, Sequence
+
+from synth.errors import InputError
+from synth.filter.bdd import Cube
+from synth.filter.language import Filter, base_name, is_pre, pre_name, request_name
+from synth.filter.model import FilterFunctions, functions
+
+__all__ = ["Algorithm", "Mode", "ACK", "Memory", "CycleResult", "Lanes", "FilterCycle", "Cover"]
+
+ACK = "Ack"
+
+Cover = tuple[tuple[tuple[str, bool], ...], ...]  # an OR of cubes, each an AND of (name, value)
+
+
+class Algorithm(StrEnum):
+    """How the outputs are computed: the closed-form equations, or the correction loop."""
+
+    ALGEBRAIC = "algebraic"
+    LOOP = "loop"
+
+
+class Mode(StrEnum):
+    """How the requests reach the filter (000:136-158)."""
+
+    SUPERVISOR = "supervisor"  # g1 = R: only the violating orders are corrected
+    BLOCKING = "blocking"  # after a violation, g1 = 0 until Ack
+
+
+@dataclass(frozen=True)
+class Memory:
+    """What a filter keeps from one cycle to the next: ``previous[i]`` is the value of
+    ``FilterCycle.remembered[i]`` at the last cycle; ``blocked`` is the latch of
+    :attr:`Mode.BLOCKING`."""
+
+    previous: tuple[bool, ...]
+    blocked: bool = False
+
+
+@dataclass(frozen=True)
+class CycleResult:
+    """One cycle: the requests and the produced outputs (in ``outputs`` order), the loop's
+    SI at each iteration, the fallback, the constraints the raw requests violate, the
+    outputs corrected (O ≠ R), whether Y was outside the synthesis care set, the
+    constraints the produced outputs still violate, and the Blocked latch after the cycle."""
+
+    requests: tuple[bool, ...]
+    outputs: tuple[bool, ...]
+    iterations: tuple[tuple[bool, ...], ...]
+    fallback: bool
+    violated: tuple[str, ...]
+    corrections: tuple[str, ...]
+    outside_care: bool
+    unsafe: tuple[str, ...]
+    blocked: bool
+
+
+@dataclass(frozen=True)
+class Lanes:
+    """A cycle evaluated on ``count`` lanes at once: every field is a bit mask over the
+    lanes (bit j = lane j), per output or per constraint where it says so."""
+
+    count: int
+    requests: tuple[int, ...]
+    outputs: tuple[int, ...]
+    iterations: tuple[tuple[int, ...], ...]  # SI per iteration (lanes that stopped keep their SI)
+    rounds: tuple[int, ...]  # rounds[n]: lanes still iterating at iteration n+1
+    fallback: int
+    violated: dict[str, int]  # constraint id -> lanes where the raw requests violate it
+    unsafe: dict[str, int]  # constraint id -> lanes where the outputs violate it
+    outside_care: int
+    blocked: int  # the latch after the cycle
+    previous: tuple[int, ...]  # the memory after the cycle, per remembered name
+
+    def lane(self, j: int) -> tuple[CycleResult, Memory]:
+        """Lane ``j`` as one cycle's result and the memory it leaves."""
+
+        def bit(m: int) -> bool:
+            return bool((m >> j) & 1)
+
+        n = sum(1 for r in self.rounds if bit(r))
+        outs = tuple(bit(o) for o in self.outputs)
+        reqs = tuple(bit(r) for r in self.requests)
+        result = CycleResult(
+            reqs, outs, tuple(tuple(bit(s) for s in si) for si in self.iterations[:n]), bit(self.fallback),
+            tuple(i for i, m in self.violated.items() if bit(m)), (), bit(self.outside_care),
+            tuple(i for i, m in self.unsafe.items() if bit(m)), bit(self.blocked))
+        return result, Memory(tuple(bit(p) for p in self.previous), bit(self.blocked))
+
+
+def _cover(cubes: Iterable[Cube]) -> Cover:
+    return tuple(tuple(c.items()) for c in cubes)
+
+
+class FilterCycle:
+    """The cycle evaluator of one filter (see the module docstring)."""
+
+    def __init__(self, f: Filter | FilterFunctions, algorithm: Algorithm = Algorithm.ALGEBRAIC,
+                 mode: Mode = Mode.SUPERVISOR, *, literal: bool = False) -> None:
+        m = f if isinstance(f, FilterFunctions) else functions(f)
+        self.functions, self.filter = m, m.filter
+        self.algorithm, self.mode, self.literal = Algorithm(algorithm), Mode(mode), literal
+        e, flt = m.engine, m.filter
+        self.outputs: tuple[str, ...] = flt.outputs
+        self.requests: tuple[str, ...] = flt.requests
+        self.constraint: dict[str, Cover] = {i: _cover(e.cover(u)) for i, u in m.constraint.items()}
+        self.combined: tuple[str, ...] = tuple(s.id for s in flt.combined)
+        self.fs0 = {o: _cover(e.cover(m.fs0[o])) for o in self.outputs}
+        self.fs1 = {o: _cover(e.cover(m.fs1[o])) for o in self.outputs}
+        # MC0/MC1 as lists: output -> the combined constraints whose relief forces it to 0 / 1
+        self.mc0 = {o: tuple(s.id for s in flt.combined if any(c.output == o and not c.value for c in s.forced))
+                    for o in self.outputs}
+        self.mc1 = {o: tuple(s.id for s in flt.combined if any(c.output == o and c.value for c in s.forced))
+                    for o in self.outputs}
+        self.equations: dict[str, Cover] = {}
+        self.care: Cover = ((),)
+        if self.algorithm is Algorithm.ALGEBRAIC:
+            from synth.filter.solve import synthesis
+
+            s = synthesis(m)
+            if s.free:
+                o = next(iter(s.free))
+                raise InputError(f"the algebraic filter of {flt.file} is not functional: {o} is free "
+                                 f"(solve reports the witness); add criteria or use --algorithm loop", None)
+            for o in self.outputs:
+                one = s.output(o)
+                self.equations[o] = _cover(e.cover(one, one | ~s.care))
+            self.care = _cover(e.cover(s.care))
+        else:
+            for s in flt.combined:
+                if not s.has_priority:
+                    raise InputError(f"{s.id} is a combined constraint without priority: the loop needs "
+                                     "`keep L` or `force o=v, ...` to relieve it", s.loc)
+        covers = [*self.constraint.values(), *self.fs0.values(), *self.fs1.values(), *self.equations.values(),
+                  self.care]
+        used = sorted({n for cover in covers for cube in cover for n, _ in cube if is_pre(n)})
+        base = [*flt.inputs, *flt.observer_names, *self.outputs]
+        base += [b for b in (base_name(n) for n in used) if b not in base]
+        self.remembered: tuple[str, ...] = tuple(base)
+        self.used: tuple[str, ...] = tuple(b for b in self.remembered if pre_name(b) in used)
+        self.reads: tuple[str, ...] = (*flt.inputs, *flt.observer_names, *self.requests) + (
+            (ACK,) if self.mode is Mode.BLOCKING else ())
+
+    # ------------------------------------------------------------------ public API
+    def initial(self) -> Memory:
+        """Every remembered value FALSE, not blocked."""
+        return Memory((False,) * len(self.remembered), False)
+
+    def step(self, memory: Memory, values: Mapping[str, bool]) -> tuple[CycleResult, Memory]:
+        """One cycle: ``values`` gives every name of :attr:`reads` (inputs, observers,
+        requests ``R_o``, and ``Ack`` in blocking mode); returns its result and the new memory."""
+        lanes = self.lanes(memory, values, ())
+        result, after = lanes.lane(0)
+        corrections = tuple(o for o, r, v in zip(self.outputs, result.requests, result.outputs) if r != v)
+        return _with_corrections(result, corrections), after
+
+    def lanes(self, memory: Memory, fixed: Mapping[str, bool], free: Sequence[str]) -> Lanes:
+        """The cycle for every valuation of the names ``free`` (lane j: bit i of j is the
+        value of ``free[i]``), the other names of :attr:`reads` given by ``fixed``."""
+        if self.literal and free:
+            raise ValueError("the literal published loop is evaluated one lane at a time")
+        count = 1 << len(free)
+        full = (1 << count) - 1
+        values: dict[str, int] = {}
+        for i, n in enumerate(free):
+            values[n] = sum(1 << j for j in range(count) if (j >> i) & 1)
+        for n in self.reads:
+            if n not in values:
+                if n not in fixed:
+                    raise KeyError(f"no value for '{n}'")
+                values[n] = full if fixed[n] else 0
+        for n, v in zip(self.remembered, memory.previous):
+            values[pre_name(n)] = full if v else 0
+
+        def ev(cover: Cover, vals: Mapping[str, int]) -> int:
+            out = 0
+            for cube in cover:
+                m = full
+                for n, v in cube:
+                    m &= vals[n] if v else full ^ vals[n]
+                    if not m:
+                        break
+                out |= m
+                if out == full:
+                    break
+            return out
+
+        requests = tuple(values[r] for r in self.requests)
+        with_requests = dict(values)
+        with_requests.update(zip(self.outputs, requests))
+        violated = {i: ev(c, with_requests) for i, c in self.constraint.items()}
+        blocked = 0
+        g1 = requests
+        if self.mode is Mode.BLOCKING:
+            blocked = (0 if not memory.blocked else full) & (full ^ values[ACK])
+            any_violation = 0
+            for v in violated.values():
+                any_violation |= v
+            blocked |= any_violation
+            g1 = tuple(r & (full ^ blocked) for r in requests)
+        iterations: list[tuple[int, ...]] = []
+        rounds: list[int] = []
+        fallback = 0
+        outside = 0
+        if self.algorithm is Algorithm.ALGEBRAIC:
+            with_g1 = dict(values)
+            with_g1.update(zip(self.requests, g1))
+            outputs = tuple(ev(self.equations[o], with_g1) for o in self.outputs)
+            outside = full ^ ev(self.care, with_g1)
+        else:
+            outputs, fallback = self._loop(values, g1, full, ev, iterations, rounds)
+        with_outputs = dict(values)
+        with_outputs.update(zip(self.outputs, outputs))
+        unsafe = {i: ev(c, with_outputs) for i, c in self.constraint.items()}
+        previous = tuple(with_outputs[n] for n in self.remembered)
+        return Lanes(count, requests, outputs, tuple(iterations), tuple(rounds), fallback,
+                     {i: m for i, m in violated.items()}, {i: m for i, m in unsafe.items()},
+                     outside, blocked, previous)
+
+    # ------------------------------------------------------------------ the loop
+    def _loop(self, values: dict[str, int], g1: tuple[int, ...], full: int, ev, iterations: list, rounds: list
+              ) -> tuple[tuple[int, ...], int]:
+        outs = self.outputs
+        fs0 = [ev(self.fs0[o], values) for o in outs]
+        fs1 = [ev(self.fs1[o], values) for o in outs]
+        fc0 = [0] * len(outs)
+        fc1 = [0] * len(outs)
+        ncsc = len(self.combined)
+        flag, cpt = full, 0  # flag: lanes still violated; the WHILE runs where flag is set
+        si: list[int] = [0] * len(outs)
+        while flag and cpt <= ncsc:
+            rounds.append(flag)
+            new = [((full ^ fs0[k]) & (((full ^ fc0[k]) & g1[k]) | fc1[k])) | fs1[k] for k in range(len(outs))]
+            si = [(n & flag) | (s & (full ^ flag)) for n, s in zip(new, si)]  # stopped lanes keep their SI
+            iterations.append(tuple(si))
+            at = dict(values)
+            at.update(zip(outs, si))
+            v = {i: ev(self.constraint[i], at) & flag for i in self.combined}
+            flag_now = 0
+            for m in v.values():
+                flag_now |= m
+            cpt += 1
+            if self.literal:
+                fc0 = [0] * len(outs)
+                fc1 = [0] * len(outs)
+            for k, o in enumerate(outs):
+                for i in self.mc0[o]:
+                    fc0[k] |= v[i]
+                for i in self.mc1[o]:
+                    fc1[k] |= v[i]
+            flag = flag_now
+        fallback = (full if cpt > ncsc else 0) if self.literal else flag
+        if fallback:
+            si = [(((full ^ fs0[k]) & fs1[k]) & fallback) | (si[k] & (full ^ fallback)) for k in range(len(outs))]
+        return tuple(si), fallback
+
+
+def _with_corrections(r: CycleResult, corrections: tuple[str, ...]) -> CycleResult:
+    return CycleResult(r.requests, r.outputs, r.iterations, r.fallback, r.violated, corrections,
+                       r.outside_care, r.unsafe, r.blocked)

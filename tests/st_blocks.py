@@ -1,0 +1,21 @@
+"""Generated filter blocks, parsed by blark and compiled by the ST interpreter once per
+test session: blark's Earley parser takes about a second per block."""
+
+from __future__ import annotations
+
+from functools import lru_cache
+from pathlib import Path
+
+from synth.codegen.filter_st import FilterBlock, filter_block
+from synth.codegen.interpreter import Module, load_st
+from synth.filter.language_check import load_filter
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+@lru_cache(maxsize=None)
+def interpreted(name: str, algorithm: str, mode: str) -> tuple[FilterBlock, Module]:
+    """The block of ``plants/<name>.filter`` and its interpreted module."""
+    f = load_filter(ROOT / "plants" / f"{name}.filter")
+    block = filter_block(f, algorithm, mode)
+    return block, load_st(block.text, f"{name}_{algorithm}_{mode}.st")
