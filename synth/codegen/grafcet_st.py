@@ -59,6 +59,7 @@ __all__ = [
     "DEFAULT_MAX_ROUNDS",
     "IEC_KEYWORDS",
     "FilterCall",
+    "filter_call",
     "StProgram",
     "generate_program",
     "grafcet_program",
@@ -88,15 +89,16 @@ class FilterCall:
     """A safety filter run after the Grafcet: the text of its function block, its type and
     instance names, and which of its inputs are requests (``R_<order>``).
 
-    The program passes the Grafcet's order ``o`` as ``R_o`` and every plant input of the same
-    name as itself, then copies the block's outputs to its own ``VAR_OUTPUT``.
+    The program passes the Grafcet's order ``o`` as ``R_o`` (``FALSE`` for an output the Grafcet
+    never orders) and every other name as the program's input of that name (declared when the
+    Grafcet does not read it), then copies the block's outputs to its own ``VAR_OUTPUT``.
     """
 
     fb_text: str
     fb_type: str
     inputs: tuple[str, ...]
     outputs: tuple[str, ...]
-    instance: str = "Filter"
+    instance: str = "_Filter"
 
 
 @dataclass(frozen=True)
@@ -191,6 +193,13 @@ class _Writer:
         self.prev = list(g.inputs) if self.event_actions else [i for i in g.inputs if i in used_edges]
         self.stored = [o for o in g.outputs
                        if any(a.kind == STORED and a.order == o for s in self.steps for a in s.actions)]
+        # with a filter: the names it reads that the Grafcet does not, and the outputs it adds
+        self.extra_inputs: list[str] = []
+        self.outputs: list[str] = list(g.outputs)
+        if filt is not None:
+            self.extra_inputs = [n for n in filt.inputs if n not in g.inputs
+                                 and not (n.startswith("R_") and n[2:] in g.outputs + filt.outputs)]
+            self.outputs += [o for o in filt.outputs if o not in g.outputs]
         self.lines: list[str] = []
         self.alias: dict[str, str] = {}  # user name -> ST name, for case clashes only
 
@@ -216,7 +225,7 @@ class _Writer:
         """Plant and step names must be IEC identifiers, not keywords, distinct from ours."""
         g = self.g
         user: dict[str, Location | None] = {}
-        for n in g.inputs + g.outputs:
+        for n in (*g.inputs, *self.extra_inputs, *self.outputs):
             user.setdefault(n, _first_loc(g, n))
         for s in self.steps:
             user.setdefault(s.variable, s.loc)
@@ -226,7 +235,7 @@ class _Writer:
         internal |= {f"_FE_{i}" for i in self.falling} | {f"_Mem_{o}" for o in self.stored}
         internal |= {f"_Tmr{k}" for k in self.timer_index.values()} | {f"_TE{k}" for k in self.timer_index.values()}
         if self.filt is not None:
-            internal |= {self.filt.instance, self.filt.fb_type} | {f"_Order_{o}" for o in g.outputs}
+            internal |= {self.filt.fb_type} | {f"_Order_{o}" for o in g.outputs}
         for n, loc in user.items():
             why = None
             if not _IDENT.match(n):
@@ -270,10 +279,12 @@ class _Writer:
         self.emit("VAR_INPUT")
         for i in g.inputs:
             self.emit(f"{self.st(i)} : BOOL;", 1)
+        for i in self.extra_inputs:
+            self.emit(f"{self.st(i)} : BOOL; (* read by the filter only *)", 1)
         self.emit("END_VAR")
         self.emit("VAR_OUTPUT")
-        for o in g.outputs:
-            self.emit(f"{self.st(o)} : BOOL;", 1)
+        for o in self.outputs:
+            self.emit(f"{self.st(o)} : BOOL;" + ("" if o in g.outputs else " (* written by the filter only *)"), 1)
         self.emit("Unstable : BOOL; (* a transient evolution did not stabilise within _MAX_ROUNDS rounds; latched *)", 1)
         self.emit("END_VAR")
         self.emit("VAR")
@@ -443,17 +454,16 @@ class _Writer:
         if self.filt is not None:
             f = self.filt
             e()
-            e("(* 4. the safety filter runs last, on the Grafcet's orders (requests R_<order>) *)")
+            e("(* 4. the safety filter runs last, on the Grafcet's orders (its requests R_<order>) *)")
             args = []
             for n in f.inputs:
-                if n.startswith("R_") and n[2:] in g.outputs:
-                    args.append(f"{n} := _Order_{n[2:]}")
-                elif n in g.inputs:
-                    args.append(f"{n} := {n}")
+                if n.startswith("R_") and n not in g.inputs and n not in self.extra_inputs:
+                    order = n[2:]
+                    args.append(f"{n} := " + (f"_Order_{self.st(order)}" if order in g.outputs else "FALSE"))
                 else:
-                    raise InputError(f"the filter reads '{n}', which is neither an input nor a request R_<order>", None)
+                    args.append(f"{n} := {self.st(n)}")
             e(f"{f.instance}(" + ", ".join(args) + ");")
-            for o in g.outputs:
+            for o in self.outputs:
                 e(f"{self.st(o)} := {f.instance}.{o};" if o in f.outputs else f"{self.st(o)} := _Order_{self.st(o)};")
         e()
         e(f"(* {5 if self.filt else 4}. for the next cycle: previous input values, timers of the steps entered now *)")
@@ -463,6 +473,11 @@ class _Writer:
             k = self.timer_index[t.id]
             e(f"_Tmr{k}(IN := {self.st('X' + t.step)}, PT := {time_literal(t.seconds, t.loc)});")
         e("END_PROGRAM")
+
+
+def filter_call(block: object) -> FilterCall:
+    """The :class:`FilterCall` of a :class:`synth.codegen.filter_st.FilterBlock`."""
+    return FilterCall(block.text, block.name, tuple(block.inputs), tuple(block.outputs))  # type: ignore[attr-defined]
 
 
 def synth_version() -> str:
