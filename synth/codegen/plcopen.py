@@ -84,7 +84,7 @@ __all__ = [
 NS = "http://www.plcopen.org/xml/tc6_0201"
 XHTML = "http://www.w3.org/1999/xhtml"
 CREATION_DATE = "2000-01-01T00:00:00"  # fixed: same input, same bytes
-SYNTH_DATA = "https://github.com/synth/plcopen/grafcet"  # our addData: the partial grafcet of a step
+SYNTH_DATA = "urn:synth:partial-grafcet"  # our addData: the partial grafcet of a step
 
 
 class Qualifier(StrEnum):
@@ -647,7 +647,8 @@ def import_sfc(data: bytes | str, file: str = "<xml>") -> str:
     except etree.XMLSyntaxError as err:
         line, col = err.position if hasattr(err, "position") else (err.lineno, 1)
         raw_line = src.lines[line - 1] if 0 < line <= len(src.lines) else ""
-        raise InputError(f"not well-formed XML: {err.msg}", Location(file, line, max(1, col), raw_line)) from None
+        message = re.sub(r", line \d+, column \d+$", "", str(err.msg))
+        raise InputError(f"not well-formed XML: {message}", Location(file, line, max(1, col), raw_line)) from None
     if etree.QName(root).namespace != NS or etree.QName(root).localname != "project":
         raise InputError(f"not a PLCopen TC6 XML v2.01 project (root element {root.tag})", src.at(root),
                          notes=(f"expected <project xmlns=\"{NS}\">",))
