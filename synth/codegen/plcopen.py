@@ -36,7 +36,7 @@ Example
 >>> xml = sfc_project_xml(g, version="0.1.0")
 >>> validation_errors(xml)
 []
->>> print(import_sfc(xml, "g.xml").split("\\n", 2)[2])
+>>> print(import_sfc(xml, "g.xml").split("\\n", 1)[1])
 inputs a
 outputs A
 <BLANKLINE>
