@@ -46,7 +46,7 @@ def random_grafcet(seed: int) -> str:
     (True, True)
     """
     rng = random.Random(seed)
-    sizes = [rng.randint(2, 3)] + ([2] if rng.random() < 0.3 else [])
+    sizes = [rng.randint(2, 3)] + ([2] if rng.random() < 0.35 else [])
     names = [[f"{10 * (g + 1) + i}" for i in range(n)] for g, n in enumerate(sizes)]
     every = [s for group in names for s in group]
     lines = [f"inputs {', '.join(INPUTS)}", f"outputs {', '.join(ASSIGNED + STORED)}"]
@@ -54,7 +54,7 @@ def random_grafcet(seed: int) -> str:
         lines.append(f"grafcet G{g + 1} {{")
         for i, s in enumerate(steps):
             actions = []
-            for _ in range(rng.choice((0, 1, 1, 2))):
+            for _ in range(rng.choice((0, 1, 1))):
                 kind = rng.random()
                 if kind < 0.4:
                     actions.append(rng.choice(ASSIGNED))

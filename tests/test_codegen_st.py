@@ -53,10 +53,10 @@ def test_receptivities_edges_and_simultaneous_firing():
     assert "_FE_go := NOT go AND _Prev_go;" in lines
     assert "_Fire[1] := X0 AND _RE_go AND (a OR NOT b); (* 0->1,2: 0 -> 1, 2 when ↑go & (a | !b) *)" in lines
     assert "_Fire[2] := X1 AND X2 AND _FE_go; (* 1,2->0: 1, 2 -> 0 when ↓go *)" in lines
-    # rule 5: a step deactivated and activated at once stays active
-    assert "_Leave[1] := _Fire[1] AND NOT _Fire[2];" in lines
-    assert "_Enter[1] := _Fire[2] AND NOT X0;" in lines
-    assert "X0 := (X0 AND NOT _Leave[1]) OR _Enter[1];" in lines
+    # rules 3 and 5: sources deactivated, targets activated; both at once stays active
+    assert "X0 := (X0 AND NOT _Fire[1]) OR _Fire[2];" in lines
+    assert "X1 := (X1 AND NOT _Fire[2]) OR _Fire[1];" in lines
+    assert not any(line.startswith("_Leave") for line in lines)  # no timer, no stored action
     # edges hold in the first round of the search for stability only
     assert lines.index("_RE_go := FALSE;") > lines.index("WHILE _Fired DO")
 

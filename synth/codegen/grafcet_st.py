@@ -200,6 +200,8 @@ class _Writer:
             self.extra_inputs = [n for n in filt.inputs if n not in g.inputs
                                  and not (n.startswith("R_") and n[2:] in g.outputs + filt.outputs)]
             self.outputs += [o for o in filt.outputs if o not in g.outputs]
+        self.needs_flags = bool(g.timers) or any(
+            a.kind == STORED and a.when in (ON_ACTIVATION, ON_DEACTIVATION) for s in self.steps for a in s.actions)
         self.lines: list[str] = []
         self.alias: dict[str, str] = {}  # user name -> ST name, for case clashes only
 
@@ -305,7 +307,7 @@ class _Writer:
             self.emit(f"_FE_{self.st(i)} : BOOL; (* \u2193{self.st(i)} *)", 1)
         if g.transitions:
             self.emit(f"_Fire : ARRAY[1..{len(g.transitions)}] OF BOOL; (* fireable transitions of the round *)", 1)
-        if self.steps:
+        if self.steps and self.needs_flags:
             self.emit(f"_Leave : ARRAY[1..{len(self.steps)}] OF BOOL; (* steps deactivated (and not activated) *)", 1)
             self.emit(f"_Enter : ARRAY[1..{len(self.steps)}] OF BOOL; (* steps activated (and not active) *)", 1)
         self.emit("_Fired : BOOL;", 1)
@@ -398,22 +400,30 @@ class _Writer:
         e("_Fired := FALSE;", 3)
         e("ELSE", 2)
         e("(* rules 3 and 5: sources deactivated, targets activated; both at once stays active *)", 3)
+        # _Leave/_Enter only for the steps whose timers or stored actions need them
+        timed = {t.step for t in g.timers}
+        on_leave = {s.name for s in self.steps if s.name in timed
+                    or any(a.kind == STORED and a.when == ON_DEACTIVATION for a in s.actions)}
+        on_enter = {s.name for s in self.steps
+                    if any(a.kind == STORED and a.when == ON_ACTIVATION for a in s.actions)}
         for s in self.steps:
             k = self.step_index[s.name]
             deact = [f"_Fire[{i}]" for i, t in enumerate(g.transitions, 1) if s.name in t.sources]
             act = [f"_Fire[{i}]" for i, t in enumerate(g.transitions, 1) if s.name in t.targets]
-            if deact:
+            if deact and s.name in on_leave:
                 e(f"_Leave[{k}] := {_paren(_or(deact))}" + (f" AND NOT {_paren(_or(act))}" if act else "") + ";", 3)
-            if act:
+            if act and s.name in on_enter:
                 e(f"_Enter[{k}] := {_paren(_or(act))} AND NOT {self.st(s.variable)};", 3)
         for s in self.steps:
-            k = self.step_index[s.name]
-            has_deact = any(s.name in t.sources for t in g.transitions)
-            has_act = any(s.name in t.targets for t in g.transitions)
-            if has_deact or has_act:
-                left = f"{self.st(s.variable)} AND NOT _Leave[{k}]" if has_deact else self.st(s.variable)
-                new = f"({left}) OR _Enter[{k}]" if has_act else left
-                e(f"{self.st(s.variable)} := {new};", 3)
+            x = self.st(s.variable)
+            deact = [f"_Fire[{i}]" for i, t in enumerate(g.transitions, 1) if s.name in t.sources]
+            act = [f"_Fire[{i}]" for i, t in enumerate(g.transitions, 1) if s.name in t.targets]
+            if deact and act:
+                e(f"{x} := ({x} AND NOT {_paren(_or(deact))}) OR {_or(act)};", 3)
+            elif deact:
+                e(f"{x} := {x} AND NOT {_paren(_or(deact))};", 3)
+            elif act:
+                e(f"{x} := {x} OR {_or(act)};", 3)
         for t in g.timers:
             if any(t.step in tr.sources for tr in g.transitions):
                 k = self.timer_index[t.id]
@@ -542,8 +552,27 @@ def generate_program(
     w.body()
     lines = w.lines
     if not comments:
-        lines = [c for c in (_COMMENT.sub("", line).strip() for line in lines) if c]
+        lines = _compact([c for c in (_COMMENT.sub("", line).strip() for line in lines) if c])
     return StProgram("\n".join(lines) + "\n", w.name, tuple(w.alias.items()))
 
 
 _COMMENT = re.compile(r"\s*\(\*.*?\*\)")
+_SHORT = {"Fired": "Fd", "Fire": "F", "Leave": "L", "Enter": "E", "Rounds": "N", "FirstCycle": "I",
+          "InputEvent": "V", "MAX_ROUNDS": "M", "Prev_": "P_", "RE_": "R_", "FE_": "D_", "Mem_": "S_",
+          "Order_": "O_", "Tmr": "T", "TE": "Q", "Filter": "Fl"}
+_INTERNAL = re.compile(r"(?<![A-Za-z0-9_])_(" + "|".join(_SHORT) + ")")
+_BOOL_DECL = re.compile(r"^(\w+) : BOOL;$")
+_BOOL_LIST = re.compile(r"^\w+(, \w+)* : BOOL;$")
+
+
+def _compact(lines: list[str]) -> list[str]:
+    """Shorter internal names (they all start with ``_``, plant names never do) and one
+    declaration line per run of plain ``BOOL`` variables: the same program in fewer characters."""
+    out: list[str] = []
+    for line in (_INTERNAL.sub(lambda m: "_" + _SHORT[m[1]], x) for x in lines):
+        m = _BOOL_DECL.match(line)
+        if m and out and _BOOL_LIST.match(out[-1]):
+            out[-1] = out[-1][: -len(" : BOOL;")] + ", " + m[1] + " : BOOL;"
+        else:
+            out.append(line)
+    return out
