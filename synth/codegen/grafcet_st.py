@@ -391,7 +391,7 @@ class _Writer:
             rec = st_expr(t.receptivity, self.ref, 2)
             enabled = [self.st("X" + s) for s in t.sources]
             terms = enabled + ([rec] if rec != "TRUE" or not enabled else [])
-            e(f"_Fire[{k}] := {' AND '.join(terms)}; (* {t.text()} *)", 1)
+            e(f"_Fire[{k}] := {' AND '.join(terms)}; (* {' '.join(t.text().split())} *)", 1)
         e("_Fired := " + _or([f"_Fire[{k}]" for k in range(1, len(g.transitions) + 1)]) + ";", 1)
         e("IF _Fired THEN", 1)
         e("_Rounds := _Rounds + 1;", 2)
