@@ -19,8 +19,10 @@ and the validation use), one PLC cycle per call:
    that a step entered in this cycle starts timing now.
 
 Every name is the plant's (inputs ``VAR_INPUT``, outputs ``VAR_OUTPUT``), step variables are
-``X<step>``; internal names (``Fire``, ``Leave``, ``Enter``, ``Prev_x``, ``RE_x``, ``FE_x``,
-``Tmr<k>``, ``TE<k>``, ``Mem_<o>``, ...) are checked not to clash with them.
+``X<step>``; the names the generator adds (``_Fire``, ``_Leave``, ``_Enter``, ``_Prev_x``,
+``_RE_x``, ``_FE_x``, ``_Tmr<k>``, ``_TE<k>``, ``_Mem_<o>``, ...) start with ``_``, which plant
+and step names never do. One ``PROGRAM`` for all partial grafcets: rule 4 fires transitions of
+every partial grafcet in the same round (see docs/codegen.md).
 
 Example
 -------
