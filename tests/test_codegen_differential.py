@@ -29,8 +29,12 @@ RANDOM_SEEDS = range(200)
 @pytest.mark.slow  # about 60 s: blark parses each program (about 1 ms per character)
 @pytest.mark.parametrize("path", BUNDLED, ids=lambda p: str(p.relative_to(ROOT)))
 def test_bundled_grafcets_exhaustively(path: Path):
+    """Also the test that blark parses the program of every bundled Grafcet: the interpreter
+    parses with blark and raises an InputError on any text blark rejects."""
     g = load_grafcet(path)
-    report = differential_check(g, depth=DEPTH.get(path.name, 4))
+    program = grafcet_st.generate_program(g, version="test")
+    assert program.text.count("PROGRAM ") == 1 and program.text.rstrip().endswith("END_PROGRAM")
+    report = differential_check(g, depth=DEPTH.get(path.name, 4), program=program)
     assert report.ok, report.text()
     assert report.sequences >= 1
 

@@ -1,4 +1,8 @@
-"""``synth.codegen.grafcet_st``: the Grafcet as one IEC 61131-3 ST program (parsed by blark)."""
+"""``synth.codegen.grafcet_st``: the Grafcet as one IEC 61131-3 ST program.
+
+That blark parses the program of every bundled Grafcet is tested by
+``tests/test_codegen_differential.py``, which runs each of them (the interpreter parses with blark).
+"""
 
 from __future__ import annotations
 
@@ -11,8 +15,6 @@ from synth.errors import InputError
 from synth.grafcet.language import load_grafcet, parse_grafcet
 
 ROOT = Path(__file__).resolve().parent.parent
-BUNDLED = sorted(ROOT.glob("grafcets/*.g7")) + sorted(ROOT.glob("tests/data/**/*.g7"))
-BUNDLED = [p for p in BUNDLED if "codegen" not in p.parts]
 
 
 def _st(text: str, **kw) -> str:
@@ -21,17 +23,6 @@ def _st(text: str, **kw) -> str:
 
 def _lines(text: str) -> list[str]:
     return [line.strip() for line in text.splitlines()]
-
-
-@pytest.mark.slow  # blark's Earley parser: about 45 s for the 17 programs
-@pytest.mark.parametrize("path", BUNDLED, ids=lambda p: str(p.relative_to(ROOT)))
-def test_every_bundled_grafcet_gives_st_that_blark_parses(path: Path):
-    from blark import parse_source_code
-
-    text = grafcet_program(load_grafcet(path), version="test")
-    result = parse_source_code(text)
-    assert result.exception is None
-    assert text.count("PROGRAM ") == 1 and text.rstrip().endswith("END_PROGRAM")
 
 
 def test_same_input_same_bytes_and_a_header_without_time():

@@ -462,7 +462,8 @@ class _Writer:
                         terms.append(f"{self.st(s.variable)} AND {st_expr(a.condition, self.ref, 2)}")
             if o in self.stored:
                 terms.append(f"_Mem_{self.st(o)}")
-            e(f"{orders}{self.st(o)} := NOT Unstable AND {_paren(_or(list(dict.fromkeys(terms))))};")
+            value = f"NOT Unstable AND {_paren(_or(list(dict.fromkeys(terms))))}" if terms else "FALSE"
+            e(f"{orders}{self.st(o)} := {value};")
         if self.filt is not None:
             f = self.filt
             e()
