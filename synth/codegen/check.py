@@ -1,0 +1,253 @@
+"""The proof by execution: the generated ST, run by the interpreter, against ``synth run``.
+
+:func:`differential_check` explores every sequence of events up to ``depth`` from the initial
+situation and plays each one on both sides:
+
+* synth's :class:`~synth.grafcet.machine.GrafcetMachine` (what ``synth run`` steps), one input
+  event (``↑x``/``↓x``) or timer event (``2s/X101``) at a time;
+* the generated program (:func:`~synth.codegen.grafcet_st.generate_program`) parsed by blark and
+  run by :mod:`synth.codegen.interpreter`, one PLC cycle per event; a timer event is the clock
+  advanced until the timer reaches its preset, then one cycle with unchanged inputs.
+
+After every cycle the active steps (``X<step>``) and the outputs must be equal; a transient
+cycle that never stabilises (an :class:`~synth.errors.InputError` of the machine) must set the
+program's ``Unstable`` flag. Time is real on the ST side, so a timer event is played only when
+it is the next to elapse (timers of different steps elapsing at the same instant are one PLC
+event but two machine events: such states are not extended by a timer event).
+
+Example
+-------
+>>> from synth.grafcet.language import parse_grafcet
+>>> g = parse_grafcet("grafcet G { initial step 0 step 1: A transition 0 -> 1 when ↑a "
+...                   "transition 1 -> 0 when 2s/X1 }", "g.g7")
+>>> report = differential_check(g, {"a": False}, depth=3)
+>>> report.ok, report.sequences, report.cycles
+(True, 3, 7)
+>>> report.text().splitlines()[0]
+'g.g7: the ST program equals synth run on 3 event sequences (7 PLC cycles, depth 3): 0 mismatches'
+"""
+
+from __future__ import annotations
+
+import copy
+from dataclasses import dataclass, field
+from enum import StrEnum
+from typing import Mapping, Sequence
+
+from synth.codegen.grafcet_st import StProgram, generate_program
+from synth.errors import InputError
+from synth.grafcet.language import Grafcet
+from synth.grafcet.machine import GrafcetMachine, Situation
+from synth.logic.events import Event
+
+__all__ = ["Aspect", "Mismatch", "DifferentialReport", "differential_check"]
+
+
+class Aspect(StrEnum):
+    """What differs between the program and ``synth run``."""
+
+    STEPS = "active steps"
+    OUTPUTS = "outputs"
+    STABILITY = "stability"
+
+
+@dataclass(frozen=True)
+class Mismatch:
+    """One difference after the last event of ``events`` (``initial`` alone: the first cycle)."""
+
+    events: tuple[str, ...]
+    aspect: Aspect
+    expected: str
+    got: str
+
+    def text(self) -> str:
+        seq = "after " + ", ".join(self.events) if self.events else "initially"
+        return f"{seq}: {self.aspect} of synth run {self.expected}, of the ST program {self.got}"
+
+
+@dataclass(frozen=True)
+class DifferentialReport:
+    """The outcome of a differential check: counts and the first mismatches."""
+
+    grafcet: str
+    depth: int
+    sequences: int
+    cycles: int
+    mismatches: tuple[Mismatch, ...] = field(default=())
+
+    @property
+    def ok(self) -> bool:
+        return not self.mismatches
+
+    def text(self) -> str:
+        head = (f"{self.grafcet}: the ST program {'equals' if self.ok else 'differs from'} synth run on "
+                f"{self.sequences} event sequences ({self.cycles} PLC cycles, depth {self.depth}): "
+                f"{len(self.mismatches)} mismatch{'es' if len(self.mismatches) != 1 else ''}")
+        return "\n".join([head] + ["  " + m.text() for m in self.mismatches]) + "\n"
+
+
+def _set_text(names: Sequence[str]) -> str:
+    return "{" + ", ".join(names) + "}"
+
+
+@dataclass
+class _Side:
+    """The machine's state along one sequence: situation, inputs, clock, step activation times."""
+
+    sit: Situation
+    inputs: dict[str, bool]
+    now: int
+    since: dict[str, int]  # active step -> clock (ms) of its last activation
+
+
+class _Checker:
+    def __init__(self, g: Grafcet, initial: Mapping[str, bool], depth: int, program: StProgram,
+                 max_mismatches: int) -> None:
+        from synth.codegen.interpreter import load_st
+
+        self.g = g
+        self.depth = depth
+        self.program = program
+        self.machine = GrafcetMachine(g)
+        self.module = load_st(program.text, f"{g.path}.st")
+        self.inst = self.module.instance(program.program)
+        self.initial = {n: bool(initial.get(n, False)) for n in g.inputs}
+        self.max_mismatches = max_mismatches
+        self.mismatches: list[Mismatch] = []
+        self.sequences = 0
+        self.cycles = 0
+        self.ms = {t.id: int(t.seconds * 1000) for t in g.timers}
+        self.step_of = {t.id: t.step for t in g.timers}
+        self.memo_base = {id(self.module): self.module}
+        for pou in self.module.pous.values():
+            self.memo_base[id(pou)] = pou
+
+    # ------------------------------------------------------------------ both sides
+    def compare(self, events: tuple[str, ...], side: _Side | None) -> bool:
+        """Compare after a cycle; False when the branch must stop (a mismatch or instability)."""
+        inst, p = self.inst, self.program
+        self.cycles += 1
+        unstable = bool(inst["Unstable"])
+        if side is None:  # the machine found a transient cycle that never stabilises
+            if not unstable:
+                self.mismatch(events, Aspect.STABILITY, "never stabilises", "stable (Unstable = FALSE)")
+            return False
+        if unstable:
+            self.mismatch(events, Aspect.STABILITY, "stable", "Unstable = TRUE")
+            return False
+        want = tuple(side.sit.step_variables)
+        got = tuple(s.variable for s in self.g.steps if inst[p.st_name(s.variable)])
+        if sorted(want) != sorted(got):
+            self.mismatch(events, Aspect.STEPS, _set_text(want), _set_text(got))
+            return False
+        orders = self.machine.orders(side.sit, side.inputs)
+        want_o = tuple(o for o in self.g.outputs if o in orders)
+        got_o = tuple(o for o in self.g.outputs if inst[p.st_name(o)])
+        if want_o != got_o:
+            self.mismatch(events, Aspect.OUTPUTS, _set_text(want_o), _set_text(got_o))
+            return False
+        return True
+
+    def mismatch(self, events: tuple[str, ...], aspect: Aspect, expected: str, got: str) -> None:
+        if len(self.mismatches) < self.max_mismatches:
+            self.mismatches.append(Mismatch(events, aspect, expected, got))
+
+    def run(self) -> None:
+        try:
+            sit, rounds = self.machine.initial(self.initial), ()
+            side: _Side | None = _Side(sit, dict(self.initial), 0, {})
+            assert side is not None
+            side.since = {s: 0 for s in sit.steps}
+        except InputError:
+            side = None
+        self.inst.cycle({self.program.st_name(n): v for n, v in self.initial.items()})
+        if self.compare((), side) and side is not None:
+            self.explore(side, ())
+        else:
+            self.sequences += 1
+
+    # ------------------------------------------------------------------ exploration
+    def events(self, side: _Side) -> list[tuple[Event, int]]:
+        """Input events (every input), then the next timer to elapse with its delay."""
+        out = [(Event.edge(n, not side.inputs[n]), 0) for n in self.g.inputs]
+        running = [t for t in self.machine.timers(side.sit)]
+        if running:
+            elapsed = set(side.sit.elapsed)
+            due = {t.id: side.since[t.step] + self.ms[t.id] for t in self.g.timers
+                   if t.step in side.since and t.id not in elapsed}
+            first = min(due.values())
+            groups = {self.machine.timer_event(t) for t, d in due.items() if d == first}
+            if len(groups) == 1:
+                (event,) = groups
+                if event in running:
+                    out.append((event, first - side.now))
+        return out
+
+    def step(self, side: _Side, event: Event) -> _Side | None:
+        """The machine after ``event``; None when it never stabilises."""
+        try:
+            if event.is_edge:
+                after = dict(side.inputs)
+                after[event.name] = event.rising
+                sit, rounds = self.machine.react_with_trace(side.sit, side.inputs, after)
+                inputs, now = after, side.now
+            else:
+                inputs = side.inputs
+                now = side.now + self._delay
+                sit, rounds = self.machine.fire_timer_with_trace(side.sit, event, inputs)
+        except InputError:
+            return None
+        restarted = set(sit.steps) - set(side.sit.steps)
+        for fire in rounds:
+            deact = {s for t in fire for s in t.sources}
+            act = {s for t in fire for s in t.targets}
+            restarted |= deact - act
+        since = {s: (now if s in restarted else side.since[s]) for s in sit.steps}
+        return _Side(sit, inputs, now, since)
+
+    def explore(self, side: _Side, events: tuple[str, ...]) -> None:
+        if len(events) == self.depth or len(self.mismatches) >= self.max_mismatches:
+            self.sequences += 1
+            return
+        for event, delay in self.events(side):
+            saved = self.save()
+            self._delay = delay
+            nxt = self.step(side, event)
+            if delay:
+                self.module.advance(delay)
+            if event.is_edge:
+                self.inst.cycle({self.program.st_name(event.name): event.rising})
+            else:
+                self.inst.cycle({})
+            seq = events + (str(event),)
+            if self.compare(seq, nxt) and nxt is not None:
+                self.explore(nxt, seq)
+            else:
+                self.sequences += 1
+            self.restore(saved)
+
+    _delay = 0
+
+    def save(self) -> tuple[object, int]:
+        return copy.deepcopy(self.inst, dict(self.memo_base)), self.module.clock_ms
+
+    def restore(self, saved: tuple[object, int]) -> None:
+        self.inst, self.module.clock_ms = saved  # type: ignore[assignment]
+
+
+def differential_check(
+    g: Grafcet,
+    initial: Mapping[str, bool] | None = None,
+    *,
+    depth: int = 4,
+    program: StProgram | None = None,
+    max_mismatches: int = 10,
+) -> DifferentialReport:
+    """Play every event sequence of length ``depth`` on ``synth run``'s machine and on the
+    generated program (``program``, else :func:`generate_program` of ``g``), comparing active
+    steps, outputs and stability after every cycle. ``initial``: the input values at start
+    (missing ones are 0)."""
+    program = program or generate_program(g, version="check")
+    checker = _Checker(g, initial or {}, depth, program, max_mismatches)
+    checker.run()
+    return DifferentialReport(g.path, depth, checker.sequences, checker.cycles, tuple(checker.mismatches))

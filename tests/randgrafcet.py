@@ -1,0 +1,107 @@
+"""Random Grafcets for the differential test of the generated ST (``tests/test_codegen_differential.py``).
+
+Every construct the code generator maps: OR and AND divergences/convergences, source and sink
+transitions, level and edge receptivities, step variables across partial grafcets, timers,
+continuous, conditional and stored actions (on activation, deactivation and events).
+Inputs are lower case (a, b, c), outputs upper case (P, Q, R assigned; M, N stored).
+"""
+
+from __future__ import annotations
+
+import random
+
+INPUTS = ("a", "b", "c")
+ASSIGNED = ("P", "Q", "R")
+STORED = ("M", "N")
+DURATIONS = ("500ms", "1s", "2s")
+
+
+def _atom(rng: random.Random, steps: list[str], src: list[str], edges: bool) -> str:
+    r = rng.random()
+    if edges and r < 0.25:
+        return rng.choice("↑↓") + rng.choice(INPUTS)
+    if r < 0.55:
+        return rng.choice(("", "!")) + rng.choice(INPUTS)
+    if r < 0.75:
+        return rng.choice(("", "!")) + "X" + rng.choice(steps)
+    if r < 0.93:
+        step = rng.choice(src) if src and rng.random() < 0.8 else rng.choice(steps)
+        return f"{rng.choice(DURATIONS)}/X{step}"
+    return rng.choice("01")
+
+
+def _expr(rng: random.Random, steps: list[str], src: list[str], edges: bool = True) -> str:
+    parts = [_atom(rng, steps, src, edges) for _ in range(rng.randint(1, 3))]
+    if len(parts) == 1:
+        return parts[0]
+    if len(parts) == 3 and rng.random() < 0.5:
+        return f"({parts[0]} + {parts[1]}) . {parts[2]}"
+    return rng.choice((" . ", " + ")).join(parts)
+
+
+def random_grafcet(seed: int) -> str:
+    """The ``.g7`` text of a random Grafcet (deterministic in ``seed``).
+
+    >>> random_grafcet(1) == random_grafcet(1), "grafcet G1" in random_grafcet(1)
+    (True, True)
+    """
+    rng = random.Random(seed)
+    sizes = [rng.randint(2, 3)] + ([2] if rng.random() < 0.35 else [])
+    names = [[f"{10 * (g + 1) + i}" for i in range(n)] for g, n in enumerate(sizes)]
+    every = [s for group in names for s in group]
+    lines = [f"inputs {', '.join(INPUTS)}", f"outputs {', '.join(ASSIGNED + STORED)}"]
+    for g, steps in enumerate(names):
+        lines.append(f"grafcet G{g + 1} {{")
+        for i, s in enumerate(steps):
+            actions = []
+            for _ in range(rng.choice((0, 1, 1))):
+                kind = rng.random()
+                if kind < 0.4:
+                    actions.append(rng.choice(ASSIGNED))
+                elif kind < 0.6:
+                    actions.append(f"{rng.choice(ASSIGNED)} if {_expr(rng, every, [s], edges=False)}")
+                elif kind < 0.8:
+                    verb = rng.choice(("set", "reset"))
+                    when = rng.choice(("", " on activation", " on deactivation"))
+                    actions.append(f"{verb} {rng.choice(STORED)}{when}")
+                else:
+                    verb = rng.choice(("set", "reset"))
+                    actions.append(f"{verb} {rng.choice(STORED)} on {rng.choice('↑↓')}{rng.choice(INPUTS)}")
+            initial = "initial " if i == 0 else ""
+            lines.append(f"  {initial}step {s}" + (": " + ", ".join(dict.fromkeys(actions)) if actions else ""))
+        trans: list[tuple[list[str], list[str]]] = [([s], [steps[(i + 1) % len(steps)]]) for i, s in enumerate(steps)]
+        for _ in range(rng.randint(0, 2) if len(steps) > 2 else rng.randint(0, 1)):
+            r = rng.random()
+            if r < 0.35:  # OR divergence
+                trans.append(([rng.choice(steps)], [rng.choice(steps)]))
+            elif r < 0.6 and len(steps) >= 3:  # AND divergence
+                trans.append(([rng.choice(steps)], rng.sample(steps, 2)))
+            elif r < 0.85 and len(steps) >= 3:  # AND convergence
+                trans.append((rng.sample(steps, 2), [rng.choice(steps)]))
+            elif r < 0.93:  # source transition, on an edge
+                trans.append(([], [rng.choice(steps)]))
+            else:  # sink transition
+                trans.append(([rng.choice(steps)], []))
+        seen = set()
+        for src, dst in trans:
+            if src == dst or (tuple(src), tuple(dst)) in seen:
+                continue
+            seen.add((tuple(src), tuple(dst)))
+            rec = _expr(rng, every, src)
+            if not src:
+                rec = f"{rng.choice('↑↓')}{rng.choice(INPUTS)}"
+            lines.append(f"  transition {', '.join(src)} -> {', '.join(dst)} when {rec}")
+        lines.append("}")
+    return "\n".join(lines) + "\n"
+
+
+def check_seed(seed: int, depth: int = 3) -> tuple[int, int, int, str]:
+    """The differential check of ``random_grafcet(seed)`` (compact ST): (seed, sequences,
+    cycles, mismatch text or ""). A top-level function, so a process pool can run it."""
+    from synth.codegen.check import differential_check
+    from synth.codegen.grafcet_st import generate_program
+    from synth.grafcet.language import parse_grafcet
+
+    g = parse_grafcet(random_grafcet(seed), f"random{seed}.g7")
+    report = differential_check(g, depth=depth, program=generate_program(g, version="test", comments=False))
+    return seed, report.sequences, report.cycles, "" if report.ok else report.text()
