@@ -74,7 +74,9 @@ class PlantEncoding:
             self.engine.disjunction(self.code(i, int(c)) for c in e.codes) for i, e in enumerate(p.elements)
         )
         self.domain: Function = self.engine.conjunction(self.domains)
-        self._current_levels = sorted(self.engine.level(v) for v in self.variables)
+        self._renames: dict[tuple, dict[str, Function]] = {}
+        self._quantified: dict[tuple, list[str]] = {}
+        self._inner = {v: self.engine.declare(v) for v in self.variables}
 
     # ---- names and renaming
     @staticmethod
@@ -83,12 +85,21 @@ class PlantEncoding:
 
     def rename(self, u: Function, source: Copy, target: Copy, names: Sequence[str] | None = None) -> Function:
         """``u`` with the ``source`` copy of ``names`` (default: every variable) renamed to ``target``."""
-        vs = self.variables if names is None else names
-        return self.engine.let({v + source.value: v + target.value for v in vs}, u)
+        key = (source, target, None if names is None else tuple(names))
+        sub = self._renames.get(key)
+        if sub is None:
+            vs = self.variables if names is None else names
+            sub = {self.engine.declare(v + source.value): self.bdd.var(self.engine.declare(v + target.value)) for v in vs}
+            self._renames[key] = sub
+        return self.bdd.let(sub, u)
 
     def exists(self, u: Function, copy: Copy, names: Sequence[str] | None = None) -> Function:
-        vs = self.variables if names is None else names
-        return self.engine.exists([v + copy.value for v in vs], u)
+        key = (copy, None if names is None else tuple(names))
+        vs = self._quantified.get(key)
+        if vs is None:
+            vs = [self.engine.declare(v + copy.value) for v in (self.variables if names is None else names)]
+            self._quantified[key] = vs
+        return self.bdd.exist(vs, u)
 
     # ---- states
     def code(self, axis: int, code: int, copy: Copy = Copy.CURRENT) -> Function:
@@ -104,11 +115,27 @@ class PlantEncoding:
         return self.engine.conjunction(self.local_state(a, k, copy) for a, k in enumerate(local))
 
     def pick(self, u: Function) -> dict[str, bool] | None:
-        """One state of ``u`` (a valuation of every current variable), ``None`` if empty."""
+        """One state of ``u`` (a valuation of every current variable), ``None`` if empty.
+        Variables ``u`` leaves free on the path taken are false (every completion of a
+        path to 1 is in ``u``)."""
         if u == self.engine.false:
             return None
-        inner = self.bdd.pick(u, care_vars=[self.engine.declare(v) for v in self.variables])
-        return {v: bool(inner[self.engine.declare(v)]) for v in self.variables}
+        values = {v: False for v in self.variables}
+        outer = self.engine._outer
+        f = u
+        true, false = self.engine.true, self.engine.false
+        while f != true:
+            lo, hi = f.low, f.high  # children of the regular node: complement them if f is
+            if f.negated:
+                lo, hi = ~lo, ~hi
+            name = outer[f.var]
+            if lo != false:
+                values[name] = False
+                f = lo
+            else:
+                values[name] = True
+                f = hi
+        return values
 
     def local(self, values: Mapping[str, bool]) -> tuple[int, ...]:
         """Local indices of the state whose variables have ``values``."""
@@ -129,7 +156,14 @@ class PlantEncoding:
     # ---- exact counting
     def count(self, u: Function, copies: Sequence[Copy] = (Copy.CURRENT,)) -> int:
         """The exact number of valuations of the given copies of the variables in ``u``
-        (``u`` must depend on those copies only)."""
+        (``u`` must depend on those copies only). CUDD's count (a double) is used when
+        it is exact (below 2^50), an exact recursion over the BDD otherwise."""
+        if u == self.engine.false:
+            return 0
+        nvars = len(self.variables) * len(copies)
+        fast = self.bdd.count(u, nvars=nvars)
+        if fast < 2**50:
+            return int(fast)
         levels = sorted(self.engine.level(v + c.value) for v in self.variables for c in copies)
         return _exact_count(u, levels, self.engine)
 

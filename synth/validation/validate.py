@@ -37,15 +37,23 @@ class Validation:
     sup_empty: bool
     homes: tuple[str, ...] = ()  # the --home conditions, as written
     never_starts: Diagnosis | None = None
+    # set by the symbolic engine, whose ``sync`` holds only the nodes a report shows:
+    counts: dict[str, int] | None = None  # the stats, counted on the whole SYNC
+    reached_steps: frozenset[str] | None = None  # steps active in some reachable situation
+    engine_stats: dict[str, int] | None = None  # BDD nodes, situations
 
     @property
     def unreached_steps(self) -> list[str]:
         """Steps active in no stable situation SYNC reaches: dead code under this plant."""
-        active = {st for n in self.sync.nodes for st in n.situation.steps}
+        active = self.reached_steps
+        if active is None:
+            active = frozenset(st for n in self.sync.nodes for st in n.situation.steps)
         return [s.variable for s in self.grafcet.steps if s.name not in active]
 
     @property
     def stats(self) -> dict[str, int]:
+        if self.counts is not None:
+            return dict(self.counts)
         return {
             "plant_states": self.plant.size,
             "sync_states": self.sync.sync_states,

@@ -1,0 +1,447 @@
+"""SYNC on BDDs: situations explicit, plant states symbolic, regions as relations.
+
+The Grafcet's stable situations stay explicit objects (:class:`~synth.grafcet.machine.Situation`,
+computed by the one :class:`~synth.grafcet.machine.GrafcetMachine`), the plant states of
+each situation are BDDs. This is what explodes in the explicit engine: N cylinders moving
+at once give every interleaving of their moves as SYNC states, while the situations stay
+few (about 2·2^N here against ~3^N·2^N plant states).
+
+For one situation ``σ`` (semantics of :mod:`synth.validation.sync`, outputs first):
+
+- the orders it emits ``W`` may depend on the inputs (conditional actions); the *region*
+  moves are the controllable moves SUP allows that flip an order towards ``W``
+  (``intra``), a relation per element;
+- ``reg[σ](x, x')``: entry state ``x`` of the region, ``x'`` one of its *settled* states
+  (no region move left), a forward closure over pairs (three variable copies);
+- the aggregated nodes of ``σ`` are the settled states; from them the plant's
+  uncontrollable moves and the situation's timers lead to entries of the next situations.
+
+*The reaction of the Grafcet* to a plant move is computed by the explicit machine on one
+state of the image, with an input mapping that records which inputs the machine read:
+the result holds for every state agreeing on those inputs (a cube), which is cut off, and
+so on until the image is covered. Each explicit call thus stands for a whole set of
+states, and the reading of IEC 60848 stays the one of the machine.
+
+The exploration is breadth-first over the aggregated automaton, level by level: the
+levels (*onion rings*) give the distances the explicit analysis sorts by, and the
+shortest traces. Edges are kept as *bundles* (source situation, event, target
+situation, the entry states), counted exactly, and merged per pair of situations into
+pair relations over (node, node') for backward fixpoints.
+
+Example
+-------
+>>> from synth.plant.rules import load_rules
+>>> from synth.plant.composition import plant, _plants
+>>> from synth.grafcet.language import load_grafcet
+>>> from synth.grafcet.machine import GrafcetMachine
+>>> rs = load_rules(_plants("tri.rules"))
+>>> p = plant(rs)
+>>> g = load_grafcet(_plants("../grafcets/tri.g7"), inputs=p.inputs, outputs=p.outputs)
+>>> s = symbolic_sync(p, rs.constraints, GrafcetMachine(g))
+>>> s.aggregated_states == 0
+False
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable, Iterable, Mapping, Sequence
+
+from synth.filter.bdd import Function
+from synth.grafcet.language import Transition
+from synth.grafcet.machine import GrafcetMachine, Situation
+from synth.logic.events import Event
+from synth.plant.composition import Plant
+from synth.plant.rules import Constraint
+from synth.symbolic.encoding import Copy, NodeBudget
+from synth.symbolic.relation import Move, image, preimage
+from synth.symbolic.supervisor import SymbolicSupervisor
+
+__all__ = ["Bundle", "Region", "SymbolicSync", "symbolic_sync"]
+
+NodeSet = dict[int, Function]  # situation index -> plant states (current copy)
+
+
+class _Recorder(dict):
+    """Input values that remember which names were read (the machine is deterministic,
+    so its answer holds for every valuation agreeing on them)."""
+
+    def __init__(self, values: Mapping[str, bool]) -> None:
+        super().__init__(values)
+        self.read: set[str] = set()
+
+    def __getitem__(self, name: str) -> bool:
+        self.read.add(name)
+        return dict.__getitem__(self, name)
+
+
+@dataclass(frozen=True)
+class Bundle:
+    """Edges ``source --event--> target``: from the nodes of situation ``source`` whose
+    move (or timer) leads to an entry in ``entries``, to the settled states of those
+    entries' regions in situation ``target``. ``move`` is None for a timer."""
+
+    source: int
+    event: Event
+    target: int
+    entries: Function
+    move: Move | None
+    key: tuple[int, int]  # exploration order of the event: (0, plant transition) or (1, timer rank)
+
+
+@dataclass
+class Region:
+    """A situation's region relation and its sets (grown as new entries arrive)."""
+
+    entered: Function
+    pairs: Function  # reg(x, x'): entry x settles in x'
+    members: Function
+    nodes: Function
+    by_orders: dict[frozenset[str], Function] = field(default_factory=dict)  # nodes per emitted orders
+
+
+class SymbolicSync:
+    """The explored SYNC (see module docstring)."""
+
+    def __init__(self, sup: SymbolicSupervisor, machine: GrafcetMachine, *, progress: Callable[[str], None] | None = None) -> None:
+        self.sup = sup
+        self.enc = sup.enc
+        self.plant: Plant = sup.plant
+        self.machine = machine
+        self.engine = sup.enc.engine
+        self.false = self.engine.false
+        self.situations: list[Situation] = []
+        self._index: dict[Situation, int] = {}
+        self.regions: list[Region] = []
+        self.bundles: list[Bundle] = []
+        self._bundles: dict[tuple[int, tuple[int, int], int], Bundle] = {}
+        self.rings: list[NodeSet] = []
+        self.edge_count = 0
+        self.conflicts: list[tuple[int, Function, Event, str, tuple[str, ...]]] = []
+        self._conflict_keys: set[tuple[str, tuple[str, ...]]] = set()
+        self._inputs = tuple(n for n in machine.inputs if n in self.plant.owner)
+        self._intra: dict[frozenset[str], tuple[tuple[Function, ...], Function, dict[Event, Function]]] = {}
+        self._eq: Function | None = None
+        self.progress = progress
+        self.initial: NodeSet = {}
+
+    # ------------------------------------------------------------------ helpers
+    def situation(self, sit: Situation) -> int:
+        i = self._index.get(sit)
+        if i is None:
+            i = len(self.situations)
+            self._index[sit] = i
+            self.situations.append(sit)
+            self.regions.append(Region(self.false, self.false, self.false, self.false))
+        return i
+
+    def values(self, u: Function) -> dict[str, bool]:
+        """The Grafcet's inputs in one state of ``u``."""
+        val = self.enc.pick(u)
+        assert val is not None
+        return {n: val[n] for n in self._inputs}
+
+    def _cell(self, rec: _Recorder) -> Function:
+        return self.engine.cube({n: dict.__getitem__(rec, n) for n in sorted(rec.read)})
+
+    def partition(self, states: Function, answer: Callable[[_Recorder], object]) -> list[tuple[object, Function]]:
+        """``states`` cut into cells on which ``answer`` (a call of the machine on recorded
+        inputs) gives one result; results in the order first met."""
+        out: list[tuple[object, Function]] = []
+        rest = states
+        while rest != self.false:
+            rec = _Recorder(self.values(rest))
+            result = answer(rec)
+            part = rest & self._cell(rec)
+            rest = rest & ~part
+            for k, (r, u) in enumerate(out):
+                if r == result:
+                    out[k] = (r, u | part)
+                    break
+            else:
+                out.append((result, part))
+        return out
+
+    @property
+    def equal(self) -> Function:
+        """x = x' on every plant variable."""
+        if self._eq is None:
+            self._eq = self.engine.conjunction(
+                self.engine.var(v).equiv(self.engine.var(v + Copy.NEXT.value)) for v in self.enc.variables)
+        return self._eq
+
+    def intra(self, wanted: frozenset[str]) -> tuple[tuple[Function, ...], Function, dict[Event, Function]]:
+        """For emitted orders ``wanted``: per element the region moves as a relation over
+        (member x', next member x''), the states with a region move left, and per order
+        event the states where SUP refuses that move."""
+        hit = self._intra.get(wanted)
+        if hit is not None:
+            return hit
+        rel = [self.false] * self.plant.ndim
+        progress = self.false
+        refused: dict[Event, Function] = {}
+        for m in self.sup.moves:
+            if not m.controllable or m.event.rising != (m.variable in wanted):
+                continue
+            ok = self.sup.allowed(m)
+            names = self.enc.element_variables[m.axis]
+            progress |= self.enc.exists(ok, Copy.NEXT, names)
+            bad = self.enc.exists(m.relation, Copy.NEXT, names) & ~self.enc.exists(ok, Copy.NEXT, names)
+            if bad != self.false:
+                refused[m.event] = refused.get(m.event, self.false) | bad
+            shifted = self.enc.rename(ok, Copy.NEXT, Copy.AUX, names)
+            rel[m.axis] |= self.enc.rename(shifted, Copy.CURRENT, Copy.NEXT)
+        hit = (tuple(rel), progress, refused)
+        self._intra[wanted] = hit
+        return hit
+
+    def region_pairs(self, entries: Function, wanted: frozenset[str]) -> Function:
+        """reg(x, x') for ``entries`` (x) under emitted orders ``wanted``: forward closure of
+        the region moves over pairs, then restricted to settled x'."""
+        rel, progress, _ = self.intra(wanted)
+        reach = entries & self.equal
+        frontier = reach
+        while frontier != self.false:
+            new = self.false
+            for axis, r in enumerate(rel):
+                if r == self.false:
+                    continue
+                names = self.enc.element_variables[axis]
+                step = self.enc.exists(frontier & r, Copy.NEXT, names)
+                new |= self.enc.rename(step, Copy.AUX, Copy.NEXT, names)
+            frontier = new & ~reach
+            reach |= frontier
+        self._members_acc = self.enc.rename(self.enc.exists(reach, Copy.CURRENT), Copy.NEXT, Copy.CURRENT)
+        return reach & ~self.enc.rename(progress, Copy.CURRENT, Copy.NEXT)
+
+    def enter(self, s: int, entries: Function) -> Function:
+        """Enter situation ``s`` at ``entries``; returns the settled states not seen before."""
+        reg = self.regions[s]
+        new_entries = entries & ~reg.entered
+        if new_entries == self.false:
+            return self.false
+        reg.entered |= new_entries
+        sit = self.situations[s]
+        fresh = self.false
+        for wanted, part in self.partition(new_entries, lambda rec: self.machine.orders(sit, rec)):
+            assert isinstance(wanted, frozenset)
+            pairs = self.region_pairs(part, wanted)
+            reg.pairs |= pairs
+            reg.members |= self._members_acc
+            settled = self.enc.rename(self.enc.exists(pairs, Copy.CURRENT), Copy.NEXT, Copy.CURRENT)
+            reg.by_orders[wanted] = reg.by_orders.get(wanted, self.false) | settled
+            fresh |= settled & ~reg.nodes
+            reg.nodes |= settled
+        self.enc.check(f"entering situation {sit.text()}")
+        return fresh
+
+    # ------------------------------------------------------------------ exploration
+    def _note_conflicts(self, s: int, sources: Function, event: Event, rounds: Sequence[Sequence[Transition]]) -> None:
+        for fired in rounds:
+            by_step: dict[str, list[str]] = {}
+            for tr in fired:
+                for st in tr.sources:
+                    by_step.setdefault(st, []).append(tr.name)
+            for st, names in by_step.items():
+                key = (st, tuple(names))
+                if len(names) > 1 and key not in self._conflict_keys:
+                    self._conflict_keys.add(key)
+                    self.conflicts.append((s, sources, event, st, tuple(names)))
+
+    def _successors(self, s: int, nodes: Function, pending: NodeSet) -> None:
+        sit = self.situations[s]
+        machine = self.machine
+        for m in self.sup.moves:
+            if m.controllable:
+                continue
+            entries = image(self.enc, nodes, m) & self.sup.kept
+            if entries == self.false:
+                continue
+            event = m.event if m.variable in self._inputs else None
+
+            def react(rec: _Recorder, event: Event | None = event) -> tuple[Situation, tuple]:
+                return machine.react_event(sit, event, rec)
+
+            for (target, rounds), part in self.partition(entries, react):
+                t = self.situation(target)
+                if rounds:
+                    self._note_conflicts(s, preimage(self.enc, part, m) & nodes, m.event, rounds)
+                self._bundle(s, m.event, t, part, m, (0, m.key), pending)
+        for rank, timer in enumerate(machine.timers(sit)):
+            def fire(rec: _Recorder, timer: Event = timer) -> tuple[Situation, tuple]:
+                return machine.fire_timer_with_trace(sit, timer, rec)
+
+            for (target, rounds), part in self.partition(nodes, fire):
+                t = self.situation(target)
+                if rounds:
+                    self._note_conflicts(s, part, timer, rounds)
+                self._bundle(s, timer, t, part, None, (1, rank), pending)
+
+    def _bundle(self, s: int, event: Event, t: int, entries: Function, move: Move | None, key: tuple[int, int],
+                pending: NodeSet) -> None:
+        fresh = self.enter(t, entries)
+        if fresh != self.false:
+            pending[t] = pending.get(t, self.false) | fresh
+        old = self._bundles.get((s, key, t))
+        self._bundles[(s, key, t)] = Bundle(s, event, t, entries if old is None else old.entries | entries, move, key)
+
+    def explore(self) -> "SymbolicSync":
+        """The reachable aggregated automaton: a worklist over situations, each expanding
+        the nodes it gained since its last turn (a plain loop until nothing is pending)."""
+        p = self.plant
+        init = self.enc.state(p.initial)
+        if (init & self.sup.kept) == self.false:
+            return self
+        values = {n: v for n, v in p.valuation(p.initial).items() if n in self._inputs}
+        s0 = self.situation(self.machine.initial(values))
+        self.initial = {s0: self.enter(s0, init)}
+        pending: NodeSet = dict(self.initial)
+        turns = 0
+        while pending:
+            s = min(pending)
+            nodes = pending.pop(s)
+            self._successors(s, nodes, pending)
+            turns += 1
+            if self.progress is not None and turns % 50 == 0:
+                self.progress(f"exploring SYNC symbolically: {len(self.situations)} situations, "
+                              f"{len(pending)} pending, {len(self.enc.bdd)} BDD nodes")
+        self.bundles = sorted(self._bundles.values(), key=lambda b: (b.source, b.key, b.target))
+        self.edge_count = sum(self.enc.count(b.entries & self.regions[b.target].pairs, (Copy.CURRENT, Copy.NEXT))
+                              for b in self.bundles)
+        return self
+
+    def onion_rings(self) -> list[NodeSet]:
+        """The nodes by distance from the initial nodes (breadth-first over the bundles),
+        computed once, on demand: only traces need them."""
+        if self.rings or not self.initial:
+            return self.rings
+        by_source: dict[int, list[Bundle]] = {}
+        for b in self.bundles:
+            by_source.setdefault(b.source, []).append(b)
+        seen: NodeSet = dict(self.initial)
+        ring: NodeSet = dict(self.initial)
+        while ring:
+            self.rings.append(ring)
+            new: NodeSet = {}
+            for s in sorted(ring):
+                for b in by_source.get(s, ()):
+                    u = self.post(ring, b)
+                    if u != self.false:
+                        new[b.target] = new.get(b.target, self.false) | u
+            ring = {}
+            for s, u in new.items():
+                u &= ~seen.get(s, self.false)
+                if u != self.false:
+                    ring[s] = u
+                    seen[s] = seen.get(s, self.false) | u
+        return self.rings
+
+    # ------------------------------------------------------------------ counts
+    @property
+    def sync_states(self) -> int:
+        return sum(self.enc.count(r.members) for r in self.regions)
+
+    @property
+    def aggregated_states(self) -> int:
+        return sum(self.enc.count(r.nodes) for r in self.regions)
+
+    @property
+    def aggregated_transitions(self) -> int:
+        return self.edge_count
+
+    # ------------------------------------------------------------------ the aggregated graph
+    def pre(self, targets: NodeSet, bundles: Iterable[Bundle] | None = None) -> NodeSet:
+        """Nodes with an edge (of ``bundles``, default all) into ``targets``."""
+        out: NodeSet = {}
+        for b in self.bundles if bundles is None else bundles:
+            t = targets.get(b.target)
+            if t is None or t == self.false:
+                continue
+            hit = b.entries & self.enc.exists(self.regions[b.target].pairs & self.enc.rename(t, Copy.CURRENT, Copy.NEXT),
+                                              Copy.NEXT)
+            if hit == self.false:
+                continue
+            src = (preimage(self.enc, hit, b.move) if b.move is not None else hit) & self.regions[b.source].nodes
+            if src != self.false:
+                out[b.source] = out.get(b.source, self.false) | src
+        return out
+
+    def post(self, sources: NodeSet, b: Bundle) -> Function:
+        """Targets (in ``b.target``) of the edges of bundle ``b`` from ``sources``."""
+        src = sources.get(b.source)
+        if src is None or src == self.false:
+            return self.false
+        n = (image(self.enc, src, b.move) if b.move is not None else src) & b.entries
+        if n == self.false:
+            return self.false
+        return self.enc.rename(self.enc.exists(n & self.regions[b.target].pairs, Copy.CURRENT), Copy.NEXT, Copy.CURRENT)
+
+    def into(self) -> dict[int, list[Bundle]]:
+        out: dict[int, list[Bundle]] = {}
+        for b in self.bundles:
+            out.setdefault(b.target, []).append(b)
+        return out
+
+    def backward(self, targets: NodeSet, within: NodeSet | None = None) -> NodeSet:
+        """Nodes from which ``targets`` can be reached (targets included): a worklist
+        fixpoint over the situations whose set grew."""
+        into = self.into()
+        reached: NodeSet = {s: u for s, u in targets.items() if u != self.false}
+        work = sorted(reached)
+        while work:
+            s = work.pop()
+            pre = self.pre({s: reached[s]}, into.get(s, ()))
+            for t, u in pre.items():
+                if within is not None:
+                    u &= within.get(t, self.false)
+                old = reached.get(t, self.false)
+                grown = u & ~old
+                if grown != self.false:
+                    reached[t] = old | grown
+                    if t not in work:
+                        work.append(t)
+        return reached
+
+    def forward(self, sources: NodeSet) -> NodeSet:
+        """Nodes reachable from ``sources`` (included)."""
+        by_source: dict[int, list[Bundle]] = {}
+        for b in self.bundles:
+            by_source.setdefault(b.source, []).append(b)
+        reached: NodeSet = {s: u for s, u in sources.items() if u != self.false}
+        work = sorted(reached)
+        while work:
+            s = work.pop()
+            for b in by_source.get(s, ()):
+                u = self.post({s: reached[s]}, b)
+                old = reached.get(b.target, self.false)
+                grown = u & ~old
+                if grown != self.false:
+                    reached[b.target] = old | grown
+                    if b.target not in work:
+                        work.append(b.target)
+        return reached
+
+    def nodes(self) -> NodeSet:
+        return {s: r.nodes for s, r in enumerate(self.regions) if r.nodes != self.false}
+
+    def depth(self, s: int, u: Function) -> int | None:
+        """The ring of the first node of ``u`` (in situation ``s``)."""
+        for k, ring in enumerate(self.onion_rings()):
+            if (ring.get(s, self.false) & u) != self.false:
+                return k
+        return None
+
+
+def symbolic_sync(
+    p: Plant,
+    constraints: Sequence[Constraint],
+    machine: GrafcetMachine,
+    *,
+    budget: NodeBudget | None = None,
+    progress: Callable[[str], None] | None = None,
+    sup: SymbolicSupervisor | None = None,
+) -> SymbolicSync:
+    """Explore SYNC symbolically (see module docstring)."""
+    if sup is None:
+        sup = SymbolicSupervisor(p, constraints, budget)
+    return SymbolicSync(sup, machine, progress=progress).explore()
