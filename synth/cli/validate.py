@@ -29,7 +29,11 @@ def register(sub: "argparse._SubParsersAction") -> None:
                    help="write DIR/index.html (default reports/<grafcet name>)")
     v.add_argument("--json", action="store_true", help="print the result as JSON (docs/validate-json.md)")
     v.add_argument("--cor", metavar="FILE", help="write the reduced controller as JSON to FILE and DOT beside it")
-    v.add_argument("--max-states", metavar="N", type=int, help="stop after N aggregated states")
+    v.add_argument("--max-states", metavar="N", type=int, help="stop after N aggregated states (explicit engine)")
+    v.add_argument("--engine", choices=("auto", "explicit", "symbolic"), default="auto",
+                   help="explicit exploration, BDDs (for many actuators moving at once), or chosen by "
+                        "estimated size (default; docs/symbolic.md)")
+    v.add_argument("--max-nodes", metavar="N", type=int, help="stop when the symbolic engine needs more than N BDD nodes")
     v.add_argument("--quiet", action="store_true", help="no progress on stderr")
     v.set_defaults(handler=cmd_validate)
 
@@ -44,15 +48,24 @@ def cmd_validate(args: argparse.Namespace) -> int:
     if args.cor and Path(args.cor).suffix == ".dot":
         raise SynthError(f"--cor {args.cor}: the JSON file must not end in .dot, the DOT file is written beside it")
     show = tty_progress(not args.quiet and sys.stderr.isatty())
-    result = validate(
-        args.grafcet,
-        args.plant,
-        expert=args.expert,
-        homes=args.home,
-        max_states=args.max_states,
-        progress=None if show is None else lambda n, pending: show(f"exploring SYNC: {n} aggregated states, {pending} to visit"),
-    )
+    if _engine(args) == "symbolic":
+        from synth.symbolic.validate import validate_symbolic
+
+        result = validate_symbolic(args.grafcet, args.plant, expert=args.expert, homes=args.home,
+                                   max_nodes=args.max_nodes, progress=show)
+    else:
+        result = validate(
+            args.grafcet,
+            args.plant,
+            expert=args.expert,
+            homes=args.home,
+            max_states=args.max_states,
+            progress=None if show is None else lambda n, pending: show(f"exploring SYNC: {n} aggregated states, {pending} to visit"),
+        )
     clear_progress(show)
+    if result.engine_stats is not None and not args.quiet:
+        print(f"symbolic engine: {result.engine_stats['bdd_nodes']} BDD nodes, "
+              f"{result.engine_stats['situations']} stable situations", file=sys.stderr)
     print_warnings(result.plant)
     if args.cor:
         cor = cor_json(result, reduced_controller(result))
@@ -67,6 +80,8 @@ def cmd_validate(args: argparse.Namespace) -> int:
         data = validation_json(result)
         if report_path is not None:
             data["report"] = str(report_path)
+        if result.engine_stats is not None:
+            data["symbolic"] = dict(result.engine_stats)
         json.dump(data, sys.stdout, indent=2, ensure_ascii=False)
         sys.stdout.write("\n")
     else:
@@ -76,3 +91,21 @@ def cmd_validate(args: argparse.Namespace) -> int:
         if args.cor:
             print(f"reduced controller: {args.cor} and {Path(args.cor).with_suffix('.dot')}")
     return 0 if result.passed else 1
+
+
+def _engine(args: argparse.Namespace) -> str:
+    """The engine ``--engine`` asks for; ``auto`` by estimated size (synth.symbolic.engine)."""
+    from synth.symbolic.engine import choose
+
+    if args.engine == "explicit":
+        return "explicit"
+    estimate = 0
+    if args.engine == "auto":
+        from synth.grafcet.language import load_grafcet
+        from synth.plant.composition import plant
+        from synth.plant.rules import load_rules
+
+        p = plant(load_rules(args.plant))
+        g = load_grafcet(args.grafcet, inputs=p.inputs, outputs=p.outputs)
+        estimate = p.size * max(1, len(g.steps))
+    return str(choose(args.engine, estimate, needs_listing=args.report is not None or bool(args.cor)))
