@@ -95,38 +95,39 @@ def prohibited_nodes(sync: SymbolicSync) -> dict[tuple[tuple[str, ...], Event], 
     return out
 
 
-def _dead_ends(sync: SymbolicSync, stuck: NodeSet) -> NodeSet:
-    """Stuck nodes without any successor."""
-    with_succ = sync.pre(sync.nodes())
-    return _minus(stuck, with_succ, sync.false)
+def _deepest(sync: SymbolicSync, u: NodeSet) -> NodeSet:
+    """One node of ``u`` from the farthest onion ring meeting it (terminal components lie deep)."""
+    rings = sync.onion_rings()
+    for ring in reversed(rings):
+        for s in sorted(ring):
+            v = u.get(s, sync.false) & ring[s]
+            if v != sync.false:
+                return {s: sync.enc.state(sync.enc.local(sync.enc.pick(v)))}
+    raise ValueError("no node of the set is reachable")
 
 
 def terminal_components(sync: SymbolicSync, stuck: NodeSet) -> list[NodeSet]:
-    """The terminal strongly connected components of the stuck nodes."""
+    """The terminal strongly connected components of the stuck nodes.
+
+    Descent: from a node ``v``, ``F`` = its forward set (closed under successors); ``F``
+    is a terminal component iff every node of ``F`` reaches ``v`` back (a backward
+    fixpoint inside ``F`` only); otherwise continue from a node of ``F`` that cannot
+    reach ``v``. Once a component is found, it and every node that can reach it leave
+    the candidates (none of them is in another terminal component)."""
     false = sync.false
     comps: list[NodeSet] = []
-    dead = _dead_ends(sync, stuck)
-    for s, u in sorted(dead.items()):
-        rest = u
-        while rest != false:
-            one = sync.enc.state(sync.enc.local(sync.enc.pick(rest)))
-            comps.append({s: one})
-            rest &= ~one
-    candidates = _minus(stuck, sync.backward(dead, within=stuck), false)
+    candidates = dict(stuck)
     while not _empty(candidates, false):
-        s = min(s for s, u in candidates.items() if u != false)
-        v = {s: sync.enc.state(sync.enc.local(sync.enc.pick(candidates[s])))}
+        v = _deepest(sync, candidates)
         while True:
             fwd = sync.forward(v)
-            bwd = sync.backward(v, within=stuck)
-            below = _minus(fwd, bwd, false)
+            back = sync.backward(v, within=fwd)
+            below = _minus(fwd, back, false)
             if _empty(below, false):
                 comps.append(fwd)
-                candidates = _minus(candidates, bwd, false)
                 break
-            candidates = _minus(candidates, bwd, false)
-            s = min(below)
-            v = {s: sync.enc.state(sync.enc.local(sync.enc.pick(below[s])))}
+            v = _deepest(sync, below)
+        candidates = _minus(candidates, sync.backward(comps[-1], within=candidates), false)
     return comps
 
 
@@ -142,7 +143,6 @@ def _key(sync: SymbolicSync, b: Bundle) -> tuple[int, int, int]:
 def _layers(sync: SymbolicSync, target: NodeSet, depth: int) -> list[NodeSet]:
     """For k ≤ depth, the ring-k nodes from which ``target`` is reachable in depth−k steps."""
     rings = sync.onion_rings()
-    into = sync.into()
     layers: list[NodeSet] = [dict() for _ in range(depth + 1)]
     layers[depth] = {s: u & rings[depth].get(s, sync.false) for s, u in target.items()}
     for k in range(depth - 1, -1, -1):
@@ -150,7 +150,7 @@ def _layers(sync: SymbolicSync, target: NodeSet, depth: int) -> list[NodeSet]:
         for t, u in layers[k + 1].items():
             if u == sync.false:
                 continue
-            for s, v in sync.pre({t: u}, into.get(t, ())).items():
+            for s, v in sync.pre({t: u}, sync.into(t)).items():
                 pre[s] = pre.get(s, sync.false) | v
         layers[k] = {s: u & rings[k].get(s, sync.false) for s, u in pre.items()}
         layers[k] = {s: u for s, u in layers[k].items() if u != sync.false}
@@ -159,16 +159,13 @@ def _layers(sync: SymbolicSync, target: NodeSet, depth: int) -> list[NodeSet]:
 
 def _greedy(sync: SymbolicSync, layers: list[NodeSet], order: Callable[[Bundle], object]) -> tuple[list[NodeSet], list[Event]]:
     """Forward through ``layers``, taking at each step the smallest event (by ``order``)."""
-    by_source: dict[int, list[Bundle]] = {}
-    for b in sync.bundles:
-        by_source.setdefault(b.source, []).append(b)
     current = layers[0]
     chosen = [current]
     events: list[Event] = []
     for k in range(1, len(layers)):
         options: dict[object, tuple[Event, NodeSet]] = {}
         for s, u in current.items():
-            for b in by_source.get(s, ()):
+            for b in sync.out_bundles(s):
                 if b.target not in layers[k]:
                     continue
                 v = sync.post({s: u}, b) & layers[k][b.target]
@@ -204,11 +201,8 @@ def first_node(sync: SymbolicSync, candidates: NodeSet) -> tuple[int, tuple[int,
     chosen, _ = _greedy(sync, layers, lambda b: _key(sync, b))
     keys: list[tuple] = []
     # the key path, for sorting several first nodes at one distance
-    by_source: dict[int, list[Bundle]] = {}
-    for b in sync.bundles:
-        by_source.setdefault(b.source, []).append(b)
     for k in range(1, len(chosen)):
-        best = min(_key(sync, b) for s in chosen[k - 1] for b in by_source.get(s, ())
+        best = min(_key(sync, b) for s in chosen[k - 1] for b in sync.out_bundles(s)
                    if b.target in chosen[k] and sync.post({s: chosen[k - 1][s]}, b) & chosen[k][b.target] != sync.false)
         keys.append(best)
     s, local = _pick(sync, chosen[-1])
@@ -226,12 +220,12 @@ def shortest_trace(sync: SymbolicSync, s: int, local: tuple[int, ...]) -> Path:
     chosen, events = _greedy(sync, layers, lambda b: b.event)
     # one concrete node per layer, backwards from the target
     nodes = [(s, local)]
-    into = sync.into()
     for k in range(depth - 1, -1, -1):
         t, loc = nodes[-1]
         target = {t: sync.enc.state(loc)}
         pre: NodeSet = {}
-        for src, u in sync.pre(target, [b for b in into.get(t, ()) if b.event == events[k]]).items():
+        arcs = [b for b in sync.bundles if b.target == t and b.event == events[k]]
+        for src, u in sync.pre(target, arcs).items():
             v = u & chosen[k].get(src, sync.false)
             if v != sync.false:
                 pre[src] = v

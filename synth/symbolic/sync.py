@@ -57,7 +57,7 @@ from synth.symbolic.encoding import Copy, NodeBudget
 from synth.symbolic.relation import Move, image, preimage
 from synth.symbolic.supervisor import SymbolicSupervisor
 
-__all__ = ["Bundle", "Region", "SymbolicSync", "symbolic_sync"]
+__all__ = ["Bundle", "Link", "Region", "SymbolicSync", "symbolic_sync"]
 
 NodeSet = dict[int, Function]  # situation index -> plant states (current copy)
 
@@ -87,6 +87,17 @@ class Bundle:
     entries: Function
     move: Move | None
     key: tuple[int, int]  # exploration order of the event: (0, plant transition) or (1, timer rank)
+    edges: Function | None = None  # (x, x'): node x of source --event--> node x' of target, once explored
+
+
+@dataclass(frozen=True)
+class Link:
+    """Every edge from situation ``source`` to situation ``target``, whatever the event,
+    as one pair relation ``edges(x, x')``."""
+
+    source: int
+    target: int
+    edges: Function
 
 
 @dataclass
@@ -114,6 +125,7 @@ class SymbolicSync:
         self._index: dict[Situation, int] = {}
         self.regions: list[Region] = []
         self.bundles: list[Bundle] = []
+        self.links: list[Link] = []
         self._bundles: dict[tuple[int, tuple[int, int], int], Bundle] = {}
         self.rings: list[NodeSet] = []
         self.edge_count = 0
@@ -305,29 +317,49 @@ class SymbolicSync:
             if self.progress is not None and turns % 50 == 0:
                 self.progress(f"exploring SYNC symbolically: {len(self.situations)} situations, "
                               f"{len(pending)} pending, {len(self.enc.bdd)} BDD nodes")
-        self.bundles = sorted(self._bundles.values(), key=lambda b: (b.source, b.key, b.target))
-        self.edge_count = sum(self.enc.count(b.entries & self.regions[b.target].pairs, (Copy.CURRENT, Copy.NEXT))
-                              for b in self.bundles)
+        self.bundles = [self._edges(b) for b in sorted(self._bundles.values(), key=lambda b: (b.source, b.key, b.target))]
+        self.edge_count = sum(self.enc.count(b.edges, (Copy.CURRENT, Copy.NEXT)) for b in self.bundles)
+        links: dict[tuple[int, int], Function] = {}
+        for b in self.bundles:
+            links[(b.source, b.target)] = links.get((b.source, b.target), self.false) | b.edges
+        self.links = [Link(a, t, e) for (a, t), e in sorted(links.items())]
+        self._into: dict[int, list[Link]] = {}
+        self._out: dict[int, list] = {}
+        for link in self.links:
+            self._into.setdefault(link.target, []).append(link)
+        for b in self.bundles:
+            self._out.setdefault(b.source, []).append(b)
         return self
 
+    def _edges(self, b: Bundle) -> Bundle:
+        """``b`` with its pair relation: source node x, target node x' (the entry n, between
+        them, quantified: it is x moved by ``b.move``, or x itself for a timer)."""
+        pairs = b.entries & self.regions[b.target].pairs  # (n, x')
+        if b.move is not None:
+            names = self.enc.element_variables[b.move.axis]
+            moved = self.enc.rename(pairs, Copy.CURRENT, Copy.AUX, names)
+            step = self.enc.rename(b.move.relation, Copy.NEXT, Copy.AUX, names)
+            pairs = self.enc.exists(moved & step, Copy.AUX, names)
+        return Bundle(b.source, b.event, b.target, b.entries, b.move, b.key, pairs)
+
     def onion_rings(self) -> list[NodeSet]:
-        """The nodes by distance from the initial nodes (breadth-first over the bundles),
+        """The nodes by distance from the initial nodes (breadth-first over the links),
         computed once, on demand: only traces need them."""
         if self.rings or not self.initial:
             return self.rings
-        by_source: dict[int, list[Bundle]] = {}
-        for b in self.bundles:
-            by_source.setdefault(b.source, []).append(b)
+        by_source: dict[int, list[Link]] = {}
+        for link in self.links:
+            by_source.setdefault(link.source, []).append(link)
         seen: NodeSet = dict(self.initial)
         ring: NodeSet = dict(self.initial)
         while ring:
             self.rings.append(ring)
             new: NodeSet = {}
             for s in sorted(ring):
-                for b in by_source.get(s, ()):
-                    u = self.post(ring, b)
+                for link in by_source.get(s, ()):
+                    u = self.post(ring, link)
                     if u != self.false:
-                        new[b.target] = new.get(b.target, self.false) | u
+                        new[link.target] = new.get(link.target, self.false) | u
             ring = {}
             for s, u in new.items():
                 u &= ~seen.get(s, self.false)
@@ -350,48 +382,41 @@ class SymbolicSync:
         return self.edge_count
 
     # ------------------------------------------------------------------ the aggregated graph
-    def pre(self, targets: NodeSet, bundles: Iterable[Bundle] | None = None) -> NodeSet:
-        """Nodes with an edge (of ``bundles``, default all) into ``targets``."""
+    def pre(self, targets: NodeSet, arcs: Iterable[Link | Bundle] | None = None) -> NodeSet:
+        """Nodes with an edge (of ``arcs``: links or bundles, default every link) into ``targets``."""
         out: NodeSet = {}
-        for b in self.bundles if bundles is None else bundles:
-            t = targets.get(b.target)
+        if arcs is None:
+            arcs = [link for t in targets for link in self._into.get(t, ())]
+        for a in arcs:
+            t = targets.get(a.target)
             if t is None or t == self.false:
                 continue
-            hit = b.entries & self.enc.exists(self.regions[b.target].pairs & self.enc.rename(t, Copy.CURRENT, Copy.NEXT),
-                                              Copy.NEXT)
-            if hit == self.false:
-                continue
-            src = (preimage(self.enc, hit, b.move) if b.move is not None else hit) & self.regions[b.source].nodes
+            src = self.enc.exists(a.edges & self.enc.rename(t, Copy.CURRENT, Copy.NEXT), Copy.NEXT)
             if src != self.false:
-                out[b.source] = out.get(b.source, self.false) | src
+                out[a.source] = out.get(a.source, self.false) | src
         return out
 
-    def post(self, sources: NodeSet, b: Bundle) -> Function:
-        """Targets (in ``b.target``) of the edges of bundle ``b`` from ``sources``."""
-        src = sources.get(b.source)
+    def post(self, sources: NodeSet, a: Link | Bundle) -> Function:
+        """Targets (nodes of ``a.target``) of the edges of ``a`` from ``sources``."""
+        src = sources.get(a.source)
         if src is None or src == self.false:
             return self.false
-        n = (image(self.enc, src, b.move) if b.move is not None else src) & b.entries
-        if n == self.false:
-            return self.false
-        return self.enc.rename(self.enc.exists(n & self.regions[b.target].pairs, Copy.CURRENT), Copy.NEXT, Copy.CURRENT)
+        return self.enc.rename(self.enc.exists(a.edges & src, Copy.CURRENT), Copy.NEXT, Copy.CURRENT)
 
-    def into(self) -> dict[int, list[Bundle]]:
-        out: dict[int, list[Bundle]] = {}
-        for b in self.bundles:
-            out.setdefault(b.target, []).append(b)
-        return out
+    def into(self, target: int) -> list[Link]:
+        return self._into.get(target, [])
+
+    def out_bundles(self, source: int) -> list[Bundle]:
+        return self._out.get(source, [])
 
     def backward(self, targets: NodeSet, within: NodeSet | None = None) -> NodeSet:
         """Nodes from which ``targets`` can be reached (targets included): a worklist
         fixpoint over the situations whose set grew."""
-        into = self.into()
         reached: NodeSet = {s: u for s, u in targets.items() if u != self.false}
         work = sorted(reached)
         while work:
             s = work.pop()
-            pre = self.pre({s: reached[s]}, into.get(s, ()))
-            for t, u in pre.items():
+            for t, u in self.pre({s: reached[s]}, self.into(s)).items():
                 if within is not None:
                     u &= within.get(t, self.false)
                 old = reached.get(t, self.false)
@@ -404,21 +429,21 @@ class SymbolicSync:
 
     def forward(self, sources: NodeSet) -> NodeSet:
         """Nodes reachable from ``sources`` (included)."""
-        by_source: dict[int, list[Bundle]] = {}
-        for b in self.bundles:
-            by_source.setdefault(b.source, []).append(b)
+        by_source: dict[int, list[Link]] = {}
+        for link in self.links:
+            by_source.setdefault(link.source, []).append(link)
         reached: NodeSet = {s: u for s, u in sources.items() if u != self.false}
         work = sorted(reached)
         while work:
             s = work.pop()
-            for b in by_source.get(s, ()):
-                u = self.post({s: reached[s]}, b)
-                old = reached.get(b.target, self.false)
+            for link in by_source.get(s, ()):
+                u = self.post({s: reached[s]}, link)
+                old = reached.get(link.target, self.false)
                 grown = u & ~old
                 if grown != self.false:
-                    reached[b.target] = old | grown
-                    if b.target not in work:
-                        work.append(b.target)
+                    reached[link.target] = old | grown
+                    if link.target not in work:
+                        work.append(link.target)
         return reached
 
     def nodes(self) -> NodeSet:
