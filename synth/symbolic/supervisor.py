@@ -158,6 +158,28 @@ class SymbolicSupervisor:
                 cut += n - ok
         return kept[0], kept[1], cut
 
+    def forbidden_counts(self) -> dict[str, int]:
+        """Cut controllable transitions per constraint id, as
+        :meth:`synth.sup.supervisor.Supervisor.forbidden_counts` (a transition counts for
+        every constraint whose violation it would make reachable, or that forbids its event)."""
+        both = (Copy.CURRENT, Copy.NEXT)
+        counts = {c.id: 0 for c in self.constraints}
+        for cid in counts:
+            threat = self.threatened(cid)
+            edge = {e: self.enc.engine.disjunction(self._product(t.factors) for t in ts if t.constraint == cid)
+                    for e, ts in self.compiled.edge_terms.items()}
+            for m in self.moves:
+                if not m.controllable:
+                    continue
+                names = self.enc.element_variables[m.axis]
+                bad = self.enc.rename(threat, Copy.CURRENT, Copy.NEXT, names)
+                if m.event in edge:
+                    bad |= edge[m.event]
+                hit = self.states & m.relation & bad
+                if hit != self.enc.engine.false:
+                    counts[cid] += self.enc.count(hit, both) // self._others(m.axis)
+        return {k: v for k, v in counts.items() if v}
+
     def _others(self, axis: int) -> int:
         """Counting over both copies counts the unconstrained next variables of the other
         elements too: this factor removes them."""
