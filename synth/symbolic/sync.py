@@ -48,9 +48,10 @@ from dataclasses import dataclass, field
 from typing import Callable, Iterable, Mapping, Sequence
 
 from synth.filter.bdd import Function
-from synth.grafcet.language import Transition
+from synth.grafcet.language import ON_EVENT, Transition
 from synth.grafcet.machine import GrafcetMachine, Situation
 from synth.logic.events import Event
+from synth.logic.expr import Edge as ExprEdge, names
 from synth.plant.composition import Plant
 from synth.plant.rules import Constraint
 from synth.symbolic.encoding import Copy, NodeBudget
@@ -127,6 +128,7 @@ class SymbolicSync:
         self.bundles: list[Bundle] = []
         self.links: list[Link] = []
         self._bundles: dict[tuple[int, tuple[int, int], int], Bundle] = {}
+        self._batch: NodeSet = {}
         self.rings: list[NodeSet] = []
         self.edge_count = 0
         self.conflicts: list[tuple[int, Function, Event, str, tuple[str, ...]]] = []
@@ -134,6 +136,8 @@ class SymbolicSync:
         self._inputs = tuple(n for n in machine.inputs if n in self.plant.owner)
         self._intra: dict[frozenset[str], tuple[tuple[Function, ...], Function, dict[Event, Function]]] = {}
         self._eq: Function | None = None
+        self._domain_cache: dict[frozenset[str], tuple[Function, ...]] = {}
+        self._unread_cache: dict[Situation, frozenset[str]] = {}
         self.progress = progress
         self.initial: NodeSet = {}
 
@@ -207,16 +211,29 @@ class SymbolicSync:
         self._intra[wanted] = hit
         return hit
 
+    def _domains(self, wanted: frozenset[str]) -> tuple[Function, ...]:
+        """Per element, the members (next copy) from which it has a region move."""
+        hit = self._domain_cache.get(wanted)
+        if hit is None:
+            rel, _, _ = self.intra(wanted)
+            hit = tuple(self.enc.exists(r, Copy.AUX, names) for r, names in zip(rel, self.enc.element_variables))
+            self._domain_cache[wanted] = hit
+        return hit
+
     def region_pairs(self, entries: Function, wanted: frozenset[str]) -> Function:
         """reg(x, x') for ``entries`` (x) under emitted orders ``wanted``: forward closure of
         the region moves over pairs, then restricted to settled x'."""
         rel, progress, _ = self.intra(wanted)
+        if (entries & progress) == self.false:  # already settled: the region is its entry
+            self._members_acc = entries
+            return entries & self.equal
+        domains = self._domains(wanted)
         reach = entries & self.equal
         frontier = reach
         while frontier != self.false:
             new = self.false
             for axis, r in enumerate(rel):
-                if r == self.false:
+                if r == self.false or (frontier & domains[axis]) == self.false:
                     continue
                 names = self.enc.element_variables[axis]
                 step = self.enc.exists(frontier & r, Copy.NEXT, names)
@@ -263,11 +280,15 @@ class SymbolicSync:
     def _successors(self, s: int, nodes: Function, pending: NodeSet) -> None:
         sit = self.situations[s]
         machine = self.machine
+        unread = self._unread(sit)
         for m in self.sup.moves:
             if m.controllable:
                 continue
             entries = image(self.enc, nodes, m) & self.sup.kept
             if entries == self.false:
+                continue
+            if m.variable in unread:  # the machine would answer: same situation, nothing fired
+                self._bundle(s, m.event, s, entries, m, (0, m.key), pending)
                 continue
             event = m.event if m.variable in self._inputs else None
 
@@ -289,13 +310,38 @@ class SymbolicSync:
                     self._note_conflicts(s, part, timer, rounds)
                 self._bundle(s, timer, t, part, None, (1, rank), pending)
 
+    def _unread(self, sit: Situation) -> frozenset[str]:
+        """Plant variables whose change cannot change ``sit``: not read by an enabled
+        transition nor by an event action of an active step (``relevant_inputs``), when no
+        enabled receptivity has an edge and no active step has event actions (the node's
+        situation is stable at its input levels, so nothing can fire). Empty otherwise."""
+        hit = self._unread_cache.get(sit)
+        if hit is None:
+            machine = self.machine
+            enabled = machine.awaited(sit)
+            has_edges = any(isinstance(n, ExprEdge) for t in enabled for n in names(t.receptivity))
+            has_events = any(machine._event_inputs[st] or any(getattr(a, "when", None) == ON_EVENT for a in machine.grafcet.step(st).actions)
+                             for st in sit.steps)
+            if has_edges or has_events:
+                hit = frozenset()
+            else:
+                hit = frozenset(self.enc.variables) - machine.relevant_inputs(sit)
+            self._unread_cache[sit] = hit
+        return hit
+
     def _bundle(self, s: int, event: Event, t: int, entries: Function, move: Move | None, key: tuple[int, int],
                 pending: NodeSet) -> None:
-        fresh = self.enter(t, entries)
-        if fresh != self.false:
-            pending[t] = pending.get(t, self.false) | fresh
+        """Record the edges; the target's region is entered once per turn (``_enter_batch``)."""
+        self._batch[t] = self._batch.get(t, self.false) | entries
         old = self._bundles.get((s, key, t))
         self._bundles[(s, key, t)] = Bundle(s, event, t, entries if old is None else old.entries | entries, move, key)
+
+    def _enter_batch(self, pending: NodeSet) -> None:
+        for t, entries in sorted(self._batch.items()):
+            fresh = self.enter(t, entries)
+            if fresh != self.false:
+                pending[t] = pending.get(t, self.false) | fresh
+        self._batch = {}
 
     def explore(self) -> "SymbolicSync":
         """The reachable aggregated automaton: a worklist over situations, each expanding
@@ -313,6 +359,7 @@ class SymbolicSync:
             s = min(pending)
             nodes = pending.pop(s)
             self._successors(s, nodes, pending)
+            self._enter_batch(pending)
             turns += 1
             if self.progress is not None and turns % 50 == 0:
                 self.progress(f"exploring SYNC symbolically: {len(self.situations)} situations, "
