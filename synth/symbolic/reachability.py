@@ -71,10 +71,10 @@ def stuck_nodes(sync: SymbolicSync, back: NodeSet) -> NodeSet:
 def held_nodes(sync: SymbolicSync) -> NodeSet:
     """Nodes from which no node with other active steps is reachable."""
     changers: NodeSet = {}
-    for b in sync.bundles:
-        if sync.situations[b.source].steps == sync.situations[b.target].steps:
+    for link in sync.links:
+        if sync.situations[link.source].steps == sync.situations[link.target].steps:
             continue
-        src = sync.pre({b.target: sync.regions[b.target].nodes}, [b])
+        src = sync.pre({link.target: sync.regions[link.target].nodes}, [link])
         for s, u in src.items():
             changers[s] = changers.get(s, sync.false) | u
     return _minus(sync.nodes(), sync.backward(changers), sync.false)

@@ -138,6 +138,7 @@ class SymbolicSync:
         self._eq: Function | None = None
         self._domain_cache: dict[frozenset[str], tuple[Function, ...]] = {}
         self._unread_cache: dict[Situation, frozenset[str]] = {}
+        self._region_moves: dict[int, tuple[Function, Function, Function]] = {}
         self.progress = progress
         self.initial: NodeSet = {}
 
@@ -199,16 +200,27 @@ class SymbolicSync:
         for m in self.sup.moves:
             if not m.controllable or m.event.rising != (m.variable in wanted):
                 continue
-            ok = self.sup.allowed(m)
-            names = self.enc.element_variables[m.axis]
-            progress |= self.enc.exists(ok, Copy.NEXT, names)
-            bad = self.enc.exists(m.relation, Copy.NEXT, names) & ~self.enc.exists(ok, Copy.NEXT, names)
+            shifted, can, bad = self._region_move(m)
+            progress |= can
             if bad != self.false:
                 refused[m.event] = refused.get(m.event, self.false) | bad
-            shifted = self.enc.rename(ok, Copy.NEXT, Copy.AUX, names)
-            rel[m.axis] |= self.enc.rename(shifted, Copy.CURRENT, Copy.NEXT)
+            rel[m.axis] |= shifted
         hit = (tuple(rel), progress, refused)
         self._intra[wanted] = hit
+        return hit
+
+    def _region_move(self, m: Move) -> tuple[Function, Function, Function]:
+        """For one controllable move, computed once: its allowed part over (member x',
+        next member x''), the states where it is allowed, those where SUP refuses it."""
+        hit = self._region_moves.get(m.key)
+        if hit is None:
+            ok = self.sup.allowed(m)
+            names = self.enc.element_variables[m.axis]
+            can = self.enc.exists(ok, Copy.NEXT, names)
+            bad = self.enc.exists(m.relation, Copy.NEXT, names) & ~can
+            shifted = self.enc.rename(self.enc.rename(ok, Copy.NEXT, Copy.AUX, names), Copy.CURRENT, Copy.NEXT)
+            hit = (shifted, can, bad)
+            self._region_moves[m.key] = hit
         return hit
 
     def _domains(self, wanted: frozenset[str]) -> tuple[Function, ...]:
