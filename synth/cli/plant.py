@@ -116,9 +116,8 @@ def cmd_sup(args: argparse.Namespace) -> int:
     if p.size > args.max_states:
         raise LimitExceeded(
             f"the plant of {args.rules} has {p.size} states, more than --max-states {args.max_states}; "
-            f"exploring SUP keeps a bitmap of visited states ({p.size / 8 / 2**30:.1f} GiB here). "
-            "Raise --max-states, or validate a Grafcet with "
-            "`synth validate`, which decides SUP membership on the fly"
+            "the explicit exploration lists every SUP state. Raise --max-states, use --engine symbolic "
+            "(counts on BDDs, any size), or validate a Grafcet with `synth validate`"
         )
     show = tty_progress(not args.quiet and sys.stderr.isatty())
     sup = supremal_controllable(p, rs.constraints, progress=show)
