@@ -68,8 +68,10 @@ def image(enc: PlantEncoding, states: Function, move: Move, relation: Function |
     """States reached from ``states`` by ``move`` (``relation``: the move restricted further)."""
     names = enc.element_variables[move.axis]
     r = move.relation if relation is None else relation
-    nxt = enc.exists(states & r, Copy.CURRENT, names)
-    return enc.rename(nxt, Copy.NEXT, Copy.CURRENT, names)
+    both = states & r
+    if both == enc.engine.false:
+        return both
+    return enc.rename(enc.exists(both, Copy.CURRENT, names), Copy.NEXT, Copy.CURRENT, names)
 
 
 def preimage(enc: PlantEncoding, states: Function, move: Move, relation: Function | None = None) -> Function:

@@ -277,6 +277,17 @@ class SymbolicSync:
         return fresh
 
     # ------------------------------------------------------------------ exploration
+    def _new_conflicts(self, rounds: Sequence[Sequence[Transition]]) -> bool:
+        """Whether ``rounds`` fire several transitions of one step not reported yet."""
+        for fired in rounds:
+            by_step: dict[str, list[str]] = {}
+            for tr in fired:
+                for st in tr.sources:
+                    by_step.setdefault(st, []).append(tr.name)
+            if any(len(v) > 1 and (st, tuple(v)) not in self._conflict_keys for st, v in by_step.items()):
+                return True
+        return False
+
     def _note_conflicts(self, s: int, sources: Function, event: Event, rounds: Sequence[Sequence[Transition]]) -> None:
         for fired in rounds:
             by_step: dict[str, list[str]] = {}
@@ -309,7 +320,7 @@ class SymbolicSync:
 
             for (target, rounds), part in self.partition(entries, react):
                 t = self.situation(target)
-                if rounds:
+                if rounds and self._new_conflicts(rounds):
                     self._note_conflicts(s, preimage(self.enc, part, m) & nodes, m.event, rounds)
                 self._bundle(s, m.event, t, part, m, (0, m.key), pending)
         for rank, timer in enumerate(machine.timers(sit)):
@@ -318,7 +329,7 @@ class SymbolicSync:
 
             for (target, rounds), part in self.partition(nodes, fire):
                 t = self.situation(target)
-                if rounds:
+                if rounds and self._new_conflicts(rounds):
                     self._note_conflicts(s, part, timer, rounds)
                 self._bundle(s, timer, t, part, None, (1, rank), pending)
 
