@@ -48,20 +48,22 @@ def cmd_validate(args: argparse.Namespace) -> int:
     if args.cor and Path(args.cor).suffix == ".dot":
         raise SynthError(f"--cor {args.cor}: the JSON file must not end in .dot, the DOT file is written beside it")
     show = tty_progress(not args.quiet and sys.stderr.isatty())
-    if _engine(args) == "symbolic":
-        from synth.symbolic.validate import validate_symbolic
+    if args.engine != "explicit" and (args.report is not None or args.cor):
+        from synth.symbolic.engine import choose
 
-        result = validate_symbolic(args.grafcet, args.plant, expert=args.expert, homes=args.home,
-                                   max_nodes=args.max_nodes, progress=show)
-    else:
-        result = validate(
-            args.grafcet,
-            args.plant,
-            expert=args.expert,
-            homes=args.home,
-            max_states=args.max_states,
-            progress=None if show is None else lambda n, pending: show(f"exploring SYNC: {n} aggregated states, {pending} to visit"),
-        )
+        choose(args.engine, 0, needs_listing=True)  # --engine symbolic with a listing: an error
+        args.engine = "explicit"
+    result = validate(
+        args.grafcet,
+        args.plant,
+        expert=args.expert,
+        homes=args.home,
+        max_states=args.max_states,
+        progress=None if show is None else lambda n, pending: show(f"exploring SYNC: {n} aggregated states, {pending} to visit"),
+        engine=args.engine,
+        max_nodes=args.max_nodes,
+        symbolic_progress=show,
+    )
     clear_progress(show)
     if result.engine_stats is not None and not args.quiet:
         print(f"symbolic engine: {result.engine_stats['bdd_nodes']} BDD nodes, "
@@ -92,20 +94,3 @@ def cmd_validate(args: argparse.Namespace) -> int:
             print(f"reduced controller: {args.cor} and {Path(args.cor).with_suffix('.dot')}")
     return 0 if result.passed else 1
 
-
-def _engine(args: argparse.Namespace) -> str:
-    """The engine ``--engine`` asks for; ``auto`` by estimated size (synth.symbolic.engine)."""
-    from synth.symbolic.engine import choose
-
-    if args.engine == "explicit":
-        return "explicit"
-    estimate = 0
-    if args.engine == "auto":
-        from synth.grafcet.language import load_grafcet
-        from synth.plant.composition import plant
-        from synth.plant.rules import load_rules
-
-        p = plant(load_rules(args.plant))
-        g = load_grafcet(args.grafcet, inputs=p.inputs, outputs=p.outputs)
-        estimate = p.size * max(1, len(g.steps))
-    return str(choose(args.engine, estimate, needs_listing=args.report is not None or bool(args.cor)))

@@ -20,11 +20,11 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Callable, Sequence
 
-from synth.grafcet.language import load_grafcet
+from synth.grafcet.language import Grafcet, load_grafcet
 from synth.grafcet.machine import GrafcetMachine
 from synth.logic.expr import evaluate
 from synth.plant.composition import Plant, plant
-from synth.plant.rules import load_rules
+from synth.plant.rules import RuleSet, load_rules
 from synth.sup.constraints import CompiledConstraints
 from synth.symbolic.encoding import NodeBudget
 from synth.symbolic.reachability import (
@@ -45,13 +45,9 @@ from synth.validation.diagnosis import diagnose, diagnose_never_starts
 from synth.validation.sync import Conflict, Edge, Node, Prohibition, Sync, _order_moves
 from synth.validation.validate import Validation, home_conditions
 
-__all__ = ["validate_symbolic", "SymbolicStats"]
+__all__ = ["validate_symbolic", "validate_loaded"]
 
 Key = tuple[int, tuple[int, ...]]
-
-
-class SymbolicStats(dict):
-    """What the symbolic engine reports besides the validation: BDD nodes, situations."""
 
 
 class _Explicit:
@@ -136,6 +132,20 @@ def validate_symbolic(
     rs = load_rules(rules_path)
     p = plant(rs)
     g = load_grafcet(grafcet_path, inputs=p.inputs, outputs=p.outputs)
+    return validate_loaded(rs, p, g, expert=expert, homes=homes, max_nodes=max_nodes, progress=progress)
+
+
+def validate_loaded(
+    rs: RuleSet,
+    p: Plant,
+    g: Grafcet,
+    *,
+    expert: bool = False,
+    homes: Sequence[str] = (),
+    max_nodes: int | None = None,
+    progress: Callable[[str], None] | None = None,
+) -> Validation:
+    """:func:`validate_symbolic` on a rule set, its plant and a Grafcet already loaded."""
     home_conditions(homes, p, g)  # input errors first, as the explicit engine reports them
     machine = GrafcetMachine(g)
     oracle = CompiledConstraints(p, rs.constraints)

@@ -108,11 +108,24 @@ def validate(
     homes: Sequence[str] = (),
     max_states: int | None = None,
     progress: Callable[[int, int], None] | None = None,
+    engine: str = "explicit",
+    max_nodes: int | None = None,
+    symbolic_progress: Callable[[str], None] | None = None,
 ) -> Validation:
-    """Run the whole method on a Grafcet and a plant; ``homes`` are ``--home`` conditions."""
+    """Run the whole method on a Grafcet and a plant; ``homes`` are ``--home`` conditions.
+
+    ``engine``: ``explicit``, ``symbolic`` (:mod:`synth.symbolic`, ``max_nodes`` its BDD
+    node budget) or ``auto`` (by estimated size, :mod:`synth.symbolic.engine`)."""
     rs = load_rules(rules_path)
     p = plant(rs)
     g = load_grafcet(grafcet_path, inputs=p.inputs, outputs=p.outputs)
+    if engine != "explicit":
+        from synth.symbolic.engine import EngineChoice, choose
+
+        if choose(engine, p.size * max(1, len(g.steps))) == EngineChoice.SYMBOLIC:
+            from synth.symbolic.validate import validate_loaded
+
+            return validate_loaded(rs, p, g, expert=expert, homes=homes, max_nodes=max_nodes, progress=symbolic_progress)
     conditions = home_conditions(homes, p, g)
     machine = GrafcetMachine(g)
     sup_empty = not CompiledConstraints(p, rs.constraints).kept(p.initial)
