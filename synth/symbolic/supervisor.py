@@ -57,10 +57,15 @@ class SymbolicSupervisor:
         return self.enc.engine.conjunction(self._factor(a, v) for a, v in factors)
 
     @cached_property
+    def removed(self) -> Function:
+        """Valuations (in or out of the domain) from which a violation is reachable by
+        uncontrollable events: the disjunction of the per-constraint products."""
+        return self.enc.engine.disjunction(self._product(f) for f in self.compiled.level_reach)
+
+    @cached_property
     def kept(self) -> Function:
         """States from which no violation is reachable by uncontrollable events."""
-        bad = self.enc.engine.disjunction(self._product(f) for f in self.compiled.level_reach)
-        return self.enc.domain & ~bad
+        return self.enc.domain & ~self.removed
 
     @cached_property
     def illegal(self) -> Function:
@@ -79,15 +84,22 @@ class SymbolicSupervisor:
                 for e, ts in self.compiled.edge_terms.items()}
 
     def allowed(self, move: Move) -> Function:
-        """The part of ``move``'s relation SUP keeps, from kept sources: the target is kept
-        and, for a controllable move, its event is not forbidden at the source."""
+        """The part of ``move``'s relation SUP keeps, from kept sources (only: the relation
+        checks the constraints the move can change): the target is kept and, for a
+        controllable move, its event is not forbidden at the source."""
         return self._allowed[move.key]
 
     @cached_property
     def _allowed(self) -> dict[int, Function]:
         names = self.enc.element_variables
         out = {}
-        kept_next = {a: self.enc.rename(self.kept, Copy.CURRENT, Copy.NEXT, names[a]) for a in range(self.plant.ndim)}
+        # from a kept source, a move of element a can only make true the terms with a factor
+        # on a (the others read unchanged variables), and its target is in a's domain by the
+        # move's relation: each relation reads the variables of a and of its constraints only
+        kept_next = {}
+        for a in range(self.plant.ndim):
+            on_a = self.enc.engine.disjunction(self._product(f) for f in self.compiled.level_reach if any(b == a for b, _ in f))
+            kept_next[a] = self.enc.rename(~on_a, Copy.CURRENT, Copy.NEXT, names[a])
         for m in self.moves:
             r = m.relation & kept_next[m.axis]
             if m.controllable and m.event in self.forbid:

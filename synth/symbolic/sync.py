@@ -139,6 +139,12 @@ class SymbolicSync:
         self._domain_cache: dict[frozenset[str], tuple[Function, ...]] = {}
         self._unread_cache: dict[Situation, frozenset[str]] = {}
         self._region_moves: dict[int, tuple[Function, Function, Function]] = {}
+        self._products: dict[frozenset[str], tuple[Function, Function] | None] = {}
+        self._aux_moves: dict[int, Function] = {}
+        self._pieces: dict[tuple[int, frozenset[str]], Function] = {}
+        self._other_orders: tuple[frozenset[str], ...] = tuple(
+            frozenset(o + Copy.NEXT.value for b, e in enumerate(self.plant.elements) if b != a for o in e.orders)
+            for a in range(self.plant.ndim))
         self.progress = progress
         self.initial: NodeSet = {}
 
@@ -223,6 +229,42 @@ class SymbolicSync:
             self._region_moves[m.key] = hit
         return hit
 
+    def _product_region(self, wanted: frozenset[str]) -> tuple[Function, Function] | None:
+        """When no element's region moves read another element's orders, a region is the
+        product of the elements' own regions (inputs do not change in a region): the
+        pairs (entry x, member x') and (entry x, settled x') as products of per-element
+        closures, cached per element and emitted orders; None otherwise."""
+        if wanted in self._products:
+            return self._products[wanted]
+        rel, progress, _ = self.intra(wanted)
+        pieces = []
+        for axis, r in enumerate(rel):
+            others = self._other_orders[axis]
+            if r != self.false and any(n in others for n in self.engine.support(r)):
+                self._products[wanted] = None
+                return None
+            key = (axis, frozenset(o for o in wanted if o in self.plant.elements[axis].orders))
+            piece = self._pieces.get(key)
+            if piece is None:
+                piece = self._element_region(axis, r)
+                self._pieces[key] = piece
+            pieces.append(piece)
+        members = self.engine.conjunction(pieces)
+        hit = (members, members & ~self.enc.rename(progress, Copy.CURRENT, Copy.NEXT))
+        self._products[wanted] = hit
+        return hit
+
+    def _element_region(self, axis: int, r: Function) -> Function:
+        """Pairs (x_a, x'_a) of element ``axis``: x'_a reachable from x_a by its region moves ``r``."""
+        names = self.enc.element_variables[axis]
+        reach = self.engine.conjunction(self.engine.var(v).equiv(self.engine.var(v + Copy.NEXT.value)) for v in names)
+        frontier = reach
+        while frontier != self.false and r != self.false:
+            step = self.enc.rename(self.enc.exists(frontier & r, Copy.NEXT, names), Copy.AUX, Copy.NEXT, names)
+            frontier = step & ~reach
+            reach |= frontier
+        return reach
+
     def _domains(self, wanted: frozenset[str]) -> tuple[Function, ...]:
         """Per element, the members (next copy) from which it has a region move."""
         hit = self._domain_cache.get(wanted)
@@ -239,6 +281,11 @@ class SymbolicSync:
         if (entries & progress) == self.false:  # already settled: the region is its entry
             self._members_acc = entries
             return entries & self.equal
+        product = self._product_region(wanted)
+        if product is not None:
+            members, settled = product
+            self._members_acc = self.enc.rename(self.enc.exists(entries & members, Copy.CURRENT), Copy.NEXT, Copy.CURRENT)
+            return entries & settled
         domains = self._domains(wanted)
         reach = entries & self.equal
         frontier = reach
@@ -408,7 +455,9 @@ class SymbolicSync:
         if b.move is not None:
             names = self.enc.element_variables[b.move.axis]
             moved = self.enc.rename(pairs, Copy.CURRENT, Copy.AUX, names)
-            step = self.enc.rename(b.move.relation, Copy.NEXT, Copy.AUX, names)
+            step = self._aux_moves.get(b.move.key)
+            if step is None:
+                step = self._aux_moves[b.move.key] = self.enc.rename(b.move.relation, Copy.NEXT, Copy.AUX, names)
             pairs = self.enc.exists(moved & step, Copy.AUX, names)
         return Bundle(b.source, b.event, b.target, b.entries, b.move, b.key, pairs)
 
