@@ -154,7 +154,7 @@ class _Checker:
 
     def run(self) -> None:
         try:
-            sit, rounds = self.machine.initial(self.initial), ()
+            sit = self.machine.initial(self.initial)
             side: _Side | None = _Side(sit, dict(self.initial), 0, {})
             assert side is not None
             side.since = {s: 0 for s in sit.steps}
