@@ -490,7 +490,6 @@ class _Source:
     def text_at(self, el, text: str, offset: int, width: int = 1) -> Location:
         """Where character ``offset`` of ``text`` (the text of ``el`` or of its child) is."""
         start = el.sourceline or 1
-        before = text[:offset]
         first = text.lstrip().split("\n")[0].strip()
         for n in range(start - 1, min(start + 20, len(self.lines))):
             if first and first in self.lines[n]:
@@ -504,7 +503,6 @@ class _Source:
                     line, col = base_line, base_col + len(rel)
                 raw = self.lines[line - 1] if line <= len(self.lines) else ""
                 return Location(self.file, line, col, raw, width)
-        del before
         return self.at(el)
 
 
@@ -786,10 +784,7 @@ def import_sfc(data: bytes | str, file: str = "<xml>") -> str:
         cond = el.find(q("condition"))
         if cond is None:
             raise InputError("a transition without a condition", src.at(el))
-        if cond.get("negated", "false") in ("true", "1"):
-            negate = True
-        else:
-            negate = False
+        negate = cond.get("negated", "false") in ("true", "1")
         inline, ref, label = cond.find(q("inline")), cond.find(q("reference")), ""
         if inline is not None:
             st = inline.find(q("ST"))
