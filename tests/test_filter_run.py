@@ -11,6 +11,7 @@ import random
 import pytest
 
 from conftest import ROOT
+from schemas import assert_valid
 from synth.errors import InputError
 from synth.filter.cycle import ACK, Algorithm, FilterCycle, Memory, Mode
 from synth.filter.language_check import load_filter, parse_filter
@@ -151,6 +152,7 @@ def test_cli_run_loop_c(cli):
     ]
     code, out, _ = cli("filter", "run", PLANTS / "loop_c.filter", "--trace", DATA / "loop_c.csv", "--json")
     data = json.loads(out)
+    assert_valid("filter_run", data)
     assert code == 0 and data["coherent"] and data["algorithm"] == "algebraic"
     # cycle 2: the priority of K2 (o2:=1) is a leading Min criterion, so o1 gives way
     assert [c["outputs"] for c in data["cycles"]] == [{"o1": 1, "o2": 0, "o3": 0}, {"o1": 0, "o2": 1, "o3": 1},
@@ -188,3 +190,25 @@ def test_run_helper_uses_fresh_memory():
     rows = read_trace("b,R_o\n1,1\n1,1\n", "t.csv", c.reads)
     assert [r.outputs for r in run(c, rows)] == [(False,), (True,)]
     assert [r.outputs for r in run(c, rows)] == [(False,), (True,)]
+
+
+def test_algebraic_is_the_printed_equations_everywhere():
+    """Outside the care set too, the outputs are those of the Y-only equations `solve`
+    prints (the text the function block implements), read back as `equation` lines."""
+    from synth.filter.model import equation_functions, functions
+
+    text = (PLANTS / "tri.filter").read_text()
+    s = synthesis(parse_filter(text, "tri.filter"))
+    printed = parse_filter(text + "".join(f"\nequation {o} = {t}" for o, t in s.equations.items()), "tri.filter")
+    m = functions(printed)
+    eqs = equation_functions(m)
+    c = FilterCycle(s.functions)
+    rnd = random.Random(5)
+    outside = 0
+    for _ in range(60):
+        point = {n: rnd.random() < 0.5 for n in m.engine.names if n not in printed.outputs}
+        memory = Memory(tuple(point.get(n + "^-1", False) for n in c.remembered))
+        r, _ = c.step(memory, {n: point[n] for n in c.reads})
+        assert r.outputs == tuple(m.engine.value(eqs[o], point) for o in printed.outputs)
+        outside += r.outside_care
+    assert 0 < outside < 60  # both sides of the care set were visited

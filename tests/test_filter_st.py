@@ -173,3 +173,18 @@ def test_cli_bad_filter_is_exit_2(tmp_path: Path, capsys: pytest.CaptureFixture[
     assert main(["filter", "st", str(bad), "--algorithm", "loop", "-o", str(out)]) == 2
     assert not out.exists()
     assert "k.filter:2:8: error: K has no priority" in capsys.readouterr().err
+
+
+def test_cli_xml_is_valid_tc6(tmp_path: Path) -> None:
+    from lxml import etree
+
+    from synth.codegen.plcopen import validation_errors
+
+    out = tmp_path / "fb.xml"
+    assert main(["filter", "st", str(ROOT / "plants" / "loop_b.filter"), "--algorithm", "loop", "--xml",
+                 "-o", str(out)]) == 0
+    data = out.read_bytes()
+    assert validation_errors(data) == []
+    ns = {"tc6": "http://www.plcopen.org/xml/tc6_0201"}
+    pou = etree.fromstring(data).find(".//tc6:pou", ns)
+    assert (pou.get("name"), pou.get("pouType")) == ("FB_loop_b_Filter", "functionBlock")

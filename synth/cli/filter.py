@@ -191,6 +191,8 @@ def register_verify(commands: "argparse._SubParsersAction") -> None:
                    help="write the changed outputs in one plant step (default: falls, then rises, in output order)")
     v.add_argument("--strict", action="store_true",
                    help="a violation before the PLC writes its outputs also makes the loop unsafe")
+    v.add_argument("--require-sup", action="store_true",
+                   help="a state outside SUP (uncontrollable events alone lead to a violation) makes the loop unsafe")
     v.add_argument("--max-states", type=int, default=1_000_000, metavar="N",
                    help="stop the exploration after N states (default 1000000)")
     v.add_argument("--json", action="store_true", help="print JSON instead of text")
@@ -206,7 +208,8 @@ def cmd_verify(args: argparse.Namespace) -> int:
     f = load_filter(args.filter)
     _warnings(f)
     v = verify(f, args.plant, args.grafcet, any_control=args.any_control, algorithm=Algorithm(args.algorithm),
-               mode=Mode(args.mode), atomic=args.atomic_outputs, strict=args.strict, max_states=args.max_states)
+               mode=Mode(args.mode), atomic=args.atomic_outputs, strict=args.strict, require_sup=args.require_sup,
+               max_states=args.max_states)
     if args.json:
         print_json(verification_json(v))
     else:

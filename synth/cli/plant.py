@@ -32,6 +32,10 @@ def register(sub: "argparse._SubParsersAction") -> None:
     s.add_argument("--max-states", metavar="N", type=int, default=DEFAULT_MAX_STATES,
                    help=f"refuse plants larger than N states (default {DEFAULT_MAX_STATES}); synth validate needs no such limit")
     s.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    s.add_argument("--engine", choices=("auto", "explicit", "symbolic"), default="auto",
+                   help="explicit exploration, or counts on BDDs for plants of any size; auto: symbolic above "
+                        "10^6 plant states unless --export or --why lists states (docs/symbolic.md)")
+    s.add_argument("--max-nodes", metavar="N", type=int, help="stop when the symbolic engine needs more than N BDD nodes")
     s.set_defaults(handler=cmd_sup)
 
 
@@ -107,12 +111,13 @@ def cmd_sup(args: argparse.Namespace) -> int:
     rs = load_rules(args.rules)
     p = plant(rs)
     print_warnings(p)
+    if _sup_engine(args, p.size) == "symbolic":
+        return _cmd_sup_symbolic(args, rs, p)
     if p.size > args.max_states:
         raise LimitExceeded(
             f"the plant of {args.rules} has {p.size} states, more than --max-states {args.max_states}; "
-            f"exploring SUP keeps a bitmap of visited states ({p.size / 8 / 2**30:.1f} GiB here). "
-            "Raise --max-states, or validate a Grafcet with "
-            "`synth validate`, which decides SUP membership on the fly"
+            "the explicit exploration lists every SUP state. Raise --max-states, use --engine symbolic "
+            "(counts on BDDs, any size), or validate a Grafcet with `synth validate`"
         )
     show = tty_progress(not args.quiet and sys.stderr.isatty())
     sup = supremal_controllable(p, rs.constraints, progress=show)
@@ -133,4 +138,49 @@ def cmd_sup(args: argparse.Namespace) -> int:
     else:
         sys.stdout.write(summary.sup_text(data, labels, explain(sup, p.initial).text(labels) if sup.empty else ""))
     _written(("libFAUDES", args.export))
+    return 0
+
+
+def _sup_engine(args: argparse.Namespace, size: int) -> str:
+    """``--engine`` for ``sup``: ``auto`` is symbolic above 10^6 plant states unless
+    ``--export`` or ``--why`` needs the explicit listing (synth.symbolic.engine)."""
+    from synth.symbolic.engine import SUP_THRESHOLD, choose
+
+    return str(choose(args.engine, size, threshold=SUP_THRESHOLD, needs_listing=bool(args.export or args.why),
+                      listing_option="--export/--why"))
+
+
+def _cmd_sup_symbolic(args: argparse.Namespace, rs: Any, p: Any) -> int:
+    """SUP's counts on BDDs: the same summary as the explicit engine (the plant-wide
+    counts included, at any size), plus the key ``symbolic`` with the BDD node count."""
+    from synth.output import summary
+    from synth.output.progress import clear_progress, tty_progress
+    from synth.sup.explain import explain
+    from synth.symbolic.encoding import NodeBudget
+    from synth.symbolic.supervisor import symbolic_supervisor
+
+    show = tty_progress(not args.quiet and sys.stderr.isatty())
+    sup = symbolic_supervisor(p, rs.constraints, budget=NodeBudget(args.max_nodes), progress=show)
+    clear_progress(show)
+    labels = {c.id: c.label for c in rs.constraints}
+    data = {
+        "file": args.rules,
+        "plant": summary._sizes(p),
+        **sup.summary(),
+        "forbidden_by_constraint": sup.forbidden_counts(),
+        "constraints": [{"id": c.id, "label": c.label, "expr": c.text()} for c in rs.constraints],
+        "empty": sup.empty,
+        "symbolic": {"bdd_nodes": sup.nodes},
+    }
+    if args.json:
+        print_json(data)
+        return 0
+    why = ""
+    if sup.empty:
+        from synth.sup.supervisor import Supervisor
+
+        why = explain(Supervisor(p, rs.constraints), p.initial).text(labels)
+    sys.stdout.write(summary.sup_text(data, labels, why))
+    if not args.quiet:
+        print(f"symbolic engine: {sup.nodes} BDD nodes", file=sys.stderr)
     return 0

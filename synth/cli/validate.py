@@ -29,7 +29,11 @@ def register(sub: "argparse._SubParsersAction") -> None:
                    help="write DIR/index.html (default reports/<grafcet name>)")
     v.add_argument("--json", action="store_true", help="print the result as JSON (docs/validate-json.md)")
     v.add_argument("--cor", metavar="FILE", help="write the reduced controller as JSON to FILE and DOT beside it")
-    v.add_argument("--max-states", metavar="N", type=int, help="stop after N aggregated states")
+    v.add_argument("--max-states", metavar="N", type=int, help="stop after N aggregated states (explicit engine)")
+    v.add_argument("--engine", choices=("auto", "explicit", "symbolic"), default="auto",
+                   help="explicit exploration, BDDs (for many actuators moving at once), or chosen by "
+                        "estimated size (default; docs/symbolic.md)")
+    v.add_argument("--max-nodes", metavar="N", type=int, help="stop when the symbolic engine needs more than N BDD nodes")
     v.add_argument("--quiet", action="store_true", help="no progress on stderr")
     v.set_defaults(handler=cmd_validate)
 
@@ -44,6 +48,11 @@ def cmd_validate(args: argparse.Namespace) -> int:
     if args.cor and Path(args.cor).suffix == ".dot":
         raise SynthError(f"--cor {args.cor}: the JSON file must not end in .dot, the DOT file is written beside it")
     show = tty_progress(not args.quiet and sys.stderr.isatty())
+    if args.engine != "explicit" and (args.report is not None or args.cor):
+        from synth.symbolic.engine import choose
+
+        choose(args.engine, 0, needs_listing=True)  # --engine symbolic with a listing: an error
+        args.engine = "explicit"
     result = validate(
         args.grafcet,
         args.plant,
@@ -51,8 +60,14 @@ def cmd_validate(args: argparse.Namespace) -> int:
         homes=args.home,
         max_states=args.max_states,
         progress=None if show is None else lambda n, pending: show(f"exploring SYNC: {n} aggregated states, {pending} to visit"),
+        engine=args.engine,
+        max_nodes=args.max_nodes,
+        symbolic_progress=show,
     )
     clear_progress(show)
+    if result.engine_stats is not None and not args.quiet:
+        print(f"symbolic engine: {result.engine_stats['bdd_nodes']} BDD nodes, "
+              f"{result.engine_stats['situations']} stable situations", file=sys.stderr)
     print_warnings(result.plant)
     if args.cor:
         cor = cor_json(result, reduced_controller(result))
@@ -67,6 +82,8 @@ def cmd_validate(args: argparse.Namespace) -> int:
         data = validation_json(result)
         if report_path is not None:
             data["report"] = str(report_path)
+        if result.engine_stats is not None:
+            data["symbolic"] = dict(result.engine_stats)
         json.dump(data, sys.stdout, indent=2, ensure_ascii=False)
         sys.stdout.write("\n")
     else:
@@ -76,3 +93,4 @@ def cmd_validate(args: argparse.Namespace) -> int:
         if args.cor:
             print(f"reduced controller: {args.cor} and {Path(args.cor).with_suffix('.dot')}")
     return 0 if result.passed else 1
+

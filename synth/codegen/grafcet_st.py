@@ -42,9 +42,11 @@ import re
 from dataclasses import dataclass, field
 from fractions import Fraction
 from pathlib import Path
-from typing import Callable, Sequence
+from typing import Sequence
 
+from synth.codegen.st import st_expr
 from synth.errors import InputError, Location
+from synth.version import version as synth_version
 from synth.grafcet.language import (
     CONDITIONAL,
     CONTINUOUS,
@@ -55,7 +57,7 @@ from synth.grafcet.language import (
     Grafcet,
     Step,
 )
-from synth.logic.expr import And, Const, Edge, Expr, Not, Or, Var, names
+from synth.logic.expr import Edge, Expr, Var, names
 
 __all__ = [
     "DEFAULT_MAX_ROUNDS",
@@ -140,29 +142,6 @@ def program_name(path: str) -> str:
     if not stem[0].isalpha():
         stem = "G_" + stem
     return stem
-
-
-_PREC = {Or: 1, And: 2, Not: 3}
-
-
-def st_expr(e: Expr, ref: Callable[[Expr], str], parent: int = 0) -> str:
-    """``e`` in ST: ``!`` → ``NOT``, ``&`` → ``AND``, ``|`` → ``OR``, parentheses only where needed;
-    ``ref`` names a variable, timer or edge.
-
-    >>> from synth.logic.expr import Var, Not, And, Or
-    >>> st_expr(And((Or((Var("a"), Var("b"))), Not(Var("c")))), lambda v: v.name)
-    '(a OR b) AND NOT c'
-    """
-    if isinstance(e, Const):
-        return "TRUE" if e.value else "FALSE"
-    if isinstance(e, (Var, Edge)):
-        return ref(e)
-    if isinstance(e, Not):
-        text = "NOT " + st_expr(e.arg, ref, 4)
-    else:
-        op = " AND " if isinstance(e, And) else " OR "
-        text = op.join(st_expr(a, ref, _PREC[type(e)]) for a in e.args)
-    return f"({text})" if _PREC[type(e)] < parent else text
 
 
 def _or(terms: Sequence[str]) -> str:
@@ -490,16 +469,6 @@ class _Writer:
 def filter_call(block: object) -> FilterCall:
     """The :class:`FilterCall` of a :class:`synth.codegen.filter_st.FilterBlock`."""
     return FilterCall(block.text, block.name, tuple(block.inputs), tuple(block.outputs))  # type: ignore[attr-defined]
-
-
-def synth_version() -> str:
-    """The installed synth's version, for the header of generated files."""
-    from importlib import metadata
-
-    try:
-        return metadata.version("synth")
-    except metadata.PackageNotFoundError:  # pragma: no cover - a bare source tree
-        return "unknown"
 
 
 def _first_loc(g: Grafcet, name: str) -> Location | None:

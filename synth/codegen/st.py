@@ -23,6 +23,7 @@ from synth.logic.expr import And, Const, Edge, Expr, Not, Or, Var
 __all__ = [
     "PAST_SUFFIX",
     "past_name",
+    "st_expr",
     "st_expression",
     "st_identifier_problem",
     "Declaration",
@@ -74,40 +75,45 @@ def _edge_default(e: Edge, name: Callable[[str], str]) -> str:
     return f"{now} AND NOT {before}" if e.rising else f"NOT {now} AND {before}"
 
 
+_PREC = {Or: 1, And: 2, Not: 3}
+
+
+def st_expr(e: Expr, ref: Callable[[Expr], str], parent: int = 0) -> str:
+    """``e`` in ST: ``!`` → ``NOT``, ``&`` → ``AND``, ``|`` → ``OR``, parentheses only where needed;
+    ``ref`` names a variable, timer or edge.
+
+    >>> from synth.logic.expr import Var, Not, And, Or
+    >>> st_expr(And((Or((Var("a"), Var("b"))), Not(Var("c")))), lambda v: v.name)
+    '(a OR b) AND NOT c'
+    """
+    if isinstance(e, Const):
+        return "TRUE" if e.value else "FALSE"
+    if isinstance(e, (Var, Edge)):
+        text = ref(e)  # an edge may be written as a conjunction: parenthesised under NOT
+        return f"({text})" if parent > _PREC[And] and " " in text else text
+    if isinstance(e, Not):
+        text = "NOT " + st_expr(e.arg, ref, 4)
+    else:
+        op = " AND " if isinstance(e, And) else " OR "
+        text = op.join(st_expr(a, ref, _PREC[type(e)]) for a in e.args)
+    return f"({text})" if _PREC[type(e)] < parent else text
+
+
+
 def st_expression(
     e: Expr,
     name: Callable[[str], str] = past_name,
     edge: Callable[[Edge], str] | None = None,
 ) -> str:
-    """``e`` in ST, with the fewest parentheses (``NOT`` binds tighter than ``AND``, which
-    binds tighter than ``OR``). ``name`` maps synth names to ST variables; an edge is
-    ``x AND NOT x_1`` (``↑x``) unless ``edge`` says otherwise."""
+    """``e`` in ST (:func:`st_expr`) with ``name`` mapping synth names to ST variables; an
+    edge is ``x AND NOT x_1`` (``↑x``) unless ``edge`` says otherwise."""
 
-    def level(x: Expr) -> int:  # 3 atom, 2 NOT, 1 AND, 0 OR
-        if isinstance(x, Or):
-            return 0
-        if isinstance(x, (And, Edge)):
-            return 1
-        if isinstance(x, Not):
-            return 2
-        return 3
-
-    def go(x: Expr, context: int) -> str:
+    def ref(x: Expr) -> str:
         if isinstance(x, Var):
-            text = name(x.name)
-        elif isinstance(x, Const):
-            text = "TRUE" if x.value else "FALSE"
-        elif isinstance(x, Edge):
-            text = edge(x) if edge is not None else _edge_default(x, name)
-        elif isinstance(x, Not):
-            text = "NOT " + go(x.arg, 2)
-        elif isinstance(x, And):
-            text = " AND ".join(go(a, 1) for a in x.args)
-        else:
-            text = " OR ".join(go(a, 0) for a in x.args)
-        return f"({text})" if level(x) < context else text
+            return name(x.name)
+        return edge(x) if edge is not None else _edge_default(x, name)
 
-    return go(e, 0)
+    return st_expr(e, ref)
 
 
 @dataclass(frozen=True)

@@ -13,7 +13,8 @@ Grafcet situation). One **PLC cycle** from a node:
    first, then rises, each in the plant's output order** (an order is released before
    another is taken); with ``atomic=True`` all at once (one step, no intermediate state).
 
-Plant orders the filter does not declare are passed through (O = R for them).
+Plant orders the filter does not declare are passed through (O = R for them); an order
+the rules ``hold`` is requested at its held value.
 
 Verdicts, over everything reachable:
 
@@ -24,7 +25,8 @@ Verdicts, over everything reachable:
   in a violating state the filter could not prevent (the PLC is synchronous, the plant
   asynchronous): such *transient* states — and the intermediate states of an ordered
   write — are counted and shown but fail the verdict only with ``strict=True``. Nodes
-  outside SUP (a violation reachable by uncontrollable events alone) are counted;
+  outside SUP (a violation reachable by uncontrollable events alone) are counted, and
+  fail the verdict only with ``require_sup=True``;
 - (b) *coherent*: the loop never falls back and the algebraic filter never meets a Y
   outside its care set;
 - (c) with a Grafcet: the cycles where O ≠ R and the largest Hamming distance.
@@ -46,6 +48,7 @@ Example
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from dataclasses import dataclass, field
 from typing import Any, Sequence
@@ -53,7 +56,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from synth.errors import InputError, LimitExceeded
-from synth.filter.cycle import ACK, Algorithm, FilterCycle, Mode
+from synth.filter.cycle import ACK, Algorithm, FilterCycle, Memory, Mode
 from synth.filter.language import Filter
 from synth.logic.events import Event
 
@@ -70,6 +73,7 @@ FINDINGS = {
     "fallback": "the loop falls back",
     "outside_care": "Y is outside the care set of the algebraic filter",
     "transient": "a plant state violates a constraint before the PLC writes its outputs",
+    "outside_sup": "uncontrollable events alone can lead from a state to a violation (it is not in SUP)",
 }
 
 
@@ -84,6 +88,7 @@ class TraceRow:
     requests: tuple[str, ...]
     orders: tuple[str, ...]
     note: str = ""
+    ran: bool = True  # False: the plant's event only, the PLC has not run yet
 
 
 @dataclass(frozen=True)
@@ -120,7 +125,7 @@ class Verification:
 
     @property
     def safe(self) -> bool:
-        bad = {"violation", "edge", "refused"} | ({"transient"} if self.strict else set())
+        bad = {"violation", "edge", "refused", "outside_sup"} | ({"transient"} if self.strict else set())
         return not any(k in self.findings for k in bad)
 
     @property
@@ -169,7 +174,10 @@ class _Product:
         self.val = {v: np.broadcast_to(p.values(v), shape).ravel().copy() for v in p.variables}
         self.orders = p.outputs
         self.passthrough = tuple(o for o in p.outputs if o not in f.outputs)
+        self.held = {v.name: v.initial for v in rs.variables if v.held}  # requested at their held value
         self.ynames = tuple(dict.fromkeys([*f.inputs, *(self.grafcet.inputs if self.grafcet else ())]))
+        if len(self.ynames) > 40:
+            raise LimitExceeded(f"{len(self.ynames)} inputs are read; verify codes an input vector in 40 bits")
         self.toggle: dict[str, np.ndarray] = {}
         self.uncontrollable: list[tuple[str, np.ndarray]] = []
         for t, src, dst in p.transition_arrays():
@@ -224,74 +232,141 @@ class _Outcome:
 
 def verify(f: Filter, rules_path: str, grafcet: str | None = None, *, any_control: bool = False,
            algorithm: Algorithm = Algorithm.ALGEBRAIC, mode: Mode = Mode.SUPERVISOR, atomic: bool = False,
-           strict: bool = False, max_states: int = 1_000_000) -> Verification:
+           strict: bool = False, require_sup: bool = False, max_states: int = 1_000_000) -> Verification:
     """Explore the closed loop (see the module docstring)."""
     if (grafcet is None) == (not any_control):
         raise InputError("verify needs a request source: --grafcet G.g7 or --any-control (one of them)", None)
     started = time.perf_counter()
     pr = _Product(f, rules_path, grafcet, Algorithm(algorithm), Mode(mode), atomic)
-    p, cyc, size = pr.plant, pr.cycle, pr.size
-    blocking = cyc.mode is Mode.BLOCKING
+    ex = _Explorer(pr, max_states)
+    ex.run()
+    findings = ex.findings()
+    if not require_sup:
+        findings.pop("outside_sup", None)
+    return Verification(
+        f.file, rules_path, grafcet if grafcet is not None else "any control", pr.cycle.algorithm, pr.cycle.mode,
+        atomic, strict, len(ex.seen_keys), len({k % pr.size for k in ex.seen_keys}), ex.cycles, ex.complete,
+        time.perf_counter() - started, len(ex.outside_sup), findings, ex.corrected, ex.max_distance)
 
-    # ---- interned auxiliary parts of a node: (memory of the used names, Blocked, situation)
-    aux_of: dict[tuple, int] = {}
-    aux_list: list[tuple] = []
 
-    def intern(a: tuple) -> int:
-        k = aux_of.get(a)
+_NOTES = {"violation": "", "edge": "output event forbidden", "refused": "output change refused",
+          "fallback": "fallback", "outside_care": "outside the care set",
+          "transient": "an intermediate state of the write violates a constraint"}
+
+
+class _Explorer:
+    """The breadth-first search over the product, one level at a time.
+
+    A node is the integer ``aux * plant.size + code``: ``code`` the plant state, ``aux``
+    an interned (memory of the names whose past value the filter reads, Blocked,
+    situation). The cycle's outcomes depend on the node only through a *class* (Y read,
+    aux before, situation after the Grafcet's reaction), computed once for every request
+    vector at once; the writes are then applied to whole arrays of (state, outcome) pairs.
+    """
+
+    def __init__(self, pr: _Product, max_states: int) -> None:
+        self.pr, self.max_states = pr, max_states
+        self.size = pr.size
+        self.aux_of: dict[tuple, int] = {}
+        self.aux_list: list[tuple] = []
+        self.classes: dict[tuple, int] = {}
+        self.outcomes: list[_Outcome] = []
+        self.outcome_of: dict[_Outcome, int] = {}
+        self.flat: list[int] = []  # the outcomes of every class, class after class
+        self.n_out: list[int] = []
+        self.arrays = _Grown(len(pr.orders))
+        self.events: list[str] = ["-"] + [e for e, _ in pr.uncontrollable]
+        self.parent: dict[int, tuple[int, str, int]] = {}  # node -> (parent node, event, outcome)
+        self.seen_keys: set[int] = set()
+        self.seen_arrays: dict[int, np.ndarray] = {}
+        self.first: dict[str, tuple[int, str, int, int, tuple[str, ...]]] = {}  # kind -> (node, event, outcome, code, ids)
+        self.counts: dict[str, set[int]] = {k: set() for k in FINDINGS}
+        self.outside_sup: set[int] = set()
+        self.first_outside_sup: int | None = None
+        self.cycles = self.corrected = self.max_distance = 0
+        self.complete = True
+        p = pr.plant
+        init = {v.name: v.initial for v in pr.rules.variables if v.is_input}
+        sit0 = pr.machine.initial({n: init[n] for n in pr.grafcet.inputs}) if pr.machine else None
+        memory = pr.cycle.initial()
+        self.key0 = self.intern((tuple(memory.previous[i] for i in pr.used_index), False, sit0)) * self.size \
+            + p.initial_index
+        self.admit_one(self.key0)
+        if pr.illegal[p.initial_index]:
+            self.counts["violation"].add(p.initial_index)
+
+    # ------------------------------------------------------------------ bookkeeping
+    def intern(self, a: tuple) -> int:
+        k = self.aux_of.get(a)
         if k is None:
-            k = aux_of[a] = len(aux_list)
-            aux_list.append(a)
+            k = self.aux_of[a] = len(self.aux_list)
+            self.aux_list.append(a)
         return k
 
-    init_inputs = {v.name: v.initial for v in pr.rules.variables if v.is_input}
-    sit0 = pr.machine.initial({n: init_inputs[n] for n in pr.grafcet.inputs}) if pr.machine else None
-    mem0 = cyc.initial()
-    aux0 = intern((tuple(mem0.previous[i] for i in pr.used_index), False, sit0))
+    def seen_array(self, aux: int) -> np.ndarray:
+        arr = self.seen_arrays.get(aux)
+        if arr is None:
+            arr = self.seen_arrays[aux] = np.zeros(self.size, dtype=bool)
+        return arr
 
-    # ---- outcomes of one cycle for a class (Y, aux before, situation after)
-    classes: dict[tuple, int] = {}
-    class_outcomes: list[list[int]] = []
-    outcomes: list[_Outcome] = []
-    outcome_of: dict[_Outcome, int] = {}
-    flat_list: list[int] = []  # the outcomes of every class, class after class
-    n_out_list: list[int] = []
-    outcome_arrays = _Grown(len(pr.orders))
+    def admit_one(self, key: int) -> None:
+        code = key % self.size
+        self.seen_keys.add(key)
+        self.seen_array(key // self.size)[code] = True
+        if self.pr.outside_sup[code]:
+            self.outside_sup.add(code)
+            self.first_outside_sup = key if self.first_outside_sup is None else self.first_outside_sup
 
-    def outcomes_for(ybits: int, aux: int, sit: Any) -> int:
+    def record(self, kind: str, mask: np.ndarray, where: np.ndarray, node: np.ndarray, event: np.ndarray,
+               oid: np.ndarray | None, shown: np.ndarray, ids: Any = ()) -> None:
+        """Count the plant states ``where[mask]``; keep the first occurrence (its node, event,
+        outcome, the state to show and the constraints, ``ids(i)`` when callable)."""
+        if not mask.any():
+            return
+        self.counts[kind].update(np.unique(where[mask]).tolist())
+        if kind not in self.first:
+            i = int(np.argmax(mask))
+            self.first[kind] = (int(node[i]), self.events[int(event[i])], -1 if oid is None else int(oid[i]),
+                                int(shown[i]), ids(i) if callable(ids) else ids)
+
+    # ------------------------------------------------------------------ one cycle's outcomes
+    def outcomes_for(self, ybits: int, aux: int, sit: Any) -> int:
+        """The class of (Y, aux before, situation after): its distinct outcomes over every
+        request vector (and Ack), each with the first request vector giving it."""
         key = (ybits, aux, sit)
-        k = classes.get(key)
+        k = self.classes.get(key)
         if k is not None:
             return k
-        mem_used, blocked, _ = aux_list[aux]
+        pr, cyc = self.pr, self.pr.cycle
+        mem_used, blocked, _ = self.aux_list[aux]
         values = {n: bool((ybits >> i) & 1) for i, n in enumerate(pr.ynames)}
         fixed = {n: values[n] for n in pr.filter.inputs}
+        free: list[str] = []
+        passed: dict[str, bool] = {}
         if sit is not None:
-            for s in pr.grafcet.steps:
-                fixed[f"X{s.name}"] = s.name in sit.steps
+            for st in pr.grafcet.steps:
+                fixed[f"X{st.name}"] = st.name in sit.steps
             orders = pr.machine.orders(sit, {n: values[n] for n in pr.grafcet.inputs})
-            fixed.update({r: o in orders for o, r in zip(cyc.outputs, cyc.requests)})
-            passed = {o: o in orders for o in pr.passthrough}
-            free: list[str] = []
+            fixed.update({r: pr.held.get(o, o in orders) for o, r in zip(cyc.outputs, cyc.requests)})
+            passed = {o: pr.held.get(o, o in orders) for o in pr.passthrough}
         else:
-            free = [*cyc.requests, *pr.passthrough]
-            passed = {}
-        if blocking:
+            fixed.update({r: pr.held[o] for o, r in zip(cyc.outputs, cyc.requests) if o in pr.held})
+            passed = {o: pr.held[o] for o in pr.passthrough if o in pr.held}
+            free = [r for o, r in zip(cyc.outputs, cyc.requests) if o not in pr.held]
+            free += [o for o in pr.passthrough if o not in pr.held]
+        if cyc.mode is Mode.BLOCKING:
             free.append(ACK)
         previous = [False] * len(cyc.remembered)
         for i, v in zip(pr.used_index, mem_used):
             previous[i] = v
-        from synth.filter.cycle import Memory
-
         lanes = cyc.lanes(Memory(tuple(previous), blocked), fixed, free)
         n = lanes.count
         out = {o: _unpack(m, n) for o, m in zip(cyc.outputs, lanes.outputs)}
         for o in pr.passthrough:
-            out[o] = np.full(n, passed[o]) if sit is not None else _unpack(_lane_bits(free.index(o), n), n)
+            out[o] = np.full(n, passed[o]) if o in passed else _unpack(_lane_bits(free.index(o), n), n)
         columns = [out[o] for o in pr.orders] + [_unpack(lanes.previous[i], n) for i in pr.used_index]
         columns += [_unpack(m, n) for m in (lanes.blocked, lanes.fallback, lanes.outside_care)]
-        table = np.stack(columns, axis=1)
-        _, firsts = np.unique(table, axis=0, return_index=True)
+        _, firsts = np.unique(np.stack(columns, axis=1), axis=0, return_index=True)
         found: list[int] = []
         for j in sorted(firsts.tolist()):  # one witness lane per distinct outcome, the first
             result, memory = lanes.lane(j)
@@ -300,121 +375,77 @@ def verify(f: Filter, rules_path: str, grafcet: str | None = None, *, any_contro
             for o in pr.passthrough:
                 targets[o] = req[o] = bool(out[o][j])
             mem = tuple(memory.previous[i] for i in pr.used_index)
-            oc = _Outcome(tuple(targets[o] for o in pr.orders), intern((mem, memory.blocked, sit)),
+            oc = _Outcome(tuple(targets[o] for o in pr.orders), self.intern((mem, memory.blocked, sit)),
                           result.fallback, result.outside_care, tuple(req[o] for o in pr.orders), result.violated)
-            g = outcome_of.get(oc)
+            g = self.outcome_of.get(oc)
             if g is None:
-                g = outcome_of[oc] = len(outcomes)
-                outcomes.append(oc)
+                g = self.outcome_of[oc] = len(self.outcomes)
+                self.outcomes.append(oc)
             found.append(g)
-        k = classes[key] = len(class_outcomes)
-        class_outcomes.append(found)
-        flat_list.extend(found)
-        n_out_list.append(len(found))
+        k = self.classes[key] = len(self.n_out)
+        self.flat.extend(found)
+        self.n_out.append(len(found))
         return k
 
-    # ---- breadth-first search, one level at a time
-    parent: dict[int, tuple[int, str, int]] = {}  # node key -> (parent key, event, outcome id)
-    key0 = aux0 * size + p.initial_index
-    seen_keys: set[int] = {key0}
-    seen_arrays: dict[int, np.ndarray] = {}
-
-    def seen_array(aux: int) -> np.ndarray:
-        arr = seen_arrays.get(aux)
-        if arr is None:
-            arr = seen_arrays[aux] = np.zeros(size, dtype=bool)
-        return arr
-
-    seen_array(aux0)[p.initial_index] = True
-    frontier = np.array([key0], dtype=np.int64)
-    findings: dict[str, tuple[int, str, int, int, tuple[str, ...]]] = {}  # kind -> (parent key, event, outcome, code, ids)
-    counts: dict[str, set[int]] = {k: set() for k in FINDINGS}
-    first_node: dict[str, int] = {}
-    if pr.illegal[p.initial_index]:
-        counts["violation"].add(p.initial_index)
-        first_node["violation"] = key0
-    cycles = corrected = max_distance = 0
-    complete = True
-    events = ["-"] + [e for e, _ in pr.uncontrollable]
-    outside_sup_codes: set[int] = set()
-    if pr.outside_sup[p.initial_index]:
-        outside_sup_codes.add(p.initial_index)
-
-    while frontier.size:
+    # ------------------------------------------------------------------ one level
+    def events_from(self, frontier: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Step 1 of a cycle for every node: (state after the plant's event, node, event id),
+        the event being none, an uncontrollable event of the plant, or a Grafcet timer."""
+        pr, size = self.pr, self.size
         codes_all, auxes_all = frontier % size, frontier // size
-        post_l, origin_l, event_l, sits_l = [], [], [], []
-        for aux in np.unique(auxes_all):
+        post_l, node_l, event_l = [], [], []
+
+        def add(post: np.ndarray, nodes: np.ndarray, ei: int) -> None:
+            post_l.append(post)
+            node_l.append(nodes)
+            event_l.append(np.full(post.size, ei, dtype=np.int64))
+
+        for aux in np.unique(auxes_all).tolist():
             sel = auxes_all == aux
-            codes, keys = codes_all[sel], frontier[sel]
-            sit = aux_list[int(aux)][2]
-            post_l.append(codes), origin_l.append(keys), event_l.append(np.zeros(codes.size, dtype=np.int64))
-            sits_l.append(np.full(codes.size, -1, dtype=np.int64))
-            for ei, (ev, nxt) in enumerate(pr.uncontrollable, 1):
+            codes, nodes = codes_all[sel], frontier[sel]
+            add(codes, nodes, 0)
+            for ei, (_, nxt) in enumerate(pr.uncontrollable, 1):
                 dst = nxt[codes]
                 ok = dst >= 0
                 if ok.any():
-                    post_l.append(dst[ok]), origin_l.append(keys[ok])
-                    event_l.append(np.full(int(ok.sum()), ei, dtype=np.int64))
-                    sits_l.append(np.full(int(ok.sum()), -1, dtype=np.int64))
+                    add(dst[ok], nodes[ok], ei)
             if pr.machine is not None:
-                for tev in pr.machine.timers(sit):
-                    if tev not in events:
-                        events.append(tev)
-                    ei = events.index(tev)
-                    post_l.append(codes), origin_l.append(keys)
-                    event_l.append(np.full(codes.size, ei, dtype=np.int64))
-                    sits_l.append(np.full(codes.size, -1, dtype=np.int64))
-        post = np.concatenate(post_l)
-        origin = np.concatenate(origin_l)
-        event_id = np.concatenate(event_l)
-        # transient: the plant's event led into a violating state before the PLC writes
-        moved = event_id > 0  # (a violation the node already had is reported for the node)
-        bad = moved & pr.illegal[post] & ~pr.illegal[origin % size]
-        if bad.any():
-            i = int(np.argmax(bad))
-            counts["transient"].update(np.unique(post[bad]).tolist())
-            if "transient" not in findings:
-                findings["transient"] = (int(origin[i]), events[int(event_id[i])], -1, int(post[i]),
-                                         pr.violated(int(post[i])))
+                for tev in pr.machine.timers(self.aux_list[aux][2]):
+                    if tev not in self.events:
+                        self.events.append(tev)
+                    add(codes, nodes, self.events.index(tev))
+        return np.concatenate(post_l), np.concatenate(node_l), np.concatenate(event_l)
+
+    def classify(self, post: np.ndarray, node: np.ndarray, event: np.ndarray) -> np.ndarray:
+        """Steps 2-3: the class of each (state after the event, node, event)."""
+        pr, width = self.pr, len(self.pr.ynames)
         ybits = np.zeros(post.size, dtype=np.int64)
         for i, n in enumerate(pr.ynames):
             ybits |= pr.val[n][post].astype(np.int64) << i
-        # classes: (Y, aux before, situation after the Grafcet's reaction)
-        origin_aux = origin // size
-        combo = (origin_aux * len(events) + event_id) * (1 << len(pr.ynames)) + ybits
+        combo = ((node // self.size) * len(self.events) + event) * (1 << width) + ybits
         uniq, inverse = np.unique(combo, return_inverse=True)
         class_ids = np.empty(uniq.size, dtype=np.int64)
         for u, c in enumerate(uniq.tolist()):
-            yb = c % (1 << len(pr.ynames))
-            rest = c >> len(pr.ynames)
-            ei, aux = rest % len(events), rest // len(events)
-            sit = aux_list[aux][2]
+            yb, rest = c % (1 << width), c >> width
+            ei, aux = rest % len(self.events), rest // len(self.events)
+            sit = self.aux_list[aux][2]
             if pr.machine is not None:
-                sit = _react(pr, sit, events[ei], yb)
-            class_ids[u] = outcomes_for(yb, aux, sit)
-        cls = class_ids[inverse]
-        n_out = np.array(n_out_list, dtype=np.int64)
-        cycles += int(n_out[cls].sum())
-        # one expansion per distinct (post state, class); the first occurrence is the parent
-        _, keep = np.unique(post * len(n_out_list) + cls, return_index=True)
-        keep.sort()
-        post, origin, event_id, cls = post[keep], origin[keep], event_id[keep], cls[keep]
-        # expand: one entry per (post state, outcome of its class)
-        offsets = np.concatenate(([0], np.cumsum(n_out)))
-        flat_outcomes = np.array(flat_list, dtype=np.int64)
-        reps = n_out[cls]
-        entry = np.repeat(np.arange(post.size), reps)
-        within = np.arange(entry.size) - np.repeat(np.cumsum(reps) - reps, reps)
-        oid = flat_outcomes[offsets[cls][entry] + within]
-        all_targets, all_fallback, all_outside, all_aux = outcome_arrays.update(outcomes)
-        cur = post[entry].copy()
-        before = cur.copy()
-        targets = all_targets[oid]
-        bits = np.stack([pr.val[z][post] for z in pr.orders], axis=1)[entry]  # the orders now
-        refused = np.zeros(entry.size, dtype=bool)
-        edge_bad = np.zeros(entry.size, dtype=bool)
-        edge_ids: list[str] = []
-        middle_bad = np.zeros(entry.size, dtype=bool)
+                sit = _react(pr, sit, self.events[ei], yb)
+            class_ids[u] = self.outcomes_for(yb, aux, sit)
+        return class_ids[inverse]
+
+    def write(self, post: np.ndarray, targets: np.ndarray
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[str], np.ndarray]:
+        """Step 5 for arrays of (state, target orders): the state after the write (-1 when
+        refused), refused, edge constraint broken (and by which events), and an
+        intermediate state violating a constraint."""
+        pr = self.pr
+        cur, before = post.copy(), post
+        bits = np.stack([pr.val[z][post] for z in pr.orders], axis=1)  # the orders now
+        refused = np.zeros(post.size, dtype=bool)
+        edge_bad = np.zeros(post.size, dtype=bool)
+        edge_events: list[str] = []
+        middle_bad = np.zeros(post.size, dtype=bool)
         for rising in (False, True):  # falls first, then rises, each in output order
             for z, name in enumerate(pr.orders):
                 idx = np.nonzero((targets[:, z] == rising) & (bits[:, z] != rising) & ~refused)[0]
@@ -426,7 +457,7 @@ def verify(f: Filter, rules_path: str, grafcet: str | None = None, *, any_contro
                     hit = pr.forbid[ev][before[idx] if pr.atomic else c]
                     if hit.any():
                         edge_bad[idx[hit]] = True
-                        edge_ids.append(ev)
+                        edge_events.append(ev)
                 nxt = pr.toggle[ev][c]
                 no = nxt < 0
                 if no.any():
@@ -437,96 +468,112 @@ def verify(f: Filter, rules_path: str, grafcet: str | None = None, *, any_contro
                 bits[idx, z] = rising
                 if not pr.atomic:
                     middle_bad[idx] |= pr.illegal[nxt]
-        final_ok = cur >= 0
-        origin_e, event_e, post_e = origin[entry], event_id[entry], post[entry]
-        final = np.where(final_ok, cur, 0)
-        violation = final_ok & pr.illegal[final]
-        middle_bad &= ~violation & ~pr.illegal[post_e]  # reported as a violation / before the write
-        fallback = all_fallback[oid]
-        outside = all_outside[oid]
-        for kind, mask, where in (("violation", violation, final), ("edge", edge_bad, post_e),
-                                  ("refused", refused, post_e), ("fallback", fallback, post_e),
-                                  ("outside_care", outside, post_e), ("transient", middle_bad, post_e)):
-            if mask.any():
-                counts[kind].update(np.unique(where[mask]).tolist())
-                i = int(np.argmax(mask))
-                if kind not in findings:
-                    ids: tuple[str, ...] = ()
-                    if kind == "violation":
-                        ids = pr.violated(int(final[i]))
-                    elif kind == "edge":
-                        ids = tuple(dict.fromkeys(c for ev in edge_ids
-                                                  for c in pr.cc.forbidding(ev, p.local(int(post_e[i])))))
-                    elif kind == "refused":
-                        ids = ()
-                    findings[kind] = (int(origin_e[i]), events[int(event_e[i])], int(oid[i]),
-                                      int(final[i]) if kind == "violation" else int(post_e[i]), ids)
-        if pr.machine is not None:
-            req = np.array([o.requests for o in outcomes], dtype=bool).reshape(len(outcomes), len(pr.orders))[oid]
-            dist = (req != targets).sum(axis=1)
-            corrected += int((dist > 0).sum())
-            if dist.size:
-                max_distance = max(max_distance, int(dist.max()))
-        # new nodes
-        aux_after = all_aux[oid]
-        keys = aux_after[final_ok] * size + final[final_ok]
-        src_entry = np.nonzero(final_ok)[0]
+        return cur, refused, edge_bad, edge_events, middle_bad
+
+    def level(self, frontier: np.ndarray) -> np.ndarray:
+        """Every cycle from the nodes of ``frontier``; returns the new nodes."""
+        pr, size = self.pr, self.size
+        post, node, event = self.events_from(frontier)
+        # a plant event into a violating state, before the PLC writes (a violation the
+        # node already had is reported for the node)
+        bad = (event > 0) & pr.illegal[post] & ~pr.illegal[node % size]
+        self.record("transient", bad, post, node, event, None, post, lambda i: pr.violated(int(post[i])))
+        cls = self.classify(post, node, event)
+        n_out = np.array(self.n_out, dtype=np.int64)
+        self.cycles += int(n_out[cls].sum())
+        # one expansion per distinct (state, class); the first occurrence is the parent
+        _, keep = np.unique(post * len(self.n_out) + cls, return_index=True)
+        keep.sort()
+        post, node, event, cls = post[keep], node[keep], event[keep], cls[keep]
+        # one entry per (state, outcome of its class)
+        reps = n_out[cls]
+        entry = np.repeat(np.arange(post.size), reps)
+        within = np.arange(entry.size) - np.repeat(np.cumsum(reps) - reps, reps)
+        offsets = np.concatenate(([0], np.cumsum(n_out)))
+        oid = np.array(self.flat, dtype=np.int64)[offsets[cls][entry] + within]
+        targets, fallback, outside, aux_after, requests = self.arrays.update(self.outcomes)
+        post, node, event, targets = post[entry], node[entry], event[entry], targets[oid]
+        cur, refused, edge_bad, edge_events, middle_bad = self.write(post, targets)
+        ok = cur >= 0
+        final = np.where(ok, cur, 0)
+        violation = ok & pr.illegal[final]
+        middle_bad &= ~violation & ~pr.illegal[post]  # reported as a violation / before the write
+        shown = np.where(ok, final, post)
+
+        def edge_ids(i: int) -> tuple[str, ...]:
+            return tuple(dict.fromkeys(c for ev in edge_events for c in pr.cc.forbidding(ev, pr.plant.local(int(post[i])))))
+
+        self.record("violation", violation, final, node, event, oid, shown, lambda i: pr.violated(int(final[i])))
+        self.record("edge", edge_bad, post, node, event, oid, shown, edge_ids)
+        for kind, mask in (("refused", refused), ("fallback", fallback[oid]), ("outside_care", outside[oid]),
+                           ("transient", middle_bad)):
+            self.record(kind, mask, post, node, event, oid, shown)
+        if pr.machine is not None and oid.size:
+            dist = (requests[oid] != targets).sum(axis=1)
+            self.corrected += int((dist > 0).sum())
+            self.max_distance = max(self.max_distance, int(dist.max()))
+        return self.admit(aux_after[oid][ok] * size + final[ok], node[ok], event[ok], oid[ok])
+
+    def admit(self, keys: np.ndarray, node: np.ndarray, event: np.ndarray, oid: np.ndarray) -> np.ndarray:
+        """The nodes of ``keys`` not seen before (their first occurrence is the parent)."""
+        size = self.size
         uk, first = np.unique(keys, return_index=True)
         fresh = np.ones(uk.size, dtype=bool)
         uk_aux = uk // size
         for a in np.unique(uk_aux).tolist():
             sel = uk_aux == a
-            fresh[sel] = ~seen_array(a)[uk[sel] % size]
-        uk, first = uk[fresh], first[fresh]
-        new_keys = []
-        for k, fi in zip(uk.tolist(), first.tolist()):
-            seen_keys.add(k)
-            seen_array(k // size)[k % size] = True
-            e_i = int(src_entry[fi])
-            parent[k] = (int(origin_e[e_i]), events[int(event_e[e_i])], int(oid[e_i]))
-            new_keys.append(k)
-            if pr.outside_sup[k % size]:
-                outside_sup_codes.add(k % size)
-            if len(seen_keys) >= max_states:
-                complete = False
+            fresh[sel] = ~self.seen_array(a)[uk[sel] % size]
+        new: list[int] = []
+        for k, i in zip(uk[fresh].tolist(), first[fresh].tolist()):
+            if len(self.seen_keys) >= self.max_states:
+                self.complete = False
                 break
-        if not complete:
-            break
-        frontier = np.array(new_keys, dtype=np.int64)
+            self.admit_one(k)
+            self.parent[k] = (int(node[i]), self.events[int(event[i])], int(oid[i]))
+            new.append(k)
+        return np.array(new, dtype=np.int64)
 
-    def trace(key: int) -> list[TraceRow]:
+    def run(self) -> None:
+        frontier = np.array([self.key0], dtype=np.int64)
+        while frontier.size and self.complete:
+            frontier = self.level(frontier)
+
+    # ------------------------------------------------------------------ traces
+    def trace(self, key: int) -> list[TraceRow]:
+        """The shortest path of cycles from the initial node to ``key``."""
         rows = []
-        while key in parent:
-            pk, ev, g = parent[key]
-            rows.append(_row(pr, outcomes[g], ev, key % size, aux_list[key // size][2]))
+        while key in self.parent:
+            pk, ev, g = self.parent[key]
+            rows.append(_row(self.pr, self.outcomes[g], ev, key % self.size, self.aux_list[key // self.size][2]))
             key = pk
-        rows.append(TraceRow("initial", pr.label(key % size), _sit_text(aux_list[key // size][2]), (), ()))
+        rows.append(TraceRow("initial", self.pr.label(key % self.size),
+                             _sit_text(self.aux_list[key // self.size][2]), (), ()))
         return rows[::-1]
 
-    result: dict[str, Finding] = {}
-    for kind, (pk, ev, g, code, ids) in findings.items():
-        rows = trace(pk)
-        if g < 0:  # the plant's event alone
-            rows.append(TraceRow(ev, pr.label(code), rows[-1].situation, (), (), "before the PLC writes"))
-        else:
-            oc = outcomes[g]
-            note = {"violation": "", "edge": "output event forbidden", "refused": "output change refused",
-                    "fallback": "fallback", "outside_care": "outside the care set",
-                    "transient": "an intermediate state of the write violates a constraint"}[kind]
-            sit = aux_list[oc.aux][2]
-            shown = code if kind == "violation" else code
-            rows.append(_row(pr, oc, ev, shown, sit, note))
-            if kind == "transient" and not ids:
-                ids = ()
-        result[kind] = Finding(kind, ids, tuple(rows), len(counts[kind]))
-    if "violation" in first_node and "violation" not in result:
-        result["violation"] = Finding("violation", pr.violated(p.initial_index), tuple(trace(key0)),
-                                      len(counts["violation"]))
-    plant_states = len({k % size for k in seen_keys})
-    return Verification(
-        f.file, rules_path, grafcet if grafcet is not None else "any control", cyc.algorithm, cyc.mode, atomic,
-        strict, len(seen_keys), plant_states, cycles, complete, time.perf_counter() - started,
-        len(outside_sup_codes), result, corrected, max_distance)
+    def findings(self) -> dict[str, Finding]:
+        out: dict[str, Finding] = {}
+        if self.pr.illegal[self.key0 % self.size]:
+            out["violation"] = Finding("violation", self.pr.violated(self.key0 % self.size),
+                                       tuple(self.trace(self.key0)), len(self.counts["violation"]))
+        for kind, (node, ev, g, code, ids) in self.first.items():
+            if kind in out:
+                continue
+            rows = self.trace(node)
+            if g < 0:  # the plant's event alone
+                rows.append(TraceRow(ev, self.pr.label(code), rows[-1].situation, (), (), "before the PLC writes",
+                                     False))
+            else:
+                oc = self.outcomes[g]
+                rows.append(_row(self.pr, oc, ev, code, self.aux_list[oc.aux][2], _NOTES[kind]))
+            out[kind] = Finding(kind, ids, tuple(rows), len(self.counts[kind]))
+        if self.first_outside_sup is not None:
+            key = self.first_outside_sup
+            rows = self.trace(key)
+            ids = tuple(self.pr.cc.threatened(self.pr.plant.local(key % self.size)))
+            rows[-1] = dataclasses.replace(rows[-1], note="; ".join(
+                n for n in (rows[-1].note, "outside SUP: uncontrollable events can lead to " + ", ".join(ids)) if n))
+            out["outside_sup"] = Finding("outside_sup", ids, tuple(rows), len(self.outside_sup))
+        return {k: out[k] for k in FINDINGS if k in out}
 
 
 def _unpack(mask: int, count: int) -> np.ndarray:
@@ -548,16 +595,20 @@ class _Grown:
         self.fallback = np.zeros(0, dtype=bool)
         self.outside = np.zeros(0, dtype=bool)
         self.aux = np.zeros(0, dtype=np.int64)
+        self.requests = np.zeros((0, width), dtype=bool)
 
-    def update(self, outcomes: Sequence[_Outcome]) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    def update(self, outcomes: Sequence[_Outcome]
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         new = outcomes[self.aux.size:]
         if new:
+            self.requests = np.concatenate((self.requests, np.array([o.requests for o in new], dtype=bool)
+                                            .reshape(len(new), self.requests.shape[1])))
             self.targets = np.concatenate((self.targets, np.array([o.targets for o in new], dtype=bool)
                                            .reshape(len(new), self.targets.shape[1])))
             self.fallback = np.concatenate((self.fallback, np.array([o.fallback for o in new], dtype=bool)))
             self.outside = np.concatenate((self.outside, np.array([o.outside_care for o in new], dtype=bool)))
             self.aux = np.concatenate((self.aux, np.array([o.aux for o in new], dtype=np.int64)))
-        return self.targets, self.fallback, self.outside, self.aux
+        return self.targets, self.fallback, self.outside, self.aux, self.requests
 
 
 def _react(pr: _Product, sit: Any, event: str, ybits: int) -> Any:
@@ -607,7 +658,7 @@ def trace_text(rows: Sequence[TraceRow]) -> str:
         line = f"{i:<3}{r.event:<{w_event}}  {r.state:<{w_state}}"
         if w_sit:
             line += f"  {r.situation:<{w_sit}}"
-        if i or r.requests or r.orders:
+        if i and r.ran:
             line += f"  requests: {_names(r.requests)}  orders: {_names(r.orders)}"
         if r.note:
             line += f"   {r.note}"
@@ -620,7 +671,7 @@ def verification_text(v: Verification) -> str:
              f"({v.algorithm.value}, {v.mode.value}, {'atomic outputs' if v.atomic else 'ordered outputs'})",
              f"explored {v.states} states ({v.plant_states} plant states), {v.cycles} cycles"
              f" in {v.seconds:.2f} s" + ("" if v.complete else " -- STOPPED at the state limit")]
-    for kind in ("violation", "edge", "refused"):
+    for kind in ("violation", "edge", "refused", "outside_sup"):
         if kind in v.findings:
             fd = v.findings[kind]
             lines.append(f"unsafe: {FINDINGS[kind]} ({fd.count} plant states)"
@@ -633,8 +684,9 @@ def verification_text(v: Verification) -> str:
         lines.append(f"{'unsafe' if v.strict else 'transient'}: {fd.count} plant states violate a constraint "
                      "between the plant's event and the end of the write"
                      + (f" ({', '.join(fd.constraints)})" if fd.constraints else ""))
-    lines.append(f"outside SUP: {v.outside_sup} explored plant states can reach a violation by "
-                 "uncontrollable events alone")
+    if "outside_sup" not in v.findings:
+        lines.append(f"outside SUP: {v.outside_sup} explored plant states can reach a violation by "
+                     "uncontrollable events alone")
     for kind in ("fallback", "outside_care"):
         if kind in v.findings:
             lines.append(f"incoherent: {FINDINGS[kind]} ({v.findings[kind].count} plant states)")
@@ -660,5 +712,6 @@ def verification_json(v: Verification) -> dict[str, Any]:
         "corrected": v.corrected, "max_distance": v.max_distance, "seconds": round(v.seconds, 3),
         "findings": {k: {"count": f.count, "constraints": list(f.constraints), "trace": [
             {"event": r.event, "state": r.state, "situation": r.situation, "requests": list(r.requests),
-             "orders": list(r.orders), "note": r.note} for r in f.trace]} for k, f in v.findings.items()},
+             "orders": list(r.orders), "note": r.note, "plc_ran": r.ran} for r in f.trace]}
+                     for k, f in v.findings.items()},
     }

@@ -46,7 +46,7 @@ from typing import Iterable, Mapping, Sequence
 
 from synth.errors import InputError
 from synth.filter.bdd import Cube
-from synth.filter.language import Filter, base_name, is_pre, pre_name, request_name
+from synth.filter.language import Filter, base_name, is_pre, pre_name
 from synth.filter.model import FilterFunctions, functions
 
 __all__ = ["Algorithm", "Mode", "ACK", "Memory", "CycleResult", "Lanes", "FilterCycle", "Cover"]
@@ -114,6 +114,7 @@ class Lanes:
     outside_care: int
     blocked: int  # the latch after the cycle
     previous: tuple[int, ...]  # the memory after the cycle, per remembered name
+    names: tuple[str, ...] = ()  # the outputs, in order
 
     def lane(self, j: int) -> tuple[CycleResult, Memory]:
         """Lane ``j`` as one cycle's result and the memory it leaves."""
@@ -126,7 +127,8 @@ class Lanes:
         reqs = tuple(bit(r) for r in self.requests)
         result = CycleResult(
             reqs, outs, tuple(tuple(bit(s) for s in si) for si in self.iterations[:n]), bit(self.fallback),
-            tuple(i for i, m in self.violated.items() if bit(m)), (), bit(self.outside_care),
+            tuple(i for i, m in self.violated.items() if bit(m)),
+            tuple(o for o, r, v in zip(self.names, reqs, outs) if r != v), bit(self.outside_care),
             tuple(i for i, m in self.unsafe.items() if bit(m)), bit(self.blocked))
         return result, Memory(tuple(bit(p) for p in self.previous), bit(self.blocked))
 
@@ -192,10 +194,7 @@ class FilterCycle:
     def step(self, memory: Memory, values: Mapping[str, bool]) -> tuple[CycleResult, Memory]:
         """One cycle: ``values`` gives every name of :attr:`reads` (inputs, observers,
         requests ``R_o``, and ``Ack`` in blocking mode); returns its result and the new memory."""
-        lanes = self.lanes(memory, values, ())
-        result, after = lanes.lane(0)
-        corrections = tuple(o for o, r, v in zip(self.outputs, result.requests, result.outputs) if r != v)
-        return _with_corrections(result, corrections), after
+        return self.lanes(memory, values, ()).lane(0)
 
     def lanes(self, memory: Memory, fixed: Mapping[str, bool], free: Sequence[str]) -> Lanes:
         """The cycle for every valuation of the names ``free`` (lane j: bit i of j is the
@@ -258,7 +257,7 @@ class FilterCycle:
         previous = tuple(with_outputs[n] for n in self.remembered)
         return Lanes(count, requests, outputs, tuple(iterations), tuple(rounds), fallback,
                      {i: m for i, m in violated.items()}, {i: m for i, m in unsafe.items()},
-                     outside, blocked, previous)
+                     outside, blocked, previous, self.outputs)
 
     # ------------------------------------------------------------------ the loop
     def _loop(self, values: dict[str, int], g1: tuple[int, ...], full: int, ev, iterations: list, rounds: list
@@ -297,7 +296,3 @@ class FilterCycle:
             si = [(((full ^ fs0[k]) & fs1[k]) & fallback) | (si[k] & (full ^ fallback)) for k in range(len(outs))]
         return tuple(si), fallback
 
-
-def _with_corrections(r: CycleResult, corrections: tuple[str, ...]) -> CycleResult:
-    return CycleResult(r.requests, r.outputs, r.iterations, r.fallback, r.violated, corrections,
-                       r.outside_care, r.unsafe, r.blocked)

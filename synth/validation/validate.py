@@ -37,15 +37,23 @@ class Validation:
     sup_empty: bool
     homes: tuple[str, ...] = ()  # the --home conditions, as written
     never_starts: Diagnosis | None = None
+    # set by the symbolic engine, whose ``sync`` holds only the nodes a report shows:
+    counts: dict[str, int] | None = None  # the stats, counted on the whole SYNC
+    reached_steps: frozenset[str] | None = None  # steps active in some reachable situation
+    engine_stats: dict[str, int] | None = None  # BDD nodes, situations
 
     @property
     def unreached_steps(self) -> list[str]:
         """Steps active in no stable situation SYNC reaches: dead code under this plant."""
-        active = {st for n in self.sync.nodes for st in n.situation.steps}
+        active = self.reached_steps
+        if active is None:
+            active = frozenset(st for n in self.sync.nodes for st in n.situation.steps)
         return [s.variable for s in self.grafcet.steps if s.name not in active]
 
     @property
     def stats(self) -> dict[str, int]:
+        if self.counts is not None:
+            return dict(self.counts)
         return {
             "plant_states": self.plant.size,
             "sync_states": self.sync.sync_states,
@@ -100,11 +108,24 @@ def validate(
     homes: Sequence[str] = (),
     max_states: int | None = None,
     progress: Callable[[int, int], None] | None = None,
+    engine: str = "explicit",
+    max_nodes: int | None = None,
+    symbolic_progress: Callable[[str], None] | None = None,
 ) -> Validation:
-    """Run the whole method on a Grafcet and a plant; ``homes`` are ``--home`` conditions."""
+    """Run the whole method on a Grafcet and a plant; ``homes`` are ``--home`` conditions.
+
+    ``engine``: ``explicit``, ``symbolic`` (:mod:`synth.symbolic`, ``max_nodes`` its BDD
+    node budget) or ``auto`` (by estimated size, :mod:`synth.symbolic.engine`)."""
     rs = load_rules(rules_path)
     p = plant(rs)
     g = load_grafcet(grafcet_path, inputs=p.inputs, outputs=p.outputs)
+    if engine != "explicit":
+        from synth.symbolic.engine import EngineChoice, choose
+
+        if choose(engine, p.size * max(1, len(g.steps))) == EngineChoice.SYMBOLIC:
+            from synth.symbolic.validate import validate_loaded
+
+            return validate_loaded(rs, p, g, expert=expert, homes=homes, max_nodes=max_nodes, progress=symbolic_progress)
     conditions = home_conditions(homes, p, g)
     machine = GrafcetMachine(g)
     sup_empty = not CompiledConstraints(p, rs.constraints).kept(p.initial)

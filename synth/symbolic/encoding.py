@@ -1,0 +1,202 @@
+"""The plant's state space on BDDs: one boolean variable per plant variable, in three copies.
+
+A plant state is the valuation of every element variable (``A1``, ``a1_0``, …): the
+*current* copy carries a variable's own name, the *next* copy ``name'`` and an *auxiliary*
+copy ``name''`` (used to compose relations); the three copies of a variable are adjacent
+in the order, elements in declaration order, so relations that change one element stay
+small. Each element's reachable local codes form its *domain*; a state set is always a
+subset of the product of the domains.
+
+Counts are exact Python integers (CUDD's own count is a double, wrong above 2^53).
+
+Example
+-------
+>>> from synth.plant.rules import load_rules
+>>> from synth.plant.composition import plant, _plants
+>>> enc = PlantEncoding(plant(load_rules(_plants("tri_annex.rules"))))
+>>> enc.count(enc.domain)
+15552
+>>> enc.local(enc.pick(enc.state(enc.plant.initial))) == enc.plant.initial
+True
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import Enum
+from typing import Iterator, Mapping, Sequence
+
+from synth.errors import LimitExceeded
+from synth.filter.bdd import Engine, Function
+from synth.plant.composition import Plant
+
+__all__ = ["Copy", "PlantEncoding", "NodeBudget"]
+
+
+class Copy(Enum):
+    """Which copy of the plant variables a BDD speaks about."""
+
+    CURRENT = ""
+    NEXT = "'"
+    AUX = "''"
+
+
+@dataclass(frozen=True)
+class NodeBudget:
+    """``--max-nodes``: the largest number of live BDD nodes allowed (None: no limit)."""
+
+    limit: int | None = None
+
+    def check(self, engine: Engine, where: str) -> None:
+        """Stop with :class:`~synth.errors.LimitExceeded` above the budget."""
+        if self.limit is None:
+            return
+        n = len(engine.bdd)
+        if n > self.limit:
+            raise LimitExceeded(
+                f"the symbolic engine needs more than {self.limit} BDD nodes ({n} while {where}); "
+                "raise --max-nodes or use --engine explicit"
+            )
+
+
+class PlantEncoding:
+    """BDD variables, domains and conversions for the states of one plant."""
+
+    def __init__(self, p: Plant, budget: NodeBudget | None = None) -> None:
+        self.plant = p
+        self.budget = budget or NodeBudget()
+        self.variables: tuple[str, ...] = tuple(v for e in p.elements for v in e.variables)
+        order = [v + c.value for v in self.variables for c in Copy]
+        self.engine = Engine(order)
+        self.bdd = self.engine.bdd
+        self.element_variables: tuple[tuple[str, ...], ...] = tuple(e.variables for e in p.elements)
+        self.domains: tuple[Function, ...] = tuple(
+            self.engine.disjunction(self.code(i, int(c)) for c in e.codes) for i, e in enumerate(p.elements)
+        )
+        self.domain: Function = self.engine.conjunction(self.domains)
+        self._renames: dict[tuple, dict[str, Function]] = {}
+        self._quantified: dict[tuple, list[str]] = {}
+        self._inner = {v: self.engine.declare(v) for v in self.variables}
+
+    # ---- names and renaming
+    @staticmethod
+    def name(v: str, copy: Copy) -> str:
+        return v + copy.value
+
+    def rename(self, u: Function, source: Copy, target: Copy, names: Sequence[str] | None = None) -> Function:
+        """``u`` with the ``source`` copy of ``names`` (default: every variable) renamed to ``target``."""
+        key = (source, target, None if names is None else tuple(names))
+        sub = self._renames.get(key)
+        if sub is None:
+            vs = self.variables if names is None else names
+            sub = {self.engine.declare(v + source.value): self.bdd.var(self.engine.declare(v + target.value)) for v in vs}
+            self._renames[key] = sub
+        return self.bdd.let(sub, u)
+
+    def exists(self, u: Function, copy: Copy, names: Sequence[str] | None = None) -> Function:
+        key = (copy, None if names is None else tuple(names))
+        vs = self._quantified.get(key)
+        if vs is None:
+            vs = [self.engine.declare(v + copy.value) for v in (self.variables if names is None else names)]
+            self._quantified[key] = vs
+        return self.bdd.exist(vs, u)
+
+    # ---- states
+    def code(self, axis: int, code: int, copy: Copy = Copy.CURRENT) -> Function:
+        """The cube of element ``axis``'s local code ``code`` (bit i = its i-th variable)."""
+        names = self.element_variables[axis]
+        return self.engine.cube({n + copy.value: bool((code >> i) & 1) for i, n in enumerate(names)})
+
+    def local_state(self, axis: int, k: int, copy: Copy = Copy.CURRENT) -> Function:
+        return self.code(axis, int(self.plant.elements[axis].codes[k]), copy)
+
+    def state(self, local: Sequence[int], copy: Copy = Copy.CURRENT) -> Function:
+        """The cube of one plant state given as local indices."""
+        return self.engine.conjunction(self.local_state(a, k, copy) for a, k in enumerate(local))
+
+    def pick(self, u: Function) -> dict[str, bool] | None:
+        """One state of ``u`` (a valuation of every current variable), ``None`` if empty.
+        Variables ``u`` leaves free on the path taken are false (every completion of a
+        path to 1 is in ``u``)."""
+        if u == self.engine.false:
+            return None
+        values = {v: False for v in self.variables}
+        outer = self.engine._outer
+        f = u
+        true, false = self.engine.true, self.engine.false
+        while f != true:
+            lo, hi = f.low, f.high  # children of the regular node: complement them if f is
+            if f.negated:
+                lo, hi = ~lo, ~hi
+            name = outer[f.var]
+            if lo != false:
+                values[name] = False
+                f = lo
+            else:
+                values[name] = True
+                f = hi
+        return values
+
+    def local(self, values: Mapping[str, bool]) -> tuple[int, ...]:
+        """Local indices of the state whose variables have ``values``."""
+        out = []
+        for e in self.plant.elements:
+            code = sum(1 << i for i, v in enumerate(e.variables) if values[v])
+            out.append(int(e.codes.searchsorted(code)))
+        return tuple(out)
+
+    def states(self, u: Function, limit: int) -> Iterator[tuple[int, ...]]:
+        """Every state of ``u`` as local indices, in a deterministic order; at most ``limit``."""
+        care = [self.engine.declare(v) for v in self.variables]
+        for n, inner in enumerate(self.bdd.pick_iter(u, care_vars=care)):
+            if n >= limit:
+                raise LimitExceeded(f"more than {limit} states to list from a BDD")
+            yield self.local({v: bool(inner[self.engine.declare(v)]) for v in self.variables})
+
+    # ---- exact counting
+    def count(self, u: Function, copies: Sequence[Copy] = (Copy.CURRENT,)) -> int:
+        """The exact number of valuations of the given copies of the variables in ``u``
+        (``u`` must depend on those copies only). CUDD's count (a double) is used when
+        it is exact (below 2^50), an exact recursion over the BDD otherwise."""
+        if u == self.engine.false:
+            return 0
+        nvars = len(self.variables) * len(copies)
+        fast = self.bdd.count(u, nvars=nvars)
+        if fast < 2**50:
+            return int(fast)
+        levels = sorted(self.engine.level(v + c.value) for v in self.variables for c in copies)
+        return _exact_count(u, levels, self.engine)
+
+    def check(self, where: str) -> None:
+        self.budget.check(self.engine, where)
+
+
+def _exact_count(u: Function, levels: Sequence[int], engine: Engine) -> int:
+    """Models of ``u`` over the variables at ``levels`` (sorted), as a Python int."""
+    position = {lv: i for i, lv in enumerate(levels)}
+    n = len(levels)
+    memo: dict[Function, int] = {}
+    true, false = engine.true, engine.false
+
+    def below(f: Function) -> int:
+        """Index in ``levels`` of ``f``'s top variable (``n`` for constants)."""
+        return n if f == true or f == false else position[f.level]
+
+    def models(f: Function) -> int:  # over levels[below(f):]
+        if f == true:
+            return 1
+        if f == false:
+            return 0
+        hit = memo.get(f)
+        if hit is not None:
+            return hit
+        if f.negated:
+            r = (1 << (n - below(f))) - models(~f)
+        else:
+            i = below(f)
+            lo, hi = f.low, f.high
+            r = models(lo) * (1 << (below(lo) - i - 1)) + models(hi) * (1 << (below(hi) - i - 1))
+        memo[f] = r
+        return r
+
+    return models(u) * (1 << below(u))

@@ -1,0 +1,253 @@
+"""Verdicts on the symbolic SYNC: coreachability, blocking components, shortest traces.
+
+The same reading as :mod:`synth.validation.analysis`, on sets of nodes (a BDD per
+situation) instead of node lists:
+
+- ``coreachable``: backward fixpoint from the home nodes;
+- *stuck* nodes (reachable, not coreachable); their terminal strongly connected
+  components: every deadlock is one; the other candidates are found by descending
+  (pick a node, its forward set; if that lies in its backward set it is a terminal
+  component, else descend into the part that cannot come back);
+- *held* nodes (no node with other active steps reachable) with a prohibited order;
+- distances from the onion rings; the node the explicit engine would number first at
+  a distance is the one whose shortest path is smallest in the explicit exploration's
+  order (element, variable, then timers); the trace to a node is the shortest path
+  whose events are smallest by name, as the explicit breadth-first search sorts them.
+
+Example
+-------
+>>> # see tests/test_symbolic.py: every result is compared with the explicit analysis
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+from synth.errors import LimitExceeded
+from synth.filter.bdd import Function
+from synth.logic.events import Event
+from synth.symbolic.encoding import Copy
+from synth.symbolic.sync import Bundle, NodeSet, SymbolicSync
+
+__all__ = ["Path", "coreachable", "stuck_nodes", "held_nodes", "terminal_components", "first_node", "shortest_trace",
+           "prohibited_nodes", "MAX_LISTED"]
+
+MAX_LISTED = 100_000
+"""At most this many nodes of one component are listed for the diagnosis."""
+
+
+@dataclass(frozen=True)
+class Path:
+    """A path of the aggregated automaton: nodes as (situation, plant state) and events."""
+
+    nodes: tuple[tuple[int, tuple[int, ...]], ...]
+    events: tuple[Event, ...]
+
+
+def _minus(a: NodeSet, b: NodeSet, false: Function) -> NodeSet:
+    out = {}
+    for s, u in a.items():
+        r = u & ~b.get(s, false)
+        if r != false:
+            out[s] = r
+    return out
+
+
+def _empty(a: NodeSet, false: Function) -> bool:
+    return all(u == false for u in a.values())
+
+
+def coreachable(sync: SymbolicSync, homes: NodeSet) -> NodeSet:
+    """Nodes from which a home node is reachable."""
+    return sync.backward(homes)
+
+
+def stuck_nodes(sync: SymbolicSync, back: NodeSet) -> NodeSet:
+    """Reachable nodes that are not coreachable."""
+    return _minus(sync.nodes(), back, sync.false)
+
+
+def held_nodes(sync: SymbolicSync) -> NodeSet:
+    """Nodes from which no node with other active steps is reachable."""
+    changers: NodeSet = {}
+    for link in sync.links:
+        if sync.situations[link.source].steps == sync.situations[link.target].steps:
+            continue
+        src = sync.pre({link.target: sync.regions[link.target].nodes}, [link])
+        for s, u in src.items():
+            changers[s] = changers.get(s, sync.false) | u
+    return _minus(sync.nodes(), sync.backward(changers), sync.false)
+
+
+def prohibited_nodes(sync: SymbolicSync) -> dict[tuple[tuple[str, ...], Event], NodeSet]:
+    """Per (active steps, refused order event), the nodes where SUP refuses it."""
+    out: dict[tuple[tuple[str, ...], Event], NodeSet] = {}
+    for s, r in enumerate(sync.regions):
+        steps = sync.situations[s].steps
+        for wanted, nodes in r.by_orders.items():
+            _, _, refused = sync.intra(wanted)
+            for event, bad in refused.items():
+                hit = nodes & bad
+                if hit != sync.false:
+                    d = out.setdefault((steps, event), {})
+                    d[s] = d.get(s, sync.false) | hit
+    return out
+
+
+def _deepest(sync: SymbolicSync, u: NodeSet) -> NodeSet:
+    """One node of ``u`` from the farthest onion ring meeting it (terminal components lie deep)."""
+    rings = sync.onion_rings()
+    for ring in reversed(rings):
+        for s in sorted(ring):
+            v = u.get(s, sync.false) & ring[s]
+            if v != sync.false:
+                return {s: sync.enc.state(sync.enc.local(sync.enc.pick(v)))}
+    raise ValueError("no node of the set is reachable")
+
+
+def terminal_components(sync: SymbolicSync, stuck: NodeSet) -> list[NodeSet]:
+    """The terminal strongly connected components of the stuck nodes.
+
+    Descent: from a node ``v``, ``F`` = its forward set (closed under successors); ``F``
+    is a terminal component iff every node of ``F`` reaches ``v`` back (a backward
+    fixpoint inside ``F`` only); otherwise continue from a node of ``F`` that cannot
+    reach ``v``. Once a component is found, it and every node that can reach it leave
+    the candidates (none of them is in another terminal component)."""
+    false = sync.false
+    comps: list[NodeSet] = []
+    candidates = dict(stuck)
+    while not _empty(candidates, false):
+        v = _deepest(sync, candidates)
+        while True:
+            fwd = sync.forward(v)
+            back = sync.backward(v, within=fwd)
+            below = _minus(fwd, back, false)
+            if _empty(below, false):
+                comps.append(fwd)
+                break
+            v = _deepest(sync, below)
+        candidates = _minus(candidates, sync.backward(comps[-1], within=candidates), false)
+    return comps
+
+
+def _key(sync: SymbolicSync, b: Bundle) -> tuple[int, int, int]:
+    """The explicit exploration's order of an event from a node: plant moves by element
+    and variable, then timers."""
+    if b.move is None:
+        return (1, b.key[1], 0)
+    e = sync.plant.elements[b.move.axis]
+    return (0, b.move.axis, e.variables.index(b.move.variable))
+
+
+def _layers(sync: SymbolicSync, target: NodeSet, depth: int) -> list[NodeSet]:
+    """For k ≤ depth, the ring-k nodes from which ``target`` is reachable in depth−k steps."""
+    rings = sync.onion_rings()
+    layers: list[NodeSet] = [dict() for _ in range(depth + 1)]
+    layers[depth] = {s: u & rings[depth].get(s, sync.false) for s, u in target.items()}
+    for k in range(depth - 1, -1, -1):
+        pre: NodeSet = {}
+        for t, u in layers[k + 1].items():
+            if u == sync.false:
+                continue
+            for s, v in sync.pre({t: u}, sync.into(t)).items():
+                pre[s] = pre.get(s, sync.false) | v
+        layers[k] = {s: u & rings[k].get(s, sync.false) for s, u in pre.items()}
+        layers[k] = {s: u for s, u in layers[k].items() if u != sync.false}
+    return layers
+
+
+def _greedy(sync: SymbolicSync, layers: list[NodeSet], order: Callable[[Bundle], object]) -> tuple[list[NodeSet], list[Event]]:
+    """Forward through ``layers``, taking at each step the smallest event (by ``order``)."""
+    current = layers[0]
+    chosen = [current]
+    events: list[Event] = []
+    for k in range(1, len(layers)):
+        options: dict[object, tuple[Event, NodeSet]] = {}
+        for s, u in current.items():
+            for b in sync.out_bundles(s):
+                if b.target not in layers[k]:
+                    continue
+                v = sync.post({s: u}, b) & layers[k][b.target]
+                if v == sync.false:
+                    continue
+                key = order(b)
+                ev, nxt = options.get(key, (b.event, {}))
+                nxt[b.target] = nxt.get(b.target, sync.false) | v
+                options[key] = (ev, nxt)
+        best = min(options)
+        ev, current = options[best]
+        events.append(ev)
+        chosen.append(current)
+    return chosen, events
+
+
+def _pick(sync: SymbolicSync, u: NodeSet) -> tuple[int, tuple[int, ...]]:
+    s = min(s for s, v in u.items() if v != sync.false)
+    return s, sync.enc.local(sync.enc.pick(u[s]))
+
+
+def first_node(sync: SymbolicSync, candidates: NodeSet) -> tuple[int, tuple[int, ...], int, tuple]:
+    """The candidate the explicit engine numbers first: smallest distance, then smallest
+    path in exploration order. Returns (situation, plant state, distance, path key)."""
+    rings = sync.onion_rings()
+    for depth, ring in enumerate(rings):
+        hit = {s: u & ring[s] for s, u in candidates.items() if s in ring and (u & ring[s]) != sync.false}
+        if hit:
+            break
+    else:
+        raise ValueError("no candidate is reachable")
+    layers = _layers(sync, hit, depth)
+    chosen, _ = _greedy(sync, layers, lambda b: _key(sync, b))
+    keys: list[tuple] = []
+    # the key path, for sorting several first nodes at one distance
+    for k in range(1, len(chosen)):
+        best = min(_key(sync, b) for s in chosen[k - 1] for b in sync.out_bundles(s)
+                   if b.target in chosen[k] and sync.post({s: chosen[k - 1][s]}, b) & chosen[k][b.target] != sync.false)
+        keys.append(best)
+    s, local = _pick(sync, chosen[-1])
+    return s, local, depth, tuple(keys)
+
+
+def shortest_trace(sync: SymbolicSync, s: int, local: tuple[int, ...]) -> Path:
+    """The shortest path from an initial node to node (``s``, ``local``) whose events are
+    smallest by name (the explicit breadth-first search's parent choice)."""
+    node = sync.enc.state(local)
+    depth = sync.depth(s, node)
+    if depth is None:
+        raise ValueError("node not reachable")
+    layers = _layers(sync, {s: node}, depth)
+    chosen, events = _greedy(sync, layers, lambda b: b.event)
+    # one concrete node per layer, backwards from the target
+    nodes = [(s, local)]
+    for k in range(depth - 1, -1, -1):
+        t, loc = nodes[-1]
+        target = {t: sync.enc.state(loc)}
+        pre: NodeSet = {}
+        arcs = [b for b in sync.bundles if b.target == t and b.event == events[k]]
+        for src, u in sync.pre(target, arcs).items():
+            v = u & chosen[k].get(src, sync.false)
+            if v != sync.false:
+                pre[src] = v
+        nodes.append(_pick(sync, pre))
+    nodes.reverse()
+    return Path(tuple(nodes), tuple(events))
+
+
+def listed(sync: SymbolicSync, u: NodeSet, limit: int = MAX_LISTED) -> list[tuple[int, tuple[int, ...]]]:
+    """The nodes of ``u``, situation by situation."""
+    out = []
+    for s in sorted(u):
+        for local in sync.enc.states(u[s], limit - len(out)):
+            out.append((s, local))
+    if len(out) > limit:  # pragma: no cover - states() raises first
+        raise LimitExceeded(f"more than {limit} nodes to list")
+    return out
+
+
+def count(sync: SymbolicSync, u: NodeSet) -> int:
+    return sum(sync.enc.count(v) for v in u.values())
+
+
+def rename_next(sync: SymbolicSync, u: Function) -> Function:
+    return sync.enc.rename(u, Copy.CURRENT, Copy.NEXT)

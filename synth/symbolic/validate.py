@@ -1,0 +1,252 @@
+"""``synth validate --engine symbolic``: the symbolic SYNC, then the explicit diagnosis.
+
+The symbolic engine decides everything that needs the whole SYNC (counts, coreachability,
+blocking components, held states, prohibited orders, never-starts); the states a report
+shows (those along each trace, the blocking components, the initial states) are then
+made explicit :class:`~synth.validation.sync.Node` objects in a small
+:class:`~synth.validation.sync.Sync`, and the existing diagnosis and output run on it
+unchanged, so the texts and the JSON are those of the explicit engine.
+
+Example
+-------
+>>> from synth.plant.composition import _plants
+>>> v = validate_symbolic(_plants("../grafcets/tri_missing_order.g7"), _plants("tri.rules"))
+>>> v.passed, v.stats["aggregated_states"]
+(False, 30)
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Callable, Sequence
+
+from synth.grafcet.language import Grafcet, load_grafcet
+from synth.grafcet.machine import GrafcetMachine
+from synth.logic.expr import evaluate
+from synth.plant.composition import Plant, plant
+from synth.plant.rules import RuleSet, load_rules
+from synth.sup.constraints import CompiledConstraints
+from synth.symbolic.encoding import NodeBudget
+from synth.symbolic.reachability import (
+    MAX_LISTED,
+    coreachable,
+    first_node,
+    held_nodes,
+    listed,
+    prohibited_nodes,
+    shortest_trace,
+    stuck_nodes,
+    terminal_components,
+)
+from synth.symbolic.supervisor import SymbolicSupervisor
+from synth.symbolic.sync import NodeSet, SymbolicSync
+from synth.validation.analysis import Analysis, Trace
+from synth.validation.diagnosis import diagnose, diagnose_never_starts
+from synth.validation.sync import Conflict, Edge, Node, Prohibition, Sync, _order_moves
+from synth.validation.validate import Validation, home_conditions
+
+__all__ = ["validate_symbolic", "validate_loaded"]
+
+Key = tuple[int, tuple[int, ...]]
+
+
+class _Explicit:
+    """The explicit nodes and edges a report needs, numbered as they are asked for."""
+
+    def __init__(self, ssync: SymbolicSync, oracle: CompiledConstraints) -> None:
+        self.ssync = ssync
+        self.p: Plant = ssync.plant
+        self.oracle = oracle
+        self.moves = _order_moves(self.p)
+        self.nodes: list[Node] = []
+        self.index: dict[Key, int] = {}
+        self.edges: list[Edge] = []
+        self._edges: set[tuple[int, str, int]] = set()
+
+    def node(self, key: Key) -> int:
+        i = self.index.get(key)
+        if i is not None:
+            return i
+        s, local = key
+        sit = self.ssync.situations[s]
+        machine = self.ssync.machine
+        inputs = {n: v for n, v in self.p.valuation(local).items() if n in machine.inputs}
+        wanted = machine.orders(sit, inputs)
+        val = self.p.valuation(local)
+        refused: list[Prohibition] = []
+        for order in sorted(self.moves):
+            if val[order] == (order in wanted):
+                continue
+            for t in self.moves[order]:
+                if t.src != local[t.axis]:
+                    continue
+                ok, why = self.oracle.move(t, local)
+                if not ok:
+                    refused.append(Prohibition(t.event, tuple(why)))
+        ords = tuple(sorted(o for o in wanted if val.get(o, False)))
+        self.index[key] = len(self.nodes)
+        self.nodes.append(Node(sit, local, frozenset(wanted), ords, tuple(sorted(refused))))
+        return self.index[key]
+
+    def trace(self, key: Key) -> Trace:
+        path = shortest_trace(self.ssync, *key)
+        ids = [self.node(k) for k in path.nodes]
+        for a, e, b in zip(ids, path.events, ids[1:]):
+            if (a, e, b) not in self._edges:
+                self._edges.add((a, e, b))
+                self.edges.append(Edge(a, e, b))
+        return Trace(tuple(ids), tuple(path.events))
+
+
+def _homes(ssync: SymbolicSync, texts: Sequence[str], p: Plant, g) -> NodeSet:
+    homes: NodeSet = dict(ssync.initial)
+    conditions = home_conditions(texts, p, g)
+    if not conditions:
+        return homes
+    engine = ssync.engine
+    for s, r in enumerate(ssync.regions):
+        steps = set(ssync.situations[s].step_variables)
+
+        def value(name: str, steps: set[str] = steps):
+            return engine.var(name) if name in p.owner else (engine.true if name in steps else engine.false)
+
+        hit = engine.false
+        for c in conditions:
+            hit |= evaluate(c, value)
+        hit &= r.nodes
+        if hit != engine.false:
+            homes[s] = homes.get(s, engine.false) | hit
+    return homes
+
+
+def validate_symbolic(
+    grafcet_path: str | Path,
+    rules_path: str | Path,
+    *,
+    expert: bool = False,
+    homes: Sequence[str] = (),
+    max_nodes: int | None = None,
+    progress: Callable[[str], None] | None = None,
+) -> Validation:
+    """Run the whole method with the symbolic engine (see module docstring)."""
+    rs = load_rules(rules_path)
+    p = plant(rs)
+    g = load_grafcet(grafcet_path, inputs=p.inputs, outputs=p.outputs)
+    return validate_loaded(rs, p, g, expert=expert, homes=homes, max_nodes=max_nodes, progress=progress)
+
+
+def validate_loaded(
+    rs: RuleSet,
+    p: Plant,
+    g: Grafcet,
+    *,
+    expert: bool = False,
+    homes: Sequence[str] = (),
+    max_nodes: int | None = None,
+    progress: Callable[[str], None] | None = None,
+) -> Validation:
+    """:func:`validate_symbolic` on a rule set, its plant and a Grafcet already loaded."""
+    home_conditions(homes, p, g)  # input errors first, as the explicit engine reports them
+    machine = GrafcetMachine(g)
+    oracle = CompiledConstraints(p, rs.constraints)
+    sup_empty = not oracle.kept(p.initial)
+    sup = SymbolicSupervisor(p, rs.constraints, NodeBudget(max_nodes))
+    ssync = SymbolicSync(sup, machine, progress=progress).explore()
+    ex = _Explicit(ssync, oracle)
+    false = ssync.false
+    stats = {
+        "plant_states": p.size,
+        "sync_states": ssync.sync_states,
+        "aggregated_states": ssync.aggregated_states,
+        "aggregated_transitions": ssync.aggregated_transitions,
+    }
+    if not ssync.situations or all(u == false for u in ssync.initial.values()):
+        sync = Sync(p, oracle, machine)
+        analysis = Analysis((), {}, {}, frozenset(), (), {})
+        return Validation(rs, p, g, sync, analysis, {}, expert, sup_empty, tuple(homes), None,
+                          counts=stats, reached_steps=frozenset(), engine_stats=_stats(ssync))
+    initial_keys = listed(ssync, ssync.initial)
+    initial = tuple(ex.node(k) for k in initial_keys)
+    home = _homes(ssync, homes, p, g)
+    back = coreachable(ssync, home)
+    stuck = stuck_nodes(ssync, back)
+    held = held_nodes(ssync)
+    proh_sets = prohibited_nodes(ssync)
+
+    def is_in(u: NodeSet, key: Key) -> bool:
+        s, local = key
+        return s in u and (u[s] & ssync.enc.state(local)) != false
+
+    # blocking: held with a prohibited order, once per set of steps; terminal components
+    found: list[tuple[int, tuple, Key, list[Key]]] = []
+    by_steps: dict[tuple[str, ...], NodeSet] = {}
+    for (steps, _), u in proh_sets.items():
+        for s, v in u.items():
+            v &= held.get(s, false)
+            if v != false:
+                d = by_steps.setdefault(steps, {})
+                d[s] = d.get(s, false) | v
+    for steps, u in by_steps.items():
+        s, local, depth, path = first_node(ssync, u)
+        found.append((depth, path, (s, local), listed(ssync, u, MAX_LISTED)))
+    for comp in terminal_components(ssync, stuck):
+        if all(ssync.situations[s].steps in by_steps for s in comp):
+            continue
+        s, local, depth, path = first_node(ssync, comp)
+        found.append((depth, path, (s, local), listed(ssync, comp, MAX_LISTED)))
+    found.sort(key=lambda f: (f[0], f[1]))
+    blocking: list[int] = []
+    components: dict[int, tuple[int, ...]] = {}
+    traces: dict[int, Trace] = {}
+    no_return: dict[int, int] = {}
+    for _, _, key, members in found:
+        b = ex.node(key)
+        blocking.append(b)
+        components[b] = tuple(sorted(ex.node(k) for k in members))
+        traces[b] = ex.trace(key)
+        keys = {v: k for k, v in ex.index.items()}
+        no_return[b] = next((n for n in traces[b].nodes if not is_in(back, keys[n])), b)
+    # prohibited orders: the first node meeting each (steps, event)
+    firsts: dict[Key, tuple] = {}
+    for u in proh_sets.values():
+        s, local, depth, path = first_node(ssync, u)
+        firsts[(s, local)] = (depth, path)
+    prohibited = [ex.node(k) for k in sorted(firsts, key=lambda k: firsts[k])]
+    for i in prohibited:
+        keys = {v: k for k, v in ex.index.items()}
+        traces.setdefault(i, ex.trace(keys[i]))
+    conflicts: list[Conflict] = []
+    for s, sources, event, step, names in ssync.conflicts:
+        cs, local, _, _ = first_node(ssync, {s: sources})
+        i = ex.node((cs, local))
+        traces.setdefault(i, ex.trace((cs, local)))
+        conflicts.append(Conflict(i, event, step, names))
+    first_steps = ssync.situations[initial_keys[0][0]].steps
+    never = all(sit.steps == first_steps for sit in ssync.situations)
+    if never:  # the explicit diagnosis reads the situation of every node: one node per situation
+        _one_per_situation(ssync, ex)
+    sync = Sync(p, oracle, machine, tuple(ex.nodes), tuple(ex.edges), initial, tuple(conflicts), stats["sync_states"])
+    keys = {v: k for k, v in ex.index.items()}
+    analysis = Analysis(
+        tuple(blocking), traces, no_return,
+        frozenset(i for i in range(len(ex.nodes)) if is_in(back, keys[i])),
+        tuple(prohibited), components,
+        frozenset(i for i in range(len(ex.nodes)) if is_in(home, keys[i])),
+        frozenset(i for i in range(len(ex.nodes)) if is_in(held, keys[i])),
+        never,
+    )
+    diagnoses = {b: diagnose(sync, b, expert=expert, component=analysis.components[b]) for b in analysis.blocking}
+    never_d = diagnose_never_starts(sync, expert=expert) if never else None
+    reached = frozenset(st for sit in ssync.situations for st in sit.steps)
+    return Validation(rs, p, g, sync, analysis, diagnoses, expert, sup_empty, tuple(homes), never_d,
+                      counts=stats, reached_steps=reached, engine_stats=_stats(ssync))
+
+
+def _one_per_situation(ssync: SymbolicSync, ex: _Explicit) -> None:
+    for s, r in enumerate(ssync.regions):
+        if r.nodes != ssync.false:
+            ex.node((s, ssync.enc.local(ssync.enc.pick(r.nodes))))
+
+
+def _stats(ssync: SymbolicSync) -> dict[str, int]:
+    return {"bdd_nodes": len(ssync.enc.bdd), "situations": len(ssync.situations)}
