@@ -57,7 +57,7 @@ from enum import StrEnum
 from functools import lru_cache
 from typing import Iterator
 
-from synth.codegen.grafcet_st import synth_version
+from synth.version import version as synth_version
 from synth.errors import InputError, Location, close_names
 from synth.grafcet.language import (
     CONDITIONAL,
