@@ -172,3 +172,10 @@ def test_named_conditions_and_negated_conditions_import():
     g7 = import_sfc(text.encode(), "x.xml")
     assert "  transition Up -> Init when !(!top)" in g7.splitlines()
     assert parse_grafcet(g7, "x.g7").transitions[-1].receptivity.text() == "!!top"
+
+
+def test_steps_that_would_share_an_sfc_name_are_a_located_error():
+    g = parse_grafcet("grafcet G { initial step 12  step S12  transition 12 -> S12 when a }", "s.g7")
+    with pytest.raises(InputError) as info:
+        sfc_project_xml(g, version="test")
+    assert info.value.render().splitlines()[0] == "s.g7:1:35: error: steps 12 and S12 would both be the SFC step S12"

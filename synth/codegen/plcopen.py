@@ -315,6 +315,12 @@ def sfc_project_xml(g: Grafcet, *, name: str | None = None, version: str | None 
 
     steps = {s.name for s in g.steps}
     timers = {t.id: t.step for t in g.timers}
+    seen: dict[str, str] = {}
+    for s in g.steps:  # step 12 is S12 in the SFC: a step named S12 as well would be the same
+        other = seen.setdefault(sfc_step_name(s.name).upper(), s.name)
+        if other != s.name:
+            raise InputError(f"steps {other} and {s.name} would both be the SFC step {sfc_step_name(s.name)}", s.loc,
+                             notes=("rename one of them",))
     ids = _Ids()
     step_id = {s.name: ids() for s in g.steps}
     trans_id = [ids() for _ in g.transitions]
