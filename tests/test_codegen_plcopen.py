@@ -157,3 +157,25 @@ def test_a_file_without_sfc_or_not_plcopen():
     with pytest.raises(InputError) as info:
         import_sfc(b"<html/>", "h.xml")
     assert info.value.render().splitlines()[0] == "h.xml:1:1: error: not a PLCopen TC6 XML v2.01 project (root element html)"
+
+
+def test_named_conditions_and_negated_conditions_import():
+    data = _edit('<condition><inline name="AtTop"><ST><xhtml:p xmlns:xhtml="http://www.w3.org/1999/xhtml">'
+                 '<![CDATA[top]]></xhtml:p></ST></inline></condition>',
+                 '<condition negated="true"><reference name="NotTop" /></condition>')
+    text = data.decode().replace(
+        "        <body>\n          <SFC>",
+        "        <transitions>\n          <transition name=\"NotTop\">\n            <body><ST><xhtml:p xmlns:xhtml="
+        "\"http://www.w3.org/1999/xhtml\"><![CDATA[NotTop := NOT top;]]></xhtml:p></ST></body>\n"
+        "          </transition>\n        </transitions>\n        <body>\n          <SFC>", 1)
+    assert validation_errors(text.encode()) == []
+    g7 = import_sfc(text.encode(), "x.xml")
+    assert "  transition Up -> Init when !(!top)" in g7.splitlines()
+    assert parse_grafcet(g7, "x.g7").transitions[-1].receptivity.text() == "!!top"
+
+
+def test_steps_that_would_share_an_sfc_name_are_a_located_error():
+    g = parse_grafcet("grafcet G { initial step 12  step S12  transition 12 -> S12 when a }", "s.g7")
+    with pytest.raises(InputError) as info:
+        sfc_project_xml(g, version="test")
+    assert info.value.render().splitlines()[0] == "s.g7:1:35: error: steps 12 and S12 would both be the SFC step S12"

@@ -155,9 +155,7 @@ class _Checker:
     def run(self) -> None:
         try:
             sit = self.machine.initial(self.initial)
-            side: _Side | None = _Side(sit, dict(self.initial), 0, {})
-            assert side is not None
-            side.since = {s: 0 for s in sit.steps}
+            side: _Side | None = _Side(sit, dict(self.initial), 0, {s: 0 for s in sit.steps})
         except InputError:
             side = None
         self.inst.cycle({self.program.st_name(n): v for n, v in self.initial.items()})
@@ -183,8 +181,8 @@ class _Checker:
                     out.append((event, first - side.now))
         return out
 
-    def step(self, side: _Side, event: Event) -> _Side | None:
-        """The machine after ``event``; None when it never stabilises."""
+    def step(self, side: _Side, event: Event, delay: int) -> _Side | None:
+        """The machine after ``event`` (``delay`` ms after the last one); None when it never stabilises."""
         try:
             if event.is_edge:
                 after = dict(side.inputs)
@@ -193,7 +191,7 @@ class _Checker:
                 inputs, now = after, side.now
             else:
                 inputs = side.inputs
-                now = side.now + self._delay
+                now = side.now + delay
                 sit, rounds = self.machine.fire_timer_with_trace(side.sit, event, inputs)
         except InputError:
             return None
@@ -211,8 +209,7 @@ class _Checker:
             return
         for event, delay in self.events(side):
             saved = self.save()
-            self._delay = delay
-            nxt = self.step(side, event)
+            nxt = self.step(side, event, delay)
             if delay:
                 self.module.advance(delay)
             if event.is_edge:
@@ -225,8 +222,6 @@ class _Checker:
             else:
                 self.sequences += 1
             self.restore(saved)
-
-    _delay = 0
 
     def save(self) -> tuple[object, int]:
         return copy.deepcopy(self.inst, dict(self.memo_base)), self.module.clock_ms

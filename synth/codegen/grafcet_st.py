@@ -163,7 +163,6 @@ class _Writer:
         self.steps: tuple[Step, ...] = g.steps
         self.step_index = {s.name: i + 1 for i, s in enumerate(self.steps)}
         self.timer_index = {t.id: i + 1 for i, t in enumerate(g.timers)}
-        self.edges: list[str] = []  # inputs whose edges are read, in input order
         used_edges = {n.name for x in self._exprs() for n in names(x) if isinstance(n, Edge)}
         self.rising = sorted({n.name for x in self._exprs() for n in names(x) if isinstance(n, Edge) and n.rising},
                              key=g.inputs.index)

@@ -57,7 +57,7 @@ from enum import StrEnum
 from functools import lru_cache
 from typing import Iterator
 
-from synth.codegen.grafcet_st import synth_version
+from synth.version import version as synth_version
 from synth.errors import InputError, Location, close_names
 from synth.grafcet.language import (
     CONDITIONAL,
@@ -315,6 +315,12 @@ def sfc_project_xml(g: Grafcet, *, name: str | None = None, version: str | None 
 
     steps = {s.name for s in g.steps}
     timers = {t.id: t.step for t in g.timers}
+    seen: dict[str, str] = {}
+    for s in g.steps:  # step 12 is S12 in the SFC: a step named S12 as well would be the same
+        other = seen.setdefault(sfc_step_name(s.name).upper(), s.name)
+        if other != s.name:
+            raise InputError(f"steps {other} and {s.name} would both be the SFC step {sfc_step_name(s.name)}", s.loc,
+                             notes=("rename one of them",))
     ids = _Ids()
     step_id = {s.name: ids() for s in g.steps}
     trans_id = [ids() for _ in g.transitions]
@@ -490,7 +496,6 @@ class _Source:
     def text_at(self, el, text: str, offset: int, width: int = 1) -> Location:
         """Where character ``offset`` of ``text`` (the text of ``el`` or of its child) is."""
         start = el.sourceline or 1
-        before = text[:offset]
         first = text.lstrip().split("\n")[0].strip()
         for n in range(start - 1, min(start + 20, len(self.lines))):
             if first and first in self.lines[n]:
@@ -504,7 +509,6 @@ class _Source:
                     line, col = base_line, base_col + len(rel)
                 raw = self.lines[line - 1] if line <= len(self.lines) else ""
                 return Location(self.file, line, col, raw, width)
-        del before
         return self.at(el)
 
 
@@ -786,10 +790,7 @@ def import_sfc(data: bytes | str, file: str = "<xml>") -> str:
         cond = el.find(q("condition"))
         if cond is None:
             raise InputError("a transition without a condition", src.at(el))
-        if cond.get("negated", "false") in ("true", "1"):
-            negate = True
-        else:
-            negate = False
+        negate = cond.get("negated", "false") in ("true", "1")
         inline, ref, label = cond.find(q("inline")), cond.find(q("reference")), ""
         if inline is not None:
             st = inline.find(q("ST"))
