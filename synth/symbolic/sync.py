@@ -342,11 +342,11 @@ class SymbolicSync:
             for tr in fired:
                 for st in tr.sources:
                     by_step.setdefault(st, []).append(tr.name)
-            for st, names in by_step.items():
-                key = (st, tuple(names))
-                if len(names) > 1 and key not in self._conflict_keys:
+            for st, fired_names in by_step.items():
+                key = (st, tuple(fired_names))
+                if len(fired_names) > 1 and key not in self._conflict_keys:
                     self._conflict_keys.add(key)
-                    self.conflicts.append((s, sources, event, st, tuple(names)))
+                    self.conflicts.append((s, sources, event, st, tuple(fired_names)))
 
     def _successors(self, s: int, nodes: Function, pending: NodeSet) -> None:
         sit = self.situations[s]
