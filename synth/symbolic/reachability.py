@@ -27,11 +27,10 @@ from typing import Callable
 from synth.errors import LimitExceeded
 from synth.filter.bdd import Function
 from synth.logic.events import Event
-from synth.symbolic.encoding import Copy
 from synth.symbolic.sync import Bundle, NodeSet, SymbolicSync
 
 __all__ = ["Path", "coreachable", "stuck_nodes", "held_nodes", "terminal_components", "first_node", "shortest_trace",
-           "prohibited_nodes", "MAX_LISTED"]
+           "prohibited_nodes", "listed", "MAX_LISTED"]
 
 MAX_LISTED = 100_000
 """At most this many nodes of one component are listed for the diagnosis."""
@@ -244,10 +243,3 @@ def listed(sync: SymbolicSync, u: NodeSet, limit: int = MAX_LISTED) -> list[tupl
         raise LimitExceeded(f"more than {limit} nodes to list")
     return out
 
-
-def count(sync: SymbolicSync, u: NodeSet) -> int:
-    return sum(sync.enc.count(v) for v in u.values())
-
-
-def rename_next(sync: SymbolicSync, u: Function) -> Function:
-    return sync.enc.rename(u, Copy.CURRENT, Copy.NEXT)

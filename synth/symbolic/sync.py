@@ -85,7 +85,7 @@ class Bundle:
     source: int
     event: Event
     target: int
-    entries: Function
+    entries: Function  # freed (false) once ``edges`` is computed
     move: Move | None
     key: tuple[int, int]  # exploration order of the event: (0, plant transition) or (1, timer rank)
     edges: Function | None = None  # (x, x'): node x of source --event--> node x' of target, once explored
@@ -147,6 +147,7 @@ class SymbolicSync:
             for a in range(self.plant.ndim))
         self.progress = progress
         self.initial: NodeSet = {}
+        self._sync_states = 0
 
     # ------------------------------------------------------------------ helpers
     def situation(self, sit: Situation) -> int:
@@ -341,11 +342,11 @@ class SymbolicSync:
             for tr in fired:
                 for st in tr.sources:
                     by_step.setdefault(st, []).append(tr.name)
-            for st, names in by_step.items():
-                key = (st, tuple(names))
-                if len(names) > 1 and key not in self._conflict_keys:
+            for st, fired_names in by_step.items():
+                key = (st, tuple(fired_names))
+                if len(fired_names) > 1 and key not in self._conflict_keys:
                     self._conflict_keys.add(key)
-                    self.conflicts.append((s, sources, event, st, tuple(names)))
+                    self.conflicts.append((s, sources, event, st, tuple(fired_names)))
 
     def _successors(self, s: int, nodes: Function, pending: NodeSet) -> None:
         sit = self.situations[s]
@@ -436,6 +437,10 @@ class SymbolicSync:
                               f"{len(pending)} pending, {len(self.enc.bdd)} BDD nodes")
         self.bundles = [self._edges(b) for b in sorted(self._bundles.values(), key=lambda b: (b.source, b.key, b.target))]
         self.edge_count = sum(self.enc.count(b.edges, (Copy.CURRENT, Copy.NEXT)) for b in self.bundles)
+        self._sync_states = sum(self.enc.count(r.members) for r in self.regions)
+        for r in self.regions:  # only the nodes are read from here on: free the rest
+            r.entered = r.pairs = r.members = self.false
+        self._bundles = {}
         links: dict[tuple[int, int], Function] = {}
         for b in self.bundles:
             links[(b.source, b.target)] = links.get((b.source, b.target), self.false) | b.edges
@@ -459,7 +464,7 @@ class SymbolicSync:
             if step is None:
                 step = self._aux_moves[b.move.key] = self.enc.rename(b.move.relation, Copy.NEXT, Copy.AUX, names)
             pairs = self.enc.exists(moved & step, Copy.AUX, names)
-        return Bundle(b.source, b.event, b.target, b.entries, b.move, b.key, pairs)
+        return Bundle(b.source, b.event, b.target, self.false, b.move, b.key, pairs)  # entries no longer needed
 
     def onion_rings(self) -> list[NodeSet]:
         """The nodes by distance from the initial nodes (breadth-first over the links),
@@ -490,7 +495,7 @@ class SymbolicSync:
     # ------------------------------------------------------------------ counts
     @property
     def sync_states(self) -> int:
-        return sum(self.enc.count(r.members) for r in self.regions)
+        return self._sync_states
 
     @property
     def aggregated_states(self) -> int:
