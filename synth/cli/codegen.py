@@ -43,14 +43,9 @@ def _load(args: argparse.Namespace) -> tuple["Grafcet", dict[str, bool], list[st
 
 
 def _write(args: argparse.Namespace, data: str | bytes) -> None:
-    from synth.output.files import write_atomic
+    from synth.output.files import write_or_print
 
-    if args.output:
-        write_atomic(args.output, data)
-    elif isinstance(data, bytes):
-        sys.stdout.buffer.write(data)
-    else:
-        sys.stdout.write(data)
+    write_or_print(args.output, data)
 
 
 def cmd_st(args: argparse.Namespace) -> int:

@@ -100,7 +100,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
 def cmd_st(args: argparse.Namespace) -> int:
     from synth.codegen.filter_st import filter_block
     from synth.filter.language_check import load_filter
-    from synth.output.files import write_atomic
+    from synth.output.files import write_or_print
 
     f = load_filter(args.filter)
     _warnings(f)
@@ -113,12 +113,7 @@ def cmd_st(args: argparse.Namespace) -> int:
         from synth.codegen.plcopen import st_project_xml
 
         text = st_project_xml(block.text, name=block.name, comment=f"safety logic filter from {args.filter}")
-    if args.output:
-        write_atomic(args.output, text)
-    elif isinstance(text, bytes):
-        sys.stdout.buffer.write(text)
-    else:
-        sys.stdout.write(text)
+    write_or_print(args.output, text)
     return 0
 
 

@@ -163,10 +163,10 @@ class _Writer:
         self.steps: tuple[Step, ...] = g.steps
         self.step_index = {s.name: i + 1 for i, s in enumerate(self.steps)}
         self.timer_index = {t.id: i + 1 for i, t in enumerate(g.timers)}
-        used_edges = {n.name for x in self._exprs() for n in names(x) if isinstance(n, Edge)}
-        self.rising = sorted({n.name for x in self._exprs() for n in names(x) if isinstance(n, Edge) and n.rising},
+        used_edges = {n.name for x in self.g.expressions() for n in names(x) if isinstance(n, Edge)}
+        self.rising = sorted({n.name for x in self.g.expressions() for n in names(x) if isinstance(n, Edge) and n.rising},
                              key=g.inputs.index)
-        self.falling = sorted({n.name for x in self._exprs() for n in names(x) if isinstance(n, Edge) and not n.rising},
+        self.falling = sorted({n.name for x in self.g.expressions() for n in names(x) if isinstance(n, Edge) and not n.rising},
                               key=g.inputs.index)
         self.event_actions = any(a.kind == STORED and a.when == ON_EVENT for s in self.steps for a in s.actions)
         # previous values: every input when an event action needs "some input changed"
@@ -188,11 +188,6 @@ class _Writer:
     def st(self, name: str) -> str:
         """The ST name of a plant input/output or step variable."""
         return self.alias.get(name, name)
-
-    def _exprs(self) -> list[Expr]:
-        out = [t.receptivity for t in self.g.transitions]
-        out += [a.condition for s in self.g.steps for a in s.actions if a.condition is not None]
-        return out
 
     # ---------------------------------------------------------------- names
     def ref(self, e: Expr) -> str:

@@ -410,7 +410,7 @@ def sfc_project_xml(g: Grafcet, *, name: str | None = None, version: str | None 
         for n in names:
             vl.append(_E("variable", {"name": n}, _E("type", None, _E("BOOL"))))
         iface.append(vl)
-    edges = sorted({(n.rising, n.name) for x in _exprs(g) for n in _edges(x)}, key=lambda e: (e[1], not e[0]))
+    edges = sorted({(n.rising, n.name) for x in g.expressions() for n in _edges(x)}, key=lambda e: (e[1], not e[0]))
     if edges:
         vl = _E("localVars")
         for rising, n in edges:
@@ -421,15 +421,6 @@ def sfc_project_xml(g: Grafcet, *, name: str | None = None, version: str | None 
         iface.append(vl)
     pou = _E("pou", {"name": pou_name, "pouType": "program"}, iface, _E("body", None, body))
     return _project(pou_name, version or synth_version(), comment, [pou])
-
-
-def _exprs(g: Grafcet) -> Iterator[Expr]:
-    for t in g.transitions:
-        yield t.receptivity
-    for s in g.steps:
-        for a in s.actions:
-            if a.condition is not None:
-                yield a.condition
 
 
 def _edges(e: Expr) -> Iterator[Edge]:

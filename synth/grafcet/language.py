@@ -257,22 +257,22 @@ class Grafcet:
     def initial_steps(self) -> tuple[str, ...]:
         return tuple(s.name for s in self.steps if s.initial)
 
+    def expressions(self) -> Iterator[Expr]:
+        """Every Boolean expression of the Grafcet: receptivities, then action conditions."""
+        for t in self.transitions:
+            yield t.receptivity
+        for s in self.steps:
+            for a in s.actions:
+                if a.condition is not None:
+                    yield a.condition
+
     @property
     def read_inputs(self) -> tuple[str, ...]:
         """Inputs the Grafcet actually reads (receptivities, conditions, events), in ``inputs`` order."""
         used: set[str] = set()
-        for x in _all_exprs(self):
+        for x in self.expressions():
             used.update(expr_inputs(x, self.inputs))
         return tuple(i for i in self.inputs if i in used)
-
-
-def _all_exprs(g: Grafcet) -> Iterator[Expr]:
-    for t in g.transitions:
-        yield t.receptivity
-    for s in g.steps:
-        for a in s.actions:
-            if a.condition is not None:
-                yield a.condition
 
 
 def expr_inputs(e: Expr, inputs: Sequence[str]) -> tuple[str, ...]:

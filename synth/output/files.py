@@ -6,7 +6,7 @@ import os
 import tempfile
 from pathlib import Path
 
-__all__ = ["write_atomic"]
+__all__ = ["write_atomic", "write_or_print"]
 
 
 def write_atomic(path: str | Path, data: str | bytes) -> Path:
@@ -35,3 +35,15 @@ def write_atomic(path: str | Path, data: str | bytes) -> Path:
             pass
         raise
     return target
+
+
+def write_or_print(path: str | Path | None, data: str | bytes) -> None:
+    """``data`` to ``path`` atomically, or to standard output when no path is given."""
+    import sys
+
+    if path:
+        write_atomic(path, data)
+    elif isinstance(data, bytes):
+        sys.stdout.buffer.write(data)
+    else:
+        sys.stdout.write(data)
