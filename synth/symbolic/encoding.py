@@ -27,10 +27,12 @@ from enum import Enum
 from typing import Iterator, Mapping, Sequence
 
 from synth.errors import LimitExceeded
-from synth.filter.bdd import Engine, Function
+from synth.filter.bdd import Engine, Function, _backend
 from synth.plant.composition import Plant
 
 __all__ = ["Copy", "PlantEncoding", "NodeBudget"]
+
+_and_exists = getattr(_backend, "and_exists", None) if _backend.__name__ == "dd.cudd" else None
 
 
 class Copy(Enum):
@@ -74,8 +76,9 @@ class PlantEncoding:
             self.engine.disjunction(self.code(i, int(c)) for c in e.codes) for i, e in enumerate(p.elements)
         )
         self.domain: Function = self.engine.conjunction(self.domains)
-        self._renames: dict[tuple, dict[str, Function]] = {}
-        self._quantified: dict[tuple, list[str]] = {}
+        self._renames: dict[tuple, tuple[Function, Function]] = {}
+        self._quantified: dict[tuple, Function] = {}
+        self._qvars: dict[tuple, list[str]] = {}
         self._inner = {v: self.engine.declare(v) for v in self.variables}
 
     # ---- names and renaming
@@ -84,22 +87,42 @@ class PlantEncoding:
         return v + copy.value
 
     def rename(self, u: Function, source: Copy, target: Copy, names: Sequence[str] | None = None) -> Function:
-        """``u`` with the ``source`` copy of ``names`` (default: every variable) renamed to ``target``."""
+        """``u`` with the ``source`` copy of ``names`` (default: every variable) renamed to
+        ``target``: ``∃source. u ∧ (source = target)``, which is the substitution
+        ``u[source := target]`` whatever ``u`` depends on (the source variables are pinned to
+        the target's values), with the cube and the equality built once per key (a vector
+        compose walks every variable of the manager on each call)."""
         key = (source, target, None if names is None else tuple(names))
-        sub = self._renames.get(key)
-        if sub is None:
+        hit = self._renames.get(key)
+        if hit is None:
             vs = self.variables if names is None else names
-            sub = {self.engine.declare(v + source.value): self.bdd.var(self.engine.declare(v + target.value)) for v in vs}
-            self._renames[key] = sub
-        return self.bdd.let(sub, u)
+            equal = self.engine.conjunction(self.engine.var(v + source.value).equiv(self.engine.var(v + target.value)) for v in vs)
+            hit = self._renames[key] = (self._cube(source, vs), equal)
+        cube, equal = hit
+        return self.and_exists(u, equal, source, names)
 
     def exists(self, u: Function, copy: Copy, names: Sequence[str] | None = None) -> Function:
+        """``∃`` the ``copy`` of ``names`` (default: every variable) in ``u``."""
         key = (copy, None if names is None else tuple(names))
-        vs = self._quantified.get(key)
-        if vs is None:
-            vs = [self.engine.declare(v + copy.value) for v in (self.variables if names is None else names)]
-            self._quantified[key] = vs
-        return self.bdd.exist(vs, u)
+        cube = self._quantified.get(key)
+        if cube is None:
+            cube = self._quantified[key] = self._cube(copy, self.variables if names is None else names)
+        return self.bdd.apply("exists", cube, u)
+
+    def and_exists(self, u: Function, v: Function, copy: Copy, names: Sequence[str] | None = None) -> Function:
+        """``∃`` the ``copy`` of ``names`` (default: every variable) in ``u ∧ v``, in one pass
+        (CUDD's relational product: the conjunction is never built)."""
+        key = (copy, None if names is None else tuple(names))
+        qvars = self._qvars.get(key)
+        if qvars is None:
+            qvars = self._qvars[key] = [self.engine.declare(n + copy.value) for n in (self.variables if names is None else names)]
+        if _and_exists is None:  # pragma: no cover - dd without its CUDD extension
+            return self.bdd.exist(qvars, u & v)
+        return _and_exists(u, v, qvars)
+
+    def _cube(self, copy: Copy, names: Sequence[str]) -> Function:
+        """The positive cube of the ``copy`` of ``names`` (what ``∃`` quantifies)."""
+        return self.bdd.cube({self.engine.declare(v + copy.value) for v in names})
 
     # ---- states
     def code(self, axis: int, code: int, copy: Copy = Copy.CURRENT) -> Function:

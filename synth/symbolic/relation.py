@@ -3,8 +3,13 @@
 A *move* is every local transition of one element that flips one variable in one
 direction (``↑a1_0`` of cylinder C1): its relation ``src(x_i) ∧ dst(x_i')`` speaks of
 that element's current and next variables only, the others being unchanged by
-construction. The plant's relation is their disjunction; images are computed move by
-move, quantifying only the moving element's variables.
+construction. The plant's relation is their disjunction.
+
+Since a move flips one variable ``v`` (its ``guard`` is the set of its sources, where
+``v`` has the value it leaves), images need no second copy of the variables:
+``image(S) = (∃v. S ∧ guard) ∧ v⁺`` and ``preimage(S) = guard ∧ ∃v. (S ∧ v⁺)``, ``v⁺``
+being the literal of ``v`` after the move: a conjunction and a one-variable
+quantification instead of a relational product and a renaming.
 
 Example
 -------
@@ -35,7 +40,9 @@ class Move:
 
     ``key`` is the position of its first local transition in ``Plant.transitions``
     (the explicit engine's exploration order); ``relation`` is over the element's
-    current and next variables; ``transitions`` are the local transitions it gathers.
+    current and next variables; ``transitions`` are the local transitions it gathers;
+    ``guard`` is the sources (current copy), ``after`` the literal of the flipped
+    variable once moved, ``cube`` that variable (what the images quantify).
     """
 
     axis: int
@@ -44,6 +51,9 @@ class Move:
     key: int
     relation: Function
     transitions: tuple[LocalTransition, ...]
+    guard: Function
+    after: Function
+    cube: Function
 
     @property
     def variable(self) -> str:
@@ -60,22 +70,26 @@ def plant_moves(enc: PlantEncoding) -> tuple[Move, ...]:
         rel = enc.engine.disjunction(
             enc.local_state(axis, t.src) & enc.local_state(axis, t.dst, Copy.NEXT) for _, t in ts
         )
-        out.append(Move(axis, event, ts[0][1].controllable, ts[0][0], rel, tuple(t for _, t in ts)))
+        codes = enc.plant.elements[axis].codes
+        bit = 1 << enc.element_variables[axis].index(event.name)
+        for _, t in ts:  # a move flips its own variable, in its own direction, and nothing else
+            if int(codes[t.dst]) != int(codes[t.src]) ^ bit or bool(int(codes[t.dst]) & bit) != event.rising:
+                raise AssertionError(f"local transition {t} does not only flip {event.name}")
+        guard = enc.engine.disjunction(enc.local_state(axis, t.src) for _, t in ts)
+        var = enc.engine.var(event.name)
+        out.append(Move(axis, event, ts[0][1].controllable, ts[0][0], rel, tuple(t for _, t in ts),
+                        guard, var if event.rising else ~var, enc.bdd.cube({enc.engine.declare(event.name)})))
     return tuple(sorted(out, key=lambda m: m.key))
 
 
-def image(enc: PlantEncoding, states: Function, move: Move, relation: Function | None = None) -> Function:
-    """States reached from ``states`` by ``move`` (``relation``: the move restricted further)."""
-    names = enc.element_variables[move.axis]
-    r = move.relation if relation is None else relation
-    both = states & r
+def image(enc: PlantEncoding, states: Function, move: Move) -> Function:
+    """States reached from ``states`` by ``move``."""
+    both = states & move.guard
     if both == enc.engine.false:
         return both
-    return enc.rename(enc.exists(both, Copy.CURRENT, names), Copy.NEXT, Copy.CURRENT, names)
+    return enc.bdd.apply("exists", move.cube, both) & move.after
 
 
-def preimage(enc: PlantEncoding, states: Function, move: Move, relation: Function | None = None) -> Function:
+def preimage(enc: PlantEncoding, states: Function, move: Move) -> Function:
     """States from which ``move`` leads into ``states``."""
-    names = enc.element_variables[move.axis]
-    r = move.relation if relation is None else relation
-    return enc.exists(enc.rename(states, Copy.CURRENT, Copy.NEXT, names) & r, Copy.NEXT, names)
+    return move.guard & enc.bdd.apply("exists", move.cube, states & move.after)

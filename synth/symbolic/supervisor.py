@@ -134,7 +134,7 @@ class SymbolicSupervisor:
             before = reached
             for axis, rel in enumerate(self.element_relations):
                 names = self.enc.element_variables[axis]
-                nxt = self.enc.rename(self.enc.exists(frontier & rel, Copy.CURRENT, names), Copy.NEXT, Copy.CURRENT, names)
+                nxt = self.enc.rename(self.enc.and_exists(frontier, rel, Copy.CURRENT, names), Copy.NEXT, Copy.CURRENT, names)
                 new = nxt & ~reached
                 reached |= new
                 frontier |= new

@@ -140,7 +140,6 @@ class SymbolicSync:
         self._unread_cache: dict[Situation, frozenset[str]] = {}
         self._region_moves: dict[int, tuple[Function, Function, Function]] = {}
         self._products: dict[frozenset[str], tuple[Function, Function] | None] = {}
-        self._aux_moves: dict[int, Function] = {}
         self._pieces: dict[tuple[int, frozenset[str]], Function] = {}
         self._other_orders: tuple[frozenset[str], ...] = tuple(
             frozenset(o + Copy.NEXT.value for b, e in enumerate(self.plant.elements) if b != a for o in e.orders)
@@ -261,7 +260,7 @@ class SymbolicSync:
         reach = self.engine.conjunction(self.engine.var(v).equiv(self.engine.var(v + Copy.NEXT.value)) for v in names)
         frontier = reach
         while frontier != self.false and r != self.false:
-            step = self.enc.rename(self.enc.exists(frontier & r, Copy.NEXT, names), Copy.AUX, Copy.NEXT, names)
+            step = self.enc.rename(self.enc.and_exists(frontier, r, Copy.NEXT, names), Copy.AUX, Copy.NEXT, names)
             frontier = step & ~reach
             reach |= frontier
         return reach
@@ -285,7 +284,7 @@ class SymbolicSync:
         product = self._product_region(wanted)
         if product is not None:
             members, settled = product
-            self._members_acc = self.enc.rename(self.enc.exists(entries & members, Copy.CURRENT), Copy.NEXT, Copy.CURRENT)
+            self._members_acc = self.enc.rename(self.enc.and_exists(entries, members, Copy.CURRENT), Copy.NEXT, Copy.CURRENT)
             return entries & settled
         domains = self._domains(wanted)
         reach = entries & self.equal
@@ -296,7 +295,7 @@ class SymbolicSync:
                 if r == self.false or (frontier & domains[axis]) == self.false:
                     continue
                 names = self.enc.element_variables[axis]
-                step = self.enc.exists(frontier & r, Copy.NEXT, names)
+                step = self.enc.and_exists(frontier, r, Copy.NEXT, names)
                 new |= self.enc.rename(step, Copy.AUX, Copy.NEXT, names)
             frontier = new & ~reach
             reach |= frontier
@@ -457,13 +456,8 @@ class SymbolicSync:
         """``b`` with its pair relation: source node x, target node x' (the entry n, between
         them, quantified: it is x moved by ``b.move``, or x itself for a timer)."""
         pairs = b.entries & self.regions[b.target].pairs  # (n, x')
-        if b.move is not None:
-            names = self.enc.element_variables[b.move.axis]
-            moved = self.enc.rename(pairs, Copy.CURRENT, Copy.AUX, names)
-            step = self._aux_moves.get(b.move.key)
-            if step is None:
-                step = self._aux_moves[b.move.key] = self.enc.rename(b.move.relation, Copy.NEXT, Copy.AUX, names)
-            pairs = self.enc.exists(moved & step, Copy.AUX, names)
+        if b.move is not None:  # n is x moved: the preimage on the current copy
+            pairs = preimage(self.enc, pairs, b.move)
         return Bundle(b.source, b.event, b.target, self.false, b.move, b.key, pairs)  # entries no longer needed
 
     def onion_rings(self) -> list[NodeSet]:
@@ -515,7 +509,7 @@ class SymbolicSync:
             t = targets.get(a.target)
             if t is None or t == self.false:
                 continue
-            src = self.enc.exists(a.edges & self.enc.rename(t, Copy.CURRENT, Copy.NEXT), Copy.NEXT)
+            src = self.enc.and_exists(a.edges, self.enc.rename(t, Copy.CURRENT, Copy.NEXT), Copy.NEXT)
             if src != self.false:
                 out[a.source] = out.get(a.source, self.false) | src
         return out
@@ -525,7 +519,7 @@ class SymbolicSync:
         src = sources.get(a.source)
         if src is None or src == self.false:
             return self.false
-        return self.enc.rename(self.enc.exists(a.edges & src, Copy.CURRENT), Copy.NEXT, Copy.CURRENT)
+        return self.enc.rename(self.enc.and_exists(a.edges, src, Copy.CURRENT), Copy.NEXT, Copy.CURRENT)
 
     def into(self, target: int) -> list[Link]:
         return self._into.get(target, [])
