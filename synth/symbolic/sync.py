@@ -65,15 +65,51 @@ NodeSet = dict[int, Function]  # situation index -> plant states (current copy)
 
 class _Recorder(dict):
     """Input values that remember which names were read (the machine is deterministic,
-    so its answer holds for every valuation agreeing on them)."""
+    so its answer holds for every valuation agreeing on them). The values are fetched
+    (a state picked from a BDD) only when the machine first looks at them: a situation
+    whose orders do not depend on the inputs costs no pick."""
 
-    def __init__(self, values: Mapping[str, bool]) -> None:
-        super().__init__(values)
+    def __init__(self, fetch: Callable[[], Mapping[str, bool]]) -> None:
+        super().__init__()
         self.read: set[str] = set()
+        self._fetch: Callable[[], Mapping[str, bool]] | None = fetch
+
+    def _load(self) -> None:
+        if self._fetch is not None:
+            dict.update(self, self._fetch())
+            self._fetch = None
 
     def __getitem__(self, name: str) -> bool:
+        self._load()
         self.read.add(name)
         return dict.__getitem__(self, name)
+
+    def __contains__(self, name: object) -> bool:
+        self._load()
+        return dict.__contains__(self, name)
+
+    def __iter__(self):  # type: ignore[no-untyped-def]
+        self._load()
+        return dict.__iter__(self)
+
+    def __len__(self) -> int:
+        self._load()
+        return dict.__len__(self)
+
+    def keys(self):  # type: ignore[no-untyped-def]
+        self._load()
+        return dict.keys(self)
+
+    def get(self, name: str, default: object = None) -> object:
+        return self[name] if name in self else default
+
+    def items(self):  # type: ignore[no-untyped-def]
+        self.read.update(self)
+        return dict.items(self)
+
+    def values(self):  # type: ignore[no-untyped-def]
+        self.read.update(self)
+        return dict.values(self)
 
 
 @dataclass(frozen=True)
@@ -122,6 +158,7 @@ class SymbolicSync:
         self.machine = machine
         self.engine = sup.enc.engine
         self.false = self.engine.false
+        self.true = self.engine.true
         self.situations: list[Situation] = []
         self._index: dict[Situation, int] = {}
         self.regions: list[Region] = []
@@ -173,7 +210,7 @@ class SymbolicSync:
         out: list[tuple[object, Function]] = []
         rest = states
         while rest != self.false:
-            rec = _Recorder(self.values(rest))
+            rec = _Recorder(lambda rest=rest: self.values(rest))
             result = answer(rec)
             part = rest & self._cell(rec)
             rest = rest & ~part
@@ -274,18 +311,19 @@ class SymbolicSync:
             self._domain_cache[wanted] = hit
         return hit
 
-    def region_pairs(self, entries: Function, wanted: frozenset[str]) -> Function:
-        """reg(x, x') for ``entries`` (x) under emitted orders ``wanted``: forward closure of
-        the region moves over pairs, then restricted to settled x'."""
+    def region_pairs(self, entries: Function, wanted: frozenset[str]) -> tuple[Function, Function, Function]:
+        """``(reg, members, settled)`` for ``entries`` under emitted orders ``wanted``:
+        ``reg(x, x')`` pairs an entry with a settled state (forward closure of the region
+        moves over pairs, restricted to settled x'), the members and the settled states
+        (current copy)."""
         rel, progress, _ = self.intra(wanted)
         if (entries & progress) == self.false:  # already settled: the region is its entry
-            self._members_acc = entries
-            return entries & self.equal
+            return entries & self.equal, entries, entries
         product = self._product_region(wanted)
         if product is not None:
             members, settled = product
-            self._members_acc = self.enc.rename(self.enc.and_exists(entries, members, Copy.CURRENT), Copy.NEXT, Copy.CURRENT)
-            return entries & settled
+            pairs = entries & settled
+            return pairs, self.post_pairs(entries, members), self.post_pairs(entries, settled)
         domains = self._domains(wanted)
         reach = entries & self.equal
         frontier = reach
@@ -299,8 +337,12 @@ class SymbolicSync:
                 new |= self.enc.rename(step, Copy.AUX, Copy.NEXT, names)
             frontier = new & ~reach
             reach |= frontier
-        self._members_acc = self.enc.rename(self.enc.exists(reach, Copy.CURRENT), Copy.NEXT, Copy.CURRENT)
-        return reach & ~self.enc.rename(progress, Copy.CURRENT, Copy.NEXT)
+        pairs = reach & ~self.enc.rename(progress, Copy.CURRENT, Copy.NEXT)
+        return pairs, self.post_pairs(self.true, reach), self.post_pairs(self.true, pairs)
+
+    def post_pairs(self, sources: Function, pairs: Function) -> Function:
+        """The x' of the pairs ``(x, x')`` whose x is in ``sources``, as current states."""
+        return self.enc.rename(self.enc.and_exists(sources, pairs, Copy.CURRENT), Copy.NEXT, Copy.CURRENT)
 
     def enter(self, s: int, entries: Function) -> Function:
         """Enter situation ``s`` at ``entries``; returns the settled states not seen before."""
@@ -313,10 +355,9 @@ class SymbolicSync:
         fresh = self.false
         for wanted, part in self.partition(new_entries, lambda rec: self.machine.orders(sit, rec)):
             assert isinstance(wanted, frozenset)
-            pairs = self.region_pairs(part, wanted)
+            pairs, members, settled = self.region_pairs(part, wanted)
             reg.pairs |= pairs
-            reg.members |= self._members_acc
-            settled = self.enc.rename(self.enc.exists(pairs, Copy.CURRENT), Copy.NEXT, Copy.CURRENT)
+            reg.members |= members
             reg.by_orders[wanted] = reg.by_orders.get(wanted, self.false) | settled
             fresh |= settled & ~reg.nodes
             reg.nodes |= settled
@@ -519,7 +560,7 @@ class SymbolicSync:
         src = sources.get(a.source)
         if src is None or src == self.false:
             return self.false
-        return self.enc.rename(self.enc.and_exists(a.edges, src, Copy.CURRENT), Copy.NEXT, Copy.CURRENT)
+        return self.post_pairs(src, a.edges)
 
     def into(self, target: int) -> list[Link]:
         return self._into.get(target, [])
