@@ -31,7 +31,7 @@ from synth.logic.events import Event
 from synth.plant.composition import LocalTransition
 from synth.symbolic.encoding import Copy, PlantEncoding
 
-__all__ = ["Move", "plant_moves", "image", "preimage"]
+__all__ = ["Move", "plant_moves", "image", "preimage", "pair_preimage"]
 
 
 @dataclass(frozen=True)
@@ -42,7 +42,7 @@ class Move:
     (the explicit engine's exploration order); ``relation`` is over the element's
     current and next variables; ``transitions`` are the local transitions it gathers;
     ``guard`` is the sources (current copy), ``after`` the literal of the flipped
-    variable once moved, ``cube`` that variable (what the images quantify).
+    variable once moved.
     """
 
     axis: int
@@ -53,7 +53,6 @@ class Move:
     transitions: tuple[LocalTransition, ...]
     guard: Function
     after: Function
-    cube: Function
 
     @property
     def variable(self) -> str:
@@ -78,18 +77,22 @@ def plant_moves(enc: PlantEncoding) -> tuple[Move, ...]:
         guard = enc.engine.disjunction(enc.local_state(axis, t.src) for _, t in ts)
         var = enc.engine.var(event.name)
         out.append(Move(axis, event, ts[0][1].controllable, ts[0][0], rel, tuple(t for _, t in ts),
-                        guard, var if event.rising else ~var, enc.bdd.cube({enc.engine.declare(event.name)})))
+                        guard, var if event.rising else ~var))
     return tuple(sorted(out, key=lambda m: m.key))
 
 
 def image(enc: PlantEncoding, states: Function, move: Move) -> Function:
     """States reached from ``states`` by ``move``."""
-    both = states & move.guard
-    if both == enc.engine.false:
-        return both
-    return enc.bdd.apply("exists", move.cube, both) & move.after
+    return enc.and_exists(states, move.guard, Copy.CURRENT, (move.variable,)) & move.after
 
 
 def preimage(enc: PlantEncoding, states: Function, move: Move) -> Function:
     """States from which ``move`` leads into ``states``."""
-    return move.guard & enc.bdd.apply("exists", move.cube, states & move.after)
+    return enc.and_exists(states, move.after, Copy.CURRENT, (move.variable,)) & move.guard
+
+
+def pair_preimage(enc: PlantEncoding, entries: Function, pairs: Function, move: Move) -> Function:
+    """``{(x, x') : (n, x') ∈ pairs, n ∈ entries}`` with ``n`` = x moved by ``move``, for
+    ``entries`` inside the image of ``move`` (so x is in its guard: only the flipped
+    variable goes back)."""
+    return enc.and_exists(entries, pairs, Copy.CURRENT, (move.variable,)) & ~move.after

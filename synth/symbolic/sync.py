@@ -55,7 +55,7 @@ from synth.logic.expr import Edge as ExprEdge, names
 from synth.plant.composition import Plant
 from synth.plant.rules import Constraint
 from synth.symbolic.encoding import Copy, NodeBudget
-from synth.symbolic.relation import Move, image, preimage
+from synth.symbolic.relation import Move, image, pair_preimage, preimage
 from synth.symbolic.supervisor import SymbolicSupervisor
 
 __all__ = ["Bundle", "Link", "Region", "SymbolicSync", "symbolic_sync"]
@@ -496,9 +496,10 @@ class SymbolicSync:
     def _edges(self, b: Bundle) -> Bundle:
         """``b`` with its pair relation: source node x, target node x' (the entry n, between
         them, quantified: it is x moved by ``b.move``, or x itself for a timer)."""
-        pairs = b.entries & self.regions[b.target].pairs  # (n, x')
-        if b.move is not None:  # n is x moved: the preimage on the current copy
-            pairs = preimage(self.enc, pairs, b.move)
+        if b.move is None:
+            pairs = b.entries & self.regions[b.target].pairs  # (n, x'): n = x
+        else:  # n is x moved: the preimage on the current copy
+            pairs = pair_preimage(self.enc, b.entries, self.regions[b.target].pairs, b.move)
         return Bundle(b.source, b.event, b.target, self.false, b.move, b.key, pairs)  # entries no longer needed
 
     def onion_rings(self) -> list[NodeSet]:
