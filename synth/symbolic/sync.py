@@ -177,7 +177,10 @@ class SymbolicSync:
         self._unread_cache: dict[Situation, frozenset[str]] = {}
         self._region_moves: dict[int, tuple[Function, Function, Function]] = {}
         self._products: dict[frozenset[str], tuple[Function, Function] | None] = {}
-        self._pieces: dict[tuple[int, frozenset[str]], Function] = {}
+        self._pieces: dict[tuple[int, frozenset[str]], Function | None] = {}  # None: reads other elements' orders
+        self._element_intras: dict[tuple[int, frozenset[str]], tuple[Function, Function, dict[Event, Function]]] = {}
+        self._orders_of = tuple(frozenset(e.orders) for e in self.plant.elements)
+        self._controllable = tuple(tuple(m for m in sup.moves if m.controllable and m.axis == a) for a in range(self.plant.ndim))
         self._other_orders: tuple[frozenset[str], ...] = tuple(
             frozenset(o + Copy.NEXT.value for b, e in enumerate(self.plant.elements) if b != a for o in e.orders)
             for a in range(self.plant.ndim))
@@ -237,19 +240,38 @@ class SymbolicSync:
         hit = self._intra.get(wanted)
         if hit is not None:
             return hit
-        rel = [self.false] * self.plant.ndim
+        rel = []
         progress = self.false
         refused: dict[Event, Function] = {}
-        for m in self.sup.moves:
-            if not m.controllable or m.event.rising != (m.variable in wanted):
-                continue
-            shifted, can, bad = self._region_move(m)
+        for axis in range(self.plant.ndim):
+            r, can, bad = self._element_intra(axis, self._own_orders(axis, wanted))
+            rel.append(r)
             progress |= can
-            if bad != self.false:
-                refused[m.event] = refused.get(m.event, self.false) | bad
-            rel[m.axis] |= shifted
+            refused.update(bad)
         hit = (tuple(rel), progress, refused)
         self._intra[wanted] = hit
+        return hit
+
+    def _own_orders(self, axis: int, wanted: frozenset[str]) -> frozenset[str]:
+        return wanted & self._orders_of[axis]
+
+    def _element_intra(self, axis: int, own: frozenset[str]) -> tuple[Function, Function, dict[Event, Function]]:
+        """:meth:`intra` for one element, whose region moves depend only on its own
+        emitted orders ``own`` (a controllable move flips one of its orders)."""
+        key = (axis, own)
+        hit = self._element_intras.get(key)
+        if hit is None:
+            rel = progress = self.false
+            refused: dict[Event, Function] = {}
+            for m in self._controllable[axis]:
+                if m.event.rising != (m.variable in own):
+                    continue
+                shifted, can, bad = self._region_move(m)
+                progress |= can
+                if bad != self.false:
+                    refused[m.event] = refused.get(m.event, self.false) | bad
+                rel |= shifted
+            hit = self._element_intras[key] = (rel, progress, refused)
         return hit
 
     def _region_move(self, m: Move) -> tuple[Function, Function, Function]:
@@ -276,15 +298,15 @@ class SymbolicSync:
         rel, progress, _ = self.intra(wanted)
         pieces = []
         for axis, r in enumerate(rel):
-            others = self._other_orders[axis]
-            if r != self.false and any(n in others for n in self.engine.support(r)):
+            key = (axis, self._own_orders(axis, wanted))
+            piece = self._pieces.get(key, self.false)
+            if piece is self.false:
+                others = self._other_orders[axis]
+                reads_others = r != self.false and any(n in others for n in self.engine.support(r))
+                piece = self._pieces[key] = None if reads_others else self._element_region(axis, r)
+            if piece is None:
                 self._products[wanted] = None
                 return None
-            key = (axis, frozenset(o for o in wanted if o in self.plant.elements[axis].orders))
-            piece = self._pieces.get(key)
-            if piece is None:
-                piece = self._element_region(axis, r)
-                self._pieces[key] = piece
             pieces.append(piece)
         members = self.engine.conjunction(pieces)
         hit = (members, members & ~self.enc.rename(progress, Copy.CURRENT, Copy.NEXT))
