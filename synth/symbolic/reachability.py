@@ -156,11 +156,14 @@ def _layers(sync: SymbolicSync, target: NodeSet, depth: int) -> list[NodeSet]:
     return layers
 
 
-def _greedy(sync: SymbolicSync, layers: list[NodeSet], order: Callable[[Bundle], object]) -> tuple[list[NodeSet], list[Event]]:
-    """Forward through ``layers``, taking at each step the smallest event (by ``order``)."""
+def _greedy(sync: SymbolicSync, layers: list[NodeSet], order: Callable[[Bundle], object]
+            ) -> tuple[list[NodeSet], list[Event], list[object]]:
+    """Forward through ``layers``, taking at each step the smallest event (by ``order``):
+    the nodes chosen per layer, the events and their keys."""
     current = layers[0]
     chosen = [current]
     events: list[Event] = []
+    keys: list[object] = []
     for k in range(1, len(layers)):
         options: dict[object, tuple[Event, NodeSet]] = {}
         for s, u in current.items():
@@ -177,8 +180,9 @@ def _greedy(sync: SymbolicSync, layers: list[NodeSet], order: Callable[[Bundle],
         best = min(options)
         ev, current = options[best]
         events.append(ev)
+        keys.append(best)
         chosen.append(current)
-    return chosen, events
+    return chosen, events, keys
 
 
 def _pick(sync: SymbolicSync, u: NodeSet) -> tuple[int, tuple[int, ...]]:
@@ -197,13 +201,7 @@ def first_node(sync: SymbolicSync, candidates: NodeSet) -> tuple[int, tuple[int,
     else:
         raise ValueError("no candidate is reachable")
     layers = _layers(sync, hit, depth)
-    chosen, _ = _greedy(sync, layers, lambda b: _key(sync, b))
-    keys: list[tuple] = []
-    # the key path, for sorting several first nodes at one distance
-    for k in range(1, len(chosen)):
-        best = min(_key(sync, b) for s in chosen[k - 1] for b in sync.out_bundles(s)
-                   if b.target in chosen[k] and sync.post({s: chosen[k - 1][s]}, b) & chosen[k][b.target] != sync.false)
-        keys.append(best)
+    chosen, _, keys = _greedy(sync, layers, lambda b: _key(sync, b))  # keys: to sort first nodes at one distance
     s, local = _pick(sync, chosen[-1])
     return s, local, depth, tuple(keys)
 
@@ -216,14 +214,14 @@ def shortest_trace(sync: SymbolicSync, s: int, local: tuple[int, ...]) -> Path:
     if depth is None:
         raise ValueError("node not reachable")
     layers = _layers(sync, {s: node}, depth)
-    chosen, events = _greedy(sync, layers, lambda b: b.event)
+    chosen, events, _ = _greedy(sync, layers, lambda b: b.event)
     # one concrete node per layer, backwards from the target
     nodes = [(s, local)]
     for k in range(depth - 1, -1, -1):
         t, loc = nodes[-1]
         target = {t: sync.enc.state(loc)}
         pre: NodeSet = {}
-        arcs = [b for b in sync.bundles if b.target == t and b.event == events[k]]
+        arcs = [b for b in sync.in_bundles(t) if b.event == events[k]]
         for src, u in sync.pre(target, arcs).items():
             v = u & chosen[k].get(src, sync.false)
             if v != sync.false:

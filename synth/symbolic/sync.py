@@ -511,8 +511,10 @@ class SymbolicSync:
         self._out: dict[int, list] = {}
         for link in self.links:
             self._into.setdefault(link.target, []).append(link)
+        self._in: dict[int, list[Bundle]] = {}
         for b in self.bundles:
             self._out.setdefault(b.source, []).append(b)
+            self._in.setdefault(b.target, []).append(b)
         return self
 
     def _edges(self, b: Bundle) -> Bundle:
@@ -536,15 +538,15 @@ class SymbolicSync:
         ring: NodeSet = dict(self.initial)
         while ring:
             self.rings.append(ring)
-            new: NodeSet = {}
+            new: NodeSet = {}  # targets in the next copy, renamed once per situation below
             for s in sorted(ring):
                 for link in by_source.get(s, ()):
-                    u = self.post(ring, link)
+                    u = self.enc.and_exists(link.edges, ring[s], Copy.CURRENT)
                     if u != self.false:
                         new[link.target] = new.get(link.target, self.false) | u
             ring = {}
             for s, u in new.items():
-                u &= ~seen.get(s, self.false)
+                u = self.enc.rename(u, Copy.NEXT, Copy.CURRENT) & ~seen.get(s, self.false)
                 if u != self.false:
                     ring[s] = u
                     seen[s] = seen.get(s, self.false) | u
@@ -569,11 +571,15 @@ class SymbolicSync:
         out: NodeSet = {}
         if arcs is None:
             arcs = [link for t in targets for link in self._into.get(t, ())]
+        primed: NodeSet = {}  # each target renamed once, whatever the number of arcs into it
         for a in arcs:
-            t = targets.get(a.target)
-            if t is None or t == self.false:
-                continue
-            src = self.enc.and_exists(a.edges, self.enc.rename(t, Copy.CURRENT, Copy.NEXT), Copy.NEXT)
+            t = primed.get(a.target)
+            if t is None:
+                t = targets.get(a.target)
+                if t is None or t == self.false:
+                    continue
+                t = primed[a.target] = self.enc.rename(t, Copy.CURRENT, Copy.NEXT)
+            src = self.enc.and_exists(a.edges, t, Copy.NEXT)
             if src != self.false:
                 out[a.source] = out.get(a.source, self.false) | src
         return out
@@ -590,6 +596,9 @@ class SymbolicSync:
 
     def out_bundles(self, source: int) -> list[Bundle]:
         return self._out.get(source, [])
+
+    def in_bundles(self, target: int) -> list[Bundle]:
+        return self._in.get(target, [])
 
     def backward(self, targets: NodeSet, within: NodeSet | None = None) -> NodeSet:
         """Nodes from which ``targets`` can be reached (targets included): a worklist
