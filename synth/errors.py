@@ -21,9 +21,11 @@ a.rules:1:5: error: unknown variable 'bar'
 
 from __future__ import annotations
 
-import difflib
 from dataclasses import dataclass
-from typing import Iterable, Sequence
+
+TYPE_CHECKING = False  # typing.TYPE_CHECKING, without importing typing
+if TYPE_CHECKING:
+    from collections.abc import Iterable, Sequence
 
 __all__ = [
     "Location",
@@ -127,6 +129,8 @@ def close_names(name: str, candidates: Iterable[str], n: int = 3) -> tuple[str, 
     >>> close_names("AVANCR1", ["AVANCER1", "RECULER1", "v10"])
     ('AVANCER1',)
     """
+    import difflib  # only when a name is wrong
+
     pool = sorted(set(candidates))
     lowered = {c.lower(): c for c in pool}
     hits = difflib.get_close_matches(name.lower(), list(lowered), n=n, cutoff=0.5)
