@@ -11,8 +11,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from lark import Token
-
 from synth.errors import InputError, Location
 from synth.grafcet.language import (
     _TIMER_RE,
@@ -26,7 +24,7 @@ from synth.grafcet.language import (
     timer_id,
 )
 from synth.logic.expr import Const, Expr, Var
-from synth.syntax import ExprTransformer, parse_tree
+from synth.syntax import ExprTransformer, Token, parse_tree
 
 __all__ = ["grafcet_items"]
 

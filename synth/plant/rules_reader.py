@@ -13,12 +13,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Iterable
 
-from lark import Token
-
 from synth.errors import Location
 from synth.logic.expr import Expr
 from synth.plant.rules import FREE, ORDER, SENSOR, Constraint, Precedence, Rule, VarDecl
-from synth.syntax import ExprTransformer, parse_tree
+from synth.syntax import ExprTransformer, Token, parse_tree
 
 __all__ = ["rules_items"]
 
