@@ -23,6 +23,8 @@ __all__ = ["rules_items"]
 
 @dataclass(frozen=True)
 class _Body:
+    """The items of a ``model`` or ``element`` body."""
+
     decls: tuple[VarDecl, ...]
     incoherences: tuple[Expr, ...]
     rules: tuple[Rule, ...]
@@ -31,6 +33,8 @@ class _Body:
 
 @dataclass(frozen=True)
 class _Model:
+    """``model NAME { … }``."""
+
     name: str
     body: _Body
     loc: Location
@@ -38,6 +42,8 @@ class _Model:
 
 @dataclass(frozen=True)
 class _Instance:
+    """``element NAME = MODEL(a = b, …)``."""
+
     name: str
     model: str
     renaming: tuple[tuple[str, str, Location, Location], ...]
@@ -47,6 +53,8 @@ class _Instance:
 
 @dataclass(frozen=True)
 class _Inline:
+    """``element NAME { … }``."""
+
     name: str
     body: _Body
     loc: Location
@@ -54,17 +62,23 @@ class _Inline:
 
 @dataclass(frozen=True)
 class _Use:
+    """``use "FILE"``."""
+
     path: str
     loc: Location
 
 
 @dataclass(frozen=True)
 class _Hold:
+    """``hold NAME = BIT, …``."""
+
     decls: tuple[VarDecl, ...]
 
 
 @dataclass(frozen=True)
 class _Vector:
+    """``inputs …`` or ``outputs …``."""
+
     kind: str  # "inputs" | "outputs"
     names: tuple[tuple[str, Location], ...]
 

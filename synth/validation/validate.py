@@ -27,6 +27,8 @@ __all__ = ["Validation", "ReducedController", "validate", "home_conditions", "ho
 
 @dataclass(frozen=True)
 class Validation:
+    """One whole run of ``synth validate``: its inputs, SYNC, the analysis and the diagnoses."""
+
     rules: RuleSet
     plant: Plant
     grafcet: Grafcet
