@@ -53,26 +53,27 @@ def environment(tree: Path | None, pycache: str) -> dict[str, str]:
     return env
 
 
-def run_once(args: list[str], env: dict[str, str]) -> float:
-    """Wall time of one fresh ``python -S ARGS`` process, in milliseconds."""
+def run_once(args: list[str], env: dict[str, str], cwd: str) -> float:
+    """Wall time of one fresh ``python -S ARGS`` process, in milliseconds, run in ``cwd``,
+    an empty folder (the current folder comes first on ``sys.path``: a stray ``.py`` file
+    there could shadow a module)."""
     start = time.perf_counter()
-    done = subprocess.run([sys.executable, "-S", *args], cwd=tempfile.gettempdir(), env=env,
-                          capture_output=True, check=False)
+    done = subprocess.run([sys.executable, "-S", *args], cwd=cwd, env=env, capture_output=True, check=False)
     elapsed = (time.perf_counter() - start) * 1000
     if done.returncode not in (0, 1):  # validate exits 1 when it finds problems
         sys.exit(f"{' '.join(args)} failed ({done.returncode}):\n{done.stderr.decode(errors='replace')}")
     return elapsed
 
 
-def measure(columns: list[tuple[list[str], dict[str, str]]], runs: int) -> list[list[float]]:
+def measure(columns: list[tuple[list[str], dict[str, str]]], runs: int, cwd: str) -> list[list[float]]:
     """``runs`` timings of each column's command, the columns interleaved run by run,
     after one untimed warm-up run of each."""
     for args, env in columns:
-        run_once(args, env)
+        run_once(args, env, cwd)
     out: list[list[float]] = [[] for _ in columns]
     for _ in range(runs):
         for times, (args, env) in zip(out, columns):
-            times.append(run_once(args, env))
+            times.append(run_once(args, env, cwd))
     return out
 
 
@@ -86,17 +87,18 @@ def main() -> None:
     ap.add_argument("--tree", action="append", type=Path, help="a synth source tree (repeatable)")
     args = ap.parse_args()
     trees = args.tree or [ROOT]
-    with tempfile.TemporaryDirectory(prefix="synth-pycache-") as pycache:
+    with tempfile.TemporaryDirectory(prefix="synth-pycache-") as pycache, \
+            tempfile.TemporaryDirectory(prefix="synth-startup-") as cwd:
         envs = [environment(tree, pycache) for tree in trees]
         print(f"python {sys.version.split()[0]}, {args.runs} runs per cell, median (minimum) wall time, "
               f"bytecode cached in a temporary PYTHONPYCACHEPREFIX")
         print(f"{'command':<32}" + "".join(f"{t.resolve().name[:24]:>26}" for t in trees))
         for name, argv in COMMANDS.items():
-            row = measure([(["-m", "synth", *argv], env) for env in envs], args.runs)
+            row = measure([(["-m", "synth", *argv], env) for env in envs], args.runs, cwd)
             print(f"{name:<32}" + "".join(f"{cell(ms):>26}" for ms in row))
         floor_env = environment(None, pycache)
         for name, argv in FLOORS.items():
-            (ms,) = measure([(argv, floor_env)], args.runs)
+            (ms,) = measure([(argv, floor_env)], args.runs, cwd)
             print(f"{name:<32}{cell(ms):>26}")
 
 
