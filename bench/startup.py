@@ -1,12 +1,20 @@
 """Start-up and end-to-end wall time of ``synth`` commands, a fresh process per run
 (``python -S``: interpreter start included, site-packages' ``.pth`` hooks left out).
 
-    python3 bench/startup.py [--runs 9] [--tree DIR] [--tree OTHER_DIR]
+    python3 bench/startup.py [--runs 15] [--tree DIR] [--tree OTHER_DIR]
 
 Each ``--tree`` is a synth source tree (default: this one); the commands run as
-``python -m synth`` with that tree first on ``PYTHONPATH``, so two checkouts (say,
-before and after a change) are measured side by side in one run. Prints the median
-and the minimum of each command, in milliseconds, process start included.
+``python -S -m synth`` with that tree first on ``PYTHONPATH``, so two checkouts (say,
+before and after a change) are measured side by side in one run, their runs
+interleaved so that a change in the machine's load hits both alike. Prints the median
+and the minimum of each command, in milliseconds, process start included, and the
+floors under them measured the same way: the bare interpreter (``-c pass``),
+``import numpy`` and ``import lark``.
+
+Like an installed wheel (pip compiles its ``.pyc`` files), every run reads compiled
+bytecode: ``PYTHONDONTWRITEBYTECODE`` is removed from the environment, bytecode goes
+to a temporary ``PYTHONPYCACHEPREFIX`` (the trees are left untouched), and one
+untimed warm-up run per command and tree fills it (and lark's grammar cache) first.
 """
 
 from __future__ import annotations
@@ -23,37 +31,75 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 COMMANDS = {
     "--help": ["--help"],
+    "validate --help": ["validate", "--help"],
     "validate tri.g7": ["validate", str(ROOT / "grafcets/tri.g7"), "--plant", str(ROOT / "plants/tri.rules")],
     "validate tri_missing_order.g7": ["validate", str(ROOT / "grafcets/tri_missing_order.g7"), "--plant", str(ROOT / "plants/tri.rules")],
 }
+FLOORS = {
+    "python -S -c pass": ["-c", "pass"],
+    "python -S -c 'import numpy'": ["-c", "import numpy"],
+    "python -S -c 'import lark'": ["-c", "import lark"],
+}
 
 
-def measure(tree: Path, argv: list[str], runs: int) -> list[float]:
-    # -S: no site processing, so an editable install of synth cannot shadow ``tree``;
-    # the dependencies come from this interpreter's site-packages, put after the tree.
+def environment(tree: Path | None, pycache: str) -> dict[str, str]:
+    """``tree`` first on ``PYTHONPATH`` (then this interpreter's site-packages, since
+    ``-S`` leaves them out, so an editable install of synth cannot shadow ``tree``),
+    bytecode read from and written to ``pycache``."""
     deps = [p for p in sys.path if p.endswith("site-packages")]
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(tree.resolve()), *deps]))
-    out = []
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
+    env["PYTHONPATH"] = os.pathsep.join([*([str(tree.resolve())] if tree else []), *deps])
+    env["PYTHONPYCACHEPREFIX"] = pycache
+    return env
+
+
+def run_once(args: list[str], env: dict[str, str], cwd: str) -> float:
+    """Wall time of one fresh ``python -S ARGS`` process, in milliseconds, run in ``cwd``,
+    an empty folder (the current folder comes first on ``sys.path``: a stray ``.py`` file
+    there could shadow a module)."""
+    start = time.perf_counter()
+    done = subprocess.run([sys.executable, "-S", *args], cwd=cwd, env=env, capture_output=True, check=False)
+    elapsed = (time.perf_counter() - start) * 1000
+    if done.returncode not in (0, 1):  # validate exits 1 when it finds problems
+        sys.exit(f"{' '.join(args)} failed ({done.returncode}):\n{done.stderr.decode(errors='replace')}")
+    return elapsed
+
+
+def measure(columns: list[tuple[list[str], dict[str, str]]], runs: int, cwd: str) -> list[list[float]]:
+    """``runs`` timings of each column's command, the columns interleaved run by run,
+    after one untimed warm-up run of each."""
+    for args, env in columns:
+        run_once(args, env, cwd)
+    out: list[list[float]] = [[] for _ in columns]
     for _ in range(runs):
-        start = time.perf_counter()
-        subprocess.run([sys.executable, "-S", "-m", "synth", *argv], cwd=tempfile.gettempdir(), env=env, capture_output=True, check=False)
-        out.append((time.perf_counter() - start) * 1000)
+        for times, (args, env) in zip(out, columns):
+            times.append(run_once(args, env, cwd))
     return out
+
+
+def cell(ms: list[float]) -> str:
+    return f"{statistics.median(ms):6.0f} ms (min {min(ms):4.0f})"
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--runs", type=int, default=9)
+    ap.add_argument("--runs", type=int, default=15)
     ap.add_argument("--tree", action="append", type=Path, help="a synth source tree (repeatable)")
     args = ap.parse_args()
     trees = args.tree or [ROOT]
-    print(f"{'command':<32}" + "".join(f"{t.resolve().name[:24]:>28}" for t in trees))
-    for name, argv in COMMANDS.items():
-        row = []
-        for tree in trees:
-            ms = measure(tree, argv, args.runs)
-            row.append(f"{statistics.median(ms):9.0f} ms (min {min(ms):5.0f})")
-        print(f"{name:<32}" + "".join(f"{r:>28}" for r in row))
+    with tempfile.TemporaryDirectory(prefix="synth-pycache-") as pycache, \
+            tempfile.TemporaryDirectory(prefix="synth-startup-") as cwd:
+        envs = [environment(tree, pycache) for tree in trees]
+        print(f"python {sys.version.split()[0]}, {args.runs} runs per cell, median (minimum) wall time, "
+              f"bytecode cached in a temporary PYTHONPYCACHEPREFIX")
+        print(f"{'command':<32}" + "".join(f"{t.resolve().name[:24]:>26}" for t in trees))
+        for name, argv in COMMANDS.items():
+            row = measure([(["-m", "synth", *argv], env) for env in envs], args.runs, cwd)
+            print(f"{name:<32}" + "".join(f"{cell(ms):>26}" for ms in row))
+        floor_env = environment(None, pycache)
+        for name, argv in FLOORS.items():
+            (ms,) = measure([(argv, floor_env)], args.runs, cwd)
+            print(f"{name:<32}{cell(ms):>26}")
 
 
 if __name__ == "__main__":

@@ -21,9 +21,12 @@ a.rules:1:5: error: unknown variable 'bar'
 
 from __future__ import annotations
 
-import difflib
 from dataclasses import dataclass
-from typing import Iterable, Sequence
+from functools import lru_cache
+
+TYPE_CHECKING = False  # typing.TYPE_CHECKING, without importing typing
+if TYPE_CHECKING:
+    from collections.abc import Iterable, Sequence
 
 __all__ = [
     "Location",
@@ -127,6 +130,8 @@ def close_names(name: str, candidates: Iterable[str], n: int = 3) -> tuple[str, 
     >>> close_names("AVANCR1", ["AVANCER1", "RECULER1", "v10"])
     ('AVANCER1',)
     """
+    import difflib  # only when a name is wrong
+
     pool = sorted(set(candidates))
     lowered = {c.lower(): c for c in pool}
     hits = difflib.get_close_matches(name.lower(), list(lowered), n=n, cutoff=0.5)
@@ -144,8 +149,14 @@ def source_lines(source: str) -> list[str]:
     return [line[:-1] if line.endswith("\r") else line for line in source.split("\n")]
 
 
+@lru_cache(maxsize=8)
+def _lines(source: str) -> tuple[str, ...]:
+    """:func:`source_lines`, split once per source however many tokens are located in it."""
+    return tuple(source_lines(source))
+
+
 def location_in(file: str, source: str, line: int, column: int, width: int = 1) -> Location:
     """A :class:`Location` whose ``text`` is taken from ``source``."""
-    lines = source_lines(source)
+    lines = _lines(source)
     text = lines[line - 1] if 0 < line <= len(lines) else ""
     return Location(file, line, column, text, width)

@@ -3,18 +3,57 @@
 
 from __future__ import annotations
 
+import sys
+import types
 from functools import lru_cache
 from importlib import resources
 from pathlib import Path
 
 from typing import Any, Sequence
 
-from lark import Lark, Token, Transformer, Tree, UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
 
-from synth.errors import InputError, InputErrors, Location, location_in, source_lines
-from synth.logic.expr import And, Const, Edge, Expr, Not, Or, Var
+class _RegexOnFirstUse(types.ModuleType):
+    """What lark's ``import regex`` gets while :func:`_import_lark` runs: the third-party
+    ``regex`` module, imported on first use of any of its attributes."""
 
-__all__ = ["grammar_text", "parser", "syntax_error", "read_source", "ExprTransformer", "Checker", "raise_all", "parse_tree", "parse_expression"]
+    def __getattr__(self, name: str) -> Any:
+        from importlib import import_module
+
+        return getattr(import_module("regex"), name)
+
+
+def _import_lark() -> None:
+    """Import lark without importing ``regex`` (about 10 ms of every command's start-up).
+
+    lark imports the third-party ``regex`` module whenever it is installed, yet uses it
+    only for ``Lark(regex=True)`` and for terminals that ``re`` cannot read; synth's
+    grammars need neither. While lark is imported, ``import regex`` gets a stand-in that
+    imports the real module on first use, so lark keeps every capability (for any other
+    user of lark in the process too); afterwards ``import regex`` gets the real module.
+    """
+    if "lark" in sys.modules or "regex" in sys.modules:
+        return
+    from importlib.util import find_spec
+
+    if find_spec("regex") is None:  # not installed: lark already goes without
+        return
+    sys.modules["regex"] = stand_in = _RegexOnFirstUse("regex")
+    try:
+        import lark  # noqa: F401
+    finally:
+        if sys.modules.get("regex") is stand_in:
+            del sys.modules["regex"]
+
+
+_import_lark()
+
+from lark import Lark, Token, Transformer, Tree, UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken  # noqa: E402
+
+from synth.errors import InputError, InputErrors, Location, location_in, source_lines  # noqa: E402
+from synth.logic.expr import And, Const, Edge, Expr, Not, Or, Var  # noqa: E402
+
+# ``Token`` is lark's, re-exported: every module of synth imports lark through this one.
+__all__ = ["grammar_text", "parser", "syntax_error", "read_source", "ExprTransformer", "Checker", "raise_all", "parse_tree", "parse_expression", "Token"]
 
 # How terminals are shown to a user in "expected ..." lists.
 _TERMINAL_TEXT = {

@@ -16,7 +16,8 @@ from __future__ import annotations
 
 import argparse
 import sys
-from typing import TYPE_CHECKING
+
+TYPE_CHECKING = False  # typing.TYPE_CHECKING, without importing typing (fast --help)
 
 if TYPE_CHECKING:  # pragma: no cover - the library is imported by the commands only (fast --help)
     from synth.grafcet.language import Grafcet

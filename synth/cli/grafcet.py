@@ -14,12 +14,12 @@ Example (text output of ``synth run``)::
 from __future__ import annotations
 
 import argparse
-import json
 import sys
-from typing import TYPE_CHECKING, Callable, Mapping
 
-
+TYPE_CHECKING = False  # typing.TYPE_CHECKING, without importing typing (fast --help)
 if TYPE_CHECKING:  # pragma: no cover - the library is imported by the commands only (fast --help)
+    from collections.abc import Callable, Mapping
+
     from synth.grafcet.language import Grafcet
 
 __all__ = ["register", "cmd_ass", "cmd_run"]
@@ -73,6 +73,8 @@ def cmd_ass(args: argparse.Namespace) -> int:
     if args.svg:
         write_svg(args.svg, dot)
     if args.json:
+        import json
+
         sys.stdout.write(json.dumps(ass_json(ass), indent=2, ensure_ascii=False) + "\n")
     else:
         sys.stdout.write(ass_text(ass, grafcet.path))

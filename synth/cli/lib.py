@@ -4,7 +4,6 @@ sensors (with initial values), and how to use them."""
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 
 __all__ = ["register", "cmd_lib"]
@@ -23,6 +22,8 @@ def cmd_lib(args: argparse.Namespace) -> int:
 
     models = library_models()
     if args.json:
+        import json
+
         sys.stdout.write(json.dumps(library_json(models), indent=2, ensure_ascii=False) + "\n")
     else:
         sys.stdout.write(library_text(models, library_dir()))

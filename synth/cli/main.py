@@ -9,10 +9,14 @@ from __future__ import annotations
 
 import argparse
 import sys
-from typing import Callable, Sequence
 
-from synth.errors import InputError, InputErrors, LimitExceeded, ModelError, SynthError
 from synth.version import version
+
+# Only argparse and sys at the top: ``synth --help`` and ``synth COMMAND --help`` import
+# nothing else (tests/test_startup.py); each command imports its library in its handler.
+TYPE_CHECKING = False  # typing.TYPE_CHECKING, without importing typing
+if TYPE_CHECKING:
+    from collections.abc import Callable, Sequence
 
 __all__ = ["main", "entry", "build_parser", "version"]
 
@@ -51,6 +55,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     handler: Callable[[argparse.Namespace], int] = args.handler
+    from synth.errors import InputError, InputErrors, LimitExceeded, ModelError, SynthError
+
     try:
         return handler(args)
     except (InputError, InputErrors) as err:

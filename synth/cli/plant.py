@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import argparse
-import json
 import sys
-from typing import Any
+
+TYPE_CHECKING = False  # typing.TYPE_CHECKING, without importing typing (fast --help)
+if TYPE_CHECKING:
+    from typing import Any
 
 __all__ = ["register", "print_warnings", "print_json"]
 
@@ -46,6 +48,8 @@ def print_warnings(p: Any) -> None:
 
 
 def print_json(data: Any) -> None:
+    import json
+
     json.dump(data, sys.stdout, indent=2, ensure_ascii=False)
     sys.stdout.write("\n")
 

@@ -3,12 +3,7 @@
 from __future__ import annotations
 
 import argparse
-import json
 import sys
-from pathlib import Path
-
-from synth.cli.plant import print_warnings
-from synth.errors import SynthError
 
 __all__ = ["register", "cmd_validate"]
 
@@ -39,6 +34,10 @@ def register(sub: "argparse._SubParsersAction") -> None:
 
 
 def cmd_validate(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from synth.cli.plant import print_warnings
+    from synth.errors import SynthError
     from synth.output.files import write_atomic
     from synth.output.html import write_report
     from synth.output.progress import clear_progress, tty_progress
@@ -70,6 +69,8 @@ def cmd_validate(args: argparse.Namespace) -> int:
               f"{result.engine_stats['situations']} stable situations", file=sys.stderr)
     print_warnings(result.plant)
     if args.cor:
+        import json
+
         cor = cor_json(result, reduced_controller(result))
         path = Path(args.cor)
         write_atomic(path, json.dumps(cor, indent=2, ensure_ascii=False) + "\n")
@@ -79,6 +80,8 @@ def cmd_validate(args: argparse.Namespace) -> int:
         directory = args.report or str(Path("reports") / Path(args.grafcet).stem)
         report_path = write_report(directory, result)
     if args.json:
+        import json
+
         data = validation_json(result)
         if report_path is not None:
             data["report"] = str(report_path)

@@ -15,8 +15,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from lark import Token
-
 from synth.errors import Location
 from synth.filter.language import (
     Assumption,
@@ -31,7 +29,7 @@ from synth.filter.language import (
     pre_name,
 )
 from synth.logic.expr import Expr, Var
-from synth.syntax import ExprTransformer, parse_tree
+from synth.syntax import ExprTransformer, Token, parse_tree
 
 __all__ = ["filter_items", "filter_expression", "Use", "Vector"]
 

@@ -11,8 +11,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from lark import Token
-
 from synth.errors import InputError, Location
 from synth.grafcet.language import (
     _TIMER_RE,
@@ -26,7 +24,7 @@ from synth.grafcet.language import (
     timer_id,
 )
 from synth.logic.expr import Const, Expr, Var
-from synth.syntax import ExprTransformer, parse_tree
+from synth.syntax import ExprTransformer, Token, parse_tree
 
 __all__ = ["grafcet_items"]
 
@@ -35,18 +33,24 @@ __all__ = ["grafcet_items"]
 
 @dataclass(frozen=True)
 class _Decl:
+    """``inputs …`` or ``outputs …``."""
+
     kind: str  # "inputs" | "outputs"
     names: tuple[tuple[str, Location], ...]
 
 
 @dataclass(frozen=True)
 class _StepRef:
+    """A step named as a transition's source or target."""
+
     name: str
     loc: Location
 
 
 @dataclass(frozen=True)
 class _Step:
+    """A step declaration with its actions."""
+
     name: str
     initial: bool
     actions: tuple[Action, ...]
@@ -55,6 +59,8 @@ class _Step:
 
 @dataclass(frozen=True)
 class _Trans:
+    """A transition: its sources, targets and receptivity."""
+
     label: str | None
     label_loc: Location | None
     sources: tuple[_StepRef, ...]
@@ -65,6 +71,8 @@ class _Trans:
 
 @dataclass(frozen=True)
 class _Graf:
+    """``grafcet NAME { … }``."""
+
     name: str
     steps: tuple[_Step, ...]
     transitions: tuple[_Trans, ...]

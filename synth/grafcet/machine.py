@@ -125,6 +125,8 @@ def _compile(e: Expr, steps: set[str], timers: set[str]) -> _Fn:
 
 @dataclass
 class _State:
+    """The machine's mutable state during one evolution: active steps, stored actions, elapsed timers."""
+
     active: set[str]
     stored: set[str]
     elapsed: set[str]

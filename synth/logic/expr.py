@@ -61,6 +61,8 @@ def edge_text(rising: bool, name: str) -> Event:
 
 @dataclass(frozen=True)
 class Var:
+    """A variable (a plant input or output, a step variable ``X12``): true or false."""
+
     name: str
     loc: Location | None = field(default=None, compare=False)
 
@@ -70,6 +72,8 @@ class Var:
 
 @dataclass(frozen=True)
 class Const:
+    """The constant ``1`` (True) or ``0`` (False)."""
+
     value: bool
     loc: Location | None = field(default=None, compare=False)
 
@@ -95,6 +99,8 @@ class Edge:
 
 @dataclass(frozen=True)
 class Not:
+    """``!arg``."""
+
     arg: "Expr"
     loc: Location | None = field(default=None, compare=False)
 
@@ -105,6 +111,8 @@ class Not:
 
 @dataclass(frozen=True)
 class And:
+    """``a & b & …``: true when every argument is."""
+
     args: tuple["Expr", ...]
     loc: Location | None = field(default=None, compare=False)
 
@@ -114,6 +122,8 @@ class And:
 
 @dataclass(frozen=True)
 class Or:
+    """``a | b | …``: true when some argument is."""
+
     args: tuple["Expr", ...]
     loc: Location | None = field(default=None, compare=False)
 

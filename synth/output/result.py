@@ -9,7 +9,6 @@ from typing import TYPE_CHECKING, Any
 
 from synth.grafcet.language import step_variable
 from synth.output.dot import dot_graph
-from synth.validation.diagnosis import diagnose_prohibition
 
 if TYPE_CHECKING:  # pragma: no cover
     from synth.validation.validate import ReducedController, Validation
@@ -47,6 +46,8 @@ def state_names(state: dict[str, Any]) -> tuple[list[str], list[str], str]:
 
 def prohibited_json(v: Validation, i: int) -> list[dict[str, Any]]:
     """One entry per order change SUP refuses in aggregated state ``i``."""
+    from synth.validation.diagnosis import diagnose_prohibition
+
     out = []
     for pr in v.sync.nodes[i].proh:
         d = state_json(v, i)
@@ -151,6 +152,8 @@ def validation_text(v: Validation) -> str:
         lines.append(f"  diagnosis [{d.verdict}]: {d.summary}")
         lines += [f"    {x}" for x in d.details]
     for k, i in enumerate(a.prohibited, 1):
+        from synth.validation.diagnosis import diagnose_prohibition
+
         lines += [""] + _problem_lines(v, f"Prohibited {k}", i)
         for pr in v.sync.nodes[i].proh:
             lines.append(f"  diagnosis: {diagnose_prohibition(v.sync, i, pr)}")

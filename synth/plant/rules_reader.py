@@ -13,18 +13,18 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Iterable
 
-from lark import Token
-
 from synth.errors import Location
 from synth.logic.expr import Expr
 from synth.plant.rules import FREE, ORDER, SENSOR, Constraint, Precedence, Rule, VarDecl
-from synth.syntax import ExprTransformer, parse_tree
+from synth.syntax import ExprTransformer, Token, parse_tree
 
 __all__ = ["rules_items"]
 
 
 @dataclass(frozen=True)
 class _Body:
+    """The items of a ``model`` or ``element`` body."""
+
     decls: tuple[VarDecl, ...]
     incoherences: tuple[Expr, ...]
     rules: tuple[Rule, ...]
@@ -33,6 +33,8 @@ class _Body:
 
 @dataclass(frozen=True)
 class _Model:
+    """``model NAME { … }``."""
+
     name: str
     body: _Body
     loc: Location
@@ -40,6 +42,8 @@ class _Model:
 
 @dataclass(frozen=True)
 class _Instance:
+    """``element NAME = MODEL(a = b, …)``."""
+
     name: str
     model: str
     renaming: tuple[tuple[str, str, Location, Location], ...]
@@ -49,6 +53,8 @@ class _Instance:
 
 @dataclass(frozen=True)
 class _Inline:
+    """``element NAME { … }``."""
+
     name: str
     body: _Body
     loc: Location
@@ -56,17 +62,23 @@ class _Inline:
 
 @dataclass(frozen=True)
 class _Use:
+    """``use "FILE"``."""
+
     path: str
     loc: Location
 
 
 @dataclass(frozen=True)
 class _Hold:
+    """``hold NAME = BIT, …``."""
+
     decls: tuple[VarDecl, ...]
 
 
 @dataclass(frozen=True)
 class _Vector:
+    """``inputs …`` or ``outputs …``."""
+
     kind: str  # "inputs" | "outputs"
     names: tuple[tuple[str, Location], ...]
 

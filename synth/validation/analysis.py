@@ -41,6 +41,8 @@ class Trace:
 
 @dataclass(frozen=True)
 class Analysis:
+    """What the graph searches found in SYNC: blocking states, their traces, prohibited orders."""
+
     blocking: tuple[int, ...]  # first state of each terminal component, by trace length
     traces: dict[int, Trace]
     no_return: dict[int, int]  # blocking node -> first node of its trace that cannot come back

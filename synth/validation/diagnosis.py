@@ -82,6 +82,8 @@ class Cause:
 
 @dataclass(frozen=True)
 class Awaited:
+    """A transition a blocked Grafcet waits on, and why it cannot fire."""
+
     transition: str
     grafcet: str
     receptivity: str
@@ -104,6 +106,8 @@ class Awaited:
 
 @dataclass(frozen=True)
 class Diagnosis:
+    """The verdict on a blocking situation (or a Grafcet that never starts), its summary and its causes."""
+
     verdict: Verdict
     summary: str
     awaited: tuple[Awaited, ...] = ()

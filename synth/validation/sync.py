@@ -71,6 +71,8 @@ class Node:
 
 @dataclass(frozen=True)
 class Edge:
+    """A transition of the aggregated SYNC: from node ``source`` to node ``target`` on ``event``."""
+
     source: int
     event: Event  # ↑v11, ↓dcy, 2s/X101
     target: int

@@ -8,25 +8,29 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable, Sequence
+from typing import TYPE_CHECKING, Callable, Sequence
 
 from synth.validation.analysis import Analysis, analyse
 from synth.plant.composition import Plant, plant
 from synth.errors import InputError, close_names
 from synth.logic.expr import Edge as ExprEdge, Expr, evaluate, names
 from synth.syntax import parse_expression
-from synth.validation.diagnosis import Diagnosis, diagnose, diagnose_never_starts
 from synth.grafcet.language import Grafcet, load_grafcet
 from synth.plant.rules import RuleSet, load_rules
 from synth.grafcet.machine import GrafcetMachine
 from synth.sup.constraints import CompiledConstraints
 from synth.validation.sync import Edge, Sync, synchronous_product
 
+if TYPE_CHECKING:  # pragma: no cover - imported by validate() when there is something to diagnose
+    from synth.validation.diagnosis import Diagnosis
+
 __all__ = ["Validation", "ReducedController", "validate", "home_conditions", "home_states", "reduced_controller"]
 
 
 @dataclass(frozen=True)
 class Validation:
+    """One whole run of ``synth validate``: its inputs, SYNC, the analysis and the diagnoses."""
+
     rules: RuleSet
     plant: Plant
     grafcet: Grafcet
@@ -131,8 +135,13 @@ def validate(
     sup_empty = not CompiledConstraints(p, rs.constraints).kept(p.initial)
     sync = synchronous_product(p, rs.constraints, machine, max_states=max_states, progress=progress)
     analysis = analyse(sync, home_states(sync, conditions))
-    diagnoses = {b: diagnose(sync, b, expert=expert, component=analysis.components[b]) for b in analysis.blocking}
-    never = diagnose_never_starts(sync, expert=expert) if analysis.never_starts else None
+    diagnoses: dict[int, Diagnosis] = {}
+    never = None
+    if analysis.blocking or analysis.never_starts:  # a passing run never imports the diagnosis
+        from synth.validation.diagnosis import diagnose, diagnose_never_starts
+
+        diagnoses = {b: diagnose(sync, b, expert=expert, component=analysis.components[b]) for b in analysis.blocking}
+        never = diagnose_never_starts(sync, expert=expert) if analysis.never_starts else None
     return Validation(rs, p, g, sync, analysis, diagnoses, expert, sup_empty, tuple(homes), never)
 
 
