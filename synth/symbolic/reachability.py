@@ -30,7 +30,7 @@ from synth.logic.events import Event
 from synth.symbolic.sync import Bundle, NodeSet, SymbolicSync
 
 __all__ = ["Path", "coreachable", "stuck_nodes", "held_nodes", "terminal_components", "first_node", "shortest_trace",
-           "prohibited_nodes", "listed", "MAX_LISTED"]
+           "prohibited_nodes", "listed", "MAX_LISTED", "node_held"]
 
 MAX_LISTED = 100_000
 """At most this many nodes of one component are listed for the diagnosis."""
@@ -77,6 +77,29 @@ def held_nodes(sync: SymbolicSync) -> NodeSet:
         for s, u in src.items():
             changers[s] = changers.get(s, sync.false) | u
     return _minus(sync.nodes(), sync.backward(changers), sync.false)
+
+
+def node_held(sync: SymbolicSync, s: int, local: tuple[int, ...]) -> bool:
+    """Whether node (``s``, ``local``) is held (:func:`held_nodes` for one node): a forward
+    search through the situations with its active steps, stopped at the first edge
+    into other active steps."""
+    steps = sync.situations[s].steps
+    reached: NodeSet = {s: sync.enc.state(local)}
+    work = [s]
+    while work:
+        a = work.pop()
+        for link in sync.out_links(a):
+            u = sync.post({a: reached[a]}, link)
+            if u == sync.false:
+                continue
+            if sync.situations[link.target].steps != steps:
+                return False
+            old = reached.get(link.target, sync.false)
+            if (u & ~old) != sync.false:
+                reached[link.target] = old | u
+                if link.target not in work:
+                    work.append(link.target)
+    return True
 
 
 def prohibited_nodes(sync: SymbolicSync) -> dict[tuple[tuple[str, ...], Event], NodeSet]:

@@ -498,19 +498,32 @@ class SymbolicSync:
                 self.progress(f"exploring SYNC symbolically: {len(self.situations)} situations, "
                               f"{len(pending)} pending, {len(self.enc.bdd)} BDD nodes")
         self.bundles = [self._edges(b) for b in sorted(self._bundles.values(), key=lambda b: (b.source, b.key, b.target))]
-        self.edge_count = sum(self.enc.count(b.edges, (Copy.CURRENT, Copy.NEXT)) for b in self.bundles)
         self._sync_states = sum(self.enc.count(r.members) for r in self.regions)
         for r in self.regions:  # only the nodes are read from here on: free the rest
             r.entered = r.pairs = r.members = self.false
         self._bundles = {}
         links: dict[tuple[int, int], Function] = {}
+        overlapping: set[tuple[int, int]] = set()  # links whose bundles share a pair of nodes
         for b in self.bundles:
-            links[(b.source, b.target)] = links.get((b.source, b.target), self.false) | b.edges
+            key = (b.source, b.target)
+            old = links.get(key)
+            if old is None:
+                links[key] = b.edges
+            else:
+                if key not in overlapping and (old & b.edges) != self.false:
+                    overlapping.add(key)
+                links[key] = old | b.edges
         self.links = [Link(a, t, e) for (a, t), e in sorted(links.items())]
+        # a transition per bundle and pair of nodes: one count per link whose bundles are disjoint
+        self.edge_count = sum(self.enc.count(e, (Copy.CURRENT, Copy.NEXT)) for k, e in links.items() if k not in overlapping)
+        self.edge_count += sum(self.enc.count(b.edges, (Copy.CURRENT, Copy.NEXT)) for b in self.bundles
+                               if (b.source, b.target) in overlapping)
         self._into: dict[int, list[Link]] = {}
         self._out: dict[int, list] = {}
+        self._from: dict[int, list[Link]] = {}
         for link in self.links:
             self._into.setdefault(link.target, []).append(link)
+            self._from.setdefault(link.source, []).append(link)
         self._in: dict[int, list[Bundle]] = {}
         for b in self.bundles:
             self._out.setdefault(b.source, []).append(b)
@@ -531,16 +544,13 @@ class SymbolicSync:
         computed once, on demand: only traces need them."""
         if self.rings or not self.initial:
             return self.rings
-        by_source: dict[int, list[Link]] = {}
-        for link in self.links:
-            by_source.setdefault(link.source, []).append(link)
         seen: NodeSet = dict(self.initial)
         ring: NodeSet = dict(self.initial)
         while ring:
             self.rings.append(ring)
             new: NodeSet = {}  # targets in the next copy, renamed once per situation below
             for s in sorted(ring):
-                for link in by_source.get(s, ()):
+                for link in self.out_links(s):
                     u = self.enc.and_exists(link.edges, ring[s], Copy.CURRENT)
                     if u != self.false:
                         new[link.target] = new.get(link.target, self.false) | u
@@ -600,6 +610,9 @@ class SymbolicSync:
     def in_bundles(self, target: int) -> list[Bundle]:
         return self._in.get(target, [])
 
+    def out_links(self, source: int) -> list[Link]:
+        return self._from.get(source, [])
+
     def backward(self, targets: NodeSet, within: NodeSet | None = None) -> NodeSet:
         """Nodes from which ``targets`` can be reached (targets included): a worklist
         fixpoint over the situations whose set grew."""
@@ -620,14 +633,11 @@ class SymbolicSync:
 
     def forward(self, sources: NodeSet) -> NodeSet:
         """Nodes reachable from ``sources`` (included)."""
-        by_source: dict[int, list[Link]] = {}
-        for link in self.links:
-            by_source.setdefault(link.source, []).append(link)
         reached: NodeSet = {s: u for s, u in sources.items() if u != self.false}
         work = sorted(reached)
         while work:
             s = work.pop()
-            for link in by_source.get(s, ()):
+            for link in self.out_links(s):
                 u = self.post({s: reached[s]}, link)
                 old = reached.get(link.target, self.false)
                 grown = u & ~old

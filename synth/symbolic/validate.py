@@ -34,6 +34,7 @@ from synth.symbolic.reachability import (
     coreachable,
     first_node,
     held_nodes,
+    node_held,
     listed,
     prohibited_nodes,
     shortest_trace,
@@ -200,18 +201,15 @@ def _validate_loaded(
     home = _homes(ssync, homes, p, g)
     back = coreachable(ssync, home)
     stuck = stuck_nodes(ssync, back)
-    held = held_nodes(ssync)
     proh_sets = prohibited_nodes(ssync)
-
-    def is_in(u: NodeSet, key: Key) -> bool:
-        s, local = key
-        return s in u and (u[s] & ssync.enc.state(local)) != false
+    held: NodeSet | None = held_nodes(ssync) if proh_sets else None  # else only the listed nodes are asked
 
     # blocking: held with a prohibited order, once per set of steps; terminal components
     found: list[tuple[int, tuple, Key, list[Key]]] = []
     by_steps: dict[tuple[str, ...], NodeSet] = {}
     for (steps, _), u in proh_sets.items():
         for s, v in u.items():
+            assert held is not None
             v &= held.get(s, false)
             if v != false:
                 d = by_steps.setdefault(steps, {})
@@ -235,7 +233,7 @@ def _validate_loaded(
         components[b] = tuple(sorted(ex.node(k) for k in members))
         traces[b] = ex.trace(key)
         keys = {v: k for k, v in ex.index.items()}
-        no_return[b] = next((n for n in traces[b].nodes if not is_in(back, keys[n])), b)
+        no_return[b] = next((n for n in traces[b].nodes if not _is_in(ssync, back, keys[n])), b)
     # prohibited orders: the first node meeting each (steps, event)
     firsts: dict[Key, tuple] = {}
     for u in proh_sets.values():
@@ -259,10 +257,10 @@ def _validate_loaded(
     keys = {v: k for k, v in ex.index.items()}
     analysis = Analysis(
         tuple(blocking), traces, no_return,
-        frozenset(i for i in range(len(ex.nodes)) if is_in(back, keys[i])),
+        frozenset(i for i in range(len(ex.nodes)) if _is_in(ssync, back, keys[i])),
         tuple(prohibited), components,
-        frozenset(i for i in range(len(ex.nodes)) if is_in(home, keys[i])),
-        frozenset(i for i in range(len(ex.nodes)) if is_in(held, keys[i])),
+        frozenset(i for i in range(len(ex.nodes)) if _is_in(ssync, home, keys[i])),
+        _held_listed(ssync, held, ex, keys),
         never,
     )
     diagnoses = {b: diagnose(sync, b, expert=expert, component=analysis.components[b]) for b in analysis.blocking}
@@ -270,6 +268,25 @@ def _validate_loaded(
     reached = frozenset(st for sit in ssync.situations for st in sit.steps)
     return Validation(rs, p, g, sync, analysis, diagnoses, expert, sup_empty, tuple(homes), never_d,
                       counts=stats, reached_steps=reached, engine_stats=_stats(ssync))
+
+
+def _held_listed(ssync: SymbolicSync, held: NodeSet | None, ex: _Explicit, keys: dict[int, Key]) -> frozenset[int]:
+    """The listed nodes that are held: read from ``held`` when it was computed (a
+    prohibited order made it necessary) or when many nodes are listed, else asked node by
+    node (a forward search that stops at the first change of active steps)."""
+    if held is None and len(ex.nodes) > _HELD_ONE_BY_ONE:
+        held = held_nodes(ssync)
+    if held is not None:
+        return frozenset(i for i in range(len(ex.nodes)) if _is_in(ssync, held, keys[i]))
+    return frozenset(i for i in range(len(ex.nodes)) if node_held(ssync, *keys[i]))
+
+
+_HELD_ONE_BY_ONE = 1000
+
+
+def _is_in(ssync: SymbolicSync, u: NodeSet, key: Key) -> bool:
+    s, local = key
+    return s in u and (u[s] & ssync.enc.state(local)) != ssync.false
 
 
 def _one_per_situation(ssync: SymbolicSync, ex: _Explicit) -> None:
