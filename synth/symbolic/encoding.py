@@ -22,7 +22,6 @@ True
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from enum import Enum
 from typing import Iterator, Mapping, Sequence
 
@@ -30,7 +29,7 @@ from synth.errors import LimitExceeded
 from synth.filter.bdd import Engine, Function, _backend
 from synth.plant.composition import Plant
 
-__all__ = ["Copy", "PlantEncoding", "NodeBudget"]
+__all__ = ["Copy", "PlantEncoding", "NodeBudget", "live_nodes"]
 
 _and_exists = getattr(_backend, "and_exists", None) if _backend.__name__ == "dd.cudd" else None
 
@@ -43,17 +42,45 @@ class Copy(Enum):
     AUX = "''"
 
 
-@dataclass(frozen=True)
-class NodeBudget:
-    """``--max-nodes``: the largest number of live BDD nodes allowed (None: no limit)."""
+def live_nodes(engine: Engine) -> int:
+    """The manager's live BDD nodes. With CUDD, its running count (keys − dead, which
+    also counts one node per variable) read through ``statistics``: ``len`` of a dd
+    manager walks every node (0.6 s at 1.6·10^6 nodes), ``statistics`` only the
+    table's slots (about 30 times less)."""
+    if _backend.__name__ != "dd.cudd":  # pragma: no cover - dd without its CUDD extension
+        return len(engine.bdd)
+    import warnings
 
-    limit: int | None = None
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # dd's note that the key 'mem' is now in bytes
+        return int(engine.bdd.statistics()["n_nodes"])
+
+
+class NodeBudget:
+    """``--max-nodes``: the largest number of live BDD nodes allowed (None: no limit).
+
+    Checked at once, then at most every :attr:`interval` seconds (a reading of the node
+    count costs milliseconds on a large manager, and is asked once per situation), so
+    the engine stops within that interval of crossing the budget."""
+
+    __slots__ = ("limit", "_next")
+    interval = 0.25
+
+    def __init__(self, limit: int | None = None) -> None:
+        self.limit = limit
+        self._next = 0.0
 
     def check(self, engine: Engine, where: str) -> None:
         """Stop with :class:`~synth.errors.LimitExceeded` above the budget."""
         if self.limit is None:
             return
-        n = len(engine.bdd)
+        from time import monotonic
+
+        now = monotonic()
+        if now < self._next:
+            return
+        n = live_nodes(engine)
+        self._next = monotonic() + self.interval
         if n > self.limit:
             raise LimitExceeded(
                 f"the symbolic engine needs more than {self.limit} BDD nodes ({n} while {where}); "

@@ -32,7 +32,7 @@ from synth.filter.bdd import Function
 from synth.plant.composition import Plant
 from synth.plant.rules import Constraint
 from synth.sup.constraints import CompiledConstraints
-from synth.symbolic.encoding import Copy, NodeBudget, PlantEncoding
+from synth.symbolic.encoding import Copy, NodeBudget, PlantEncoding, live_nodes
 from synth.symbolic.relation import Move, plant_moves
 
 __all__ = ["SymbolicSupervisor", "symbolic_supervisor"]
@@ -142,7 +142,7 @@ class SymbolicSupervisor:
             sweeps += 1
             self.enc.check(f"exploring SUP (sweep {sweeps})")
             if progress is not None:
-                progress(f"exploring SUP symbolically: sweep {sweeps}, {len(self.enc.bdd)} BDD nodes")
+                progress(f"exploring SUP symbolically: sweep {sweeps}, {live_nodes(self.enc.engine)} BDD nodes")
         self.states = reached
         return self
 
@@ -153,7 +153,7 @@ class SymbolicSupervisor:
     @property
     def nodes(self) -> int:
         """Live BDD nodes in the manager (the engine's memory)."""
-        return len(self.enc.bdd)
+        return live_nodes(self.enc.engine)
 
     @cached_property
     def _counts(self) -> tuple[int, int, int]:

@@ -54,7 +54,7 @@ from synth.logic.events import Event
 from synth.logic.expr import Edge as ExprEdge, names
 from synth.plant.composition import Plant
 from synth.plant.rules import Constraint
-from synth.symbolic.encoding import Copy, NodeBudget
+from synth.symbolic.encoding import Copy, NodeBudget, live_nodes
 from synth.symbolic.relation import Move, image, pair_preimage, preimage
 from synth.symbolic.supervisor import SymbolicSupervisor
 
@@ -496,7 +496,7 @@ class SymbolicSync:
             turns += 1
             if self.progress is not None and turns % 50 == 0:
                 self.progress(f"exploring SYNC symbolically: {len(self.situations)} situations, "
-                              f"{len(pending)} pending, {len(self.enc.bdd)} BDD nodes")
+                              f"{len(pending)} pending, {live_nodes(self.engine)} BDD nodes")
         self.bundles = [self._edges(b) for b in sorted(self._bundles.values(), key=lambda b: (b.source, b.key, b.target))]
         self._sync_states = sum(self.enc.count(r.members) for r in self.regions)
         for r in self.regions:  # only the nodes are read from here on: free the rest

@@ -28,7 +28,7 @@ from synth.logic.expr import evaluate
 from synth.plant.composition import Plant, plant
 from synth.plant.rules import RuleSet, load_rules
 from synth.sup.constraints import CompiledConstraints
-from synth.symbolic.encoding import NodeBudget
+from synth.symbolic.encoding import NodeBudget, live_nodes
 from synth.symbolic.reachability import (
     MAX_LISTED,
     coreachable,
@@ -296,4 +296,4 @@ def _one_per_situation(ssync: SymbolicSync, ex: _Explicit) -> None:
 
 
 def _stats(ssync: SymbolicSync) -> dict[str, int]:
-    return {"bdd_nodes": len(ssync.enc.bdd), "situations": len(ssync.situations)}
+    return {"bdd_nodes": live_nodes(ssync.enc.engine), "situations": len(ssync.situations)}
