@@ -83,7 +83,10 @@ def plant_moves(enc: PlantEncoding) -> tuple[Move, ...]:
 
 def image(enc: PlantEncoding, states: Function, move: Move) -> Function:
     """States reached from ``states`` by ``move``."""
-    return enc.and_exists(states, move.guard, Copy.CURRENT, (move.variable,)) & move.after
+    both = states & move.guard  # most moves cannot happen from most sets: tested first
+    if both == enc.engine.false:
+        return both
+    return enc.exists(both, Copy.CURRENT, (move.variable,)) & move.after
 
 
 def preimage(enc: PlantEncoding, states: Function, move: Move) -> Function:

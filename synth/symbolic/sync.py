@@ -299,11 +299,11 @@ class SymbolicSync:
         pieces = []
         for axis, r in enumerate(rel):
             key = (axis, self._own_orders(axis, wanted))
-            piece = self._pieces.get(key, self.false)
-            if piece is self.false:
+            if key not in self._pieces:
                 others = self._other_orders[axis]
                 reads_others = r != self.false and any(n in others for n in self.engine.support(r))
-                piece = self._pieces[key] = None if reads_others else self._element_region(axis, r)
+                self._pieces[key] = None if reads_others else self._element_region(axis, r)
+            piece = self._pieces[key]
             if piece is None:
                 self._products[wanted] = None
                 return None
