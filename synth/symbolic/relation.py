@@ -7,9 +7,9 @@ construction. The plant's relation is their disjunction.
 
 Since a move flips one variable ``v`` (its ``guard`` is the set of its sources, where
 ``v`` has the value it leaves), images need no second copy of the variables:
-``image(S) = (∃v. S ∧ guard) ∧ v⁺`` and ``preimage(S) = guard ∧ ∃v. (S ∧ v⁺)``, ``v⁺``
-being the literal of ``v`` after the move: a conjunction and a one-variable
-quantification instead of a relational product and a renaming.
+``image(S) = (S ∧ guard)[v := ¬v]`` and ``preimage(S) = guard ∧ (S ∧ v⁺)[v := ¬v]``,
+``v⁺`` being the literal of ``v`` after the move: a conjunction and a composition
+instead of a relational product and a renaming.
 
 Example
 -------
@@ -31,7 +31,7 @@ from synth.logic.events import Event
 from synth.plant.composition import LocalTransition
 from synth.symbolic.encoding import Copy, PlantEncoding
 
-__all__ = ["Move", "plant_moves", "image", "preimage", "pair_preimage"]
+__all__ = ["Move", "plant_moves", "image", "preimage", "pair_preimage", "flipped"]
 
 
 @dataclass(frozen=True)
@@ -53,6 +53,7 @@ class Move:
     transitions: tuple[LocalTransition, ...]
     guard: Function
     after: Function
+    flip: tuple[str, Function]  # the BDD variable of ``variable`` and its negation: u[v := ¬v]
 
     @property
     def variable(self) -> str:
@@ -77,25 +78,31 @@ def plant_moves(enc: PlantEncoding) -> tuple[Move, ...]:
         guard = enc.engine.disjunction(enc.local_state(axis, t.src) for _, t in ts)
         var = enc.engine.var(event.name)
         out.append(Move(axis, event, ts[0][1].controllable, ts[0][0], rel, tuple(t for _, t in ts),
-                        guard, var if event.rising else ~var))
+                        guard, var if event.rising else ~var, (enc.engine.declare(event.name), ~var)))
     return tuple(sorted(out, key=lambda m: m.key))
 
 
 def image(enc: PlantEncoding, states: Function, move: Move) -> Function:
-    """States reached from ``states`` by ``move``."""
+    """States reached from ``states`` by ``move``: those of its guard, the variable flipped."""
     both = states & move.guard  # most moves cannot happen from most sets: tested first
     if both == enc.engine.false:
         return both
-    return enc.exists(both, Copy.CURRENT, (move.variable,)) & move.after
+    return flipped(enc, both, move)
 
 
 def preimage(enc: PlantEncoding, states: Function, move: Move) -> Function:
     """States from which ``move`` leads into ``states``."""
-    return enc.and_exists(states, move.after, Copy.CURRENT, (move.variable,)) & move.guard
+    return flipped(enc, states & move.after, move) & move.guard
 
 
 def pair_preimage(enc: PlantEncoding, entries: Function, pairs: Function, move: Move) -> Function:
     """``{(x, x') : (n, x') ∈ pairs, n ∈ entries}`` with ``n`` = x moved by ``move``, for
     ``entries`` inside the image of ``move`` (so x is in its guard: only the flipped
     variable goes back)."""
-    return enc.and_exists(entries, pairs, Copy.CURRENT, (move.variable,)) & ~move.after
+    return flipped(enc, entries & pairs, move)
+
+
+def flipped(enc: PlantEncoding, u: Function, move: Move) -> Function:
+    """``u`` with the move's variable negated (current copy): one composition."""
+    name, negation = move.flip
+    return enc.bdd.let({name: negation}, u)

@@ -344,8 +344,8 @@ class SymbolicSync:
         product = self._product_region(wanted)
         if product is not None:
             members, settled = product
-            pairs = entries & settled
-            return pairs, self.post_pairs(entries, members), self.post_pairs(entries, settled)
+            members = self.post_pairs(entries, members)
+            return entries & settled, members, members & ~progress  # settled: members with no region move left
         domains = self._domains(wanted)
         reach = entries & self.equal
         frontier = reach
@@ -359,8 +359,8 @@ class SymbolicSync:
                 new |= self.enc.rename(step, Copy.AUX, Copy.NEXT, names)
             frontier = new & ~reach
             reach |= frontier
-        pairs = reach & ~self.enc.rename(progress, Copy.CURRENT, Copy.NEXT)
-        return pairs, self.post_pairs(self.true, reach), self.post_pairs(self.true, pairs)
+        members = self.post_pairs(self.true, reach)
+        return reach & ~self.enc.rename(progress, Copy.CURRENT, Copy.NEXT), members, members & ~progress
 
     def post_pairs(self, sources: Function, pairs: Function) -> Function:
         """The x' of the pairs ``(x, x')`` whose x is in ``sources``, as current states."""
