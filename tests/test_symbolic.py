@@ -279,3 +279,24 @@ def test_live_nodes_and_throttled_budget():
     budget._next = 0.0
     with pytest.raises(LimitExceeded, match="more than 1 BDD nodes"):
         budget.check(enc.engine, "here")
+
+
+@pytest.mark.parametrize("grafcet", ["tri.g7", "tri_missing_order.g7"])
+def test_node_held_agrees_with_held_nodes(grafcet):
+    """The node-by-node answer (used when no prohibited order needs the whole set) is the
+    whole set's, on every node of the symbolic SYNC; and the explicit engine's held set."""
+    from synth.grafcet.language import load_grafcet
+    from synth.grafcet.machine import GrafcetMachine
+    from synth.symbolic.reachability import held_nodes, listed, node_held
+    from synth.symbolic.sync import symbolic_sync
+
+    rs = load_rules(P / "tri.rules")
+    p = plant(rs)
+    s = symbolic_sync(p, rs.constraints, GrafcetMachine(load_grafcet(G / grafcet, inputs=p.inputs, outputs=p.outputs)))
+    held = held_nodes(s)
+    nodes = listed(s, s.nodes())
+    flags = [node_held(s, k, local) for k, local in nodes]
+    assert flags == [k in held and (held[k] & s.enc.state(local)) != s.false for k, local in nodes]
+    explicit = validate(G / grafcet, P / "tri.rules")
+    assert sum(flags) == len(explicit.analysis.held)
+    assert (sum(flags) > 0) == (grafcet == "tri_missing_order.g7")  # its blocking situation is held
