@@ -55,7 +55,6 @@ import re
 from dataclasses import dataclass
 from enum import StrEnum
 from functools import lru_cache
-from typing import Iterator
 
 from synth.version import version as synth_version
 from synth.errors import InputError, Location, close_names
@@ -67,7 +66,7 @@ from synth.grafcet.language import (
     ON_EVENT,
     Grafcet,
 )
-from synth.logic.expr import And, Const, Edge, Expr, Not, Or, Var
+from synth.logic.expr import And, Const, Edge, Expr, Not, Or, Var, names as expr_names
 
 __all__ = [
     "NS",
@@ -410,7 +409,7 @@ def sfc_project_xml(g: Grafcet, *, name: str | None = None, version: str | None 
         for n in names:
             vl.append(_E("variable", {"name": n}, _E("type", None, _E("BOOL"))))
         iface.append(vl)
-    edges = sorted({(n.rising, n.name) for x in g.expressions() for n in _edges(x)}, key=lambda e: (e[1], not e[0]))
+    edges = sorted({(n.rising, n.name) for x in g.expressions() for n in expr_names(x) if isinstance(n, Edge)}, key=lambda e: (e[1], not e[0]))
     if edges:
         vl = _E("localVars")
         for rising, n in edges:
@@ -421,16 +420,6 @@ def sfc_project_xml(g: Grafcet, *, name: str | None = None, version: str | None 
         iface.append(vl)
     pou = _E("pou", {"name": pou_name, "pouType": "program"}, iface, _E("body", None, body))
     return _project(pou_name, version or synth_version(), comment, [pou])
-
-
-def _edges(e: Expr) -> Iterator[Edge]:
-    if isinstance(e, Edge):
-        yield e
-    elif isinstance(e, Not):
-        yield from _edges(e.arg)
-    elif isinstance(e, (And, Or)):
-        for a in e.args:
-            yield from _edges(a)
 
 
 def _action(a, local_id: int, k: int, steps: set[str], timers: dict[str, str]):

@@ -282,7 +282,7 @@ class SymbolicSync:
             ok = self.sup.allowed(m)
             names = self.enc.element_variables[m.axis]
             can = self.enc.exists(ok, Copy.NEXT, names)
-            bad = self.enc.exists(m.relation, Copy.NEXT, names) & ~can
+            bad = m.guard & ~can  # the guard: where the move exists at all
             shifted = self.enc.rename(self.enc.rename(ok, Copy.NEXT, Copy.AUX, names), Copy.CURRENT, Copy.NEXT)
             hit = (shifted, can, bad)
             self._region_moves[m.key] = hit
