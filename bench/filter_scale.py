@@ -48,7 +48,7 @@ out["st_lines"] = fb.text.count("\n") + lp.text.count("\n")
 out["bdd_nodes"] = len(m.engine.bdd)
 if int(sys.argv[2]):  # the truth-table oracle: global consistency by enumeration
     from synth.logic.expr import Edge, evaluate
-    from synth.filter.language import pre_name
+    from synth.logic.past import pre_name
     t = time.perf_counter()
     from synth.logic.expr import names
     used = set()

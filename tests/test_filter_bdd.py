@@ -8,7 +8,7 @@ from itertools import product
 
 import pytest
 
-from synth.filter.bdd import Engine, cube_text
+from synth.logic.bdd import Engine, cube_text
 from synth.filter.language_check import parse_filter
 from synth.logic.expr import Edge, evaluate
 
@@ -113,7 +113,7 @@ def test_pure_python_backend_gives_the_same_filter(monkeypatch):
     from dd import autoref
 
     from conftest import ROOT
-    from synth.filter import bdd
+    from synth.logic import bdd
     from synth.filter.coherence import coherence
     from synth.filter.language_check import load_filter
     from synth.filter.solve import synthesis
@@ -131,7 +131,7 @@ def test_dd_loads_without_networkx_and_leaves_it_importable() -> None:
     import subprocess
     import sys
 
-    code = ("import sys; import synth.filter.bdd as b; loaded = 'networkx' in sys.modules; "
+    code = ("import sys; import synth.logic.bdd as b; loaded = 'networkx' in sys.modules; "
             "import networkx; print(b.BACKEND, loaded, networkx.__name__)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
     assert out[1:] == ["False", "networkx"] and out[0] in ("dd.cudd", "dd.autoref")

@@ -10,7 +10,8 @@ from itertools import product
 import pytest
 
 from synth.filter.coherence import Property, coherence
-from synth.filter.language import Sense, pre_name, request_name
+from synth.filter.language import Sense, request_name
+from synth.logic.past import pre_name
 from synth.filter.language_check import parse_filter
 from synth.filter.solve import criteria, synthesis
 from synth.logic.expr import Edge, evaluate

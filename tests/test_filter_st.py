@@ -13,7 +13,7 @@ from synth.cli.main import main
 from synth.codegen.filter_st import filter_block
 from synth.codegen.interpreter import load_st
 from synth.errors import InputError, ModelError
-from synth.filter.language import pre_name
+from synth.logic.past import pre_name
 from synth.filter.language_check import load_filter, parse_filter
 from synth.filter.solve import requested, synthesis
 from st_blocks import interpreted

@@ -41,10 +41,11 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from synth.codegen.st import Declaration, header, indent, past_name, st_expression, st_identifier_problem, var_block
+from synth.codegen.st import Declaration, header, indent, st_expression, st_identifier_problem, var_block
 from synth.errors import InputError, ModelError
 from synth.filter.cycle import Algorithm, Mode
-from synth.filter.language import Filter, base_name, is_pre, pre_name, request_name
+from synth.filter.language import Filter, request_name
+from synth.logic.past import base_name, is_pre, pre_name, st_past_name
 from synth.logic.expr import Edge, Expr, names
 
 __all__ = ["filter_function_block", "filter_block_name", "FilterBlock", "filter_block"]
@@ -82,7 +83,7 @@ class _Writer:
     def name(self, n: str) -> str:
         if is_pre(n):
             self.past.add(base_name(n))
-            return past_name(n)
+            return st_past_name(n)
         if self.gated and n in self.f.requests:
             return _GATED + n[len("R_"):]
         return n
@@ -104,7 +105,7 @@ class _Writer:
 def _check_names(f: Filter, extra: tuple[str, ...]) -> None:
     """Every name the block declares must be a distinct IEC 61131-3 identifier."""
     declared = [*f.requests, *f.inputs, *f.observer_names, *f.outputs, *extra]
-    declared += [past_name(pre_name(n)) for n in (*f.inputs, *f.observer_names, *f.outputs)]
+    declared += [st_past_name(pre_name(n)) for n in (*f.inputs, *f.observer_names, *f.outputs)]
     seen: dict[str, str] = {}
     for n in declared:
         problem = st_identifier_problem(n)
@@ -158,8 +159,8 @@ def filter_block(f: Filter, algorithm: Algorithm | str = Algorithm.ALGEBRAIC, mo
         local += decls
     stored = [x for x in (*f.inputs, *f.observer_names, *f.outputs) if x in w.past]
     if stored:
-        body += ["(* the previous cycle's values *)"] + [f"{past_name(pre_name(x))} := {x};" for x in stored]
-    local = [Declaration(past_name(pre_name(x)), comment=f"{x} at the previous cycle") for x in stored] + local
+        body += ["(* the previous cycle's values *)"] + [f"{st_past_name(pre_name(x))} := {x};" for x in stored]
+    local = [Declaration(st_past_name(pre_name(x)), comment=f"{x} at the previous cycle") for x in stored] + local
     inputs = [Declaration(r, comment=f"request of {o}") for r, o in zip(f.requests, f.outputs)]
     inputs += [Declaration(x) for x in (*f.inputs, *f.observer_names)]
     if blocking:
@@ -191,7 +192,7 @@ def _requested(e: Expr, outputs: tuple[str, ...]) -> Expr:
 def _algebraic(f: Filter, w: _Writer, notes: list[str], order: list[str] | None) -> list[str]:
     from synth.filter.language_reader import filter_expression
     from synth.filter.solve import synthesis
-    from synth.filter.bdd import cube_text
+    from synth.logic.bdd import cube_text
 
     s = synthesis(f, order)
     if not s.functional:

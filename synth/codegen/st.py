@@ -6,7 +6,7 @@ block), so that the same Boolean expression always becomes the same ST text.
 Example
 -------
 >>> from synth.logic.expr import And, Edge, Not, Or, Var
->>> st_expression(Or((And((Var("a"), Not(Var("b^-1")))), Edge(True, "c"))), past_name)
+>>> st_expression(Or((And((Var("a"), Not(Var("b^-1")))), Edge(True, "c"))), st_past_name)
 'a AND NOT b_1 OR c AND NOT c_1'
 >>> st_identifier_problem("IN"), st_identifier_problem("a__b"), st_identifier_problem("V1")
 ('IN is a reserved word of IEC 61131-3', 'a__b has two underscores in a row', None)
@@ -19,10 +19,9 @@ from dataclasses import dataclass
 from typing import Callable, Iterable, Sequence
 
 from synth.logic.expr import And, Const, Edge, Expr, Not, Or, Var
+from synth.logic.past import pre_name, st_past_name
 
 __all__ = [
-    "PAST_SUFFIX",
-    "past_name",
     "st_expr",
     "st_expression",
     "st_identifier_problem",
@@ -32,8 +31,6 @@ __all__ = [
     "indent",
 ]
 
-PAST_SUFFIX = "_1"
-_PRE = "^-1"
 
 # IEC 61131-3 keywords and the standard function blocks/functions a variable may not shadow.
 _RESERVED = frozenset("""
@@ -52,11 +49,6 @@ WORD WSTRING XOR
 _IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
 
 
-def past_name(name: str) -> str:
-    """The ST variable of a name as synth writes it: ``x^-1`` (the previous cycle's value) is ``x_1``."""
-    return name[: -len(_PRE)] + PAST_SUFFIX if name.endswith(_PRE) else name
-
-
 def st_identifier_problem(name: str) -> str | None:
     """Why ``name`` cannot be an IEC 61131-3 identifier, or ``None`` when it can."""
     if not _IDENTIFIER.match(name):
@@ -71,7 +63,7 @@ def st_identifier_problem(name: str) -> str | None:
 
 
 def _edge_default(e: Edge, name: Callable[[str], str]) -> str:
-    now, before = name(e.name), name(e.name + _PRE)
+    now, before = name(e.name), name(pre_name(e.name))
     return f"{now} AND NOT {before}" if e.rising else f"NOT {now} AND {before}"
 
 
@@ -102,7 +94,7 @@ def st_expr(e: Expr, ref: Callable[[Expr], str], parent: int = 0) -> str:
 
 def st_expression(
     e: Expr,
-    name: Callable[[str], str] = past_name,
+    name: Callable[[str], str] = st_past_name,
     edge: Callable[[Edge], str] | None = None,
 ) -> str:
     """``e`` in ST (:func:`st_expr`) with ``name`` mapping synth names to ST variables; an

@@ -24,7 +24,7 @@ from enum import StrEnum
 from itertools import combinations, product
 from typing import Any, Sequence
 
-from synth.filter.bdd import Cube, Function, cube_text
+from synth.logic.bdd import Cube, Function, cube_text
 from synth.filter.model import FilterFunctions, edge_rule, equation_functions, functions
 
 __all__ = ["Property", "Status", "Finding", "GoEdge", "Cycle", "Coherence", "coherence", "go_graph"]

@@ -45,8 +45,9 @@ from enum import StrEnum
 from typing import Iterable, Mapping, Sequence
 
 from synth.errors import InputError
-from synth.filter.bdd import Cube
-from synth.filter.language import Filter, base_name, is_pre, pre_name
+from synth.logic.bdd import Cube
+from synth.filter.language import Filter
+from synth.logic.past import base_name, is_pre, pre_name
 from synth.filter.model import FilterFunctions, functions
 
 __all__ = ["Algorithm", "Mode", "ACK", "Memory", "CycleResult", "Lanes", "FilterCycle", "Cover"]

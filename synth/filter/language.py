@@ -7,8 +7,8 @@ output ``o`` is the variable ``R_o``. An edge ``↑x`` stands for ``!x^-1 & x``.
 
 Example
 -------
->>> pre_name("A2"), request_name("A2"), base_name("A2^-1")
-('A2^-1', 'R_A2', 'A2')
+>>> request_name("A2")
+'R_A2'
 """
 
 from __future__ import annotations
@@ -20,12 +20,8 @@ from synth.errors import InputError, Location
 from synth.logic.expr import Expr
 
 __all__ = [
-    "PRE_SUFFIX",
     "REQUEST_PREFIX",
-    "pre_name",
     "request_name",
-    "base_name",
-    "is_pre",
     "VarKind",
     "ConstraintKind",
     "Sense",
@@ -39,28 +35,12 @@ __all__ = [
     "Filter",
 ]
 
-PRE_SUFFIX = "^-1"
 REQUEST_PREFIX = "R_"
-
-
-def pre_name(name: str) -> str:
-    """The variable holding ``name`` at the previous cycle."""
-    return name + PRE_SUFFIX
 
 
 def request_name(output: str) -> str:
     """The request ``R_o`` of output ``o`` (the program's order, 000's g1)."""
     return REQUEST_PREFIX + output
-
-
-def is_pre(name: str) -> bool:
-    """Whether ``name`` is a previous-cycle value ``x^-1``."""
-    return name.endswith(PRE_SUFFIX)
-
-
-def base_name(name: str) -> str:
-    """``x`` for ``x^-1``, ``name`` itself otherwise."""
-    return name[: -len(PRE_SUFFIX)] if is_pre(name) else name
 
 
 class VarKind(StrEnum):

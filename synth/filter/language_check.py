@@ -25,15 +25,15 @@ from synth.filter.language import (
     Safety,
     SimCriterion,
     VarKind,
-    base_name,
     request_name,
 )
 from synth.filter.language_reader import Use, Vector, filter_items
+from synth.logic.past import base_name
 from synth.logic.expr import And, Edge, Expr, Not, Or, Var, names
 from synth.syntax import Checker, read_source
 
 if TYPE_CHECKING:
-    from synth.filter.bdd import Engine
+    from synth.logic.bdd import Engine
 
 __all__ = ["parse_filter", "load_filter", "output_polarities"]
 
@@ -190,7 +190,7 @@ class _FilterChecker(Checker):
         return self.relieving(s, tuple(forced))
 
     def relieving(self, s: Safety, forced: tuple[Forcing, ...]) -> tuple[Forcing, ...] | None:
-        from synth.filter.bdd import Engine
+        from synth.logic.bdd import Engine
 
         if self.engine is None:  # one manager for the file: creating one costs ~10 ms
             self.engine = Engine()

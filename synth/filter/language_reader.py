@@ -26,8 +26,8 @@ from synth.filter.language import (
     Sense,
     SimCriterion,
     VarKind,
-    pre_name,
 )
+from synth.logic.past import pre_name
 from synth.logic.expr import Expr, Var
 from synth.syntax import ExprTransformer, Token, parse_tree
 

@@ -14,8 +14,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from synth.filter.bdd import Engine, Function
-from synth.filter.language import Criterion, Filter, base_name, pre_name
+from synth.logic.bdd import Engine, Function
+from synth.filter.language import Criterion, Filter
+from synth.logic.past import base_name, pre_name
 from synth.logic.expr import Var, names
 
 __all__ = ["FilterFunctions", "functions", "variable_order", "edge_rule", "equation_functions"]

@@ -29,8 +29,9 @@ from dataclasses import dataclass, field
 from typing import Any, Sequence
 
 from synth.errors import InputError
-from synth.filter.bdd import Cube, Function, cube_text
-from synth.filter.language import Criterion, Filter, Sense, SimCriterion, pre_name, request_name
+from synth.logic.bdd import Cube, Function, cube_text
+from synth.filter.language import Criterion, Filter, Sense, SimCriterion, request_name
+from synth.logic.past import pre_name
 from synth.filter.model import FilterFunctions, equation_functions, functions
 from synth.logic.expr import And, Const, Edge, Expr, Not, Or, Var
 

@@ -26,12 +26,10 @@ from enum import Enum
 from typing import Iterator, Mapping, Sequence
 
 from synth.errors import LimitExceeded
-from synth.filter.bdd import Engine, Function, _backend
+from synth.logic.bdd import Engine, Function
 from synth.plant.composition import Plant
 
 __all__ = ["Copy", "PlantEncoding", "NodeBudget", "live_nodes"]
-
-_and_exists = getattr(_backend, "and_exists", None) if _backend.__name__ == "dd.cudd" else None
 
 
 class Copy(Enum):
@@ -43,17 +41,8 @@ class Copy(Enum):
 
 
 def live_nodes(engine: Engine) -> int:
-    """The manager's live BDD nodes. With CUDD, its running count (keys − dead, which
-    also counts one node per variable) read through ``statistics``: ``len`` of a dd
-    manager walks every node (0.6 s at 1.6·10^6 nodes), ``statistics`` only the
-    table's slots (about 30 times less)."""
-    if _backend.__name__ != "dd.cudd":  # pragma: no cover - dd without its CUDD extension
-        return len(engine.bdd)
-    import warnings
-
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # dd's note that the key 'mem' is now in bytes
-        return int(engine.bdd.statistics()["n_nodes"])
+    """The manager's live BDD nodes (:meth:`Engine.live_nodes`)."""
+    return engine.live_nodes()
 
 
 class NodeBudget:
@@ -143,9 +132,7 @@ class PlantEncoding:
         qvars = self._qvars.get(key)
         if qvars is None:
             qvars = self._qvars[key] = [self.engine.declare(n + copy.value) for n in (self.variables if names is None else names)]
-        if _and_exists is None:  # pragma: no cover - dd without its CUDD extension
-            return self.bdd.exist(qvars, u & v)
-        return _and_exists(u, v, qvars)
+        return self.engine.and_exists(u, v, qvars)
 
     def _cube(self, copy: Copy, names: Sequence[str]) -> Function:
         """The positive cube of the ``copy`` of ``names`` (what ``∃`` quantifies)."""
@@ -171,14 +158,14 @@ class PlantEncoding:
         if u == self.engine.false:
             return None
         values = {v: False for v in self.variables}
-        outer = self.engine._outer
+        outer = self.engine.name_of
         f = u
         true, false = self.engine.true, self.engine.false
         while f != true:
             lo, hi = f.low, f.high  # children of the regular node: complement them if f is
             if f.negated:
                 lo, hi = ~lo, ~hi
-            name = outer[f.var]
+            name = outer(f.var)
             if lo != false:
                 values[name] = False
                 f = lo

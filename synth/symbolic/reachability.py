@@ -25,7 +25,7 @@ from dataclasses import dataclass
 from typing import Callable
 
 from synth.errors import LimitExceeded
-from synth.filter.bdd import Function
+from synth.logic.bdd import Function
 from synth.logic.events import Event
 from synth.symbolic.sync import Bundle, NodeSet, SymbolicSync
 

@@ -26,7 +26,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from synth.filter.bdd import Function
+from synth.logic.bdd import Function
 from synth.logic.events import Event
 from synth.plant.composition import LocalTransition
 from synth.symbolic.encoding import Copy, PlantEncoding

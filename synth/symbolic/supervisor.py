@@ -28,7 +28,7 @@ from typing import Callable, Sequence
 
 import numpy as np
 
-from synth.filter.bdd import Function
+from synth.logic.bdd import Function
 from synth.plant.composition import Plant
 from synth.plant.rules import Constraint
 from synth.sup.constraints import CompiledConstraints

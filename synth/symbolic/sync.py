@@ -47,7 +47,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Callable, Iterable, Mapping, Sequence
 
-from synth.filter.bdd import Function
+from synth.logic.bdd import Function
 from synth.grafcet.language import ON_EVENT, Transition
 from synth.grafcet.machine import GrafcetMachine, Situation
 from synth.logic.events import Event

@@ -1,10 +1,10 @@
-"""The Boolean engine of the filter: BDDs (``dd.cudd`` when importable, else ``dd.autoref``)
+"""The one BDD layer of synth (the filter and the symbolic engine): BDDs (``dd.cudd`` when importable, else ``dd.autoref``)
 over filter names, the shared expression AST translated into them, minimal cubes for
 counterexamples, and a BDD printed back as a readable expression in filter syntax
 (an irredundant sum of prime implicants, Minato–Morreale ISOP then expansion, with
 edges recognised and common literals factored out).
 
-Variables keep the filter's names (``A2``, ``A2^-1``, ``R_A2``); the manager uses
+Variables keep the callers' names (``A2``, ``A2^-1``, ``R_A2``); the manager uses
 internal names ``v0``, ``v1``, … in a fixed order (no dynamic reordering, so every
 printed result is deterministic).
 
@@ -25,7 +25,7 @@ import sys
 from functools import reduce
 from typing import Any, Iterable, Mapping, Sequence
 
-from synth.filter.language import PRE_SUFFIX, pre_name
+from synth.logic.past import PRE_SUFFIX, pre_name
 from synth.logic.expr import And, Const, Edge, Expr, Not, Var
 
 
@@ -53,9 +53,10 @@ def _dd_backend() -> Any:
 
 _backend = _dd_backend()
 
-__all__ = ["Engine", "Function", "Cube", "cube_text", "BACKEND"]
+__all__ = ["Engine", "Function", "Cube", "cube_text", "BACKEND", "CUDD"]
 
 BACKEND: str = _backend.__name__
+CUDD: bool = BACKEND == "dd.cudd"  # whether the fast native operations (and-abstract, node counts) exist
 Function = Any  # a dd Function of the active backend
 Cube = dict[str, bool]  # filter name -> value
 
@@ -75,6 +76,7 @@ class Engine:
 
     def __init__(self, order: Iterable[str] = ()) -> None:
         self.bdd = _backend.BDD()
+        self.cudd = _backend.__name__ == "dd.cudd"
         self.bdd.configure(reordering=False)
         self._inner: dict[str, str] = {}
         self._outer: dict[str, str] = {}
@@ -91,6 +93,10 @@ class Engine:
             self._inner[name] = inner
             self._outer[inner] = name
         return inner
+
+    def name_of(self, inner: str) -> str:
+        """The caller's name of the manager's variable ``inner`` (``u.var`` of a node)."""
+        return self._outer[inner]
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -146,6 +152,26 @@ class Engine:
         vs = [self.declare(n) for n in names]
         return self.bdd.exist(vs, u) if vs else u
 
+    def and_exists(self, u: Function, v: Function, inner: Sequence[str]) -> Function:
+        """The relational product ``∃inner. u ∧ v`` in one pass (CUDD's and-abstract), over
+        the manager's variables ``inner`` (internal names, from :meth:`declare`)."""
+        if not self.cudd:  # pragma: no cover - dd without its CUDD extension
+            return self.bdd.exist(inner, u & v)
+        return _backend.and_exists(u, v, inner)
+
+    def live_nodes(self) -> int:
+        """The manager's live BDD nodes. With CUDD, its running count (keys − dead, which
+        also counts one node per variable) read through ``statistics``: ``len`` of a dd
+        manager walks every node (0.6 s at 1.6·10^6 nodes), ``statistics`` only the
+        table's slots (about 30 times less)."""
+        if not self.cudd:  # pragma: no cover - dd without its CUDD extension
+            return len(self.bdd)
+        import warnings
+
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # dd's note that the key 'mem' is now in bytes
+            return int(self.bdd.statistics()["n_nodes"])
+
     def forall(self, names: Iterable[str], u: Function) -> Function:
         vs = [self.declare(n) for n in names]
         return self.bdd.forall(vs, u) if vs else u
@@ -173,7 +199,7 @@ class Engine:
             return None
         cube: Cube = {}
         while u != self.true:  # cofactors by let: dd.cudd's low/high ignore complement edges
-            name = self._outer[u.var]
+            name = self.name_of(u.var)
             low = self.bdd.let({u.var: False}, u)
             if low != self.false:
                 cube[name], u = False, low
@@ -223,7 +249,7 @@ class Engine:
         c0, f0 = self._isop(l0 & ~u1, u0, memo)
         c1, f1 = self._isop(l1 & ~u0, u1, memo)
         cd, fd = self._isop((l0 & ~f0) | (l1 & ~f1), u0 & u1, memo)
-        name = self._outer[inner]
+        name = self.name_of(inner)
         cover = [{name: False, **c} for c in c0] + [{name: True, **c} for c in c1] + cd
         result = (cover, (~x & f0) | (x & f1) | fd)
         memo[key] = result
