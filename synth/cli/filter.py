@@ -57,7 +57,7 @@ def _warnings(f: "Filter") -> None:
 
 
 def cmd_check(args: argparse.Namespace) -> int:
-    from synth.cli.plant import print_json
+    from synth.output.summary import print_json
     from synth.filter.coherence import coherence
     from synth.filter.language_check import load_filter
     from synth.filter.model import functions
@@ -79,7 +79,7 @@ def cmd_check(args: argparse.Namespace) -> int:
 
 
 def cmd_solve(args: argparse.Namespace) -> int:
-    from synth.cli.plant import print_json
+    from synth.output.summary import print_json
     from synth.filter.language_check import load_filter
     from synth.filter.solve import synthesis
 
@@ -139,7 +139,7 @@ def register_run(commands: "argparse._SubParsersAction") -> None:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    from synth.cli.plant import print_json
+    from synth.output.summary import print_json
     from synth.filter.cycle import Algorithm, FilterCycle, Mode
     from synth.filter.language_check import load_filter
     from synth.filter.run import load_trace, run, run_json, run_text
@@ -196,7 +196,7 @@ def register_verify(commands: "argparse._SubParsersAction") -> None:
 
 
 def cmd_verify(args: argparse.Namespace) -> int:
-    from synth.cli.plant import print_json
+    from synth.output.summary import print_json
     from synth.filter.closed_loop import verification_json, verification_text, verify
     from synth.filter.cycle import Algorithm, Mode
     from synth.filter.language_check import load_filter

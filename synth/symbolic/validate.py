@@ -44,9 +44,9 @@ from synth.symbolic.reachability import (
 from synth.symbolic.supervisor import SymbolicSupervisor
 from synth.symbolic.sync import NodeSet, SymbolicSync
 from synth.validation.analysis import Analysis, Trace
-from synth.validation.diagnosis import diagnose, diagnose_never_starts
+from synth.validation.diagnosis import diagnose_all
 from synth.validation.sync import Conflict, Edge, Node, Prohibition, Sync, _order_moves
-from synth.validation.validate import Validation, home_conditions
+from synth.validation.result import Validation, home_conditions
 
 __all__ = ["validate_symbolic", "validate_loaded"]
 
@@ -263,10 +263,9 @@ def _validate_loaded(
         _held_listed(ssync, held, ex, keys),
         never,
     )
-    diagnoses = {b: diagnose(sync, b, expert=expert, component=analysis.components[b]) for b in analysis.blocking}
-    never_d = diagnose_never_starts(sync, expert=expert) if never else None
+    diagnoses, never_d, prohibitions = diagnose_all(sync, analysis, expert=expert)
     reached = frozenset(st for sit in ssync.situations for st in sit.steps)
-    return Validation(rs, p, g, sync, analysis, diagnoses, expert, sup_empty, tuple(homes), never_d,
+    return Validation(rs, p, g, sync, analysis, diagnoses, expert, sup_empty, tuple(homes), never_d, prohibitions,
                       counts=stats, reached_steps=reached, engine_stats=_stats(ssync))
 
 

@@ -32,9 +32,11 @@ from synth.logic.events import Event
 from synth.plant.composition import Plant
 from synth.plant.element import ElementAutomaton
 from synth.plant.rules import VarKind
+from synth.validation.analysis import Analysis
 from synth.validation.sync import Node, Prohibition, Sync
 
-__all__ = ["Verdict", "Cause", "Awaited", "Diagnosis", "diagnose", "diagnose_never_starts", "diagnose_prohibition"]
+__all__ = ["Verdict", "Cause", "Awaited", "Diagnosis", "diagnose", "diagnose_never_starts", "diagnose_prohibition",
+           "diagnose_all"]
 
 
 class Verdict(StrEnum):
@@ -398,3 +400,14 @@ def diagnose_prohibition(sync: Sync, node_index: int, pr: Prohibition) -> str:
         f"{_named(sync, pr.constraints)}: SUP forbids {pr.event} there"
     )
 
+
+
+def diagnose_all(sync: Sync, analysis: Analysis, *, expert: bool = False
+                 ) -> tuple[dict[int, Diagnosis], Diagnosis | None, dict[int, tuple[str, ...]]]:
+    """Every diagnosis a validation shows, computed once: each blocking state's, the
+    never-starts one (None when the Grafcet starts), and for each prohibited node the
+    words for each order change refused there (in the order of ``proh``)."""
+    blocking = {b: diagnose(sync, b, expert=expert, component=analysis.components[b]) for b in analysis.blocking}
+    never = diagnose_never_starts(sync, expert=expert) if analysis.never_starts else None
+    prohibitions = {i: tuple(diagnose_prohibition(sync, i, pr) for pr in sync.nodes[i].proh) for i in analysis.prohibited}
+    return blocking, never, prohibitions
