@@ -45,11 +45,12 @@ False
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Callable, Iterable, Mapping, Sequence
+from typing import Callable, Iterable, Sequence
 
 from synth.logic.bdd import Function
 from synth.grafcet.language import ON_EVENT, Transition
 from synth.grafcet.machine import GrafcetMachine, Situation
+from synth.grafcet.recorder import InputRecorder
 from synth.logic.events import Event
 from synth.logic.expr import Edge as ExprEdge, names
 from synth.plant.composition import Plant
@@ -57,59 +58,11 @@ from synth.plant.rules import Constraint
 from synth.symbolic.encoding import Copy, NodeBudget, live_nodes
 from synth.symbolic.relation import Move, image, pair_preimage, preimage
 from synth.symbolic.supervisor import SymbolicSupervisor
+from synth.validation.conflicts import ConflictLog
 
 __all__ = ["Bundle", "Link", "Region", "SymbolicSync", "symbolic_sync"]
 
 NodeSet = dict[int, Function]  # situation index -> plant states (current copy)
-
-
-class _Recorder(dict):
-    """Input values that remember which names were read (the machine is deterministic,
-    so its answer holds for every valuation agreeing on them). The values are fetched
-    (a state picked from a BDD) only when the machine first looks at them: a situation
-    whose orders do not depend on the inputs costs no pick."""
-
-    def __init__(self, fetch: Callable[[], Mapping[str, bool]]) -> None:
-        super().__init__()
-        self.read: set[str] = set()
-        self._fetch: Callable[[], Mapping[str, bool]] | None = fetch
-
-    def _load(self) -> None:
-        if self._fetch is not None:
-            dict.update(self, self._fetch())
-            self._fetch = None
-
-    def __getitem__(self, name: str) -> bool:
-        self._load()
-        self.read.add(name)
-        return dict.__getitem__(self, name)
-
-    def __contains__(self, name: object) -> bool:
-        self._load()
-        return dict.__contains__(self, name)
-
-    def __iter__(self):  # type: ignore[no-untyped-def]
-        self._load()
-        return dict.__iter__(self)
-
-    def __len__(self) -> int:
-        self._load()
-        return dict.__len__(self)
-
-    def keys(self):  # type: ignore[no-untyped-def]
-        self._load()
-        return dict.keys(self)
-
-    def get(self, name: str, default: object = None) -> object:
-        return self[name] if name in self else default
-
-    def items(self):  # type: ignore[no-untyped-def]
-        self.read.update(self)
-        return dict.items(self)
-
-    def values(self):  # type: ignore[no-untyped-def]
-        self.read.update(self)
-        return dict.values(self)
 
 
 @dataclass(frozen=True)
@@ -169,7 +122,7 @@ class SymbolicSync:
         self.rings: list[NodeSet] = []
         self.edge_count = 0
         self.conflicts: list[tuple[int, Function, Event, str, tuple[str, ...]]] = []
-        self._conflict_keys: set[tuple[str, tuple[str, ...]]] = set()
+        self._conflict_log = ConflictLog()
         self._inputs = tuple(n for n in machine.inputs if n in self.plant.owner)
         self._intra: dict[frozenset[str], tuple[tuple[Function, ...], Function, dict[Event, Function]]] = {}
         self._eq: Function | None = None
@@ -204,18 +157,15 @@ class SymbolicSync:
         assert val is not None
         return {n: val[n] for n in self._inputs}
 
-    def _cell(self, rec: _Recorder) -> Function:
-        return self.engine.cube({n: dict.__getitem__(rec, n) for n in sorted(rec.read)})
-
-    def partition(self, states: Function, answer: Callable[[_Recorder], object]) -> list[tuple[object, Function]]:
+    def partition(self, states: Function, answer: Callable[[InputRecorder], object]) -> list[tuple[object, Function]]:
         """``states`` cut into cells on which ``answer`` (a call of the machine on recorded
         inputs) gives one result; results in the order first met."""
         out: list[tuple[object, Function]] = []
         rest = states
         while rest != self.false:
-            rec = _Recorder(lambda rest=rest: self.values(rest))
+            rec = InputRecorder(lambda rest=rest: self.values(rest))
             result = answer(rec)
-            part = rest & self._cell(rec)
+            part = rest & self.engine.cube(rec.cell())
             rest = rest & ~part
             for k, (r, u) in enumerate(out):
                 if r == result:
@@ -387,29 +337,6 @@ class SymbolicSync:
         return fresh
 
     # ------------------------------------------------------------------ exploration
-    def _new_conflicts(self, rounds: Sequence[Sequence[Transition]]) -> bool:
-        """Whether ``rounds`` fire several transitions of one step not reported yet."""
-        for fired in rounds:
-            by_step: dict[str, list[str]] = {}
-            for tr in fired:
-                for st in tr.sources:
-                    by_step.setdefault(st, []).append(tr.name)
-            if any(len(v) > 1 and (st, tuple(v)) not in self._conflict_keys for st, v in by_step.items()):
-                return True
-        return False
-
-    def _note_conflicts(self, s: int, sources: Function, event: Event, rounds: Sequence[Sequence[Transition]]) -> None:
-        for fired in rounds:
-            by_step: dict[str, list[str]] = {}
-            for tr in fired:
-                for st in tr.sources:
-                    by_step.setdefault(st, []).append(tr.name)
-            for st, fired_names in by_step.items():
-                key = (st, tuple(fired_names))
-                if len(fired_names) > 1 and key not in self._conflict_keys:
-                    self._conflict_keys.add(key)
-                    self.conflicts.append((s, sources, event, st, tuple(fired_names)))
-
     def _successors(self, s: int, nodes: Function, pending: NodeSet) -> None:
         sit = self.situations[s]
         machine = self.machine
@@ -425,22 +352,24 @@ class SymbolicSync:
                 continue
             event = m.event if m.variable in self._inputs else None
 
-            def react(rec: _Recorder, event: Event | None = event) -> tuple[Situation, tuple]:
+            def react(rec: InputRecorder, event: Event | None = event) -> tuple[Situation, tuple]:
                 return machine.react_event(sit, event, rec)
 
             for (target, rounds), part in self.partition(entries, react):
                 t = self.situation(target)
-                if rounds and self._new_conflicts(rounds):
-                    self._note_conflicts(s, preimage(self.enc, part, m) & nodes, m.event, rounds)
+                found = self._conflict_log.fresh(rounds) if rounds else []
+                if found:
+                    sources = preimage(self.enc, part, m) & nodes
+                    self.conflicts += [(s, sources, m.event, st, fired) for st, fired in found]
                 self._bundle(s, m.event, t, part, m, (0, m.key), pending)
         for rank, timer in enumerate(machine.timers(sit)):
-            def fire(rec: _Recorder, timer: Event = timer) -> tuple[Situation, tuple]:
+            def fire(rec: InputRecorder, timer: Event = timer) -> tuple[Situation, tuple]:
                 return machine.fire_timer_with_trace(sit, timer, rec)
 
             for (target, rounds), part in self.partition(nodes, fire):
                 t = self.situation(target)
-                if rounds and self._new_conflicts(rounds):
-                    self._note_conflicts(s, part, timer, rounds)
+                found = self._conflict_log.fresh(rounds) if rounds else []
+                self.conflicts += [(s, part, timer, st, fired) for st, fired in found]
                 self._bundle(s, timer, t, part, None, (1, rank), pending)
 
     def _unread(self, sit: Situation) -> frozenset[str]:

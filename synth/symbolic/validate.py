@@ -45,7 +45,8 @@ from synth.symbolic.supervisor import SymbolicSupervisor
 from synth.symbolic.sync import NodeSet, SymbolicSync
 from synth.validation.analysis import Analysis, Trace
 from synth.validation.diagnosis import diagnose_all
-from synth.validation.sync import Conflict, Edge, Node, Prohibition, Sync, _order_moves
+from synth.validation.conflicts import Conflict
+from synth.validation.sync import Edge, Node, Prohibition, Sync, _order_moves
 from synth.validation.result import Validation, home_conditions
 
 __all__ = ["validate_symbolic", "validate_loaded"]
