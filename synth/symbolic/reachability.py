@@ -27,7 +27,8 @@ from typing import Callable
 from synth.errors import LimitExceeded
 from synth.logic.bdd import Function
 from synth.logic.events import Event
-from synth.symbolic.sync import Bundle, NodeSet, SymbolicSync
+from synth.symbolic.graph import Bundle, NodeSet
+from synth.symbolic.sync import SymbolicSync
 
 __all__ = ["Path", "coreachable", "stuck_nodes", "held_nodes", "terminal_components", "first_node", "shortest_trace",
            "prohibited_nodes", "listed", "MAX_LISTED", "node_held"]

@@ -42,7 +42,8 @@ from synth.symbolic.reachability import (
     terminal_components,
 )
 from synth.symbolic.supervisor import SymbolicSupervisor
-from synth.symbolic.sync import NodeSet, SymbolicSync
+from synth.symbolic.graph import NodeSet
+from synth.symbolic.sync import SymbolicSync
 from synth.validation.analysis import Analysis, Trace
 from synth.validation.diagnosis import diagnose_all
 from synth.validation.conflicts import Conflict
