@@ -125,6 +125,15 @@ class SupRun:
 
         return None if isinstance(self.sup, Supervisor) else self.sup.nodes
 
+    def listed(self) -> Supervisor:
+        """SUP with its states listed, for ``--export``: the explicit engine's
+        (``needs_listing`` chose it)."""
+        from synth.sup.supervisor import Supervisor
+
+        if not isinstance(self.sup, Supervisor):
+            raise SynthError("the symbolic engine lists no state: use --engine explicit")
+        return self.sup
+
     @property
     def labels(self) -> dict[str, str]:
         return {c.id: c.label for c in self.rules.constraints}

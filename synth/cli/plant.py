@@ -113,7 +113,7 @@ def cmd_sup(args: argparse.Namespace) -> int:
             print(ex.text(run.labels))
         return 0
     if args.export:
-        write_atomic(args.export, supervisor_generator(run.sup, "sup"))
+        write_atomic(args.export, supervisor_generator(run.listed(), "sup"))
     if args.json:
         print_json(run.summary())
     else:

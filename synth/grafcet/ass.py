@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from collections import deque
 from dataclasses import dataclass, field
+from functools import partial
 from typing import Callable, Mapping
 
 from synth.errors import LimitExceeded
@@ -156,7 +157,7 @@ def stable_situation_automaton(
                 rest &= ~covered
         while rest:
             v = (rest & -rest).bit_length() - 1
-            reader = InputRecorder(lambda v=v: valuation(v))
+            reader = InputRecorder(partial(valuation, v))
             if event.kind is EventKind.TIMER:
                 result = machine.fire_timer_with_trace(sits[k], event, reader)[0]
             else:

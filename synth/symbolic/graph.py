@@ -142,7 +142,8 @@ class SyncGraph:
                         new[link.target] = new.get(link.target, self.false) | u
             ring = {}
             for s, u in new.items():
-                u = self.enc.rename(u, Copy.NEXT, Copy.CURRENT) & ~seen.get(s, self.false)
+                known: Function = seen.get(s, self.false)
+                u = self.enc.rename(u, Copy.NEXT, Copy.CURRENT) & ~known
                 if u != self.false:
                     ring[s] = u
                     seen[s] = seen.get(s, self.false) | u
@@ -209,7 +210,7 @@ class SyncGraph:
             for t, u in self.pre({s: reached[s]}, self.into(s)).items():
                 if within is not None:
                     u &= within.get(t, self.false)
-                old = reached.get(t, self.false)
+                old: Function = reached.get(t, self.false)
                 grown = u & ~old
                 if grown != self.false:
                     reached[t] = old | grown
@@ -225,7 +226,7 @@ class SyncGraph:
             s = work.pop()
             for link in self.out_links(s):
                 u = self.post({s: reached[s]}, link)
-                old = reached.get(link.target, self.false)
+                old: Function = reached.get(link.target, self.false)
                 grown = u & ~old
                 if grown != self.false:
                     reached[link.target] = old | grown

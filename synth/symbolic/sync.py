@@ -44,9 +44,10 @@ False
 
 from __future__ import annotations
 
-from typing import Callable, Sequence
+from functools import partial
+from typing import Callable, Sequence, TypeVar
 
-from synth.grafcet.language import ON_EVENT
+from synth.grafcet.language import ON_EVENT, Transition
 from synth.grafcet.machine import GrafcetMachine, Situation
 from synth.grafcet.recorder import InputRecorder
 from synth.logic.bdd import Function
@@ -61,6 +62,9 @@ from synth.symbolic.supervisor import SymbolicSupervisor
 from synth.validation.conflicts import ConflictLog
 
 __all__ = ["SymbolicSync", "symbolic_sync"]
+
+R = TypeVar("R")  # what the machine answers
+Rounds = tuple[tuple[Transition, ...], ...]  # the transitions fired, round by round
 
 
 
@@ -110,13 +114,13 @@ class SymbolicSync(SyncGraph):
         assert val is not None
         return {n: val[n] for n in self._inputs}
 
-    def partition(self, states: Function, answer: Callable[[InputRecorder], object]) -> list[tuple[object, Function]]:
+    def partition(self, states: Function, answer: Callable[[InputRecorder], R]) -> list[tuple[R, Function]]:
         """``states`` cut into cells on which ``answer`` (a call of the machine on recorded
         inputs) gives one result; results in the order first met."""
-        out: list[tuple[object, Function]] = []
+        out: list[tuple[R, Function]] = []
         rest = states
         while rest != self.false:
-            rec = InputRecorder(lambda rest=rest: self.values(rest))
+            rec = InputRecorder(partial(self.values, rest))
             result = answer(rec)
             part = rest & self.engine.cube(rec.cell())
             rest = rest & ~part
@@ -279,7 +283,6 @@ class SymbolicSync(SyncGraph):
         sit = self.situations[s]
         fresh = self.false
         for wanted, part in self.partition(new_entries, lambda rec: self.machine.orders(sit, rec)):
-            assert isinstance(wanted, frozenset)
             pairs, members, settled = self.region_pairs(part, wanted)
             reg.pairs |= pairs
             reg.members |= members
@@ -305,7 +308,7 @@ class SymbolicSync(SyncGraph):
                 continue
             event = m.event if m.variable in self._inputs else None
 
-            def react(rec: InputRecorder, event: Event | None = event) -> tuple[Situation, tuple]:
+            def react(rec: InputRecorder, event: Event | None = event) -> tuple[Situation, Rounds]:
                 return machine.react_event(sit, event, rec)
 
             for (target, rounds), part in self.partition(entries, react):
@@ -316,7 +319,7 @@ class SymbolicSync(SyncGraph):
                     self.conflicts += [(s, sources, m.event, st, fired) for st, fired in found]
                 self._bundle(s, m.event, t, part, m, (0, m.key), pending)
         for rank, timer in enumerate(machine.timers(sit)):
-            def fire(rec: InputRecorder, timer: Event = timer) -> tuple[Situation, tuple]:
+            def fire(rec: InputRecorder, timer: Event = timer) -> tuple[Situation, Rounds]:
                 return machine.fire_timer_with_trace(sit, timer, rec)
 
             for (target, rounds), part in self.partition(nodes, fire):

@@ -242,10 +242,10 @@ def _verdict(
 ) -> tuple[Verdict, str]:
     p = sync.plant
     if not awaited:
-        steps = ", ".join(node.situation.step_variables)
+        active = ", ".join(node.situation.step_variables)
         return (
             Verdict.DEAD_END,
-            f"no transition leaves the active steps {{{steps}}}: the Grafcet stops here and never returns "
+            f"no transition leaves the active steps {{{active}}}: the Grafcet stops here and never returns "
             "to its initial situation",
         )
     free = [(a, c) for a in awaited for c in a.causes if c.free]
@@ -280,8 +280,8 @@ def _verdict(
     # the awaited event comes by itself: the Grafcet moves on, in a loop that never meets a home
     for a, c in items:
         if c.producible_now:
-            sits = sorted({sync.nodes[i].situation.steps for i in component} or {node.situation.steps})
-            loop = " → ".join("{" + ", ".join(step_variable(x) for x in steps) + "}" for steps in sits)
+            step_sets = sorted({sync.nodes[i].situation.steps for i in component} or {node.situation.steps})
+            loop = " → ".join("{" + ", ".join(step_variable(x) for x in st) + "}" for st in step_sets)
             home = " & ".join(step_variable(x) for x in node.situation.steps)
             return (
                 Verdict.LIVELOCK,
