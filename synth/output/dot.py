@@ -94,19 +94,33 @@ def element_dot(a: "ElementAutomaton", highlight: Iterable[str] = (), current: i
     return dot_graph(a.name, nodes, edges)
 
 
-def element_neighbourhood(a: "ElementAutomaton", path: Iterable[int], highlight: Iterable[str] = ()) -> frozenset[int]:
-    """The states of ``path`` (an element's states along a trace), those its ``highlight``
-    transitions lead to from there (the awaited event and the orders causing it), and
-    the direct neighbours of all these: what a drawing of the trace's element needs."""
-    marked = set(highlight)
-    pairs = [(int(a.src[t]), int(a.dst[t]), a.event(t) in marked) for t in range(a.src.size)]
+def element_neighbourhood(a: "ElementAutomaton", path: Sequence[int], highlight: Iterable[str] = ()) -> frozenset[int]:
+    """What a drawing of a trace's element needs: the states of ``path`` (the element's
+    states along the trace) and their direct neighbours, and a shortest way from its last
+    state to each ``highlight`` event (the awaited event, the orders that cause it) with
+    that event's targets."""
+    moves: dict[int, list[tuple[int, str]]] = {}
+    for t in range(a.src.size):
+        moves.setdefault(int(a.src[t]), []).append((int(a.dst[t]), a.event(t)))
+    near = {d for s in path for d, _ in moves.get(s, ())}
+    near |= {s for s, out in moves.items() for d, _ in out if d in path}
     core = set(path)
-    grown = True
-    while grown:
-        more = {d for s, d, hot in pairs if hot and s in core} - core
-        core |= more
-        grown = bool(more)
-    near = {d for s, d, _ in pairs if s in core} | {s for s, d, _ in pairs if d in core}
+    if path:
+        parent = {path[-1]: path[-1]}
+        order = [path[-1]]
+        for s in order:  # breadth-first: ``order`` grows while it is read
+            for d, _ in moves.get(s, ()):
+                if d not in parent:
+                    parent[d] = s
+                    order.append(d)
+        for event in set(highlight):
+            s = next((s for s in order if any(ev == event for _, ev in moves.get(s, ()))), None)
+            if s is None:
+                continue
+            core.update(d for d, ev in moves[s] if ev == event)
+            while s not in core:
+                core.add(s)
+                s = parent[s]
     return frozenset(core | near)
 
 
