@@ -164,6 +164,7 @@ def report_html(v: "Validation") -> str:
         grafcet_svg=Markup(_figure(chart, ident="grafcet")),
         glossary=GLOSSARY_TERMS,
         aggregated_cut=keep is not None,
+        aggregated_states=shown,
         situations=len({n.situation for n in v.sync.nodes}),
         steps_covered=steps_total - len(data["unreached_steps"]),
         steps_total=steps_total,
