@@ -114,13 +114,13 @@ def element_neighbourhood(a: "ElementAutomaton", path: Sequence[int], highlight:
                     parent[d] = s
                     order.append(d)
         for event in set(highlight):
-            s = next((s for s in order if any(ev == event for _, ev in moves.get(s, ()))), None)
-            if s is None:
+            found = next((s for s in order if any(ev == event for _, ev in moves.get(s, ()))), None)
+            if found is None:
                 continue
-            core.update(d for d, ev in moves[s] if ev == event)
-            while s not in core:
-                core.add(s)
-                s = parent[s]
+            core.update(d for d, ev in moves[found] if ev == event)
+            while found not in core:
+                core.add(found)
+                found = parent[found]
     return frozenset(core | near)
 
 
@@ -195,7 +195,7 @@ def sup_neighbourhood_dot(sync: "Sync", local: tuple[int, ...]) -> str:
     oracle = sync.oracle
     centre = p.label(local)
     nodes = [("c", centre, {"shape": "box", "color": "#c0392b", "penwidth": "2"})]
-    edges = []
+    edges: list[tuple[str, str, str, Mapping[str, str | Html]]] = []
     for k, (t, nxt) in enumerate(p.successors(local)):
         nid = f"s{k}"
         label = p.label(nxt)

@@ -1,4 +1,11 @@
-"""The only layer that calls Graphviz: DOT text → SVG, and atomic file output."""
+"""The only layer that calls Graphviz: DOT text → SVG, and the HTML report (each drawing
+at its natural size in one scroll box).
+
+Example
+-------
+>>> _figure("<svg></svg>", ident="chart", kind="whole")
+'<div class="figure whole" id="chart"><svg></svg></div>'
+"""
 
 from __future__ import annotations
 
