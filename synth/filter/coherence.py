@@ -25,9 +25,11 @@ from itertools import combinations, product
 from typing import Any, Sequence
 
 from synth.logic.bdd import Cube, Function, cube_text
+from synth.filter.language import Filter
 from synth.filter.model import FilterFunctions, edge_rule, equation_functions, functions
+from synth.filter.solve import differences, synthesis
 
-__all__ = ["Property", "Status", "Finding", "GoEdge", "Cycle", "Coherence", "coherence", "go_graph"]
+__all__ = ["Property", "Status", "Finding", "GoEdge", "Cycle", "Coherence", "coherence", "go_graph", "Check", "check"]
 
 
 class Property(StrEnum):
@@ -107,11 +109,6 @@ class Coherence:
     @property
     def holds(self) -> bool:
         return all(f.holds for f in self.findings)
-
-    def text(self) -> str:
-        lines = [f.text() for f in self.findings]
-        lines += [f"GO edge: {e.text()}" for e in self.go]
-        return "\n".join(lines) + "\n"
 
     def as_dict(self) -> dict[str, Any]:
         return {"holds": self.holds, "findings": [f.as_dict() for f in self.findings],
@@ -270,3 +267,23 @@ def coherence(m: FilterFunctions | Any) -> Coherence:
     if m.filter.equations:
         found += _equations(m)
     return Coherence(tuple(found), edges, cycles)
+
+
+@dataclass(frozen=True)
+class Check:
+    """``synth filter check``: the coherence, and how the file's ``equation`` lines differ
+    from the synthesis (none without equations)."""
+
+    coherence: Coherence
+    differences: tuple[str, ...]
+
+    @property
+    def holds(self) -> bool:
+        return self.coherence.holds
+
+
+def check(f: Filter) -> Check:
+    """The coherence of ``f`` and, when it states equations, their differences from the synthesis."""
+    m = functions(f)
+    report = coherence(m)
+    return Check(report, tuple(differences(synthesis(m))) if f.equations else ())

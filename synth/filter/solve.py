@@ -26,7 +26,7 @@ Example (004 eqs. 4-13)
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Sequence
+from typing import Sequence
 
 from synth.errors import InputError
 from synth.logic.bdd import Cube, Function, cube_text
@@ -168,32 +168,6 @@ class Synthesis:
         """The synthesised output ``o`` as a function of Y."""
         m = self.functions
         return m.engine.exists(m.outputs, self.admissible & m.engine.var(o))
-
-    def as_dict(self) -> dict[str, Any]:
-        return {
-            "functional": self.functional,
-            "consistent": self.consistent,
-            "equations": dict(self.equations),
-            "chained": {"order": list(self.chained), "equations": dict(self.chained)},
-            "warnings": self.warnings,
-            "notes": list(self.notes),
-            "criteria": [{"sense": a.criterion.sense.value, "expression": a.criterion.expr.text(),
-                          "origin": a.criterion.origin, "narrows": a.narrows, "effect": a.effect} for a in self.applied],
-            "free": {o: {n: int(v) for n, v in c.items()} for o, c in self.free.items()},
-            "inconsistent": None if self.inconsistent is None else {
-                "counterexample": {n: int(v) for n, v in self.inconsistent.items()},
-                "expression": self.inconsistent_text},
-        }
-
-    def text(self) -> str:
-        lines = [f"equation {o} = {t}" for o, t in self.chained.items()]
-        for o, c in self.free.items():
-            lines.append(f"not functional: {o} is free when {cube_text(c)}")
-        if self.inconsistent is not None:
-            lines.append(f"inconsistent: no safe output vector when {cube_text(self.inconsistent)}"
-                         + (f" (wherever {self.inconsistent_text})" if self.inconsistent_text != cube_text(
-                             self.inconsistent) else ""))
-        return "\n".join(lines) + "\n"
 
 
 def synthesis(f: Filter | FilterFunctions, order: Sequence[str] | None = None) -> Synthesis:
