@@ -19,6 +19,7 @@ K1 -(o2:=0)-> K2 -(o2:=1)-> K1
 
 from __future__ import annotations
 
+import builtins
 from dataclasses import dataclass
 from enum import StrEnum
 from itertools import combinations, product
@@ -81,7 +82,7 @@ class Finding:
     constraints: tuple[str, ...] = ()
     detail: str = ""
 
-    @property
+    @builtins.property  # the field ``property`` hides the builtin in this class body
     def holds(self) -> bool:
         return self.status is not Status.VIOLATED
 
@@ -129,8 +130,9 @@ def _judged(m: FilterFunctions, prop: Property, subject: str, parts: Sequence[tu
         return Finding(prop, subject, Status.EDGE_RULE)
     if literal == e.false:
         return Finding(prop, subject, Status.HOLDS)
-    only = cube_text(e.minimal_cube(literal))
-    return Finding(prop, subject, Status.ASSUMED, detail=f"fails only {outside}, e.g. when {only}")
+    only = e.minimal_cube(literal)
+    assert only is not None  # literal is not false
+    return Finding(prop, subject, Status.ASSUMED, detail=f"fails only {outside}, e.g. when {cube_text(only)}")
 
 
 def _p1(m: FilterFunctions, o: str) -> Finding:
@@ -172,6 +174,7 @@ def _consistency(m: FilterFunctions) -> Finding:
     if bad == e.false:
         return _judged(m, Property.CONSISTENCY, "", [((), "", stuck)], m.assumed)
     cube = e.witness(stuck, m.assumed)
+    assert cube is not None  # stuck & assumed is not false
     where = e.cube(cube) & m.assumed
     core = list(m.constraint)
     for ident in list(core):  # a minimal set of constraints still unsatisfiable on the cube
@@ -220,7 +223,7 @@ def go_graph(m: FilterFunctions) -> tuple[tuple[GoEdge, ...], tuple[Cycle, ...]]
     for start in ids:
         if start in covered:
             continue
-        back = {start: None}  # breadth-first: the shortest way back to start
+        back: dict[str, GoEdge | None] = {start: None}  # breadth-first: the shortest way back to start
         frontier, found = [start], None
         while frontier and found is None:
             nxt = []
@@ -239,9 +242,9 @@ def go_graph(m: FilterFunctions) -> tuple[tuple[GoEdge, ...], tuple[Cycle, ...]]
             continue
         path = [found[1]]
         n = found[0]
-        while back[n] is not None:
-            path.append(back[n])
-            n = back[n].source
+        while (edge := back[n]) is not None:
+            path.append(edge)
+            n = edge.source
         cycle = Cycle(tuple(reversed(path)))
         covered.update(g.source for g in cycle.edges)
         cycles.append(cycle)

@@ -128,7 +128,7 @@ class Explorer:
         fixed = {n: values[n] for n in pr.filter.inputs}
         free: list[str] = []
         passed: dict[str, bool] = {}
-        if sit is not None:
+        if sit is not None and pr.machine is not None:
             for step in pr.steps:
                 fixed[f"X{step}"] = step in sit.steps
             orders = pr.machine.orders(sit, {n: values[n] for n in pr.grafcet_inputs})

@@ -66,7 +66,7 @@ def requested(e: Expr, outputs: Sequence[str]) -> Expr:
         return e
     if isinstance(e, Not):
         return Not(requested(e.arg, outputs), e.loc)
-    args = []
+    args: list[Expr] = []
     for a in e.args:  # flatten the And an edge became
         r = requested(a, outputs)
         args.extend(r.args if isinstance(r, type(e)) and not isinstance(a, type(e)) else (r,))
@@ -212,7 +212,9 @@ def synthesis(f: Filter | FilterFunctions, order: Sequence[str] | None = None) -
         one = e.exists(outs, admissible & e.var(o))
         zero = e.exists(outs, admissible & ~e.var(o))
         if (one & zero) != e.false:
-            result.free[o] = e.minimal_cube(one & zero)
+            free = e.minimal_cube(one & zero)
+            assert free is not None  # one & zero is not false
+            result.free[o] = free
         else:
             result.equations[o] = e.text(one, one | ~care)
     result.chained = chained_equations(result)
@@ -255,11 +257,10 @@ def differences(s: Synthesis) -> list[str]:
         terms = q.expr.args if isinstance(q.expr, Or) else (q.expr,)
         for t in terms:
             extra = e.let(printed, e.expr(t)) & ~mine
-            if (extra & s.care) != e.false:
+            if (cube := e.witness(extra, s.care)) is not None:
                 lines.append(f"{q.output}: the printed term {t.text()} gives 1 where the synthesis gives 0, "
-                             f"e.g. when {cube_text(e.witness(extra, s.care))}")
-        missing = mine & ~theirs
-        if (missing & s.care) != e.false:
+                             f"e.g. when {cube_text(cube)}")
+        if (cube := e.witness(mine & ~theirs, s.care)) is not None:
             lines.append(f"{q.output}: the synthesis gives 1 where no printed term does, "
-                         f"e.g. when {cube_text(e.witness(missing, s.care))}")
+                         f"e.g. when {cube_text(cube)}")
     return lines
