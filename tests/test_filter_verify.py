@@ -22,7 +22,7 @@ from synth.filter.from_rules import skeleton
 from synth.filter.language_check import load_filter, parse_filter
 from synth.logic.events import Event
 from synth.plant.composition import plant
-from synth.plant.rules import load_rules
+from synth.plant.rules_check import load_rules
 from synth.sup.constraints import CompiledConstraints
 
 DATA = ROOT / "tests" / "data" / "filter"

@@ -140,7 +140,7 @@ class _Product:
     def __init__(self, f: Filter, rules_path: str, grafcet_path: str | None, algorithm: Algorithm,
                  mode: Mode, atomic: bool) -> None:
         from synth.plant.composition import plant
-        from synth.plant.rules import load_rules
+        from synth.plant.rules_check import load_rules
         from synth.sup.constraints import CompiledConstraints, _product
 
         rs = load_rules(rules_path)
@@ -159,7 +159,7 @@ class _Product:
         self.machine = None
         self.grafcet = None
         if grafcet_path is not None:
-            from synth.grafcet.language import load_grafcet
+            from synth.grafcet.language_check import load_grafcet
             from synth.grafcet.machine import GrafcetMachine
 
             self.grafcet = load_grafcet(grafcet_path, inputs=rs.inputs, outputs=rs.outputs)

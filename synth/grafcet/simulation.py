@@ -3,7 +3,7 @@ errors, the IEC 60848 machine stepped, one row per stable situation.
 
 Example
 -------
->>> from synth.grafcet.language import parse_grafcet
+>>> from synth.grafcet.language_check import parse_grafcet
 >>> g = parse_grafcet("grafcet G { initial step 0 step 1: A transition 0 -> 1 when ↑a "
 ...                   "transition 1 -> 0 when !a }", "g.g7")
 >>> rows = simulate(g, {"a": False}, parse_events("^a, _a", g))

@@ -14,7 +14,7 @@ reachable plant state: ``|Q| = Π|Q_i|`` and ``|δ| = Σ_i |δ_i| Π_{j≠i} |Q_
 
 Example
 -------
->>> from synth.plant.rules import load_rules
+>>> from synth.plant.rules_check import load_rules
 >>> p = plant(load_rules(_plants("tri_annex.rules")))
 >>> p.size, p.count_transitions(controllable=False) > 0
 (15552, True)
@@ -163,7 +163,7 @@ class Plant:
         are free) agrees with some plant state: each element's inputs must match one of its
         local states. Used to keep a Grafcet's exploration to vectors the plant can produce.
 
-        >>> from synth.plant.rules import load_rules
+        >>> from synth.plant.rules_check import load_rules
         >>> ok = plant(load_rules(_plants("tri.rules"))).admissible_inputs()
         >>> ok({"cp11": True, "cp12": False}), ok({"cp11": True, "cp12": True})
         (True, False)

@@ -24,7 +24,7 @@ held in numpy arrays: the work is linear in SUP's transitions, not in the plant.
 
 Example
 -------
->>> from synth.plant.rules import load_rules
+>>> from synth.plant.rules_check import load_rules
 >>> from synth.plant.composition import plant, _plants
 >>> rs = load_rules(_plants("tri_annex.rules"))
 >>> sup = supremal_controllable(plant(rs), rs.constraints)
