@@ -33,7 +33,7 @@ from typing import Iterable
 
 import numpy as np
 
-from synth.errors import InputError
+from synth.errors import InputError, Severity
 from synth.logic.events import Event
 from synth.logic.expr import evaluate
 from synth.plant.rules import ElementSpec, VarKind
@@ -229,7 +229,7 @@ def element_automaton(e: ElementSpec) -> ElementAutomaton:
                 r.loc,
                 notes=("its guard, a precedence or the incoherences rule it out everywhere: the element will never "
                        f"produce {r.consequence.text()} this way",),
-                severity="warning",
+                severity=Severity.WARNING,
             )
             for k, r in enumerate(e.rules)
             if k not in applied and not (held.get(r.cause.name) is not None and held[r.cause.name] != r.cause.rising)
