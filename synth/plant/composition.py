@@ -32,7 +32,6 @@ import numpy as np
 
 from synth.errors import SynthError, close_names
 from synth.logic.events import Event
-from synth.logic.expr import Expr, evaluate
 from synth.plant.element import ElementAutomaton, element_automaton
 from synth.plant.rules import RuleSet
 
@@ -133,11 +132,6 @@ class Plant:
         shape = [1] * self.ndim
         shape[i] = v.size
         return v.reshape(shape)
-
-    def grid(self, e: Expr) -> np.ndarray:
-        """The boolean grid of states where level expression ``e`` holds."""
-        r = evaluate(e, self.values)
-        return np.broadcast_to(np.asarray(r, dtype=bool), self.shape)
 
     def valuation(self, local: tuple[int, ...]) -> dict[str, bool]:
         """Every variable's value in the state ``local`` (a tuple of local indices)."""
