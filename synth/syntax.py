@@ -158,8 +158,9 @@ def syntax_error(err: UnexpectedInput, file: str, source: str, p: Lark) -> Input
             found = f"end of line after '{prev}'"
             width = 1
     elif isinstance(err, UnexpectedCharacters):
-        if err.pos_in_stream < len(source):
-            char = source[err.pos_in_stream]
+        pos = err.pos_in_stream if err.pos_in_stream is not None else len(source)
+        if pos < len(source):
+            char = source[pos]
             found = f"character '{char}'" if char.isprintable() else f"control character U+{ord(char):04X}"
         else:
             found = "end of file"

@@ -166,8 +166,8 @@ class GrafcetMachine:
         self._enabled_cache: dict[frozenset[str], tuple[int, ...]] = {}
         self._rec_inputs = [frozenset(receptivity_inputs(t, self.inputs)) for t in self.transitions]
         self._rec_steps = [
-            frozenset(step_of(n.name, steps) for n in names(t.receptivity)
-                      if isinstance(n, Var) and n.name not in timers and step_of(n.name, steps) is not None)
+            frozenset(s for s in (step_of(n.name, steps) for n in names(t.receptivity)
+                                  if isinstance(n, Var) and n.name not in timers) if s is not None)
             for t in self.transitions
         ]
         self._index = {t: i for i, t in enumerate(self.transitions)}

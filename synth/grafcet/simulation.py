@@ -90,7 +90,7 @@ def parse_events(text: str, grafcet: Grafcet) -> list[tuple[Event, Location]]:
             out.append((Event.timer(item), loc))
         else:
             edges = [Event.edge(i, r) for r in (True, False) for i in grafcet.inputs]
-            hint = close_names(item, timers + edges)
+            hint = close_names(item, [*timers, *edges])
             raise InputError(
                 f"unknown event '{item}'",
                 loc,

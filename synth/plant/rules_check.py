@@ -231,14 +231,14 @@ class RulesChecker(Checker):
                     c.loc,
                     notes=("split it into several constraints",),
                 )
-            for n in names(c.expr):
-                if n.name not in all_names:
-                    what = "edge of an undeclared variable" if isinstance(n, Edge) else "undeclared variable"
-                    self.unknown_use(n.name, f"constraint {c.id} uses {what} '{n.name}'", n.loc, close_names(n.name, all_names))
-                elif isinstance(n, Edge) and owner[n.name][1].kind != VarKind.ORDER:
+            for x in names(c.expr):
+                if x.name not in all_names:
+                    what = "edge of an undeclared variable" if isinstance(x, Edge) else "undeclared variable"
+                    self.unknown_use(x.name, f"constraint {c.id} uses {what} '{x.name}'", x.loc, close_names(x.name, all_names))
+                elif isinstance(x, Edge) and owner[x.name][1].kind != VarKind.ORDER:
                     self.fail(
-                        f"constraint {c.id}: edges in constraints must be edges of orders; '{n.name}' is an input of element {owner[n.name][0].name}",
-                        n.loc,
+                        f"constraint {c.id}: edges in constraints must be edges of orders; '{x.name}' is an input of element {owner[x.name][0].name}",
+                        x.loc,
                         notes=("an edge restricts the matching controllable event; inputs are written as levels",),
                     )
 
@@ -363,13 +363,16 @@ def _rename(name: str, model: Model, mapping: Mapping[str, str], loc: Location) 
     def rx(x: Expr) -> Expr:
         return renamed(x, r)
 
+    def re_(x: Edge) -> Edge:
+        return Edge(x.rising, r(x.name), x.loc)
+
     b = model.body
     return ElementSpec(
         name,
         tuple(replace(d, name=r(d.name)) for d in b.decls),
         tuple(rx(i) for i in b.incoherences),
-        tuple(Rule(rx(x.cause), rx(x.guard) if x.guard is not None else None, rx(x.consequence), x.loc) for x in b.rules),
-        tuple(Precedence(rx(p.cause), rx(p.first), rx(p.then), p.loc) for p in b.precedences),
+        tuple(Rule(re_(x.cause), rx(x.guard) if x.guard is not None else None, re_(x.consequence), x.loc) for x in b.rules),
+        tuple(Precedence(re_(p.cause), re_(p.first), re_(p.then), p.loc) for p in b.precedences),
         loc,
         model.name,
     )
