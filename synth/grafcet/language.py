@@ -15,10 +15,12 @@ Example
 -------
 >>> from synth.logic.expr import Edge
 >>> t = Transition("t1", ("0",), ("1",), Edge(True, "dcy"), "G1")
->>> g = Grafcet((PartialGrafcet("G1", (Step("0", "G1", True), Step("1", "G1", actions=(Action(CONTINUOUS, "TAPIS"),))), (t,)),), ("dcy",), ("TAPIS",))
+>>> steps = (Step("0", "G1", initial=True), Step("1", "G1", actions=(Action(CONTINUOUS, "TAPIS"),)))
+>>> g = Grafcet((PartialGrafcet("G1", steps, (t,)),), inputs=("dcy",), outputs=("TAPIS",))
 >>> g.initial_steps, t.text(), g.step("1").actions[0].text()
 (('0',), 't1: 0 -> 1 when ↑dcy', 'TAPIS')
 """
+
 from __future__ import annotations
 
 import re
