@@ -1,10 +1,21 @@
 """Loading the lark grammars shipped in ``grammars/`` and turning lark errors into
-:class:`~synth.errors.InputError` with a caret and what was expected."""
+:class:`~synth.errors.InputError` with a caret and what was expected; what the languages
+share (expressions, ``inputs``/``outputs`` lines, the error-collecting checker).
+
+Example
+-------
+>>> try:
+...     parse_expression("a &", "--home")
+... except InputError as err:
+...     print(err.message)
+syntax error: unexpected end of file
+"""
 
 from __future__ import annotations
 
 import sys
 import types
+from enum import StrEnum
 from functools import lru_cache
 from importlib import resources
 from pathlib import Path
@@ -53,7 +64,10 @@ from synth.errors import InputError, InputErrors, Location, location_in, source_
 from synth.logic.expr import And, Const, Edge, Expr, Not, Or, Var  # noqa: E402
 
 # ``Token`` is lark's, re-exported: every module of synth imports lark through this one.
-__all__ = ["grammar_text", "parser", "syntax_error", "read_source", "ExprTransformer", "Checker", "raise_all", "parse_tree", "parse_expression", "Token"]
+__all__ = [
+    "grammar_text", "parser", "syntax_error", "read_source", "ExprTransformer", "VectorKind", "Checker", "raise_all",
+    "parse_tree", "parse_expression", "Token",
+]
 
 # How terminals are shown to a user in "expected ..." lists.
 _TERMINAL_TEXT = {
@@ -144,8 +158,9 @@ def syntax_error(err: UnexpectedInput, file: str, source: str, p: Lark) -> Input
             found = f"end of line after '{prev}'"
             width = 1
     elif isinstance(err, UnexpectedCharacters):
-        if err.pos_in_stream < len(source):
-            char = source[err.pos_in_stream]
+        pos = err.pos_in_stream if err.pos_in_stream is not None else len(source)
+        if pos < len(source):
+            char = source[pos]
             found = f"character '{char}'" if char.isprintable() else f"control character U+{ord(char):04X}"
         else:
             found = "end of file"
@@ -221,6 +236,13 @@ class ExprTransformer(Transformer):
 
     def or_expr(self, items: list) -> Or:
         return Or(tuple(i for i in items if not isinstance(i, Token)))
+
+
+class VectorKind(StrEnum):
+    """Which vector an ``inputs …`` or ``outputs …`` line lists (rules and ``.g7`` files)."""
+
+    INPUTS = "inputs"
+    OUTPUTS = "outputs"
 
 
 def raise_all(errors: Sequence[InputError]) -> None:

@@ -18,7 +18,7 @@ from synth.filter.verification import FindingKind
 from synth.logic.events import Event
 from synth.output.filter_text import FINDINGS, check_text, run_json, skeleton_text, verification_json
 from synth.plant.composition import plant
-from synth.plant.rules import load_rules
+from synth.plant.rules_check import load_rules
 from synth.sup.constraints import CompiledConstraints
 
 DATA = ROOT / "tests" / "data" / "filter"

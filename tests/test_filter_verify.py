@@ -23,7 +23,7 @@ from synth.filter.language_check import load_filter, parse_filter
 from synth.logic.events import Event
 from synth.output.filter_text import trace_text
 from synth.plant.composition import plant
-from synth.plant.rules import load_rules
+from synth.plant.rules_check import load_rules
 from synth.sup.constraints import CompiledConstraints
 
 DATA = ROOT / "tests" / "data" / "filter"

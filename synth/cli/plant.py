@@ -66,7 +66,7 @@ def cmd_plant(args: argparse.Namespace) -> int:
     from synth.output.files import write_atomic
     from synth.output.html import write_svg
     from synth.plant.composition import plant
-    from synth.plant.rules import load_rules
+    from synth.plant.rules_check import load_rules
 
     rs = load_rules(args.rules)
     p = plant(rs)
@@ -108,7 +108,7 @@ def cmd_sup(args: argparse.Namespace) -> int:
     from synth.output.files import write_atomic
     from synth.output.progress import clear_progress, tty_progress
     from synth.plant.composition import plant
-    from synth.plant.rules import load_rules
+    from synth.plant.rules_check import load_rules
     from synth.sup.explain import explain
     from synth.sup.supervisor import supremal_controllable
 

@@ -33,7 +33,8 @@ from pathlib import Path
 
 from synth.filter.language import Filter
 from synth.filter.language_check import output_polarities, parse_filter
-from synth.plant.rules import RuleSet, load_rules
+from synth.plant.rules import RuleSet
+from synth.plant.rules_check import load_rules
 
 __all__ = ["Classification", "Classified", "Skeleton", "skeleton"]
 

@@ -83,7 +83,7 @@ class _FilterChecker(Checker):
         self.declared[name] = Declared(name, kind, loc, grafcet)
 
     def use(self, u: Use) -> None:
-        from synth.plant.rules import load_rules
+        from synth.plant.rules_check import load_rules
 
         if self.plant is not None:
             self.fail("a filter uses at most one plant", u.loc)

@@ -42,7 +42,7 @@ class Product:
     def __init__(self, f: Filter, rules_path: str, grafcet_path: str | None, algorithm: Algorithm,
                  mode: Mode, atomic: bool) -> None:
         from synth.plant.composition import plant
-        from synth.plant.rules import load_rules
+        from synth.plant.rules_check import load_rules
         from synth.sup.supervisor import Supervisor
 
         rs = load_rules(rules_path)
@@ -61,7 +61,7 @@ class Product:
         self.machine: GrafcetMachine | None = None
         self.grafcet: Grafcet | None = None
         if grafcet_path is not None:
-            from synth.grafcet.language import load_grafcet
+            from synth.grafcet.language_check import load_grafcet
             from synth.grafcet.machine import GrafcetMachine
 
             self.grafcet = load_grafcet(grafcet_path, inputs=rs.inputs, outputs=rs.outputs)

@@ -11,7 +11,7 @@ boolean arrays (then the result is an array, broadcast as numpy does).
 Example
 -------
 >>> e = And((Var("a"), Not(Var("b"))))
->>> e.evaluate(lambda n: {"a": True, "b": False}[n])
+>>> evaluate(e, lambda n: {"a": True, "b": False}[n])
 True
 >>> e.text()
 'a & !b'
@@ -40,6 +40,8 @@ __all__ = [
     "Monomial",
     "disjunctive_normal_form",
     "edge_text",
+    "evaluate",
+    "names",
     "renamed",
     "NegatedEdge",
     "NormalFormTooLarge",
@@ -192,12 +194,6 @@ def renamed(e: Expr, rename: Callable[[str], str]) -> Expr:
     if isinstance(e, Not):
         return Not(renamed(e.arg, rename), e.loc)
     return type(e)(tuple(renamed(a, rename) for a in e.args), e.loc)
-
-
-# Methods attached here so that the dataclasses stay plain data.
-for _cls in (Var, Const, Edge, Not, And, Or):
-    _cls.evaluate = evaluate  # type: ignore[attr-defined]
-    _cls.names = names  # type: ignore[attr-defined]
 
 
 @dataclass(frozen=True, order=True)

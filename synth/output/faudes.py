@@ -6,7 +6,7 @@ All states are marked: SUP is a closed-behaviour notion and language comparisons
 
 Example
 -------
->>> from synth.plant.rules import load_rules
+>>> from synth.plant.rules_check import load_rules
 >>> from synth.plant.composition import plant, _plants
 >>> text = plant_generator(plant(load_rules(_plants("tri_annex.rules"))), "tri")
 >>> text.splitlines()[0], "+C+" in text

@@ -15,8 +15,10 @@ from synth.plant.composition import Plant, plant
 from synth.errors import InputError, close_names
 from synth.logic.expr import Edge as ExprEdge, Expr, evaluate, names
 from synth.syntax import parse_expression
-from synth.grafcet.language import Grafcet, load_grafcet
-from synth.plant.rules import RuleSet, load_rules
+from synth.grafcet.language import Grafcet
+from synth.grafcet.language_check import load_grafcet
+from synth.plant.rules import RuleSet
+from synth.plant.rules_check import load_rules
 from synth.grafcet.machine import GrafcetMachine
 from synth.sup.constraints import CompiledConstraints
 from synth.validation.sync import Edge, Sync, synchronous_product
