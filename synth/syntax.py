@@ -253,15 +253,40 @@ def raise_all(errors: Sequence[InputError]) -> None:
         raise InputErrors(errors)
 
 
-def parse_tree(grammar: str, source: str, file: str, transformer: Transformer) -> Any:
-    """Parse ``source`` with ``grammars/<grammar>.lark`` and transform it; a syntax error
-    becomes a located :class:`InputError`, and so does every error the transformer collected
-    in an ``errors`` list."""
-    p = parser(grammar)
+MAX_DEPTH = 200
+"""How deeply a parse tree may nest (``!``, ``&``, ``|`` and parentheses around operators
+each add a level; ``((x))`` adds none): the readers and every walker over expressions
+recurse, and a deeper input is refused with a located error instead of exhausting the
+interpreter's stack."""
+
+
+def _parsed(p: Lark, source: str, file: str) -> Tree:
+    """``source`` parsed by ``p``: a syntax error, or a tree nested deeper than
+    :data:`MAX_DEPTH`, becomes a located :class:`InputError`."""
     try:
         tree = p.parse(source)
     except UnexpectedInput as err:
         raise syntax_error(err, file, source, p) from None
+    stack: list[tuple[Tree, int]] = [(tree, 1)]
+    while stack:  # iterative: the check itself must not recurse
+        node, depth = stack.pop()
+        if depth > MAX_DEPTH:
+            meta = node.meta
+            line, column = (meta.line, meta.column) if not meta.empty else (1, 1)
+            raise InputError(
+                f"expression nested too deeply: more than {MAX_DEPTH} levels of '!', '&', '|' or parentheses",
+                location_in(file, source, line, column, 1),
+                notes=("write !!x as x, and a long chain a & (b & (c & …)) as a & b & c & …",),
+            )
+        stack.extend((c, depth + 1) for c in node.children if isinstance(c, Tree))
+    return tree
+
+
+def parse_tree(grammar: str, source: str, file: str, transformer: Transformer) -> Any:
+    """Parse ``source`` with ``grammars/<grammar>.lark`` and transform it; a syntax error
+    becomes a located :class:`InputError`, and so does every error the transformer collected
+    in an ``errors`` list."""
+    tree = _parsed(parser(grammar), source, file)
     result = transformer.transform(tree)
     raise_all(getattr(transformer, "errors", ()))
     return result
@@ -275,11 +300,7 @@ def parse_expression(source: str, file: str, grammar: str = "rules", transformer
     >>> parse_expression("X0 & !v10", "--home").text()
     'X0 & !v10'
     """
-    p = parser(grammar, "expr")
-    try:
-        tree = p.parse(source)
-    except UnexpectedInput as err:
-        raise syntax_error(err, file, source, p) from None
+    tree = _parsed(parser(grammar, "expr"), source, file)
     return (transformer or ExprTransformer(file, source)).transform(tree)
 
 

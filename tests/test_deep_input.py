@@ -1,0 +1,56 @@
+"""Inputs nested deeper than the readers can follow (issue 24: ~500 consecutive ``!`` ended
+in a RecursionError traceback in every language): a located error, exit 2, in each."""
+
+from __future__ import annotations
+
+import pytest
+
+from conftest import ROOT
+from synth.cli.main import main
+from synth.syntax import MAX_DEPTH
+
+DEEP = "!" * 600
+
+
+def _run(argv: list[str], capsys) -> tuple[int, str]:
+    code = main(argv)
+    return code, capsys.readouterr().err
+
+
+def test_deep_negation_in_rules(tmp_path, capsys):
+    text = (ROOT / "tests/data/home/cylinder.rules").read_text().replace("↑AVANCER [v0]", f"↑AVANCER [{DEEP}v0]")
+    (tmp_path / "deep.rules").write_text(text)
+    code, err = _run(["plant", str(tmp_path / "deep.rules")], capsys)
+    line = next(i for i, t in enumerate(text.splitlines(), 1) if DEEP in t)
+    assert code == 2
+    assert f"deep.rules:{line}:" in err and "nested too deeply" in err and "Traceback" not in err
+
+
+def test_deep_negation_in_grafcet(tmp_path, capsys):
+    text = (ROOT / "tests/data/home/production_loop.g7").read_text().replace("when v1", f"when {DEEP}v1")
+    (tmp_path / "deep.g7").write_text(text)
+    code, err = _run(["validate", str(tmp_path / "deep.g7"), "--plant", str(ROOT / "tests/data/home/cylinder.rules")], capsys)
+    assert code == 2
+    assert "deep.g7:8:" in err and "nested too deeply" in err
+
+
+def test_deep_negation_in_filter(tmp_path, capsys):
+    (tmp_path / "deep.filter").write_text(f"outputs o1, o2\n\nsafety CSc1: {DEEP}o1 & o2   keep o1\n")
+    code, err = _run(["filter", "check", str(tmp_path / "deep.filter")], capsys)
+    assert code == 2
+    assert "deep.filter:3:" in err and "nested too deeply" in err
+
+
+@pytest.mark.parametrize("home", [DEEP + "X1", "X1 & (" * 300 + "X1" + ")" * 300])
+def test_deep_home_condition(home, capsys):
+    code, err = _run(["validate", str(ROOT / "tests/data/home/production_loop.g7"), "--plant",
+                      str(ROOT / "tests/data/home/cylinder.rules"), "--home", home], capsys)
+    assert code == 2
+    assert "--home:1:" in err and f"more than {MAX_DEPTH} levels" in err
+
+
+def test_nesting_within_the_limit_and_redundant_parentheses_are_read(capsys):
+    for home in ("!" * 150 + "X1", "(" * 5000 + "X1" + ")" * 5000):
+        code, _ = _run(["validate", str(ROOT / "tests/data/home/production_loop.g7"), "--plant",
+                        str(ROOT / "tests/data/home/cylinder.rules"), "--home", home, "--json"], capsys)
+        assert code in (0, 1)
