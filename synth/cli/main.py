@@ -17,14 +17,15 @@ from synth.version import version
 TYPE_CHECKING = False  # typing.TYPE_CHECKING, without importing typing
 if TYPE_CHECKING:
     from collections.abc import Callable, Sequence
+    from typing import NoReturn
 
 __all__ = ["main", "entry", "build_parser", "version"]
 
-EXIT_PASS, EXIT_FAIL, EXIT_INPUT = 0, 1, 2
+EXIT_INPUT = 2  # bad input or a limit reached (0: a pass, 1: a model that fails)
 
 
 class _Parser(argparse.ArgumentParser):
-    def error(self, message: str) -> None:  # argparse's own errors: exit 2 as for bad input
+    def error(self, message: str) -> NoReturn:  # argparse's own errors: exit 2 as for bad input
         self.print_usage(sys.stderr)
         self.exit(EXIT_INPUT, f"{self.prog}: error: {message}\n")
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from synth.errors import InputError, Location, close_names, location_in
+from synth.errors import InputError, Location, Severity, close_names, location_in
 from synth.filter.language import (
     Assumption,
     ConstraintKind,
@@ -145,7 +145,7 @@ class _FilterChecker(Checker):
             if s.has_priority:
                 self.warnings.append(InputError(
                     f"{s.id} is a simple constraint (output {outs[0]}): its relief is implied, keep/force is ignored",
-                    s.loc, severity="warning"))
+                    s.loc, severity=Severity.WARNING))
             return s
         forced = self.forced(s)
         if forced is None:

@@ -124,10 +124,6 @@ def element_neighbourhood(a: "ElementAutomaton", path: Sequence[int], highlight:
     return frozenset(core | near)
 
 
-def _vector_text(names: Iterable[str], values: Mapping[str, bool]) -> str:
-    return "[" + "".join("1" if values[n] else "0" for n in names) + "]"
-
-
 def true_names(names: Iterable[str], values: Mapping[str, bool]) -> str:
     """The variables that are true, by name (``v10 cp12``), ``-`` for none."""
     return " ".join(n for n in names if values[n]) or "-"
