@@ -115,10 +115,34 @@ def parser(name: str, start: str = "start") -> Lark:
     """A cached LALR parser for ``grammars/<name>.lark`` from rule ``start`` (positions propagated)."""
     options = dict(parser="lalr", propagate_positions=True, maybe_placeholders=True, start=start)
     text = grammar_text(name)
-    try:  # lark caches the compiled LALR tables in the temporary folder, keyed by grammar and options
-        return Lark(text, cache=True, **options)
-    except OSError:  # a read-only temporary folder: build the tables again
-        return Lark(text, **options)
+    cache = _cache_file(name, start, text)
+    if cache is not None:
+        try:  # the compiled LALR tables, in the user's cache folder
+            return Lark(text, cache=str(cache), **options)
+        except OSError:  # an unwritable cache folder: build the tables again
+            pass
+    return Lark(text, **options)
+
+
+def _cache_file(name: str, start: str, text: str) -> Path | None:
+    """Where lark keeps the tables of one grammar: ``$XDG_CACHE_HOME/synth`` (by default
+    ``~/.cache/synth``), one file per grammar text, start rule and lark version (never the
+    shared temporary folder); ``None`` when there is no home to cache in."""
+    import hashlib
+    import os
+
+    import lark
+
+    base = os.environ.get("XDG_CACHE_HOME") or (os.path.join(os.path.expanduser("~"), ".cache") if os.path.expanduser("~") != "~" else "")
+    if not base:
+        return None
+    key = hashlib.sha256(f"{lark.__version__}\0{start}\0{text}".encode()).hexdigest()[:16]
+    folder = Path(base) / "synth"
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError:
+        return None
+    return folder / f"lark-{name}-{start}-{key}.cache"
 
 
 def _shown(terminal: str, p: Lark) -> str:

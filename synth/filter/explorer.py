@@ -8,8 +8,7 @@ Example
 >>> from synth.filter.from_rules import skeleton
 >>> from synth.filter.cycle import Algorithm
 >>> from synth.filter.product import Product
->>> import tempfile, pathlib
->>> sk = skeleton(_plants("tri.rules"), pathlib.Path(tempfile.mkdtemp()) / "F.filter")
+>>> sk = skeleton(_plants("tri.rules"), _plants("F.filter"))  # the text only: nothing is written
 >>> ex = Explorer(Product(sk.filter, _plants("tri.rules"), None, Algorithm.ALGEBRAIC, Mode.SUPERVISOR, False), 100)
 >>> ex.run()
 >>> ex.complete, len(ex.seen_keys)

@@ -13,11 +13,12 @@ is no filter constraint: it is kept as a comment. The text is checked by parsing
 Example
 -------
 >>> import tempfile, pathlib
->>> d = pathlib.Path(tempfile.mkdtemp())
->>> _ = (d / "p.rules").write_text('''element E { order A = 0, B = 0  sensor s = 0  ↑A -> ↑s  ↓A -> ↓s }
+>>> with tempfile.TemporaryDirectory() as tmp:
+...     d = pathlib.Path(tmp)
+...     _ = (d / "p.rules").write_text('''element E { order A = 0, B = 0  sensor s = 0  ↑A -> ↑s  ↓A -> ↓s }
 ... constraint K "not both": A & B = 0
 ... constraint S: B & s = 0''')
->>> sk = skeleton(d / "p.rules", d / "p.filter")
+...     sk = skeleton(d / "p.rules", d / "p.filter")
 >>> [(c.id, str(c.kind)) for c in sk.constraints]
 [('K', 'combined'), ('S', 'simple')]
 >>> print(sk.text.splitlines()[5])

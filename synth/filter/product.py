@@ -8,8 +8,7 @@ Example
 -------
 >>> from synth.plant.composition import _plants
 >>> from synth.filter.from_rules import skeleton
->>> import tempfile, pathlib
->>> sk = skeleton(_plants("tri.rules"), pathlib.Path(tempfile.mkdtemp()) / "F.filter")
+>>> sk = skeleton(_plants("tri.rules"), _plants("F.filter"))  # the text only: nothing is written
 >>> pr = Product(sk.filter, _plants("tri.rules"), None, Algorithm.ALGEBRAIC, Mode.SUPERVISOR, False)
 >>> pr.size == pr.plant.size, bool(pr.illegal[pr.plant.initial_index])
 (True, False)
