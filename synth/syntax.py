@@ -13,6 +13,7 @@ syntax error: unexpected end of file
 
 from __future__ import annotations
 
+import os
 import sys
 import types
 from enum import StrEnum
@@ -200,12 +201,34 @@ def syntax_error(err: UnexpectedInput, file: str, source: str, p: Lark) -> Input
     )
 
 
-def read_source(path: str | Path) -> str:
-    """The text of a user file; an unreadable or non-UTF-8 file is an :class:`InputError`."""
+MAX_SOURCE_BYTES = 64 * 1024 * 1024
+"""The largest input file synth reads (a model of a real machine is a few hundred kB)."""
+
+
+def read_source(path: str | Path, at: Location | None = None) -> str:
+    """The text of a user file; an unreadable, non-regular (``/dev/zero``, a folder, a
+    pipe), over-large or non-UTF-8 file is an :class:`InputError`, located at ``at`` (the
+    ``use`` that names it) when given.
+
+    >>> read_source("/dev/zero")
+    Traceback (most recent call last):
+    ...
+    synth.errors.InputError: error: cannot read '/dev/zero': not a regular file
+    """
+    import stat
+
     try:
-        data = Path(path).read_bytes()
+        with open(path, "rb") as fh:
+            info = os.fstat(fh.fileno())
+            if not stat.S_ISREG(info.st_mode):
+                raise InputError(f"cannot read '{path}': not a regular file", at)
+            if info.st_size > MAX_SOURCE_BYTES:
+                raise InputError(f"cannot read '{path}': {info.st_size} bytes, more than the {MAX_SOURCE_BYTES} synth reads", at)
+            data = fh.read(MAX_SOURCE_BYTES + 1)
     except OSError as exc:
-        raise InputError(f"cannot read '{path}': {exc.strerror or exc}", None) from None
+        raise InputError(f"cannot read '{str(path)[:200]}': {exc.strerror or exc}", at) from None
+    except ValueError as exc:  # a NUL byte in the name
+        raise InputError(f"cannot read {str(path)[:200]!r}: {exc}", at) from None
     try:
         return data.decode("utf-8-sig")  # a byte-order mark is dropped
     except UnicodeDecodeError as exc:

@@ -54,3 +54,18 @@ def test_nesting_within_the_limit_and_redundant_parentheses_are_read(capsys):
         code, _ = _run(["validate", str(ROOT / "tests/data/home/production_loop.g7"), "--plant",
                         str(ROOT / "tests/data/home/cylinder.rules"), "--home", home, "--json"], capsys)
         assert code in (0, 1)
+
+
+@pytest.mark.parametrize("use,message", [
+    ('"a\x00b"', "embedded null byte"),
+    ('"/dev/zero"', "not a regular file"),
+    ('"' + "a" * 5000 + '"', "cannot read"),
+    ('"."', "Is a directory"),
+])
+def test_bad_use_paths_are_located(use, message, tmp_path, capsys):
+    """A NUL byte, a device that never ends (it hung and grew to 3.4 GB), a name longer than
+    the system allows (it said "cannot write" with no location), a folder."""
+    (tmp_path / "p.rules").write_text(f"use {use}\nfree x = 0\n")
+    code, err = _run(["plant", str(tmp_path / "p.rules")], capsys)
+    assert code == 2
+    assert "p.rules:1:5: error: " in err and message in err and "Traceback" not in err

@@ -79,6 +79,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         where = f" '{err.filename}'" if getattr(err, "filename", None) else ""
         print(f"error: cannot write{where}: {err.strerror or err}", file=sys.stderr)
         return EXIT_INPUT
+    except MemoryError:  # a model larger than this machine: a limit reached, not a verdict
+        print("stopped: out of memory; bound the exploration with --max-states (or --max-nodes)", file=sys.stderr)
+        return EXIT_INPUT
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)
         return 130

@@ -92,17 +92,18 @@ class RulesChecker(Checker):
                 self.vectors.append(it)
 
     def use(self, u: Use, base: Path | None) -> None:
-        target = library_file(u.path, base)
         try:
+            target = library_file(u.path, base)
             resolved = target.resolve()
-            if resolved in self.loaded:
-                return
-            source = target.read_text(encoding="utf-8-sig")
-        except OSError as exc:
-            self.fail(f"cannot read '{u.path}': {exc.strerror or exc}", u.loc)
+        except (OSError, ValueError) as exc:  # a name too long, a NUL byte
+            self.fail(f"cannot read {u.path[:200]!r}: {getattr(exc, 'strerror', None) or exc}", u.loc)
             return
-        except UnicodeDecodeError:
-            self.fail(f"'{u.path}' is not UTF-8 text", u.loc)
+        if resolved in self.loaded:
+            return
+        try:
+            source = read_source(target, u.loc)
+        except InputError as err:
+            self.errors.append(err)
             return
         self.loaded.add(resolved)
         try:
