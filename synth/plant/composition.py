@@ -62,7 +62,11 @@ class Plant:
         self.shape = tuple(e.size for e in elements)
         self.ndim = len(elements)
         self.size = math.prod(self.shape) if elements else 0  # a Python int: no overflow
-        self.strides = tuple(math.prod(self.shape[i + 1:]) for i in range(len(self.shape)))
+        strides, size = [], 1
+        for n in reversed(self.shape):  # row-major strides in one pass (was quadratic in the elements)
+            strides.append(size)
+            size *= n
+        self.strides = tuple(reversed(strides))
         self.owner: dict[str, int] = {v: i for i, e in enumerate(elements) for v in e.variables}
         self.initial = tuple(e.initial for e in elements)
         if rules is not None:
