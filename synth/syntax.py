@@ -89,7 +89,7 @@ _TERMINAL_TEXT = {
     "RSQB": "]",
     "COLON": ":",
     "SEMICOLON": ";",
-    "COMMA": ",",
+    "COMMA": "','",
     "EQUAL": "=",
     "LESSTHAN": "<",
     "SLASH": "/",
@@ -194,11 +194,39 @@ def syntax_error(err: UnexpectedInput, file: str, source: str, p: Lark) -> Input
     else:  # pragma: no cover - lark has no other kinds
         found, width, expected = "input", 1, set()
     shown = sorted({_shown(t, p) for t in expected if not t.startswith("__ANON")})
-    return InputError(
-        f"syntax error: unexpected {found}",
-        location_in(file, source, line, column, width),
-        expected=shown[:12],
-    )
+    here = location_in(file, source, line, column, width)
+    opened = _unclosed_parenthesis(source, err) if "RPAR" in expected else None
+    if opened is not None and opened[0] != line:  # a '(' left open on an earlier line: report it there
+        o_line, o_column = opened
+        return InputError(
+            "syntax error: '(' is never closed",
+            location_in(file, source, o_line, o_column, 1),
+            notes=(f"expected ')' before {found} at {line}:{column}",),
+        )
+    return InputError(f"syntax error: unexpected {found}", here, expected=shown[:12])
+
+
+def _unclosed_parenthesis(source: str, err: UnexpectedInput) -> tuple[int, int] | None:
+    """(line, column) of the innermost '(' still open where the parser stopped, or ``None``.
+    Everything before that point was accepted, so its parentheses balance but for the open
+    ones: the first unmatched '(' found walking back is the innermost."""
+    pos = getattr(err, "pos_in_stream", None)
+    token = getattr(err, "token", None)
+    if pos is None and token is not None:
+        pos = getattr(token, "start_pos", None)
+    if pos is None:
+        pos = len(source)
+    depth = 0
+    for i in range(min(pos, len(source)) - 1, -1, -1):
+        c = source[i]
+        if c == ")":
+            depth += 1
+        elif c == "(":
+            if depth == 0:
+                line = source.count("\n", 0, i) + 1
+                return line, i - (source.rfind("\n", 0, i) + 1) + 1
+            depth -= 1
+    return None
 
 
 MAX_SOURCE_BYTES = 64 * 1024 * 1024
@@ -307,13 +335,45 @@ recurse, and a deeper input is refused with a located error instead of exhaustin
 interpreter's stack."""
 
 
-def _parsed(p: Lark, source: str, file: str) -> Tree:
+# What each language's files look like: a suffix, and keywords only its statements open with.
+_KINDS = {
+    "rules": (".rules", "a plant's rules file (.rules)", ("element ", "free ", "constraint ", "model ")),
+    "grafcet": (".g7", "a Grafcet file (.g7)", ("grafcet ",)),
+    "filter": (".filter", "a safety filter file (.filter)", ("safety ",)),
+}
+
+
+def file_kind_hint(grammar: str, file: str, source: str) -> str | None:
+    """When a file that fails to parse as ``grammar`` is another language's file (by its
+    suffix, or, without its own suffix, by the keyword of a statement), say so.
+
+    >>> file_kind_hint("rules", "tri.g7", "outputs A")
+    "tri.g7 is a Grafcet file (.g7), not a plant's rules file (.rules): check the order of the arguments"
+    >>> file_kind_hint("grafcet", "tri.g7", "grafcet G {") is None
+    True
+    """
+    if grammar not in _KINDS:
+        return None
+    own_suffix, own_what, _ = _KINDS[grammar]
+    starts = [ln.strip() for ln in source.splitlines()[:200]]
+    for other, (suffix, what, openers) in _KINDS.items():
+        if other != grammar and (file.endswith(suffix) or (
+                not file.endswith(own_suffix) and any(ln.startswith(openers) for ln in starts))):
+            return f"{file} is {what}, not {own_what}: check the order of the arguments"
+    return None
+
+
+def _parsed(p: Lark, source: str, file: str, grammar: str) -> Tree:
     """``source`` parsed by ``p``: a syntax error, or a tree nested deeper than
     :data:`MAX_DEPTH`, becomes a located :class:`InputError`."""
     try:
         tree = p.parse(source)
     except UnexpectedInput as err:
-        raise syntax_error(err, file, source, p) from None
+        error = syntax_error(err, file, source, p)
+        hint = file_kind_hint(grammar, file, source)
+        if hint:
+            error.notes = (*error.notes, hint)
+        raise error from None
     stack: list[tuple[Tree, int]] = [(tree, 1)]
     while stack:  # iterative: the check itself must not recurse
         node, depth = stack.pop()
@@ -333,7 +393,7 @@ def parse_tree(grammar: str, source: str, file: str, transformer: Transformer) -
     """Parse ``source`` with ``grammars/<grammar>.lark`` and transform it; a syntax error
     becomes a located :class:`InputError`, and so does every error the transformer collected
     in an ``errors`` list."""
-    tree = _parsed(parser(grammar), source, file)
+    tree = _parsed(parser(grammar), source, file, grammar)
     result = transformer.transform(tree)
     raise_all(getattr(transformer, "errors", ()))
     return result
@@ -347,7 +407,7 @@ def parse_expression(source: str, file: str, grammar: str = "rules", transformer
     >>> parse_expression("X0 & !v10", "--home").text()
     'X0 & !v10'
     """
-    tree = _parsed(parser(grammar, "expr"), source, file)
+    tree = _parsed(parser(grammar, "expr"), source, file, "")
     return (transformer or ExprTransformer(file, source)).transform(tree)
 
 

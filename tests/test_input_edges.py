@@ -83,3 +83,28 @@ def test_ten_thousand_free_inputs(tmp_path):
     local = tuple(k % 2 for k in range(10_000))
     assert p.strides[-1] == 1 and p.strides[0] == 2**9_999
     assert p.local(p.index(local)) == local
+
+
+@pytest.mark.parametrize("argv,note", [
+    (["validate", "grafcets/tri.g7", "--plant", "grafcets/tri.g7"],
+     "grafcets/tri.g7 is a Grafcet file (.g7), not a plant's rules file (.rules)"),
+    (["validate", "plants/tri.rules", "--plant", "plants/tri.rules"],
+     "plants/tri.rules is a plant's rules file (.rules), not a Grafcet file (.g7)"),
+    (["filter", "check", "plants/tri.rules"],
+     "plants/tri.rules is a plant's rules file (.rules), not a safety filter file (.filter)"),
+])
+def test_a_file_of_another_language_says_which(argv, note, capsys, monkeypatch):
+    monkeypatch.chdir(ROOT)
+    code, err = _run(argv, capsys)
+    assert code == 2
+    assert f"= note: {note}: check the order of the arguments" in err
+    assert ",," not in err  # the comma is quoted in the expected list, not a stray ",,"
+
+
+def test_an_unclosed_parenthesis_is_reported_where_it_opens(tmp_path, capsys):
+    (tmp_path / "p.g7").write_text("grafcet G {\n  initial step 0\n  step 1\n"
+                                   "  transition 0 -> 1 when (dcy & v0\n  transition 1 -> 0 when v1\n}\n")
+    code, err = _run(["validate", str(tmp_path / "p.g7"), "--plant", str(ROOT / "tests/data/home/cylinder.rules")], capsys)
+    assert code == 2
+    assert "p.g7:4:26: error: syntax error: '(' is never closed" in err
+    assert "  4 |   transition 0 -> 1 when (dcy & v0" in err
