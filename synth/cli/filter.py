@@ -27,6 +27,7 @@ def register(sub: "argparse._SubParsersAction") -> None:
     c = commands.add_parser("check", help="P1-P4, GO cycles, pair conditions, global consistency, equations")
     c.add_argument("filter", metavar="F.filter", help="the .filter file")
     c.add_argument("--json", action="store_true", help="print JSON instead of text")
+    ci_options(c)
     c.set_defaults(handler=cmd_check)
 
     s = commands.add_parser("solve", help="algebraic synthesis: one equation per output")
@@ -52,6 +53,12 @@ def register_st(commands: "argparse._SubParsersAction") -> None:
     register_from_rules(commands)
 
 
+def ci_options(p: argparse.ArgumentParser) -> None:
+    """``--junit FILE`` and ``--sarif FILE``: the findings for a CI server (synth.output.ci)."""
+    p.add_argument("--junit", metavar="FILE", help="also write the findings as JUnit XML (one test case per finding)")
+    p.add_argument("--sarif", metavar="FILE", help="also write the findings as SARIF 2.1.0 (one result per finding)")
+
+
 def _load(path: str) -> "Filter":
     """The filter of ``path``; its warnings (a relief on a simple constraint) on stderr."""
     from synth.filter.language_check import load_filter
@@ -72,7 +79,12 @@ def cmd_check(args: argparse.Namespace) -> int:
     from synth.filter.coherence import check
     from synth.output.filter_text import check_json, check_text
 
-    c = check(_load(args.filter))
+    f = _load(args.filter)
+    c = check(f)
+    if args.junit or args.sarif:
+        from synth.output.ci import filter_check_report, write_ci
+
+        write_ci([filter_check_report(f, c)], args.junit, args.sarif)
     if args.json:
         print_json(check_json(args.filter, c))
     else:
@@ -183,6 +195,7 @@ def register_verify(commands: "argparse._SubParsersAction") -> None:
     v.add_argument("--max-states", type=int, default=1_000_000, metavar="N",
                    help="stop the exploration after N states (default 1000000)")
     v.add_argument("--json", action="store_true", help="print JSON instead of text")
+    ci_options(v)
     v.set_defaults(handler=cmd_verify)
 
 
@@ -192,9 +205,14 @@ def cmd_verify(args: argparse.Namespace) -> int:
     from synth.filter.cycle import Algorithm, Mode
     from synth.output.filter_text import verification_json, verification_text
 
-    v = verify(_load(args.filter), args.plant, args.grafcet, any_control=args.any_control, algorithm=Algorithm(args.algorithm),
+    f = _load(args.filter)
+    v = verify(f, args.plant, args.grafcet, any_control=args.any_control, algorithm=Algorithm(args.algorithm),
                mode=Mode(args.mode), atomic=args.atomic_outputs, strict=args.strict, require_sup=args.require_sup,
                max_states=args.max_states)
+    if args.junit or args.sarif:
+        from synth.output.ci import filter_verify_report, write_ci
+
+        write_ci([filter_verify_report(f, v)], args.junit, args.sarif)
     if args.json:
         print_json(verification_json(v))
     else:
