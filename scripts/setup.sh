@@ -11,7 +11,7 @@
 #   SYNTH_PYTHON        the Python to build the venv from (default: python3)
 #   SYNTH_VENV          where the venv goes (default: .venv in the repository)
 #   SYNTH_SKIP_APT=1    never call apt-get (tests, machines without root)
-#   SYNTH_SETUP_TESTS=1    also install the test dependencies (.[test]) and setuptools>=68, wheel
+#   SYNTH_SETUP_TESTS=1    also install the test dependencies (.[test]) and setuptools>=77, wheel
 #   SYNTH_SETUP_BROWSER=1  also install chromium and libatomic1 (the browser test)
 #   SYNTH_PIP_ARGS      extra pip arguments (e.g. --no-deps for an offline re-install)
 #   SYNTH_VENV_ARGS     extra venv arguments (e.g. --system-site-packages)
@@ -62,10 +62,10 @@ if [ ! -x "$VENV/bin/python" ]; then
 fi
 pip=("$VENV/bin/python" -m pip install --quiet --disable-pip-version-check)
 if [ "${SYNTH_SETUP_TESTS:-0}" = 1 ]; then
-  # the wheel test builds without isolation: Debian's venv brings setuptools 66 and no wheel
+  # the wheel test builds without isolation: Debian's venv brings setuptools 66 and no wheel; the SPDX licence field needs 77
   echo "== installing synth and its test dependencies into $VENV" >&2
   # shellcheck disable=SC2086
-  "${pip[@]}" ${SYNTH_PIP_ARGS:-} "setuptools>=68" wheel >&2
+  "${pip[@]}" ${SYNTH_PIP_ARGS:-} "setuptools>=77" wheel >&2
   # shellcheck disable=SC2086
   "${pip[@]}" ${SYNTH_PIP_ARGS:-} -e ".[test]" >&2
 else
