@@ -53,7 +53,7 @@ def _worker_synth(rules: Path, out: dict) -> None:
     t0 = time.perf_counter()
     from synth.plant.composition import plant
     from synth.syntax import parser
-    from synth.plant.rules import load_rules
+    from synth.plant.rules_check import load_rules
     from synth.sup.supervisor import supremal_controllable
 
     parser("rules")  # one-time start-up: lark builds the LALR tables (about 0.1 s)
@@ -89,7 +89,7 @@ def _worker_faudes(rules: Path, workdir: Path, out: dict) -> None:
     import faudes  # prints two harmless WARNING lines (no matplotlib/pillow)
 
     from faudes_route import run_faudes, write_inputs
-    from synth.plant.rules import load_rules
+    from synth.plant.rules_check import load_rules
 
     out["import_s"] = time.perf_counter() - t0
     out["base_mib"] = _maxrss_mib()
@@ -115,7 +115,7 @@ def _worker_check(rules: Path, workdir: Path, out: dict) -> None:
     from faudes_route import run_faudes, write_inputs
     from synth.plant.composition import plant
     from synth.output.faudes import supervisor_generator
-    from synth.plant.rules import load_rules
+    from synth.plant.rules_check import load_rules
     from synth.sup.supervisor import supremal_controllable
 
     rs = load_rules(rules)

@@ -43,7 +43,7 @@ from synth.logic.events import Event
 from synth.logic.expr import Edge, evaluate, names  # noqa: E402
 from synth.output.faudes import element_generator, generator_text  # noqa: E402
 from synth.plant.element import element_automaton  # noqa: E402
-from synth.plant.rules import ORDER, Constraint, RuleSet  # noqa: E402
+from synth.plant.rules import Constraint, RuleSet, VarKind  # noqa: E402
 
 __all__ = ["FaudesInputs", "constraint_observer", "write_inputs", "run_faudes"]
 
@@ -63,7 +63,7 @@ def constraint_observer(rs: RuleSet, c: Constraint) -> tuple[str, set[str]]:
     events: dict[Event, bool] = {}
     for v in variables:
         if not decls[v].held:
-            ctrl = decls[v].kind == ORDER
+            ctrl = decls[v].kind == VarKind.ORDER
             events[Event.rise(v)] = ctrl
             events[Event.fall(v)] = ctrl
     events = dict(sorted(events.items()))

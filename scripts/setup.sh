@@ -1,14 +1,18 @@
 #!/usr/bin/env bash
 # Set-up on a fresh machine (stock Debian 12 included): a project virtual environment
-# .venv with synth and its test dependencies, Graphviz's dot from Debian when missing,
-# and, with SYNTH_SETUP_BROWSER=1 (CI), Debian's chromium for the report's browser test.
-# Writes nothing outside .venv (and Debian's packages). Safe to run again.
+# .venv with synth and its runtime dependencies, Graphviz's dot from Debian when missing;
+# with SYNTH_SETUP_TESTS=1 (CI) also the test dependencies (pytest, libFAUDES, blark,
+# jsonschema, Playwright, mypy) and the build tools the wheel test uses, and with
+# SYNTH_SETUP_BROWSER=1 Debian's chromium and libatomic1 (Playwright's driver needs it)
+# for the report's browser test. Writes nothing outside .venv (and Debian's packages).
+# Safe to run again.
 #
 # Environment:
 #   SYNTH_PYTHON        the Python to build the venv from (default: python3)
 #   SYNTH_VENV          where the venv goes (default: .venv in the repository)
 #   SYNTH_SKIP_APT=1    never call apt-get (tests, machines without root)
-#   SYNTH_SETUP_BROWSER=1  also install chromium (the browser test)
+#   SYNTH_SETUP_TESTS=1    also install the test dependencies (.[test]) and setuptools>=77, wheel
+#   SYNTH_SETUP_BROWSER=1  also install chromium and libatomic1 (the browser test)
 #   SYNTH_PIP_ARGS      extra pip arguments (e.g. --no-deps for an offline re-install)
 #   SYNTH_VENV_ARGS     extra venv arguments (e.g. --system-site-packages)
 set -euo pipefail
@@ -35,8 +39,14 @@ apt_install() {  # apt_install PACKAGE...: Debian packages, as root or through s
 if ! command -v dot >/dev/null 2>&1; then
   apt_install graphviz || echo "== warning: no Graphviz: reports are written without drawings" >&2
 fi
-if [ "${SYNTH_SETUP_BROWSER:-0}" = 1 ] && ! command -v chromium >/dev/null 2>&1; then
-  apt_install chromium || echo "== warning: no chromium: the browser test will be skipped" >&2
+if [ "${SYNTH_SETUP_BROWSER:-0}" = 1 ]; then
+  browser=()
+  command -v chromium >/dev/null 2>&1 || browser+=(chromium)
+  # Playwright's node driver links libatomic.so.1, which a stock Debian 12 lacks
+  { ldconfig -p 2>/dev/null || /sbin/ldconfig -p 2>/dev/null; } | grep -q 'libatomic\.so\.1' || browser+=(libatomic1)
+  if [ "${#browser[@]}" -gt 0 ]; then
+    apt_install "${browser[@]}" || echo "== warning: no ${browser[*]}: the browser test will be skipped" >&2
+  fi
 fi
 
 # the venv: python3 -m venv needs Debian's python3-venv (ensurepip) on stock Debian
@@ -50,7 +60,17 @@ if [ ! -x "$VENV/bin/python" ]; then
   # shellcheck disable=SC2086
   "$PYTHON" -m venv ${SYNTH_VENV_ARGS:-} "$VENV"
 fi
-echo "== installing synth into $VENV" >&2
-# shellcheck disable=SC2086
-"$VENV/bin/python" -m pip install --quiet --disable-pip-version-check ${SYNTH_PIP_ARGS:-} -e ".[test]" >&2
+pip=("$VENV/bin/python" -m pip install --quiet --disable-pip-version-check)
+if [ "${SYNTH_SETUP_TESTS:-0}" = 1 ]; then
+  # the wheel test builds without isolation: Debian's venv brings setuptools 66 and no wheel; the SPDX licence field needs 77
+  echo "== installing synth and its test dependencies into $VENV" >&2
+  # shellcheck disable=SC2086
+  "${pip[@]}" ${SYNTH_PIP_ARGS:-} "setuptools>=77" wheel >&2
+  # shellcheck disable=SC2086
+  "${pip[@]}" ${SYNTH_PIP_ARGS:-} -e ".[test]" >&2
+else
+  echo "== installing synth into $VENV" >&2
+  # shellcheck disable=SC2086
+  "${pip[@]}" ${SYNTH_PIP_ARGS:-} -e . >&2
+fi
 echo "== ready: $VENV/bin/synth (or: export PATH=\"$(cd "$VENV" && pwd)/bin:\$PATH\")" >&2

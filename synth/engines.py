@@ -85,9 +85,9 @@ def validate(
     or ``--cor`` will list every aggregated state (explicit engine only; with ``--engine
     symbolic`` an error before any input is read); ``max_states`` bounds the explicit
     engine, ``max_nodes`` the symbolic one; ``progress`` receives progress lines."""
-    from synth.grafcet.language import load_grafcet
+    from synth.grafcet.language_check import load_grafcet
     from synth.plant.composition import plant
-    from synth.plant.rules import load_rules
+    from synth.plant.rules_check import load_rules
 
     asked = choose(engine, 0, needs_listing=True) if needs_listing else EngineChoice(engine)
     rs = load_rules(rules_path)
@@ -178,7 +178,7 @@ def supervisor(
     plants in the explicit engine; ``loaded(plant)`` is called once the plant is built,
     before anything can fail on its size (the CLI prints the plant's warnings)."""
     from synth.plant.composition import plant
-    from synth.plant.rules import load_rules
+    from synth.plant.rules_check import load_rules
 
     rs = load_rules(rules_path)
     p = plant(rs)

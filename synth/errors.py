@@ -22,6 +22,7 @@ a.rules:1:5: error: unknown variable 'bar'
 from __future__ import annotations
 
 from dataclasses import dataclass
+from enum import StrEnum
 from functools import lru_cache
 
 TYPE_CHECKING = False  # typing.TYPE_CHECKING, without importing typing
@@ -30,6 +31,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "Location",
+    "Severity",
     "SynthError",
     "InputError",
     "InputErrors",
@@ -55,6 +57,13 @@ class Location:
         return f"{self.file}:{self.line}:{self.column}"
 
 
+class Severity(StrEnum):
+    """How bad a reported input mistake is: an error stops the command, a warning does not."""
+
+    ERROR = "error"
+    WARNING = "warning"
+
+
 class SynthError(Exception):
     """Base of every error synth raises on purpose."""
 
@@ -70,10 +79,10 @@ class InputError(SynthError):
         expected: Sequence[str] = (),
         suggestions: Sequence[str] = (),
         notes: Sequence[str] = (),
-        severity: str = "error",
+        severity: Severity = Severity.ERROR,
     ) -> None:
         super().__init__(message)
-        self.severity = severity
+        self.severity = Severity(severity)
         self.message = message
         self.location = location
         self.expected = tuple(expected)

@@ -1,10 +1,22 @@
 """Loading the lark grammars shipped in ``grammars/`` and turning lark errors into
-:class:`~synth.errors.InputError` with a caret and what was expected."""
+:class:`~synth.errors.InputError` with a caret and what was expected; what the languages
+share (expressions, ``inputs``/``outputs`` lines, the error-collecting checker).
+
+Example
+-------
+>>> try:
+...     parse_expression("a &", "--home")
+... except InputError as err:
+...     print(err.message)
+syntax error: unexpected end of file
+"""
 
 from __future__ import annotations
 
+import os
 import sys
 import types
+from enum import StrEnum
 from functools import lru_cache
 from importlib import resources
 from pathlib import Path
@@ -53,7 +65,10 @@ from synth.errors import InputError, InputErrors, Location, location_in, source_
 from synth.logic.expr import And, Const, Edge, Expr, Not, Or, Var  # noqa: E402
 
 # ``Token`` is lark's, re-exported: every module of synth imports lark through this one.
-__all__ = ["grammar_text", "parser", "syntax_error", "read_source", "ExprTransformer", "Checker", "raise_all", "parse_tree", "parse_expression", "Token"]
+__all__ = [
+    "grammar_text", "parser", "syntax_error", "read_source", "ExprTransformer", "VectorKind", "Checker", "raise_all",
+    "parse_tree", "parse_expression", "Token",
+]
 
 # How terminals are shown to a user in "expected ..." lists.
 _TERMINAL_TEXT = {
@@ -74,7 +89,7 @@ _TERMINAL_TEXT = {
     "RSQB": "]",
     "COLON": ":",
     "SEMICOLON": ";",
-    "COMMA": ",",
+    "COMMA": "','",
     "EQUAL": "=",
     "LESSTHAN": "<",
     "SLASH": "/",
@@ -101,10 +116,34 @@ def parser(name: str, start: str = "start") -> Lark:
     """A cached LALR parser for ``grammars/<name>.lark`` from rule ``start`` (positions propagated)."""
     options = dict(parser="lalr", propagate_positions=True, maybe_placeholders=True, start=start)
     text = grammar_text(name)
-    try:  # lark caches the compiled LALR tables in the temporary folder, keyed by grammar and options
-        return Lark(text, cache=True, **options)
-    except OSError:  # a read-only temporary folder: build the tables again
-        return Lark(text, **options)
+    cache = _cache_file(name, start, text)
+    if cache is not None:
+        try:  # the compiled LALR tables, in the user's cache folder
+            return Lark(text, cache=str(cache), **options)
+        except OSError:  # an unwritable cache folder: build the tables again
+            pass
+    return Lark(text, **options)
+
+
+def _cache_file(name: str, start: str, text: str) -> Path | None:
+    """Where lark keeps the tables of one grammar: ``$XDG_CACHE_HOME/synth`` (by default
+    ``~/.cache/synth``), one file per grammar text, start rule and lark version (never the
+    shared temporary folder); ``None`` when there is no home to cache in."""
+    import hashlib
+    import os
+
+    import lark
+
+    base = os.environ.get("XDG_CACHE_HOME") or (os.path.join(os.path.expanduser("~"), ".cache") if os.path.expanduser("~") != "~" else "")
+    if not base:
+        return None
+    key = hashlib.sha256(f"{lark.__version__}\0{start}\0{text}".encode()).hexdigest()[:16]
+    folder = Path(base) / "synth"
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError:
+        return None
+    return folder / f"lark-{name}-{start}-{key}.cache"
 
 
 def _shown(terminal: str, p: Lark) -> str:
@@ -144,8 +183,9 @@ def syntax_error(err: UnexpectedInput, file: str, source: str, p: Lark) -> Input
             found = f"end of line after '{prev}'"
             width = 1
     elif isinstance(err, UnexpectedCharacters):
-        if err.pos_in_stream < len(source):
-            char = source[err.pos_in_stream]
+        pos = err.pos_in_stream if err.pos_in_stream is not None else len(source)
+        if pos < len(source):
+            char = source[pos]
             found = f"character '{char}'" if char.isprintable() else f"control character U+{ord(char):04X}"
         else:
             found = "end of file"
@@ -154,19 +194,69 @@ def syntax_error(err: UnexpectedInput, file: str, source: str, p: Lark) -> Input
     else:  # pragma: no cover - lark has no other kinds
         found, width, expected = "input", 1, set()
     shown = sorted({_shown(t, p) for t in expected if not t.startswith("__ANON")})
-    return InputError(
-        f"syntax error: unexpected {found}",
-        location_in(file, source, line, column, width),
-        expected=shown[:12],
-    )
+    here = location_in(file, source, line, column, width)
+    opened = _unclosed_parenthesis(source, err) if "RPAR" in expected else None
+    if opened is not None and opened[0] != line:  # a '(' left open on an earlier line: report it there
+        o_line, o_column = opened
+        return InputError(
+            "syntax error: '(' is never closed",
+            location_in(file, source, o_line, o_column, 1),
+            notes=(f"expected ')' before {found} at {line}:{column}",),
+        )
+    return InputError(f"syntax error: unexpected {found}", here, expected=shown[:12])
 
 
-def read_source(path: str | Path) -> str:
-    """The text of a user file; an unreadable or non-UTF-8 file is an :class:`InputError`."""
+def _unclosed_parenthesis(source: str, err: UnexpectedInput) -> tuple[int, int] | None:
+    """(line, column) of the innermost '(' still open where the parser stopped, or ``None``.
+    Everything before that point was accepted, so its parentheses balance but for the open
+    ones: the first unmatched '(' found walking back is the innermost."""
+    pos = getattr(err, "pos_in_stream", None)
+    token = getattr(err, "token", None)
+    if pos is None and token is not None:
+        pos = getattr(token, "start_pos", None)
+    if pos is None:
+        pos = len(source)
+    depth = 0
+    for i in range(min(pos, len(source)) - 1, -1, -1):
+        c = source[i]
+        if c == ")":
+            depth += 1
+        elif c == "(":
+            if depth == 0:
+                line = source.count("\n", 0, i) + 1
+                return line, i - (source.rfind("\n", 0, i) + 1) + 1
+            depth -= 1
+    return None
+
+
+MAX_SOURCE_BYTES = 64 * 1024 * 1024
+"""The largest input file synth reads (a model of a real machine is a few hundred kB)."""
+
+
+def read_source(path: str | Path, at: Location | None = None) -> str:
+    """The text of a user file; an unreadable, non-regular (``/dev/zero``, a folder, a
+    pipe), over-large or non-UTF-8 file is an :class:`InputError`, located at ``at`` (the
+    ``use`` that names it) when given.
+
+    >>> read_source("/dev/zero")
+    Traceback (most recent call last):
+    ...
+    synth.errors.InputError: error: cannot read '/dev/zero': not a regular file
+    """
+    import stat
+
     try:
-        data = Path(path).read_bytes()
+        with open(path, "rb") as fh:
+            info = os.fstat(fh.fileno())
+            if not stat.S_ISREG(info.st_mode):
+                raise InputError(f"cannot read '{path}': not a regular file", at)
+            if info.st_size > MAX_SOURCE_BYTES:
+                raise InputError(f"cannot read '{path}': {info.st_size} bytes, more than the {MAX_SOURCE_BYTES} synth reads", at)
+            data = fh.read(MAX_SOURCE_BYTES + 1)
     except OSError as exc:
-        raise InputError(f"cannot read '{path}': {exc.strerror or exc}", None) from None
+        raise InputError(f"cannot read '{str(path)[:200]}': {exc.strerror or exc}", at) from None
+    except ValueError as exc:  # a NUL byte in the name
+        raise InputError(f"cannot read {str(path)[:200]!r}: {exc}", at) from None
     try:
         return data.decode("utf-8-sig")  # a byte-order mark is dropped
     except UnicodeDecodeError as exc:
@@ -223,6 +313,13 @@ class ExprTransformer(Transformer):
         return Or(tuple(i for i in items if not isinstance(i, Token)))
 
 
+class VectorKind(StrEnum):
+    """Which vector an ``inputs …`` or ``outputs …`` line lists (rules and ``.g7`` files)."""
+
+    INPUTS = "inputs"
+    OUTPUTS = "outputs"
+
+
 def raise_all(errors: Sequence[InputError]) -> None:
     """Raise the errors of one file together (one :class:`InputError`, or :class:`InputErrors`)."""
     if len(errors) == 1:
@@ -231,15 +328,72 @@ def raise_all(errors: Sequence[InputError]) -> None:
         raise InputErrors(errors)
 
 
+MAX_DEPTH = 200
+"""How deeply a parse tree may nest (``!``, ``&``, ``|`` and parentheses around operators
+each add a level; ``((x))`` adds none): the readers and every walker over expressions
+recurse, and a deeper input is refused with a located error instead of exhausting the
+interpreter's stack."""
+
+
+# What each language's files look like: a suffix, and keywords only its statements open with.
+_KINDS = {
+    "rules": (".rules", "a plant's rules file (.rules)", ("element ", "free ", "constraint ", "model ")),
+    "grafcet": (".g7", "a Grafcet file (.g7)", ("grafcet ",)),
+    "filter": (".filter", "a safety filter file (.filter)", ("safety ",)),
+}
+
+
+def file_kind_hint(grammar: str, file: str, source: str) -> str | None:
+    """When a file that fails to parse as ``grammar`` is another language's file (by its
+    suffix, or, without its own suffix, by the keyword of a statement), say so.
+
+    >>> file_kind_hint("rules", "tri.g7", "outputs A")
+    "tri.g7 is a Grafcet file (.g7), not a plant's rules file (.rules): check the order of the arguments"
+    >>> file_kind_hint("grafcet", "tri.g7", "grafcet G {") is None
+    True
+    """
+    if grammar not in _KINDS:
+        return None
+    own_suffix, own_what, _ = _KINDS[grammar]
+    starts = [ln.strip() for ln in source.splitlines()[:200]]
+    for other, (suffix, what, openers) in _KINDS.items():
+        if other != grammar and (file.endswith(suffix) or (
+                not file.endswith(own_suffix) and any(ln.startswith(openers) for ln in starts))):
+            return f"{file} is {what}, not {own_what}: check the order of the arguments"
+    return None
+
+
+def _parsed(p: Lark, source: str, file: str, grammar: str) -> Tree:
+    """``source`` parsed by ``p``: a syntax error, or a tree nested deeper than
+    :data:`MAX_DEPTH`, becomes a located :class:`InputError`."""
+    try:
+        tree = p.parse(source)
+    except UnexpectedInput as err:
+        error = syntax_error(err, file, source, p)
+        hint = file_kind_hint(grammar, file, source)
+        if hint:
+            error.notes = (*error.notes, hint)
+        raise error from None
+    stack: list[tuple[Tree, int]] = [(tree, 1)]
+    while stack:  # iterative: the check itself must not recurse
+        node, depth = stack.pop()
+        if depth > MAX_DEPTH:
+            meta = node.meta
+            line, column = (meta.line, meta.column) if not meta.empty else (1, 1)
+            raise InputError(
+                f"expression nested too deeply: more than {MAX_DEPTH} levels of '!', '&', '|' or parentheses",
+                location_in(file, source, line, column, 1),
+                notes=("write !!x as x, and a long chain a & (b & (c & …)) as a & b & c & …",),
+            )
+        stack.extend((c, depth + 1) for c in node.children if isinstance(c, Tree))
+    return tree
+
+
 def parse_tree(grammar: str, source: str, file: str, transformer: Transformer) -> Any:
     """Parse ``source`` with ``grammars/<grammar>.lark`` and transform it; a syntax error
     becomes a located :class:`InputError`, and so does every error the transformer collected
     in an ``errors`` list."""
-    p = parser(grammar)
-    try:
-        tree = p.parse(source)
-    except UnexpectedInput as err:
-        raise syntax_error(err, file, source, p) from None
+    tree = _parsed(parser(grammar), source, file, grammar)
     result = transformer.transform(tree)
     raise_all(getattr(transformer, "errors", ()))
     return result
@@ -253,11 +407,7 @@ def parse_expression(source: str, file: str, grammar: str = "rules", transformer
     >>> parse_expression("X0 & !v10", "--home").text()
     'X0 & !v10'
     """
-    p = parser(grammar, "expr")
-    try:
-        tree = p.parse(source)
-    except UnexpectedInput as err:
-        raise syntax_error(err, file, source, p) from None
+    tree = _parsed(parser(grammar, "expr"), source, file, "")
     return (transformer or ExprTransformer(file, source)).transform(tree)
 
 

@@ -100,7 +100,7 @@ def check_seed(seed: int, depth: int = 3) -> tuple[int, int, int, str]:
     cycles, mismatch text or ""). A top-level function, so a process pool can run it."""
     from synth.codegen.check import differential_check
     from synth.codegen.grafcet_st import generate_program
-    from synth.grafcet.language import parse_grafcet
+    from synth.grafcet.language_check import parse_grafcet
 
     g = parse_grafcet(random_grafcet(seed), f"random{seed}.g7")
     report = differential_check(g, depth=depth, program=generate_program(g, version="test", comments=False))

@@ -14,7 +14,7 @@ import pytest
 
 from synth.plant.composition import plant
 from synth.output.faudes import supervisor_generator
-from synth.plant.rules import load_rules
+from synth.plant.rules_check import load_rules
 from synth.sup.supervisor import supremal_controllable
 
 from conftest import ROOT

@@ -13,7 +13,7 @@ import pytest
 from synth.cli.main import main
 from synth.output.dot import ass_dot
 from synth.grafcet.ass import stable_situation_automaton
-from synth.grafcet.language import load_grafcet
+from synth.grafcet.language_check import load_grafcet
 from synth.grafcet.machine import GrafcetMachine
 
 ROOT = Path(__file__).resolve().parent.parent

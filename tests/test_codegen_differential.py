@@ -15,7 +15,7 @@ import pytest
 
 from synth.codegen import grafcet_st
 from synth.codegen.check import differential_check
-from synth.grafcet.language import load_grafcet, parse_grafcet
+from synth.grafcet.language_check import load_grafcet, parse_grafcet
 
 from randgrafcet import check_seed, random_grafcet
 
@@ -40,7 +40,7 @@ def test_bundled_grafcets_exhaustively(path: Path):
 
 
 def test_box_sorting_with_the_plants_initial_inputs():
-    from synth.plant.rules import load_rules
+    from synth.plant.rules_check import load_rules
 
     rs = load_rules(ROOT / "plants/tri.rules")
     g = load_grafcet(ROOT / "grafcets/tri.g7", inputs=rs.inputs, outputs=rs.outputs)

@@ -10,7 +10,7 @@ import pytest
 
 from synth.codegen.check import differential_check
 from synth.codegen.grafcet_st import grafcet_program
-from synth.grafcet.language import parse_grafcet
+from synth.grafcet.language_check import parse_grafcet
 
 DOC = Path(__file__).resolve().parent.parent / "docs/codegen.md"
 PAIRS = re.findall(r"```g7\n(.*?)```\n```st\n(.*?)```", DOC.read_text(), re.S)

@@ -11,7 +11,7 @@ from synth.codegen.grafcet_st import grafcet_program, synth_version
 from synth.codegen.plcopen import import_sfc, sfc_project_xml, st_project_xml, validation_errors
 from synth.errors import InputError
 from synth.grafcet.ass import stable_situation_automaton
-from synth.grafcet.language import load_grafcet, parse_grafcet
+from synth.grafcet.language_check import load_grafcet, parse_grafcet
 from synth.grafcet.machine import GrafcetMachine
 from synth.output.summary import ass_json
 

@@ -12,7 +12,7 @@ import pytest
 
 from synth.codegen.grafcet_st import grafcet_program
 from synth.errors import InputError
-from synth.grafcet.language import load_grafcet, parse_grafcet
+from synth.grafcet.language_check import load_grafcet, parse_grafcet
 
 ROOT = Path(__file__).resolve().parent.parent
 

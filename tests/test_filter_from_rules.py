@@ -8,7 +8,7 @@ from synth.filter.from_rules import skeleton
 from synth.filter.language_check import load_filter
 from synth.filter.model import functions
 from synth.filter.solve import synthesis
-from synth.plant.rules import load_rules
+from synth.plant.rules_check import load_rules
 
 TRI = ROOT / "plants" / "tri.rules"
 

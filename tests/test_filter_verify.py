@@ -16,13 +16,14 @@ import pytest
 from conftest import ROOT
 from schemas import assert_valid
 from synth.errors import InputError
-from synth.filter.closed_loop import trace_text, verify
+from synth.filter.closed_loop import verify
 from synth.filter.cycle import Algorithm, FilterCycle, Mode
 from synth.filter.from_rules import skeleton
 from synth.filter.language_check import load_filter, parse_filter
 from synth.logic.events import Event
+from synth.output.filter_text import trace_text
 from synth.plant.composition import plant
-from synth.plant.rules import load_rules
+from synth.plant.rules_check import load_rules
 from synth.sup.constraints import CompiledConstraints
 
 DATA = ROOT / "tests" / "data" / "filter"

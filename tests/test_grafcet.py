@@ -15,10 +15,9 @@ from synth.grafcet.language import (
     ON_DEACTIVATION,
     ON_EVENT,
     STORED,
-    load_grafcet,
-    parse_grafcet,
     receptivity_inputs,
 )
+from synth.grafcet.language_check import load_grafcet, parse_grafcet
 
 ROOT = Path(__file__).resolve().parent.parent
 TRI_INPUTS = ("dcy", "v10", "v11", "v20", "v21", "v30", "v31", "v40", "v41", "cp11", "cp12")
@@ -123,7 +122,7 @@ def test_source_and_sink_transitions():
 
 
 def test_tri_grafcet_loads_with_the_plant():
-    from synth.plant.rules import load_rules
+    from synth.plant.rules_check import load_rules
 
     rs = load_rules(ROOT / "plants/tri.rules")
     g = load_grafcet(ROOT / "grafcets/tri.g7", inputs=rs.inputs, outputs=rs.outputs)

@@ -9,7 +9,7 @@ import pytest
 
 from synth.plant.composition import plant
 from synth.plant.element import element_automaton
-from synth.plant.rules import load_rules, parse_rules
+from synth.plant.rules_check import load_rules, parse_rules
 
 from conftest import ROOT
 

@@ -94,3 +94,51 @@ def test_other_reports_open_cleanly(browser, tmp_path, capsys, case):
     if case[1] == "plants/tri.rules":
         assert "What was checked" in page.inner_text("#checked")
         assert "Prohibited orders met: none" in page.inner_text("#checked")
+
+
+NESTED_SCROLL_BOXES = """() => {
+  const scrolls = e => ['auto', 'scroll'].some(v => [getComputedStyle(e).overflowX, getComputedStyle(e).overflowY].includes(v));
+  return Array.from(document.body.querySelectorAll('*')).filter(e => scrolls(e))
+    .filter(e => { for (let p = e.parentElement; p && p !== document.body; p = p.parentElement) if (scrolls(p)) return true; return false; })
+    .map(e => e.tagName + '#' + e.id + '.' + e.className);
+}"""
+
+
+def test_report_layout(browser, tmp_path, capsys):
+    """Issue 24: one scroll box per drawing, the drawn trace whole (its blocking state
+    inside its box), the element drawing readable at 100 % (text at least 10 px high)."""
+    path = _report(tmp_path, "grafcets/tri_missing_order.g7", "plants/tri.rules")
+    capsys.readouterr()
+    errors: list[str] = []
+    page = _open(browser, path, errors)
+    page.evaluate("document.querySelectorAll('details').forEach(d => d.open = true)")
+    assert page.evaluate(NESTED_SCROLL_BOXES) == []
+    inside = page.evaluate("""() => {
+      const fig = Array.from(document.querySelectorAll('#blocking-1 details'))
+        .find(d => d.querySelector('summary').textContent.startsWith('Trace to the blocking state')).querySelector('.figure');
+      const nodes = fig.querySelectorAll('svg g.node');
+      const last = nodes[nodes.length - 1];
+      const f = fig.getBoundingClientRect(), n = last.getBoundingClientRect();
+      return [last.querySelector('text').textContent,
+              n.top >= f.top && n.left >= f.left && n.bottom <= f.top + fig.clientHeight && n.right <= f.left + fig.clientWidth];
+    }""")
+    assert inside == ["5: Sit={X1, X103, X200, X300}", True]  # the blocking state, not cut off
+    heights = page.evaluate("""() => {
+      const el = Array.from(document.querySelectorAll('#blocking-1 details'))
+        .find(d => d.querySelector('summary').textContent.startsWith('Element V2'));
+      return Array.from(el.querySelector('.figure svg').querySelectorAll('text')).map(t => t.getBoundingClientRect().height);
+    }""")
+    assert heights and min(heights) >= 10, heights
+    assert errors == []
+
+
+def test_passing_report_draws_the_grafcet(browser, tmp_path, capsys):
+    path = _report(tmp_path, "grafcets/tri.g7", "plants/tri.rules")
+    capsys.readouterr()
+    errors: list[str] = []
+    page = _open(browser, path, errors)
+    steps = page.evaluate("""() => Array.from(document.querySelectorAll('#chart svg g.node title'))
+        .map(t => t.textContent).filter(t => t.startsWith('step_'))""")
+    assert "step_0" in steps and "step_103" in steps
+    assert page.evaluate(NESTED_SCROLL_BOXES) == []
+    assert errors == []

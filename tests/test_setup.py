@@ -9,6 +9,7 @@ import os
 import shutil
 import subprocess
 import sys
+import sysconfig
 import textwrap
 
 import pytest
@@ -56,7 +57,12 @@ def test_installed_wheel_validates_a_lone_copy_of_tri_rules(tmp_path):
     r = _run([sys.executable, "-m", "pip", "wheel", "-q", "--no-deps", "--no-build-isolation", "-w", str(wheels), str(ROOT)])
     assert r.returncode == 0, r.stderr
     venv = tmp_path / "venv"
-    assert _run([sys.executable, "-m", "venv", "--system-site-packages", "--without-pip", str(venv)]).returncode == 0
+    assert _run([sys.executable, "-m", "venv", "--without-pip", str(venv)]).returncode == 0
+    # synth's dependencies from this interpreter's site-packages, by a path line (the .pth
+    # files there, the editable install of this tree among them, are not run)
+    site_dirs = dict.fromkeys(sysconfig.get_path(k) for k in ("purelib", "platlib"))
+    (new_site,) = venv.glob("lib/python*/site-packages")
+    (new_site / "synth_test_dependencies.pth").write_text("".join(d + "\n" for d in site_dirs))
     (wheel,) = wheels.glob("synth-*.whl")
     r = _run([sys.executable, "-m", "pip", "--python", str(venv / "bin/python"), "install", "-q", "--no-deps",
               "--force-reinstall", str(wheel)])
@@ -75,13 +81,14 @@ def test_installed_wheel_validates_a_lone_copy_of_tri_rules(tmp_path):
 
 def test_report_without_graphviz_still_answers(tmp_path):
     """No ``dot`` on the PATH: the verdict, the diagnosis and the exit code are the same,
-    and the report says where drawings are missing."""
+    and the report says where drawings are missing. The venv's interpreter runs by its own
+    path (a symlink to it elsewhere would start the base interpreter, without synth's
+    dependencies), with a PATH that holds an empty folder only."""
     bin_dir = tmp_path / "bin"
     bin_dir.mkdir()
-    (bin_dir / "python3").symlink_to(sys.executable)
     env = dict(os.environ, PATH=str(bin_dir), PYTHONPATH=str(ROOT))
     out = tmp_path / "rep"
-    r = _run([str(bin_dir / "python3"), "-m", "synth", "validate", str(ROOT / "grafcets/tri_missing_order.g7"),
+    r = _run([sys.executable, "-m", "synth", "validate", str(ROOT / "grafcets/tri_missing_order.g7"),
               "--plant", str(ROOT / "plants/tri.rules"), "--report", str(out)], env=env, cwd=tmp_path)
     assert r.returncode == 1, r.stderr
     assert "diagnosis [missing_order]: missing order AVANCER2 in step 103" in r.stdout

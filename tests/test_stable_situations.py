@@ -7,9 +7,9 @@ from pathlib import Path
 import pytest
 
 from synth.errors import InputError
-from synth.grafcet.language import parse_grafcet
+from synth.grafcet.language_check import parse_grafcet
 from synth.grafcet.ass import stable_situation_automaton
-from synth.grafcet.language import load_grafcet
+from synth.grafcet.language_check import load_grafcet
 from synth.grafcet.machine import GrafcetMachine, Situation
 from synth.logic.events import EventKind, parse_event
 
@@ -456,7 +456,7 @@ def test_ass_never_stable_is_reported():
 
 
 def test_ass_of_the_box_sorting_grafcet():
-    from synth.plant.rules import load_rules
+    from synth.plant.rules_check import load_rules
 
     rs = load_rules(ROOT / "plants/tri.rules")
     g = load_grafcet(ROOT / "grafcets/tri.g7", inputs=rs.inputs, outputs=rs.outputs)

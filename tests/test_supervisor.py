@@ -9,7 +9,7 @@ import pytest
 
 from synth.plant.composition import plant
 from synth.output.faudes import _grid_generator, plant_generator, supervisor_generator
-from synth.plant.rules import load_rules, parse_rules
+from synth.plant.rules_check import load_rules, parse_rules
 from synth.sup.constraints import CompiledConstraints
 from synth.sup.explain import explain
 from synth.sup.supervisor import supremal_controllable

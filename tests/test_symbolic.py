@@ -18,7 +18,7 @@ import pytest
 from synth.errors import InputError, SynthError
 from synth.output.result import validation_json, validation_text
 from synth.plant.composition import plant
-from synth.plant.rules import load_rules, parse_rules
+from synth.plant.rules_check import load_rules, parse_rules
 from synth.sup.supervisor import supremal_controllable
 from synth.symbolic.supervisor import symbolic_supervisor
 from synth.symbolic.validate import validate_symbolic
@@ -266,7 +266,7 @@ def test_live_nodes_and_throttled_budget():
     it at once, then at most every ``interval`` seconds, and stops above the limit."""
     from synth.errors import LimitExceeded
     from synth.plant.composition import plant
-    from synth.plant.rules import load_rules
+    from synth.plant.rules_check import load_rules
     from synth.symbolic.encoding import NodeBudget, PlantEncoding, live_nodes
 
     enc = PlantEncoding(plant(load_rules(P / "tri.rules")))
@@ -285,7 +285,7 @@ def test_live_nodes_and_throttled_budget():
 def test_node_held_agrees_with_held_nodes(grafcet):
     """The node-by-node answer (used when no prohibited order needs the whole set) is the
     whole set's, on every node of the symbolic SYNC; and the explicit engine's held set."""
-    from synth.grafcet.language import load_grafcet
+    from synth.grafcet.language_check import load_grafcet
     from synth.grafcet.machine import GrafcetMachine
     from synth.symbolic.reachability import held_nodes, listed, node_held
     from synth.symbolic.sync import symbolic_sync

@@ -7,7 +7,7 @@ import json
 
 from conftest import ROOT
 from synth.cli.main import main
-from synth.grafcet.language import load_grafcet
+from synth.grafcet.language_check import load_grafcet
 from synth.grafcet.machine import GrafcetMachine
 
 D = ROOT / "tests" / "data"

@@ -8,8 +8,8 @@ import shutil
 import pytest
 
 from synth.plant.composition import plant
-from synth.grafcet.language import load_grafcet
-from synth.plant.rules import load_rules
+from synth.grafcet.language_check import load_grafcet
+from synth.plant.rules_check import load_rules
 from synth.grafcet.machine import GrafcetMachine
 from synth.sup.supervisor import supremal_controllable
 from synth.validation.sync import synchronous_product

@@ -27,12 +27,12 @@ __all__ = ["register", "cmd_st", "cmd_sfc", "cmd_import"]
 
 def _load(args: argparse.Namespace) -> tuple["Grafcet", dict[str, bool], list[str]]:
     """The Grafcet (checked against the plant if given), the initial inputs, the source files."""
-    from synth.grafcet.language import load_grafcet
+    from synth.grafcet.language_check import load_grafcet
 
     sources = [args.file]
     initial: dict[str, bool] = {}
     if args.plant:
-        from synth.plant.rules import load_rules
+        from synth.plant.rules_check import load_rules
 
         rs = load_rules(args.plant)
         grafcet = load_grafcet(args.file, inputs=rs.inputs, outputs=rs.outputs)
@@ -93,7 +93,7 @@ def cmd_sfc(args: argparse.Namespace) -> int:
 
 def cmd_import(args: argparse.Namespace) -> int:
     from synth.codegen.plcopen import import_sfc
-    from synth.grafcet.language import parse_grafcet
+    from synth.grafcet.language_check import parse_grafcet
 
     with open(args.file, "rb") as fh:
         data = fh.read()

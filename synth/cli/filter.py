@@ -1,7 +1,9 @@
-"""``synth filter check`` and ``synth filter solve``: parse arguments, call the library, print.
+"""``synth filter check|solve|st|run|verify|from-rules``: each handler parses its arguments,
+calls one library function and prints (the texts and JSON of :mod:`synth.output.filter_text`).
 
-Exit codes: 0 every property holds / the synthesis is functional and consistent,
-1 it does not, 2 bad input.
+Exit codes: 0 every property holds / the synthesis is functional and consistent / the
+trace or the closed loop is coherent (and safe), 1 it does not, 2 bad input (or
+``verify`` stopped at ``--max-states``).
 """
 
 from __future__ import annotations
@@ -25,6 +27,7 @@ def register(sub: "argparse._SubParsersAction") -> None:
     c = commands.add_parser("check", help="P1-P4, GO cycles, pair conditions, global consistency, equations")
     c.add_argument("filter", metavar="F.filter", help="the .filter file")
     c.add_argument("--json", action="store_true", help="print JSON instead of text")
+    ci_options(c)
     c.set_defaults(handler=cmd_check)
 
     s = commands.add_parser("solve", help="algebraic synthesis: one equation per output")
@@ -50,47 +53,55 @@ def register_st(commands: "argparse._SubParsersAction") -> None:
     register_from_rules(commands)
 
 
-def _warnings(f: "Filter") -> None:
-    """The file's warnings (a relief on a simple constraint), on stderr."""
+def ci_options(p: argparse.ArgumentParser) -> None:
+    """``--junit FILE`` and ``--sarif FILE``: the findings for a CI server (synth.output.ci)."""
+    p.add_argument("--junit", metavar="FILE", help="also write the findings as JUnit XML (one test case per finding)")
+    p.add_argument("--sarif", metavar="FILE", help="also write the findings as SARIF 2.1.0 (one result per finding)")
+
+
+def _load(path: str) -> "Filter":
+    """The filter of ``path``; its warnings (a relief on a simple constraint) on stderr."""
+    from synth.filter.language_check import load_filter
+
+    f = load_filter(path)
     for w in f.warnings:
         print(w.render(), file=sys.stderr)
+    return f
+
+
+def _order(text: str | None) -> list[str] | None:
+    """``--order O1,O2,...`` as a list of names (None when not given)."""
+    return [o.strip() for o in text.split(",") if o.strip()] if text else None
 
 
 def cmd_check(args: argparse.Namespace) -> int:
     from synth.output.summary import print_json
-    from synth.filter.coherence import coherence
-    from synth.filter.language_check import load_filter
-    from synth.filter.model import functions
-    from synth.filter.solve import differences, synthesis
+    from synth.filter.coherence import check
+    from synth.output.filter_text import check_json, check_text
 
-    f = load_filter(args.filter)
-    _warnings(f)
-    m = functions(f)
-    report = coherence(m)
-    diffs = differences(synthesis(m)) if f.equations else []
+    f = _load(args.filter)
+    c = check(f)
+    if args.junit or args.sarif:
+        from synth.output.ci import filter_check_report, write_ci
+
+        write_ci([filter_check_report(f, c)], args.junit, args.sarif)
     if args.json:
-        data = {"file": args.filter, **report.as_dict(), "differences": diffs}
-        print_json(data)
+        print_json(check_json(args.filter, c))
     else:
-        sys.stdout.write(report.text())
-        for d in diffs:
-            print(f"differs: {d}")
-    return 0 if report.holds else 1
+        sys.stdout.write(check_text(c))
+    return 0 if c.holds else 1
 
 
 def cmd_solve(args: argparse.Namespace) -> int:
     from synth.output.summary import print_json
-    from synth.filter.language_check import load_filter
     from synth.filter.solve import synthesis
+    from synth.output.filter_text import synthesis_json, synthesis_text
 
-    f = load_filter(args.filter)
-    _warnings(f)
-    order = [o.strip() for o in args.order.split(",") if o.strip()] if args.order else None
-    s = synthesis(f, order)
+    s = synthesis(_load(args.filter), _order(args.order))
     if args.json:
-        print_json({"file": args.filter, **s.as_dict()})
+        print_json(synthesis_json(args.filter, s))
     else:
-        sys.stdout.write(s.text())
+        sys.stdout.write(synthesis_text(s))
         for n in s.notes:
             print(f"note: {n}", file=sys.stderr)
         for w in s.warnings:
@@ -100,13 +111,9 @@ def cmd_solve(args: argparse.Namespace) -> int:
 
 def cmd_st(args: argparse.Namespace) -> int:
     from synth.codegen.filter_st import filter_block
-    from synth.filter.language_check import load_filter
     from synth.output.files import write_or_print
 
-    f = load_filter(args.filter)
-    _warnings(f)
-    order = [o.strip() for o in args.order.split(",") if o.strip()] if args.order else None
-    block = filter_block(f, args.algorithm, args.mode, args.name, order)
+    block = filter_block(_load(args.filter), args.algorithm, args.mode, args.name, _order(args.order))
     for n in block.notes:
         print(f"note: {n}", file=sys.stderr)
     text: str | bytes = block.text
@@ -140,21 +147,16 @@ def register_run(commands: "argparse._SubParsersAction") -> None:
 
 def cmd_run(args: argparse.Namespace) -> int:
     from synth.output.summary import print_json
-    from synth.filter.cycle import Algorithm, FilterCycle, Mode
-    from synth.filter.language_check import load_filter
-    from synth.filter.run import load_trace, run, run_json, run_text
+    from synth.filter.cycle import Algorithm, Mode
+    from synth.filter.run import run_trace
+    from synth.output.filter_text import run_json, run_text
 
-    f = load_filter(args.filter)
-    _warnings(f)
-    cycle = FilterCycle(f, Algorithm(args.algorithm), Mode(args.mode))
-    rows = load_trace(args.trace, cycle.reads)
-    results = run(cycle, rows)
+    r = run_trace(_load(args.filter), args.trace, Algorithm(args.algorithm), Mode(args.mode))
     if args.json:
-        data = run_json(cycle, rows, results)
-        print_json({"file": args.filter, "trace": args.trace, **data})
+        print_json(run_json(args.filter, r))
     else:
-        sys.stdout.write(run_text(cycle, rows, results))
-    return 0 if not any(r.fallback or r.outside_care for r in results) else 1
+        sys.stdout.write(run_text(r))
+    return 0 if r.coherent else 1
 
 
 def register_from_rules(commands: "argparse._SubParsersAction") -> None:
@@ -165,12 +167,13 @@ def register_from_rules(commands: "argparse._SubParsersAction") -> None:
 
 
 def cmd_from_rules(args: argparse.Namespace) -> int:
-    from synth.filter.from_rules import write_skeleton
+    from synth.filter.from_rules import skeleton
+    from synth.output.files import write_atomic
+    from synth.output.filter_text import skeleton_text
 
-    sk = write_skeleton(args.rules, args.output)
-    for c in sk.constraints:
-        what = {"simple": "CSs", "combined": "CSc (no priority)", "skipped": "skipped: no order"}[c.kind]
-        print(f"{c.id}: {what}" + (f" on {', '.join(c.outputs)}" if c.outputs else ""))
+    sk = skeleton(args.rules, args.output)
+    write_atomic(args.output, sk.text)
+    sys.stdout.write(skeleton_text(sk))
     print(f"wrote {args.output}")
     return 0
 
@@ -192,20 +195,24 @@ def register_verify(commands: "argparse._SubParsersAction") -> None:
     v.add_argument("--max-states", type=int, default=1_000_000, metavar="N",
                    help="stop the exploration after N states (default 1000000)")
     v.add_argument("--json", action="store_true", help="print JSON instead of text")
+    ci_options(v)
     v.set_defaults(handler=cmd_verify)
 
 
 def cmd_verify(args: argparse.Namespace) -> int:
     from synth.output.summary import print_json
-    from synth.filter.closed_loop import verification_json, verification_text, verify
+    from synth.filter.closed_loop import verify
     from synth.filter.cycle import Algorithm, Mode
-    from synth.filter.language_check import load_filter
+    from synth.output.filter_text import verification_json, verification_text
 
-    f = load_filter(args.filter)
-    _warnings(f)
+    f = _load(args.filter)
     v = verify(f, args.plant, args.grafcet, any_control=args.any_control, algorithm=Algorithm(args.algorithm),
                mode=Mode(args.mode), atomic=args.atomic_outputs, strict=args.strict, require_sup=args.require_sup,
                max_states=args.max_states)
+    if args.junit or args.sarif:
+        from synth.output.ci import filter_verify_report, write_ci
+
+        write_ci([filter_verify_report(f, v)], args.junit, args.sarif)
     if args.json:
         print_json(verification_json(v))
     else:

@@ -31,13 +31,13 @@ __all__ = ["register", "cmd_ass", "cmd_run"]
 def _load(args: argparse.Namespace) -> tuple[Grafcet, dict[str, bool], Callable[[Mapping[str, bool]], bool] | None]:
     """The Grafcet (checked against the plant if given), the initial input values, and
     the plant's test of admissible input vectors (None without a plant)."""
-    from synth.grafcet.language import load_grafcet
+    from synth.grafcet.language_check import load_grafcet
 
     initial: dict[str, bool] = {}
     admissible = None
     if args.plant:
         from synth.plant.composition import plant
-        from synth.plant.rules import load_rules
+        from synth.plant.rules_check import load_rules
 
         rs = load_rules(args.plant)
         grafcet = load_grafcet(args.file, inputs=rs.inputs, outputs=rs.outputs)

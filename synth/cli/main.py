@@ -17,14 +17,15 @@ from synth.version import version
 TYPE_CHECKING = False  # typing.TYPE_CHECKING, without importing typing
 if TYPE_CHECKING:
     from collections.abc import Callable, Sequence
+    from typing import NoReturn
 
 __all__ = ["main", "entry", "build_parser", "version"]
 
-EXIT_PASS, EXIT_FAIL, EXIT_INPUT = 0, 1, 2
+EXIT_INPUT = 2  # bad input or a limit reached (0: a pass, 1: a model that fails)
 
 
 class _Parser(argparse.ArgumentParser):
-    def error(self, message: str) -> None:  # argparse's own errors: exit 2 as for bad input
+    def error(self, message: str) -> NoReturn:  # argparse's own errors: exit 2 as for bad input
         self.print_usage(sys.stderr)
         self.exit(EXIT_INPUT, f"{self.prog}: error: {message}\n")
 
@@ -53,6 +54,9 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
+    if not (sys.argv[1:] if argv is None else argv):  # ``synth`` alone: the command list
+        parser.print_help(sys.stderr)
+        return EXIT_INPUT
     args = parser.parse_args(argv)
     handler: Callable[[argparse.Namespace], int] = args.handler
     from synth.errors import InputError, InputErrors, LimitExceeded, ModelError, SynthError
@@ -74,6 +78,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except OSError as err:  # an output file that cannot be written
         where = f" '{err.filename}'" if getattr(err, "filename", None) else ""
         print(f"error: cannot write{where}: {err.strerror or err}", file=sys.stderr)
+        return EXIT_INPUT
+    except MemoryError:  # a model larger than this machine: a limit reached, not a verdict
+        print("stopped: out of memory; bound the exploration with --max-states (or --max-nodes)", file=sys.stderr)
         return EXIT_INPUT
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)

@@ -59,7 +59,7 @@ def cmd_plant(args: argparse.Namespace) -> int:
     from synth.output.files import write_atomic
     from synth.output.html import write_svg
     from synth.plant.composition import plant
-    from synth.plant.rules import load_rules
+    from synth.plant.rules_check import load_rules
 
     rs = load_rules(args.rules)
     p = plant(rs)

@@ -17,7 +17,7 @@ event but two machine events: such states are not extended by a timer event).
 
 Example
 -------
->>> from synth.grafcet.language import parse_grafcet
+>>> from synth.grafcet.language_check import parse_grafcet
 >>> g = parse_grafcet("grafcet G { initial step 0 step 1: A transition 0 -> 1 when ↑a "
 ...                   "transition 1 -> 0 when 2s/X1 }", "g.g7")
 >>> report = differential_check(g, {"a": False}, depth=3)

@@ -26,7 +26,7 @@ every partial grafcet in the same round (see docs/codegen.md).
 
 Example
 -------
->>> from synth.grafcet.language import parse_grafcet
+>>> from synth.grafcet.language_check import parse_grafcet
 >>> g = parse_grafcet("grafcet G { initial step 0 step 1: A "
 ...                   "transition 0 -> 1 when ↑a transition 1 -> 0 when !a }", "g.g7")
 >>> text = grafcet_program(g, version="0.1.0")

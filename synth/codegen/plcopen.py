@@ -30,7 +30,7 @@ Nothing written depends on the time of day: ``creationDateTime`` is a fixed date
 
 Example
 -------
->>> from synth.grafcet.language import parse_grafcet
+>>> from synth.grafcet.language_check import parse_grafcet
 >>> g = parse_grafcet("grafcet G { initial step 0 step 1: A "
 ...                   "transition 0 -> 1 when ↑a transition 1 -> 0 when !a }", "g.g7")
 >>> xml = sfc_project_xml(g, version="0.1.0")

@@ -12,7 +12,6 @@ __getattr__, __all__ = lazy_exports(
         "Safety": "language",
         "load_filter": "language_check",
         "parse_filter": "language_check",
-        "Engine": "bdd",
         "FilterFunctions": "model",
         "functions": "model",
         "Coherence": "coherence",

@@ -19,15 +19,18 @@ K1 -(o2:=0)-> K2 -(o2:=1)-> K1
 
 from __future__ import annotations
 
+import builtins
 from dataclasses import dataclass
 from enum import StrEnum
 from itertools import combinations, product
 from typing import Any, Sequence
 
 from synth.logic.bdd import Cube, Function, cube_text
+from synth.filter.language import Filter
 from synth.filter.model import FilterFunctions, edge_rule, equation_functions, functions
+from synth.filter.solve import differences, synthesis
 
-__all__ = ["Property", "Status", "Finding", "GoEdge", "Cycle", "Coherence", "coherence", "go_graph"]
+__all__ = ["Property", "Status", "Finding", "GoEdge", "Cycle", "Coherence", "coherence", "go_graph", "Check", "check"]
 
 
 class Property(StrEnum):
@@ -79,7 +82,7 @@ class Finding:
     constraints: tuple[str, ...] = ()
     detail: str = ""
 
-    @property
+    @builtins.property  # the field ``property`` hides the builtin in this class body
     def holds(self) -> bool:
         return self.status is not Status.VIOLATED
 
@@ -108,11 +111,6 @@ class Coherence:
     def holds(self) -> bool:
         return all(f.holds for f in self.findings)
 
-    def text(self) -> str:
-        lines = [f.text() for f in self.findings]
-        lines += [f"GO edge: {e.text()}" for e in self.go]
-        return "\n".join(lines) + "\n"
-
     def as_dict(self) -> dict[str, Any]:
         return {"holds": self.holds, "findings": [f.as_dict() for f in self.findings],
                 "go": {"edges": [e.text() for e in self.go], "cycles": [c.text() for c in self.cycles]}}
@@ -132,8 +130,9 @@ def _judged(m: FilterFunctions, prop: Property, subject: str, parts: Sequence[tu
         return Finding(prop, subject, Status.EDGE_RULE)
     if literal == e.false:
         return Finding(prop, subject, Status.HOLDS)
-    only = cube_text(e.minimal_cube(literal))
-    return Finding(prop, subject, Status.ASSUMED, detail=f"fails only {outside}, e.g. when {only}")
+    only = e.minimal_cube(literal)
+    assert only is not None  # literal is not false
+    return Finding(prop, subject, Status.ASSUMED, detail=f"fails only {outside}, e.g. when {cube_text(only)}")
 
 
 def _p1(m: FilterFunctions, o: str) -> Finding:
@@ -175,6 +174,7 @@ def _consistency(m: FilterFunctions) -> Finding:
     if bad == e.false:
         return _judged(m, Property.CONSISTENCY, "", [((), "", stuck)], m.assumed)
     cube = e.witness(stuck, m.assumed)
+    assert cube is not None  # stuck & assumed is not false
     where = e.cube(cube) & m.assumed
     core = list(m.constraint)
     for ident in list(core):  # a minimal set of constraints still unsatisfiable on the cube
@@ -223,7 +223,7 @@ def go_graph(m: FilterFunctions) -> tuple[tuple[GoEdge, ...], tuple[Cycle, ...]]
     for start in ids:
         if start in covered:
             continue
-        back = {start: None}  # breadth-first: the shortest way back to start
+        back: dict[str, GoEdge | None] = {start: None}  # breadth-first: the shortest way back to start
         frontier, found = [start], None
         while frontier and found is None:
             nxt = []
@@ -242,9 +242,9 @@ def go_graph(m: FilterFunctions) -> tuple[tuple[GoEdge, ...], tuple[Cycle, ...]]
             continue
         path = [found[1]]
         n = found[0]
-        while back[n] is not None:
-            path.append(back[n])
-            n = back[n].source
+        while (edge := back[n]) is not None:
+            path.append(edge)
+            n = edge.source
         cycle = Cycle(tuple(reversed(path)))
         covered.update(g.source for g in cycle.edges)
         cycles.append(cycle)
@@ -270,3 +270,23 @@ def coherence(m: FilterFunctions | Any) -> Coherence:
     if m.filter.equations:
         found += _equations(m)
     return Coherence(tuple(found), edges, cycles)
+
+
+@dataclass(frozen=True)
+class Check:
+    """``synth filter check``: the coherence, and how the file's ``equation`` lines differ
+    from the synthesis (none without equations)."""
+
+    coherence: Coherence
+    differences: tuple[str, ...]
+
+    @property
+    def holds(self) -> bool:
+        return self.coherence.holds
+
+
+def check(f: Filter) -> Check:
+    """The coherence of ``f`` and, when it states equations, their differences from the synthesis."""
+    m = functions(f)
+    report = coherence(m)
+    return Check(report, tuple(differences(synthesis(m))) if f.equations else ())

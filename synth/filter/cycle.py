@@ -173,10 +173,10 @@ class FilterCycle:
                 self.equations[o] = _cover(e.cover(one, one | ~s.care))
             self.care = _cover(e.cover(s.care))
         else:
-            for s in flt.combined:
-                if not s.has_priority:
-                    raise InputError(f"{s.id} is a combined constraint without priority: the loop needs "
-                                     "`keep L` or `force o=v, ...` to relieve it", s.loc)
+            for c in flt.combined:
+                if not c.has_priority:
+                    raise InputError(f"{c.id} is a combined constraint without priority: the loop needs "
+                                     "`keep L` or `force o=v, ...` to relieve it", c.loc)
         covers = [*self.constraint.values(), *self.fs0.values(), *self.fs1.values(), *self.equations.values(),
                   self.care]
         used = sorted({n for cover in covers for cube in cover for n, _ in cube if is_pre(n)})
@@ -237,8 +237,8 @@ class FilterCycle:
         if self.mode is Mode.BLOCKING:
             blocked = (0 if not memory.blocked else full) & (full ^ values[ACK])
             any_violation = 0
-            for v in violated.values():
-                any_violation |= v
+            for mask in violated.values():
+                any_violation |= mask
             blocked |= any_violation
             g1 = tuple(r & (full ^ blocked) for r in requests)
         iterations: list[tuple[int, ...]] = []

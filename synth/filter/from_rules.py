@@ -8,17 +8,18 @@ edge of an output is a literal of that output at t: a simple constraint). The fi
 checker classifies each one (one output at t: CSs, more: CSc); combined constraints get
 no priority, only a comment saying to add ``keep``/``force``. A constraint on inputs only
 is no filter constraint: it is kept as a comment. The text is checked by parsing it back
-before it is written (atomically).
+(``synth filter from-rules`` then writes it).
 
 Example
 -------
 >>> import tempfile, pathlib
->>> d = pathlib.Path(tempfile.mkdtemp())
->>> _ = (d / "p.rules").write_text('''element E { order A = 0, B = 0  sensor s = 0  ↑A -> ↑s  ↓A -> ↓s }
+>>> with tempfile.TemporaryDirectory() as tmp:
+...     d = pathlib.Path(tmp)
+...     _ = (d / "p.rules").write_text('''element E { order A = 0, B = 0  sensor s = 0  ↑A -> ↑s  ↓A -> ↓s }
 ... constraint K "not both": A & B = 0
 ... constraint S: B & s = 0''')
->>> sk = skeleton(d / "p.rules", d / "p.filter")
->>> [(c.id, c.kind) for c in sk.constraints]
+...     sk = skeleton(d / "p.rules", d / "p.filter")
+>>> [(c.id, str(c.kind)) for c in sk.constraints]
 [('K', 'combined'), ('S', 'simple')]
 >>> print(sk.text.splitlines()[5])
 safety K "not both": A & B
@@ -28,22 +29,32 @@ from __future__ import annotations
 
 import os
 from dataclasses import dataclass
+from enum import StrEnum
 from pathlib import Path
 
 from synth.filter.language import Filter
 from synth.filter.language_check import output_polarities, parse_filter
-from synth.plant.rules import RuleSet, load_rules
+from synth.plant.rules import RuleSet
+from synth.plant.rules_check import load_rules
 
-__all__ = ["Classified", "Skeleton", "skeleton", "write_skeleton"]
+__all__ = ["Classification", "Classified", "Skeleton", "skeleton"]
+
+
+class Classification(StrEnum):
+    """How a rules constraint enters the skeleton: a simple or combined filter constraint,
+    or skipped (no order in it)."""
+
+    SIMPLE = "simple"
+    COMBINED = "combined"
+    SKIPPED = "skipped"
 
 
 @dataclass(frozen=True)
 class Classified:
-    """A rules constraint as the filter sees it: ``simple``/``combined``, or ``skipped``
-    (no order in it); the outputs at t it involves."""
+    """A rules constraint as the filter sees it, and the outputs at t it involves."""
 
     id: str
-    kind: str
+    kind: Classification
     outputs: tuple[str, ...]
     expression: str
 
@@ -98,24 +109,16 @@ def skeleton(rules_path: str | Path, output: str | Path) -> Skeleton:
         label = f' "{c.label.replace(chr(34), chr(39))}"' if c.label else ""
         if not involved:
             lines.append(f"# {c.id}{label}: {text}  -- involves no order: not a filter constraint")
-            kinds.append(Classified(c.id, "skipped", (), text))
+            kinds.append(Classified(c.id, Classification.SKIPPED, (), text))
             continue
         lines.append(f"safety {c.id}{label}: {text}")
         if len(involved) > 1:
             lines.append("    # combined: add `keep L` or `force o=v, ...` (needed by --algorithm loop)")
-        kinds.append(Classified(c.id, "simple" if len(involved) == 1 else "combined", involved, text))
+        kind = Classification.SIMPLE if len(involved) == 1 else Classification.COMBINED
+        kinds.append(Classified(c.id, kind, involved, text))
     text = "\n".join(lines) + "\n"
     f = parse_filter(text, str(output), output.resolve().parent)  # errors are synth's: never written
     for k in kinds:  # the filter checker agrees with the classification above
-        if k.kind != "skipped":
+        if k.kind is not Classification.SKIPPED:
             assert f.safety(k.id).kind.value == k.kind and f.safety(k.id).outputs == k.outputs, k
     return Skeleton(text, tuple(kinds), f)
-
-
-def write_skeleton(rules_path: str | Path, output: str | Path) -> Skeleton:
-    """:func:`skeleton`, written atomically to ``output``."""
-    from synth.output.files import write_atomic
-
-    sk = skeleton(rules_path, output)
-    write_atomic(output, sk.text)
-    return sk

@@ -13,7 +13,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from synth.errors import InputError, Location, close_names, location_in
+from synth.errors import InputError, Location, Severity, close_names, location_in
 from synth.filter.language import (
     Assumption,
     ConstraintKind,
@@ -83,7 +83,7 @@ class _FilterChecker(Checker):
         self.declared[name] = Declared(name, kind, loc, grafcet)
 
     def use(self, u: Use) -> None:
-        from synth.plant.rules import load_rules
+        from synth.plant.rules_check import load_rules
 
         if self.plant is not None:
             self.fail("a filter uses at most one plant", u.loc)
@@ -145,7 +145,7 @@ class _FilterChecker(Checker):
             if s.has_priority:
                 self.warnings.append(InputError(
                     f"{s.id} is a simple constraint (output {outs[0]}): its relief is implied, keep/force is ignored",
-                    s.loc, severity="warning"))
+                    s.loc, severity=Severity.WARNING))
             return s
         forced = self.forced(s)
         if forced is None:
@@ -258,7 +258,10 @@ class _FilterChecker(Checker):
         ids: dict[str, Safety] = {}
         simmed: set[str] = set()
         eqs: dict[str, Equation] = {}
-        safeties, assumptions, criteria, equations = [], [], [], []
+        safeties: list[Safety | None] = []
+        assumptions: list[Assumption | None] = []
+        criteria: list[Criterion | SimCriterion | None] = []
+        equations: list[Equation | None] = []
         for it in items:
             if isinstance(it, Safety):
                 safeties.append(self.safety(it, ids))
@@ -270,16 +273,16 @@ class _FilterChecker(Checker):
                 criteria.append(self.sim(it, simmed))
             elif isinstance(it, Equation):
                 equations.append(self.equation(it, eqs))
-        self.raise_errors()
+        self.raise_errors()  # every None above came with an error
         return Filter(
             self.file,
             self.of_kind(VarKind.INPUT),
             outputs,
             tuple(d for d in self.declared.values() if d.kind is VarKind.OBSERVER),
-            tuple(assumptions),
-            tuple(safeties),
-            tuple(criteria),
-            tuple(equations),
+            tuple(a for a in assumptions if a is not None),
+            tuple(s for s in safeties if s is not None),
+            tuple(c for c in criteria if c is not None),
+            tuple(q for q in equations if q is not None),
             self.plant,
             tuple(self.warnings),
         )

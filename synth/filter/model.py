@@ -6,8 +6,8 @@ Example
 -------
 >>> from synth.filter.language_check import parse_filter
 >>> m = functions(parse_filter("inputs i\\noutputs o\\nsafety S: i & o\\nsafety T: !i & !o", "x.filter"))
->>> m.engine.text(m.fs0["o"]), m.engine.text(m.fs1["o"]), m.ids_forcing("o", True)
-('i', '!i', ('T',))
+>>> m.engine.text(m.fs0["o"]), m.engine.text(m.fs1["o"]), [i for i, _ in m.forcing_parts("o", True)]
+('i', '!i', ['T'])
 """
 
 from __future__ import annotations
@@ -63,10 +63,6 @@ class FilterFunctions:
     def simple_forbidden(self) -> Function:
         """ΣCSs(O, Y)."""
         return self.engine.disjunction(self.constraint[s.id] for s in self.filter.simple)
-
-    def ids_forcing(self, output: str, value: bool) -> tuple[str, ...]:
-        """The simple constraints that force ``output`` to ``value`` somewhere."""
-        return tuple(i for i, _ in self.forcing.get((output, value), []))
 
     def forcing_parts(self, output: str, value: bool) -> list[tuple[str, Function]]:
         """(id, where it forces) for each simple constraint forcing ``output`` to ``value``."""

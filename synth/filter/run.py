@@ -1,5 +1,5 @@
 """``synth filter run``: a trace of cycles read from a CSV file, evaluated cycle by cycle
-with :class:`~synth.filter.cycle.FilterCycle`, printed as text or JSON.
+with :class:`~synth.filter.cycle.FilterCycle` (:mod:`synth.output.filter_text` prints it).
 
 The CSV's header names every input, observer and request ``R_o`` of the filter (and
 ``Ack`` in blocking mode), in any order; each following line is one PLC cycle, its cells
@@ -18,12 +18,13 @@ Example
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Sequence
+from typing import Sequence
 
 from synth.errors import InputError, Location, close_names
-from synth.filter.cycle import Algorithm, CycleResult, FilterCycle
+from synth.filter.cycle import Algorithm, CycleResult, FilterCycle, Mode
+from synth.filter.language import Filter
 
-__all__ = ["Row", "read_trace", "load_trace", "run", "run_text", "run_json"]
+__all__ = ["Row", "read_trace", "load_trace", "run", "Run", "run_trace"]
 
 
 @dataclass(frozen=True)
@@ -107,60 +108,24 @@ def run(cycle: FilterCycle, rows: Sequence[Row]) -> list[CycleResult]:
     return out
 
 
-def _bits(v: Sequence[bool]) -> str:
-    return "".join("1" if b else "0" for b in v)
+@dataclass(frozen=True)
+class Run:
+    """``synth filter run``: the cycle evaluated, the trace's rows and each cycle's result."""
+
+    cycle: FilterCycle
+    trace: str
+    rows: tuple[Row, ...]
+    results: tuple[CycleResult, ...]
+
+    @property
+    def coherent(self) -> bool:
+        """No cycle fell back or met a Y outside the care set."""
+        return not any(r.fallback or r.outside_care for r in self.results)
 
 
-def run_text(cycle: FilterCycle, rows: Sequence[Row], results: Sequence[CycleResult]) -> str:
-    """One line per cycle: the true read-only values, R -> O as bit strings in output
-    order, then what happened; the loop's iterations on a second line."""
-    f = cycle.filter
-    ys = [n for n in cycle.reads if n not in cycle.requests]
-    lines = [f"outputs: {', '.join(f.outputs)}   ({cycle.algorithm.value}, {cycle.mode.value})"]
-    width = len(str(len(rows)))
-    for k, (row, r) in enumerate(zip(rows, results), 1):
-        vals = dict(row.values)
-        y = ", ".join(n for n in ys if vals[n])
-        line = f"{k:>{width}}  Y: {{{y}}}  R: {_bits(r.requests)} -> O: {_bits(r.outputs)}"
-        if r.violated:
-            line += "  violated: " + ", ".join(r.violated)
-        if r.corrections:
-            line += "  corrected: " + ", ".join(r.corrections)
-        for flag, word in ((r.fallback, "FALLBACK"), (r.outside_care, "OUTSIDE CARE SET"), (r.blocked, "blocked")):
-            if flag:
-                line += f"  {word}"
-        if r.unsafe:
-            line += "  UNSAFE: " + ", ".join(r.unsafe)
-        lines.append(line)
-        if cycle.algorithm is Algorithm.LOOP:
-            lines.append(" " * width + "  iterations: " + " ".join(_bits(si) for si in r.iterations))
-    bad = sum(1 for r in results if r.fallback or r.outside_care)
-    lines.append(f"{len(results)} cycles, {sum(1 for r in results if r.corrections)} corrected, "
-                 f"{sum(1 for r in results if r.fallback)} fallback, "
-                 f"{sum(1 for r in results if r.outside_care)} outside the care set"
-                 + ("" if bad else ": coherent"))
-    return "\n".join(lines) + "\n"
-
-
-def run_json(cycle: FilterCycle, rows: Sequence[Row], results: Sequence[CycleResult]) -> dict[str, Any]:
-    outs = cycle.outputs
-
-    def named(v: Sequence[bool]) -> dict[str, int]:
-        return {o: int(b) for o, b in zip(outs, v)}
-
-    return {
-        "algorithm": cycle.algorithm.value,
-        "mode": cycle.mode.value,
-        "outputs": list(outs),
-        "cycles": [{
-            "cycle": k, "line": row.line,
-            "read": {n: int(v) for n, v in row.values},
-            "requests": named(r.requests), "outputs": named(r.outputs),
-            "iterations": [named(si) for si in r.iterations],
-            "fallback": r.fallback, "violated": list(r.violated), "corrections": list(r.corrections),
-            "outside_care": r.outside_care, "unsafe": list(r.unsafe), "blocked": r.blocked,
-        } for k, (row, r) in enumerate(zip(rows, results), 1)],
-        "fallbacks": sum(1 for r in results if r.fallback),
-        "outside_care": sum(1 for r in results if r.outside_care),
-        "coherent": not any(r.fallback or r.outside_care for r in results),
-    }
+def run_trace(f: Filter, path: str, algorithm: Algorithm = Algorithm.ALGEBRAIC,
+              mode: Mode = Mode.SUPERVISOR) -> Run:
+    """The filter's cycle on the CSV trace ``path`` (:func:`load_trace`, then :func:`run`)."""
+    cycle = FilterCycle(f, Algorithm(algorithm), Mode(mode))
+    rows = load_trace(path, cycle.reads)
+    return Run(cycle, path, tuple(rows), tuple(run(cycle, rows)))

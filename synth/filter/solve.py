@@ -26,7 +26,7 @@ Example (004 eqs. 4-13)
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Sequence
+from typing import Sequence
 
 from synth.errors import InputError
 from synth.logic.bdd import Cube, Function, cube_text
@@ -66,7 +66,7 @@ def requested(e: Expr, outputs: Sequence[str]) -> Expr:
         return e
     if isinstance(e, Not):
         return Not(requested(e.arg, outputs), e.loc)
-    args = []
+    args: list[Expr] = []
     for a in e.args:  # flatten the And an edge became
         r = requested(a, outputs)
         args.extend(r.args if isinstance(r, type(e)) and not isinstance(a, type(e)) else (r,))
@@ -169,32 +169,6 @@ class Synthesis:
         m = self.functions
         return m.engine.exists(m.outputs, self.admissible & m.engine.var(o))
 
-    def as_dict(self) -> dict[str, Any]:
-        return {
-            "functional": self.functional,
-            "consistent": self.consistent,
-            "equations": dict(self.equations),
-            "chained": {"order": list(self.chained), "equations": dict(self.chained)},
-            "warnings": self.warnings,
-            "notes": list(self.notes),
-            "criteria": [{"sense": a.criterion.sense.value, "expression": a.criterion.expr.text(),
-                          "origin": a.criterion.origin, "narrows": a.narrows, "effect": a.effect} for a in self.applied],
-            "free": {o: {n: int(v) for n, v in c.items()} for o, c in self.free.items()},
-            "inconsistent": None if self.inconsistent is None else {
-                "counterexample": {n: int(v) for n, v in self.inconsistent.items()},
-                "expression": self.inconsistent_text},
-        }
-
-    def text(self) -> str:
-        lines = [f"equation {o} = {t}" for o, t in self.chained.items()]
-        for o, c in self.free.items():
-            lines.append(f"not functional: {o} is free when {cube_text(c)}")
-        if self.inconsistent is not None:
-            lines.append(f"inconsistent: no safe output vector when {cube_text(self.inconsistent)}"
-                         + (f" (wherever {self.inconsistent_text})" if self.inconsistent_text != cube_text(
-                             self.inconsistent) else ""))
-        return "\n".join(lines) + "\n"
-
 
 def synthesis(f: Filter | FilterFunctions, order: Sequence[str] | None = None) -> Synthesis:
     """Solve the filter's constraints with its criteria (the relational semantics of 004)."""
@@ -238,7 +212,9 @@ def synthesis(f: Filter | FilterFunctions, order: Sequence[str] | None = None) -
         one = e.exists(outs, admissible & e.var(o))
         zero = e.exists(outs, admissible & ~e.var(o))
         if (one & zero) != e.false:
-            result.free[o] = e.minimal_cube(one & zero)
+            free = e.minimal_cube(one & zero)
+            assert free is not None  # one & zero is not false
+            result.free[o] = free
         else:
             result.equations[o] = e.text(one, one | ~care)
     result.chained = chained_equations(result)
@@ -281,11 +257,10 @@ def differences(s: Synthesis) -> list[str]:
         terms = q.expr.args if isinstance(q.expr, Or) else (q.expr,)
         for t in terms:
             extra = e.let(printed, e.expr(t)) & ~mine
-            if (extra & s.care) != e.false:
+            if (cube := e.witness(extra, s.care)) is not None:
                 lines.append(f"{q.output}: the printed term {t.text()} gives 1 where the synthesis gives 0, "
-                             f"e.g. when {cube_text(e.witness(extra, s.care))}")
-        missing = mine & ~theirs
-        if (missing & s.care) != e.false:
+                             f"e.g. when {cube_text(cube)}")
+        if (cube := e.witness(mine & ~theirs, s.care)) is not None:
             lines.append(f"{q.output}: the synthesis gives 1 where no printed term does, "
-                         f"e.g. when {cube_text(e.witness(missing, s.care))}")
+                         f"e.g. when {cube_text(cube)}")
     return lines

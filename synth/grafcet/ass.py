@@ -86,7 +86,7 @@ def stable_situation_automaton(
     Sets of valuations are handled as bit sets, so a situation is processed at once
     for all the valuations that reach it.
 
-    >>> from synth.grafcet.language import parse_grafcet
+    >>> from synth.grafcet.language_check import parse_grafcet
     >>> g = parse_grafcet("grafcet G { initial step 0 step 1: A "
     ...                   "transition 0 -> 1 when ↑a . b  transition 1 -> 0 when !b }")
     >>> ass = stable_situation_automaton(GrafcetMachine(g))

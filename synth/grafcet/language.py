@@ -1,9 +1,9 @@
-"""The Grafcet language (``.g7``): parsing and checking into a frozen model.
+"""The Grafcet language (``.g7``) as plain frozen data: partial grafcets, steps with their
+actions, transitions with their receptivities, gathered in a :class:`Grafcet`.
 
-``load_grafcet(path)`` reads a ``.g7`` file and returns an immutable
-:class:`Grafcet` (partial grafcets, steps with their actions, transitions with
-their receptivities). Every mistake is an :class:`~synth.errors.InputError`
-pointing at the offending token. The syntax is described in ``docs/grafcet.md``.
+:mod:`synth.grafcet.language_reader` turns the text into items;
+:mod:`synth.grafcet.language_check` checks them (``load_grafcet`` / ``parse_grafcet``).
+The syntax is described in ``docs/grafcet.md``.
 
 Receptivities and action conditions are :mod:`synth.logic.expr` expressions in which
 
@@ -13,18 +13,12 @@ Receptivities and action conditions are :mod:`synth.logic.expr` expressions in w
 
 Example
 -------
->>> g = parse_grafcet('''
-... grafcet G1 {
-...   initial step 0
-...   step 1: TAPIS
-...   transition t1: 0 -> 1 when ↑dcy
-...   transition 1 -> 0 when /dcy . X1
-... }
-... ''', "demo.g7")
->>> g.inputs, g.outputs
-(('dcy',), ('TAPIS',))
->>> [(t.name, t.sources, t.targets, t.receptivity.text()) for t in g.transitions]
-[('t1', ('0',), ('1',), '↑dcy'), ('1->0', ('1',), ('0',), '!dcy & X1')]
+>>> from synth.logic.expr import Edge
+>>> t = Transition("t1", ("0",), ("1",), Edge(True, "dcy"), "G1")
+>>> steps = (Step("0", "G1", initial=True), Step("1", "G1", actions=(Action(CONTINUOUS, "TAPIS"),)))
+>>> g = Grafcet((PartialGrafcet("G1", steps, (t,)),), inputs=("dcy",), outputs=("TAPIS",))
+>>> g.initial_steps, t.text(), g.step("1").actions[0].text()
+(('0',), 't1: 0 -> 1 when ↑dcy', 'TAPIS')
 """
 
 from __future__ import annotations
@@ -33,15 +27,15 @@ import re
 from fractions import Fraction
 from dataclasses import dataclass, field
 from enum import StrEnum
-from pathlib import Path
 from typing import Collection, Iterator, Sequence
 
 from synth.errors import Location
 from synth.logic.expr import Expr, Var, names
-from synth.syntax import read_source
 
 __all__ = [
     "STEP_PREFIX",
+    "TIMER_RE",
+    "duration_seconds",
     "step_variable",
     "step_of",
     "ActionKind",
@@ -58,8 +52,6 @@ __all__ = [
     "Transition",
     "PartialGrafcet",
     "Grafcet",
-    "parse_grafcet",
-    "load_grafcet",
     "receptivity_inputs",
     "expr_inputs",
     "step_key",
@@ -85,7 +77,8 @@ class StoredWhen(StrEnum):
 CONTINUOUS, CONDITIONAL, STORED = ActionKind.CONTINUOUS, ActionKind.CONDITIONAL, ActionKind.STORED
 ON_ACTIVATION, ON_DEACTIVATION, ON_EVENT = StoredWhen.ACTIVATION, StoredWhen.DEACTIVATION, StoredWhen.EVENT
 
-_TIMER_RE = re.compile(r"^([0-9]+(?:\.[0-9]+)?)(ms|s|min|h)/X([A-Za-z0-9_]+)$")
+# a timer atom: duration, unit and step, e.g. ``2s/X101``
+TIMER_RE = re.compile(r"^([0-9]+(?:\.[0-9]+)?)(ms|s|min|h)/X([A-Za-z0-9_]+)$")
 _SECONDS = {"ms": Fraction(1, 1000), "s": Fraction(1), "min": Fraction(60), "h": Fraction(3600)}
 
 
@@ -142,11 +135,11 @@ class Action:
       ``condition`` is the event expression for ``on <event>``).
     """
 
-    kind: str
+    kind: ActionKind
     order: str
     condition: Expr | None = None
     value: bool = True
-    when: str = ""
+    when: StoredWhen | None = None
     loc: Location | None = field(default=None, compare=False)
 
     def text(self) -> str:
@@ -294,33 +287,8 @@ def receptivity_inputs(t: Transition, inputs: Sequence[str] | None = None) -> tu
         return expr_inputs(t.receptivity, inputs)
     out: list[str] = []
     for n in names(t.receptivity):
-        if _TIMER_RE.match(n.name) or (isinstance(n, Var) and n.name.startswith("X") and n.name[1:].isdigit()):
+        if TIMER_RE.match(n.name) or (isinstance(n, Var) and n.name.startswith("X") and n.name[1:].isdigit()):
             continue
         if n.name not in out:
             out.append(n.name)
     return tuple(out)
-
-
-def parse_grafcet(
-    source: str,
-    file: str = "<grafcet>",
-    *,
-    inputs: Sequence[str] | None = None,
-    outputs: Sequence[str] | None = None,
-) -> Grafcet:
-    """Parse and check ``.g7`` text; ``inputs``/``outputs`` are the plant's, if known."""
-    from synth.grafcet.language_check import GrafcetChecker
-    from synth.grafcet.language_reader import grafcet_items
-
-    items = grafcet_items(source, file)
-    return GrafcetChecker(file, source, inputs, outputs).check(items)
-
-
-def load_grafcet(
-    path: str | Path,
-    *,
-    inputs: Sequence[str] | None = None,
-    outputs: Sequence[str] | None = None,
-) -> Grafcet:
-    """Read, parse and check a ``.g7`` file (see :func:`parse_grafcet`)."""
-    return parse_grafcet(read_source(path), str(path), inputs=inputs, outputs=outputs)

@@ -1,9 +1,24 @@
 """Checking the ``.g7`` language: names, steps, variables and orders, every error of a
-file collected and reported together.
+file collected and reported together; ``load_grafcet`` / ``parse_grafcet``.
+
+``load_grafcet(path)`` reads a ``.g7`` file and returns an immutable
+:class:`~synth.grafcet.language.Grafcet`. Every mistake is an
+:class:`~synth.errors.InputError` pointing at the offending token.
 
 Example
 -------
->>> from synth.grafcet.language_reader import grafcet_items
+>>> g = parse_grafcet('''
+... grafcet G1 {
+...   initial step 0
+...   step 1: TAPIS
+...   transition t1: 0 -> 1 when ↑dcy
+...   transition 1 -> 0 when /dcy . X1
+... }
+... ''', "demo.g7")
+>>> g.inputs, g.outputs
+(('dcy',), ('TAPIS',))
+>>> [(t.name, t.sources, t.targets, t.receptivity.text()) for t in g.transitions]
+[('t1', ('0',), ('1',), '↑dcy'), ('1->0', ('1',), ('0',), '!dcy & X1')]
 >>> items = grafcet_items("grafcet G { initial step 0 transition 0 -> 9 when 1 }", "g.g7")
 >>> try:
 ...     GrafcetChecker("g.g7", "", None, None).check(items)
@@ -15,11 +30,12 @@ unknown step 9
 from __future__ import annotations
 
 import re
+from pathlib import Path
 from typing import Sequence
 
 from synth.errors import close_names, location_in
 from synth.grafcet.language import (
-    _TIMER_RE,
+    TIMER_RE,
     CONDITIONAL,
     ON_EVENT,
     STORED,
@@ -35,11 +51,10 @@ from synth.grafcet.language import (
     step_variable,
 )
 from synth.logic.expr import Edge, Expr, Var, names
-from synth.grafcet.language_reader import _Decl, _Graf, _Step, _StepRef, _Trans
-from synth.syntax import Checker
+from synth.grafcet.language_reader import GrafcetDecl, StepDecl, StepRef, TransitionDecl, VectorDecl, grafcet_items
+from synth.syntax import Checker, VectorKind, read_source
 
-__all__ = ["GrafcetChecker"]
-
+__all__ = ["GrafcetChecker", "parse_grafcet", "load_grafcet"]
 
 
 class GrafcetChecker(Checker):
@@ -51,11 +66,11 @@ class GrafcetChecker(Checker):
         self.source = source
         self.plant_inputs = tuple(plant_inputs) if plant_inputs is not None else None
         self.plant_outputs = tuple(plant_outputs) if plant_outputs is not None else None
-        self.steps: dict[str, tuple[_Step, str]] = {}
+        self.steps: dict[str, tuple[StepDecl, str]] = {}
         self.timers: dict[str, Timer] = {}
 
     # ---- declarations
-    def declared(self, decls: list[_Decl], kind: str, plant: tuple[str, ...] | None) -> tuple[str, ...] | None:
+    def declared(self, decls: list[VectorDecl], kind: VectorKind, plant: tuple[str, ...] | None) -> tuple[str, ...] | None:
         names_: list[str] = []
         for d in decls:
             if d.kind != kind:
@@ -76,14 +91,14 @@ class GrafcetChecker(Checker):
         return tuple(names_) if any(d.kind == kind for d in decls) else None
 
     # ---- the whole file
-    def check(self, items: list) -> Grafcet:
-        decls = [i for i in items if isinstance(i, _Decl)]
-        grafs = [i for i in items if isinstance(i, _Graf)]
-        inputs = self.declared(decls, "inputs", self.plant_inputs)
-        outputs = self.declared(decls, "outputs", self.plant_outputs)
+    def check(self, items: list[VectorDecl | GrafcetDecl]) -> Grafcet:
+        decls = [i for i in items if isinstance(i, VectorDecl)]
+        grafs = [i for i in items if isinstance(i, GrafcetDecl)]
+        inputs = self.declared(decls, VectorKind.INPUTS, self.plant_inputs)
+        outputs = self.declared(decls, VectorKind.OUTPUTS, self.plant_outputs)
         if inputs is not None and outputs is not None:
             for d in decls:
-                if d.kind == "inputs":
+                if d.kind is VectorKind.INPUTS:
                     for n, loc in d.names:
                         if n in outputs:
                             self.fail(f"'{n}' is declared both as an input and as an output", loc)
@@ -95,7 +110,7 @@ class GrafcetChecker(Checker):
             )
             self.raise_errors()
         # steps (unique across the whole file)
-        gnames: dict[str, _Graf] = {}
+        gnames: dict[str, GrafcetDecl] = {}
         for g in grafs:
             if g.name in gnames:
                 self.fail(f"partial grafcet '{g.name}' is defined twice", g.loc, notes=(f"first defined at {gnames[g.name].loc}",))
@@ -127,7 +142,7 @@ class GrafcetChecker(Checker):
         # transitions and expressions
         built: list[PartialGrafcet] = []
         for g in grafs:
-            labels: dict[str, _Trans] = {}
+            labels: dict[str, TransitionDecl] = {}
             transitions: list[Transition] = []
             for t in g.transitions:
                 if t.label is not None:
@@ -165,7 +180,7 @@ class GrafcetChecker(Checker):
         timers = tuple(sorted(self.timers.values(), key=lambda x: (step_key(x.step), x.seconds, x.id)))
         return Grafcet(tuple(built), tuple(inputs), tuple(outputs), timers, self.file)
 
-    def infer_inputs(self, grafs: list[_Graf], step_vars: set[str]) -> tuple[str, ...]:
+    def infer_inputs(self, grafs: list[GrafcetDecl], step_vars: set[str]) -> tuple[str, ...]:
         found: list[str] = []
         exprs: list[Expr] = []
         for g in grafs:
@@ -173,7 +188,7 @@ class GrafcetChecker(Checker):
             exprs.extend(a.condition for s in g.steps for a in s.actions if a.condition is not None)
         for e in exprs:
             for n in names(e):
-                if n.name in step_vars or _TIMER_RE.match(n.name):
+                if n.name in step_vars or TIMER_RE.match(n.name):
                     continue
                 if isinstance(n, Var) and re.fullmatch(r"X[0-9]+", n.name):
                     continue  # X of a missing step: reported by check_expr
@@ -181,7 +196,7 @@ class GrafcetChecker(Checker):
                     found.append(n.name)
         return tuple(found)
 
-    def check_step_ref(self, r: _StepRef, grafcet: str) -> None:
+    def check_step_ref(self, r: StepRef, grafcet: str) -> None:
         if r.name not in self.steps:
             self.fail(
                 f"unknown step {r.name}",
@@ -201,7 +216,7 @@ class GrafcetChecker(Checker):
     def check_expr(self, e: Expr, inputs: Sequence[str], role: str, allow_edges: bool) -> None:
         known = set(inputs)
         for n in names(e):
-            m = _TIMER_RE.match(n.name)
+            m = TIMER_RE.match(n.name)
             if m is not None:
                 step = m.group(3)
                 if isinstance(n, Edge):
@@ -269,7 +284,7 @@ class GrafcetChecker(Checker):
                     notes=("write an input event such as ↑cp12 (possibly with a condition: ↑cp12 . v10)",),
                 )
 
-    def check_stored_outputs(self, grafs: list[_Graf]) -> None:
+    def check_stored_outputs(self, grafs: list[GrafcetDecl]) -> None:
         stored = {a.order for g in grafs for s in g.steps for a in s.actions if a.kind == STORED}
         for g in grafs:
             for s in g.steps:
@@ -280,3 +295,24 @@ class GrafcetChecker(Checker):
                             a.loc,
                             notes=("an output is either assigned (continuous/conditional actions) or stored (set/reset), not both",),
                         )
+
+
+def parse_grafcet(
+    source: str,
+    file: str = "<grafcet>",
+    *,
+    inputs: Sequence[str] | None = None,
+    outputs: Sequence[str] | None = None,
+) -> Grafcet:
+    """Parse and check ``.g7`` text; ``inputs``/``outputs`` are the plant's, if known."""
+    return GrafcetChecker(file, source, inputs, outputs).check(grafcet_items(source, file))
+
+
+def load_grafcet(
+    path: str | Path,
+    *,
+    inputs: Sequence[str] | None = None,
+    outputs: Sequence[str] | None = None,
+) -> Grafcet:
+    """Read, parse and check a ``.g7`` file (see :func:`parse_grafcet`)."""
+    return parse_grafcet(read_source(path), str(path), inputs=inputs, outputs=outputs)

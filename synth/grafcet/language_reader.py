@@ -4,7 +4,7 @@ checked by :mod:`synth.grafcet.language_check`.
 Example
 -------
 >>> [type(i).__name__ for i in grafcet_items("grafcet G { initial step 0 }", "g.g7")]
-['_Graf']
+['GrafcetDecl']
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 from synth.errors import InputError, Location
 from synth.grafcet.language import (
-    _TIMER_RE,
+    TIMER_RE,
     CONDITIONAL,
     CONTINUOUS,
     ON_ACTIVATION,
@@ -21,26 +21,25 @@ from synth.grafcet.language import (
     ON_EVENT,
     STORED,
     Action,
+    StoredWhen,
     timer_id,
 )
 from synth.logic.expr import Const, Expr, Var
-from synth.syntax import ExprTransformer, Token, parse_tree
+from synth.syntax import ExprTransformer, Token, VectorKind, parse_tree
 
-__all__ = ["grafcet_items"]
-
-
+__all__ = ["VectorDecl", "StepRef", "StepDecl", "TransitionDecl", "GrafcetDecl", "grafcet_items"]
 
 
 @dataclass(frozen=True)
-class _Decl:
+class VectorDecl:
     """``inputs …`` or ``outputs …``."""
 
-    kind: str  # "inputs" | "outputs"
+    kind: VectorKind
     names: tuple[tuple[str, Location], ...]
 
 
 @dataclass(frozen=True)
-class _StepRef:
+class StepRef:
     """A step named as a transition's source or target."""
 
     name: str
@@ -48,7 +47,7 @@ class _StepRef:
 
 
 @dataclass(frozen=True)
-class _Step:
+class StepDecl:
     """A step declaration with its actions."""
 
     name: str
@@ -58,24 +57,24 @@ class _Step:
 
 
 @dataclass(frozen=True)
-class _Trans:
+class TransitionDecl:
     """A transition: its sources, targets and receptivity."""
 
     label: str | None
     label_loc: Location | None
-    sources: tuple[_StepRef, ...]
-    targets: tuple[_StepRef, ...]
+    sources: tuple[StepRef, ...]
+    targets: tuple[StepRef, ...]
     receptivity: Expr
     loc: Location
 
 
 @dataclass(frozen=True)
-class _Graf:
+class GrafcetDecl:
     """``grafcet NAME { … }``."""
 
     name: str
-    steps: tuple[_Step, ...]
-    transitions: tuple[_Trans, ...]
+    steps: tuple[StepDecl, ...]
+    transitions: tuple[TransitionDecl, ...]
     loc: Location
 
 
@@ -96,7 +95,7 @@ class _ToModel(ExprTransformer):
 
     def timer(self, items: list) -> Var:
         (tok,) = items
-        m = _TIMER_RE.match(str(tok))
+        m = TIMER_RE.match(str(tok))
         assert m is not None
         number, unit, step = m.groups()
         if "." in number:
@@ -104,16 +103,16 @@ class _ToModel(ExprTransformer):
         return Var(timer_id(number + unit, step), self._loc(tok))
 
     # declarations
-    def inputs_decl(self, items: list) -> _Decl:
-        return _Decl("inputs", tuple((str(t), self._loc(t)) for t in items))
+    def inputs_decl(self, items: list) -> VectorDecl:
+        return VectorDecl(VectorKind.INPUTS, tuple((str(t), self._loc(t)) for t in items))
 
-    def outputs_decl(self, items: list) -> _Decl:
-        return _Decl("outputs", tuple((str(t), self._loc(t)) for t in items))
+    def outputs_decl(self, items: list) -> VectorDecl:
+        return VectorDecl(VectorKind.OUTPUTS, tuple((str(t), self._loc(t)) for t in items))
 
     # steps and actions
-    def step_id(self, items: list) -> _StepRef:
+    def step_id(self, items: list) -> StepRef:
         (tok,) = items
-        return _StepRef(str(tok), self._loc(tok))
+        return StepRef(str(tok), self._loc(tok))
 
     def continuous(self, items: list) -> Action:
         (tok,) = items
@@ -123,19 +122,19 @@ class _ToModel(ExprTransformer):
         tok, cond = items
         return Action(CONDITIONAL, str(tok), cond, loc=self._loc(tok))
 
-    def on_activation(self, items: list) -> tuple[str, Expr | None]:
+    def on_activation(self, items: list) -> tuple[StoredWhen, Expr | None]:
         return (ON_ACTIVATION, None)
 
-    def on_deactivation(self, items: list) -> tuple[str, Expr | None]:
+    def on_deactivation(self, items: list) -> tuple[StoredWhen, Expr | None]:
         return (ON_DEACTIVATION, None)
 
-    def on_event(self, items: list) -> tuple[str, Expr | None]:
+    def on_event(self, items: list) -> tuple[StoredWhen, Expr | None]:
         return (ON_EVENT, items[0])
 
     def _stored(self, items: list, value: bool) -> Action:
         tok, when = items
-        kind, cond = when if when is not None else (ON_ACTIVATION, None)
-        return Action(STORED, str(tok), cond, value, kind, self._loc(tok))
+        moment, cond = when if when is not None else (ON_ACTIVATION, None)
+        return Action(STORED, str(tok), cond, value, moment, self._loc(tok))
 
     def set_action(self, items: list) -> Action:
         return self._stored(items, True)
@@ -143,22 +142,22 @@ class _ToModel(ExprTransformer):
     def reset_action(self, items: list) -> Action:
         return self._stored(items, False)
 
-    def step(self, items: list) -> _Step:
+    def step(self, items: list) -> StepDecl:
         initial, ref, *actions = items
-        return _Step(ref.name, initial is not None, tuple(a for a in actions if a is not None), ref.loc)
+        return StepDecl(ref.name, initial is not None, tuple(a for a in actions if a is not None), ref.loc)
 
     # transitions
     def tlabel(self, items: list) -> Token:
         return items[0]
 
-    def step_list(self, items: list) -> tuple[_StepRef, ...]:
+    def step_list(self, items: list) -> tuple[StepRef, ...]:
         return tuple(items)
 
-    def transition(self, items: list) -> _Trans:
+    def transition(self, items: list) -> TransitionDecl:
         label, sources, arrow, targets, receptivity = items
         loc = self._loc(label) if label is not None else None
         where = loc or (sources[0].loc if sources else self._loc(arrow))
-        return _Trans(
+        return TransitionDecl(
             str(label) if label is not None else None,
             loc,
             sources or (),
@@ -167,16 +166,16 @@ class _ToModel(ExprTransformer):
             where,
         )
 
-    def grafcet(self, items: list) -> _Graf:
+    def grafcet(self, items: list) -> GrafcetDecl:
         name, *body = items
-        steps = tuple(b for b in body if isinstance(b, _Step))
-        trans = tuple(b for b in body if isinstance(b, _Trans))
-        return _Graf(str(name), steps, trans, self._loc(name))
+        steps = tuple(b for b in body if isinstance(b, StepDecl))
+        trans = tuple(b for b in body if isinstance(b, TransitionDecl))
+        return GrafcetDecl(str(name), steps, trans, self._loc(name))
 
     def start(self, items: list) -> list:
         return items
 
 
-def grafcet_items(source: str, file: str) -> list:
+def grafcet_items(source: str, file: str) -> list[VectorDecl | GrafcetDecl]:
     """The top-level items of a ``.g7`` text, in file order."""
     return parse_tree("grafcet", source, file, _ToModel(file, source))

@@ -20,7 +20,7 @@ included. A transient cycle that never stabilises is an :class:`InputError`.
 
 Example
 -------
->>> from synth.grafcet.language import parse_grafcet
+>>> from synth.grafcet.language_check import parse_grafcet
 >>> g = parse_grafcet('''
 ... grafcet G { initial step 0
 ...   step 1: A
@@ -166,8 +166,8 @@ class GrafcetMachine:
         self._enabled_cache: dict[frozenset[str], tuple[int, ...]] = {}
         self._rec_inputs = [frozenset(receptivity_inputs(t, self.inputs)) for t in self.transitions]
         self._rec_steps = [
-            frozenset(step_of(n.name, steps) for n in names(t.receptivity)
-                      if isinstance(n, Var) and n.name not in timers and step_of(n.name, steps) is not None)
+            frozenset(s for s in (step_of(n.name, steps) for n in names(t.receptivity)
+                                  if isinstance(n, Var) and n.name not in timers) if s is not None)
             for t in self.transitions
         ]
         self._index = {t: i for i, t in enumerate(self.transitions)}
@@ -238,7 +238,7 @@ class GrafcetMachine:
     def timer_event(self, timer: str) -> Event:
         """The event of ``timer``: itself, or the first timer of its step with the same duration.
 
-        >>> from synth.grafcet.language import parse_grafcet
+        >>> from synth.grafcet.language_check import parse_grafcet
         >>> m = GrafcetMachine(parse_grafcet("grafcet G { initial step 0 step 1 step 2 "
         ...     "transition 0 -> 1 when 2s/X0  transition 0 -> 2 when 2000ms/X0 }"))
         >>> m.timer_event("2s/X0"), m.timer_event("2000ms/X0")
@@ -291,7 +291,7 @@ class GrafcetMachine:
         """The single input changes that would make ``t`` fireable in ``sit`` (inputs at
         ``inputs``), in input-name order.
 
-        >>> from synth.grafcet.language import parse_grafcet
+        >>> from synth.grafcet.language_check import parse_grafcet
         >>> m = GrafcetMachine(parse_grafcet("grafcet G { initial step 0 step 1 "
         ...                    "transition 0 -> 1 when ↑a . !b }"))
         >>> s0 = m.initial({"a": False, "b": False})

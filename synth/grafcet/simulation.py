@@ -3,7 +3,7 @@ errors, the IEC 60848 machine stepped, one row per stable situation.
 
 Example
 -------
->>> from synth.grafcet.language import parse_grafcet
+>>> from synth.grafcet.language_check import parse_grafcet
 >>> g = parse_grafcet("grafcet G { initial step 0 step 1: A transition 0 -> 1 when ↑a "
 ...                   "transition 1 -> 0 when !a }", "g.g7")
 >>> rows = simulate(g, {"a": False}, parse_events("^a, _a", g))
@@ -90,7 +90,7 @@ def parse_events(text: str, grafcet: Grafcet) -> list[tuple[Event, Location]]:
             out.append((Event.timer(item), loc))
         else:
             edges = [Event.edge(i, r) for r in (True, False) for i in grafcet.inputs]
-            hint = close_names(item, timers + edges)
+            hint = close_names(item, [*timers, *edges])
             raise InputError(
                 f"unknown event '{item}'",
                 loc,

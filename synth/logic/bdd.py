@@ -44,7 +44,7 @@ def _dd_backend() -> Any:
         try:
             from dd import cudd as backend
         except ImportError:  # pragma: no cover - depends on the installation
-            from dd import autoref as backend  # type: ignore[no-redef]
+            from dd import autoref as backend
     finally:
         if hide and sys.modules.get("networkx", ...) is None:
             del sys.modules["networkx"]

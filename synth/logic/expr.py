@@ -11,7 +11,7 @@ boolean arrays (then the result is an array, broadcast as numpy does).
 Example
 -------
 >>> e = And((Var("a"), Not(Var("b"))))
->>> e.evaluate(lambda n: {"a": True, "b": False}[n])
+>>> evaluate(e, lambda n: {"a": True, "b": False}[n])
 True
 >>> e.text()
 'a & !b'
@@ -40,6 +40,8 @@ __all__ = [
     "Monomial",
     "disjunctive_normal_form",
     "edge_text",
+    "evaluate",
+    "names",
     "renamed",
     "NegatedEdge",
     "NormalFormTooLarge",
@@ -134,6 +136,40 @@ class Or:
 Expr = Union[Var, Const, Edge, Not, And, Or]
 
 
+def _not(r: Any) -> Any:
+    if isinstance(r, bool):
+        return not r
+    if type(r).__module__ == "numpy":  # arrays of values: numpy is loaded already
+        import numpy as np
+
+        return np.logical_not(r)
+    return ~r  # a BDD (or any value with Boolean operators)
+
+
+def _and(a: Any, b: Any) -> Any:
+    if isinstance(a, bool):
+        return b if a else False
+    if isinstance(b, bool):
+        return a if b else False
+    if type(a).__module__ == "numpy" or type(b).__module__ == "numpy":
+        import numpy as np
+
+        return np.logical_and(a, b)
+    return a & b
+
+
+def _or(a: Any, b: Any) -> Any:
+    if isinstance(a, bool):
+        return True if a else b
+    if isinstance(b, bool):
+        return True if b else a
+    if type(a).__module__ == "numpy" or type(b).__module__ == "numpy":
+        import numpy as np
+
+        return np.logical_or(a, b)
+    return a | b
+
+
 def _evaluate(e: Expr, value: Callable[[str], Any], edge: Callable[[Edge], Any]) -> Any:
     if isinstance(e, Var):
         return value(e.name)
@@ -142,19 +178,13 @@ def _evaluate(e: Expr, value: Callable[[str], Any], edge: Callable[[Edge], Any])
     if isinstance(e, Edge):
         return edge(e)
     if isinstance(e, Not):
-        r = _evaluate(e.arg, value, edge)
-        if isinstance(r, bool):
-            return not r
-        import numpy as np  # arrays of values: numpy is loaded already
-
-        return np.logical_not(r)
+        return _not(_evaluate(e.arg, value, edge))
     parts = [_evaluate(a, value, edge) for a in e.args]
     if all(isinstance(p, bool) for p in parts):
         return all(parts) if isinstance(e, And) else any(parts)
-    import numpy as np
-
-    op = np.logical_and if isinstance(e, And) else np.logical_or
-    return reduce(op, parts)
+    if isinstance(e, And):
+        return reduce(_and, parts, True)
+    return reduce(_or, parts, False)
 
 
 def _no_edge(e: Edge) -> bool:
@@ -162,7 +192,22 @@ def _no_edge(e: Edge) -> bool:
 
 
 def evaluate(e: Expr, value: Callable[[str], Any], edge: Callable[[Edge], Any] = _no_edge) -> Any:
-    """Value of ``e``; names through ``value``, edges through ``edge`` (false by default)."""
+    """Value of ``e``; names through ``value``, edges through ``edge`` (false by default).
+
+    One walker for every kind of value: Python booleans, numpy arrays of them (element by
+    element), and BDDs or anything else with the Boolean operators ``~ & |`` (the symbolic
+    engine's ``--home``); a Python boolean next to such a value is absorbed or neutral.
+
+    >>> e = And((Var("a"), Not(Var("b"))))
+    >>> evaluate(e, {"a": True, "b": False}.__getitem__)
+    True
+    >>> class Bits(int):  # values with Boolean operators, as BDDs have
+    ...     def __invert__(self): return Bits(~int(self) & 0b1111)
+    ...     def __and__(self, o): return Bits(int(self) & int(o))
+    ...     def __or__(self, o): return Bits(int(self) | int(o))
+    >>> bin(evaluate(Or((e, Const(False))), {"a": Bits(0b1100), "b": Bits(0b1010)}.__getitem__))
+    '0b100'
+    """
     return _evaluate(e, value, edge)
 
 
@@ -192,12 +237,6 @@ def renamed(e: Expr, rename: Callable[[str], str]) -> Expr:
     if isinstance(e, Not):
         return Not(renamed(e.arg, rename), e.loc)
     return type(e)(tuple(renamed(a, rename) for a in e.args), e.loc)
-
-
-# Methods attached here so that the dataclasses stay plain data.
-for _cls in (Var, Const, Edge, Not, And, Or):
-    _cls.evaluate = evaluate  # type: ignore[attr-defined]
-    _cls.names = names  # type: ignore[attr-defined]
 
 
 @dataclass(frozen=True, order=True)

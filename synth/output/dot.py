@@ -9,6 +9,7 @@ Example
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Iterable, Mapping, Sequence
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -18,25 +19,33 @@ if TYPE_CHECKING:  # pragma: no cover
     from synth.plant.element import ElementAutomaton
     from synth.validation.sync import Sync
 
-__all__ = ["dot_graph", "dot_escape", "element_dot", "trace_dot", "sup_neighbourhood_dot", "aggregated_dot", "ass_dot", "orders_text", "plant_dot", "grafcet_dot", "true_names"]
+__all__ = ["Html", "dot_graph", "dot_escape", "element_dot", "element_neighbourhood", "trace_dot", "sup_neighbourhood_dot", "aggregated_dot", "ass_dot", "orders_text", "plant_dot", "grafcet_dot", "true_names"]
 
 CONTROLLABLE_STYLE = {"color": "#1f5fa8", "fontcolor": "#1f5fa8"}
 UNCONTROLLABLE_STYLE = {"color": "#b03a2e", "fontcolor": "#b03a2e", "style": "dashed"}
 HIGHLIGHT_STYLE = {"penwidth": "3", "color": "#e67e22", "fontcolor": "#e67e22"}
 
 
+@dataclass(frozen=True)
+class Html:
+    """An HTML-like Graphviz label, written ``<…>`` (its text escaped by the caller)."""
+
+    text: str
+
+
 def dot_escape(text: str) -> str:
     return text.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n")
 
 
-def _attrs(attrs: Mapping[str, str]) -> str:
-    return ", ".join(f'{k}="{dot_escape(str(v))}"' for k, v in sorted(attrs.items()))
+def _attrs(attrs: Mapping[str, str | Html]) -> str:
+    return ", ".join(f"{k}=<{v.text}>" if isinstance(v, Html) else f'{k}="{dot_escape(str(v))}"'
+                     for k, v in sorted(attrs.items()))
 
 
 def dot_graph(
     name: str,
-    nodes: Iterable[tuple[str, str, Mapping[str, str]]],
-    edges: Iterable[tuple[str, str, str, Mapping[str, str]]],
+    nodes: Iterable[tuple[str, str | Html, Mapping[str, str | Html]]],
+    edges: Iterable[tuple[str, str, str, Mapping[str, str | Html]]],
     *,
     rankdir: str = "LR",
     node_defaults: Mapping[str, str] | None = None,
@@ -58,29 +67,61 @@ def dot_graph(
     return "\n".join(out) + "\n"
 
 
-def element_dot(a: "ElementAutomaton", highlight: Iterable[str] = (), current: int | None = None) -> str:
-    """An element automaton; controllable edges solid blue, uncontrollable dashed red;
-    transitions whose event is in ``highlight`` drawn thick orange; the local state
-    ``current`` (e.g. the element's state in a blocking situation) filled."""
+def element_dot(a: "ElementAutomaton", highlight: Iterable[str] = (), current: int | None = None,
+                keep: Iterable[int] | None = None) -> str:
+    """An element automaton (or its states ``keep`` and the transitions among them);
+    controllable edges solid blue, uncontrollable dashed red; transitions whose event is
+    in ``highlight`` drawn thick orange; the local state ``current`` (e.g. the element's
+    state in a blocking situation) filled."""
     marked = set(highlight)
+    inside = set(range(a.size)) if keep is None else set(keep)
     nodes = []
-    for k in range(a.size):
+    for k in sorted(inside):
         attrs = {"peripheries": "2"} if k == a.initial else {}
         if k == current:
             attrs.update({"style": "filled", "fillcolor": "#fadbd8", "color": "#c0392b", "penwidth": "2"})
         nodes.append((str(k), a.state_label(k), attrs))
     edges = []
     for t in range(a.src.size):
+        src, dst = int(a.src[t]), int(a.dst[t])
+        if src not in inside or dst not in inside:
+            continue
         ev = a.event(t)
         style = dict(CONTROLLABLE_STYLE if a.controllable[t] else UNCONTROLLABLE_STYLE)
         if ev in marked:
             style.update(HIGHLIGHT_STYLE)
-        edges.append((str(int(a.src[t])), str(int(a.dst[t])), ev, style))
+        edges.append((str(src), str(dst), ev, style))
     return dot_graph(a.name, nodes, edges)
 
 
-def _vector_text(names: Iterable[str], values: Mapping[str, bool]) -> str:
-    return "[" + "".join("1" if values[n] else "0" for n in names) + "]"
+def element_neighbourhood(a: "ElementAutomaton", path: Sequence[int], highlight: Iterable[str] = ()) -> frozenset[int]:
+    """What a drawing of a trace's element needs: the states of ``path`` (the element's
+    states along the trace) and their direct neighbours, and a shortest way from its last
+    state to each ``highlight`` event (the awaited event, the orders that cause it) with
+    that event's targets."""
+    moves: dict[int, list[tuple[int, str]]] = {}
+    for t in range(a.src.size):
+        moves.setdefault(int(a.src[t]), []).append((int(a.dst[t]), a.event(t)))
+    near = {d for s in path for d, _ in moves.get(s, ())}
+    near |= {s for s, out in moves.items() for d, _ in out if d in path}
+    core = set(path)
+    if path:
+        parent = {path[-1]: path[-1]}
+        order = [path[-1]]
+        for s in order:  # breadth-first: ``order`` grows while it is read
+            for d, _ in moves.get(s, ()):
+                if d not in parent:
+                    parent[d] = s
+                    order.append(d)
+        for event in set(highlight):
+            found = next((s for s in order if any(ev == event for _, ev in moves.get(s, ()))), None)
+            if found is None:
+                continue
+            core.update(d for d, ev in moves[found] if ev == event)
+            while found not in core:
+                core.add(found)
+                found = parent[found]
+    return frozenset(core | near)
 
 
 def true_names(names: Iterable[str], values: Mapping[str, bool]) -> str:
@@ -90,10 +131,13 @@ def true_names(names: Iterable[str], values: Mapping[str, bool]) -> str:
 
 def grafcet_dot(g: "Grafcet") -> str:
     """The Grafcet as a chart: steps (initial ones double) with their actions, each
-    transition a bar labelled with its receptivity. Step nodes are named ``step_<name>``
-    so that a page can mark the active steps."""
-    nodes: list[tuple[str, str, Mapping[str, str]]] = []
-    edges: list[tuple[str, str, str, Mapping[str, str]]] = []
+    transition a bar with its name and receptivity beside it (one node, so that no edge
+    crosses the text). Step nodes are named ``step_<name>`` so that a page can mark the
+    active steps."""
+    from html import escape
+
+    nodes: list[tuple[str, str | Html, Mapping[str, str | Html]]] = []
+    edges: list[tuple[str, str, str, Mapping[str, str | Html]]] = []
     for step in g.steps:
         label = step.variable + ("\n" + "\n".join(a.text() for a in step.actions) if step.actions else "")
         attrs = {"shape": "box", "style": "filled", "fillcolor": "#ffffff"}
@@ -102,12 +146,14 @@ def grafcet_dot(g: "Grafcet") -> str:
         nodes.append((f"step_{step.name}", label, attrs))
     for k, t in enumerate(g.transitions):
         bar = f"t{k}"
-        nodes.append((bar, "", {"shape": "rect", "height": "0.04", "width": "0.5", "style": "filled",
-                                "fillcolor": "#222222", "xlabel": f"{t.name}: {t.receptivity.text()}"}))
+        text = escape(f"{t.name}: {t.receptivity.text()}", quote=False)
+        nodes.append((bar, Html('<table border="0" cellborder="0" cellspacing="0" cellpadding="0"><tr>'
+                                '<td port="bar" width="40" height="4" fixedsize="true" bgcolor="#222222"></td>'
+                                f'<td align="left">&nbsp;{text}</td></tr></table>'), {"shape": "plaintext"}))
         for src in t.sources:
-            edges.append((f"step_{src}", bar, "", {"arrowhead": "none"}))
+            edges.append((f"step_{src}", bar, "", {"arrowhead": "none", "headport": "bar"}))
         for dst in t.targets:
-            edges.append((bar, f"step_{dst}", "", {}))
+            edges.append((bar, f"step_{dst}", "", {"tailport": "bar"}))
     return dot_graph(g.path or "grafcet", nodes, edges, rankdir="TB")
 
 
@@ -145,7 +191,7 @@ def sup_neighbourhood_dot(sync: "Sync", local: tuple[int, ...]) -> str:
     oracle = sync.oracle
     centre = p.label(local)
     nodes = [("c", centre, {"shape": "box", "color": "#c0392b", "penwidth": "2"})]
-    edges = []
+    edges: list[tuple[str, str, str, Mapping[str, str | Html]]] = []
     for k, (t, nxt) in enumerate(p.successors(local)):
         nid = f"s{k}"
         label = p.label(nxt)

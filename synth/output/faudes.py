@@ -6,7 +6,7 @@ All states are marked: SUP is a closed-behaviour notion and language comparisons
 
 Example
 -------
->>> from synth.plant.rules import load_rules
+>>> from synth.plant.rules_check import load_rules
 >>> from synth.plant.composition import plant, _plants
 >>> text = plant_generator(plant(load_rules(_plants("tri_annex.rules"))), "tri")
 >>> text.splitlines()[0], "+C+" in text
@@ -15,7 +15,7 @@ Example
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Mapping
 
 from synth.logic.events import Event
 
@@ -39,7 +39,7 @@ def generator_text(
     name: str,
     n_states: int,
     initial: int | None,
-    events: dict[str, bool],
+    events: Mapping[Event, bool],
     src: np.ndarray,
     ev: np.ndarray,
     dst: np.ndarray,
@@ -48,8 +48,8 @@ def generator_text(
     names = list(events)
     alphabet = " ".join(f'"{faudes_event(e)}"' + (" +C+" if events[e] else "") for e in names)
     order = np.lexsort((dst, ev, src))
-    quoted = np.array([f'"{faudes_event(e)}"' for e in names], dtype=object)
-    lines = [f"{s} {q} {d}" for s, q, d in zip((src[order] + 1).tolist(), quoted[ev[order]].tolist(), (dst[order] + 1).tolist())]
+    quoted = [f'"{faudes_event(e)}"' for e in names]
+    lines = [f"{s} {quoted[q]} {d}" for s, q, d in zip((src[order] + 1).tolist(), ev[order].tolist(), (dst[order] + 1).tolist())]
     states = "\n".join(str(i) for i in range(1, n_states + 1))
     return (
         f'<Generator>\n"{name}"\n<Alphabet>\n{alphabet}\n</Alphabet>\n<States>\n{states}\n</States>\n'

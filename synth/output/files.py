@@ -13,8 +13,8 @@ def write_atomic(path: str | Path, data: str | bytes) -> Path:
     """Write ``data`` to a temporary file beside ``path``, then rename it into place.
 
     >>> import tempfile, pathlib
-    >>> d = pathlib.Path(tempfile.mkdtemp())
-    >>> write_atomic(d / "a.txt", "hello").read_text()
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     write_atomic(pathlib.Path(d) / "a.txt", "hello").read_text()
     'hello'
     """
     target = Path(path)

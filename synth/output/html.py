@@ -1,4 +1,11 @@
-"""The only layer that calls Graphviz: DOT text → SVG, and atomic file output."""
+"""The only layer that calls Graphviz: DOT text → SVG, and the HTML report (each drawing
+at its natural size in one scroll box).
+
+Example
+-------
+>>> _figure("<svg></svg>", ident="chart", kind="whole")
+'<div class="figure whole" id="chart"><svg></svg></div>'
+"""
 
 from __future__ import annotations
 
@@ -57,16 +64,28 @@ MISSING_DOT_NOTE = ("drawing missing: Graphviz's dot program is not installed (D
                     "its DOT text follows")
 
 
-def _inline_svg(dot_text: str) -> str:
-    """The drawing inline; without Graphviz, a note and the DOT text (folded away)."""
+def _drawing(dot_text: str) -> str:
+    """The drawing as inline SVG at its natural size (Graphviz's 10 pt text is 13 px at
+    100 %); without Graphviz, a note and the DOT text (folded away)."""
     if not dot_available():
         from markupsafe import escape
 
-        return (f'<div class="figure missing"><p class="note">{escape(MISSING_DOT_NOTE)}</p>'
-                f"<details><summary>DOT</summary><pre>{escape(dot_text)}</pre></details></div>")
+        return (f'<p class="note">{escape(MISSING_DOT_NOTE)}</p>'
+                f"<details><summary>DOT</summary><pre>{escape(dot_text)}</pre></details>")
     text = svg(dot_text)
     start = text.find("<svg")
-    return f'<div class="figure">{text[start:] if start >= 0 else text}</div>'
+    return text[start:] if start >= 0 else text
+
+
+def _figure(drawing: str, *, ident: str = "", kind: str = "") -> str:
+    """A drawing in its one scroll box (``kind`` ``whole``: never cut in height)."""
+    classes = "figure" + (f" {kind}" if kind else "") + ("" if drawing.startswith("<svg") else " missing")
+    where = f' id="{ident}"' if ident else ""
+    return f'<div class="{classes}"{where}>{drawing}</div>'
+
+
+def _inline_svg(dot_text: str, *, kind: str = "") -> str:
+    return _figure(_drawing(dot_text), kind=kind)
 
 
 def _walk_step(event: str, state: dict) -> dict:
@@ -92,13 +111,13 @@ def report_html(v: "Validation") -> str:
     and the Grafcet's active steps, then what was checked, a legend and the drawings."""
     from markupsafe import Markup
 
-    from synth.output.dot import aggregated_dot, element_dot, grafcet_dot, sup_neighbourhood_dot, trace_dot
+    from synth.output.dot import aggregated_dot, element_dot, element_neighbourhood, grafcet_dot, sup_neighbourhood_dot, trace_dot
+    from synth.output.glossary import GLOSSARY_TERMS
     from synth.output.result import prohibited_json, validation_json
 
     data = validation_json(v)
     a = v.analysis
-    chart = grafcet_dot(v.grafcet)
-    chart_svg = Markup(_inline_svg(chart))
+    chart = _drawing(grafcet_dot(v.grafcet))
     blocking = []
     walks: dict[str, list[dict]] = {}
     for k, (b, item) in enumerate(zip(a.blocking, data["blocking"]), 1):
@@ -110,8 +129,11 @@ def report_html(v: "Validation") -> str:
             axis = next(i for i, e in enumerate(v.plant.elements) if e.name == name)
             el = v.plant.elements[axis]
             here = v.sync.nodes[b].plant[axis]
-            elements.append({"name": name, "state": el.state_label(here),
-                             "svg": Markup(_inline_svg(element_dot(el, highlight=events, current=here)))})
+            near = element_neighbourhood(el, [v.sync.nodes[n].plant[axis] for n in tr.nodes], events)
+            whole = len(near) == el.size
+            elements.append({"name": name, "state": el.state_label(here), "size": el.size,
+                             "svg": Markup(_inline_svg(element_dot(el, highlight=events, current=here, keep=near))),
+                             "full_svg": None if whole else Markup(_inline_svg(element_dot(el, highlight=events, current=here)))})
         steps = [_walk_step(ev, st) for ev, st in zip(["initial"] + list(tr.events), item["trace_states"])]
         walks[f"b{k}"] = steps
         blocking.append({
@@ -119,8 +141,8 @@ def report_html(v: "Validation") -> str:
             "item": item,
             "steps": steps,
             "diagnosis": d,
-            "grafcet_svg": chart_svg,
-            "trace_svg": Markup(_inline_svg(trace_dot(v.sync, tr.nodes, tr.events, blocking=b))),
+            "grafcet_svg": Markup(_figure(chart, ident=f"grafcet-b{k}")),
+            "trace_svg": Markup(_inline_svg(trace_dot(v.sync, tr.nodes, tr.events, blocking=b), kind="whole")),
             "elements": elements,
             "sup_svg": Markup(_inline_svg(sup_neighbourhood_dot(v.sync, v.sync.nodes[b].plant))),
         })
@@ -131,7 +153,7 @@ def report_html(v: "Validation") -> str:
             "situation": v.sync.nodes[i].situation.text(),
             "entries": prohibited_json(v, i),
             "trace": tr.events,
-            "trace_svg": Markup(_inline_svg(trace_dot(v.sync, tr.nodes, tr.events, blocking=None))),
+            "trace_svg": Markup(_inline_svg(trace_dot(v.sync, tr.nodes, tr.events, blocking=None), kind="whole")),
         })
     keep = None
     if a.blocking:  # the part that leads to the blocking states
@@ -146,7 +168,10 @@ def report_html(v: "Validation") -> str:
         blocking=blocking,
         prohibited=prohibited,
         aggregated_svg=aggregated,
+        grafcet_svg=Markup(_figure(chart, ident="grafcet")),
+        glossary=GLOSSARY_TERMS,
         aggregated_cut=keep is not None,
+        aggregated_states=shown,
         situations=len({n.situation for n in v.sync.nodes}),
         steps_covered=steps_total - len(data["unreached_steps"]),
         steps_total=steps_total,

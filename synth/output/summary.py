@@ -5,7 +5,7 @@ in ``synth/output/schemas/`` describe them (the tests validate every ``--json`` 
 
 Example
 -------
->>> from synth.grafcet.language import parse_grafcet
+>>> from synth.grafcet.language_check import parse_grafcet
 >>> from synth.grafcet.machine import GrafcetMachine
 >>> from synth.grafcet.ass import stable_situation_automaton
 >>> g = parse_grafcet("grafcet G { initial step 0 step 1: A transition 0 -> 1 when ↑a transition 1 -> 0 when !a }")

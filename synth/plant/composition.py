@@ -14,7 +14,7 @@ reachable plant state: ``|Q| = Π|Q_i|`` and ``|δ| = Σ_i |δ_i| Π_{j≠i} |Q_
 
 Example
 -------
->>> from synth.plant.rules import load_rules
+>>> from synth.plant.rules_check import load_rules
 >>> p = plant(load_rules(_plants("tri_annex.rules")))
 >>> p.size, p.count_transitions(controllable=False) > 0
 (15552, True)
@@ -32,7 +32,6 @@ import numpy as np
 
 from synth.errors import SynthError, close_names
 from synth.logic.events import Event
-from synth.logic.expr import Expr, evaluate
 from synth.plant.element import ElementAutomaton, element_automaton
 from synth.plant.rules import RuleSet
 
@@ -63,7 +62,11 @@ class Plant:
         self.shape = tuple(e.size for e in elements)
         self.ndim = len(elements)
         self.size = math.prod(self.shape) if elements else 0  # a Python int: no overflow
-        self.strides = tuple(math.prod(self.shape[i + 1:]) for i in range(len(self.shape)))
+        strides, size = [], 1
+        for n in reversed(self.shape):  # row-major strides in one pass (was quadratic in the elements)
+            strides.append(size)
+            size *= n
+        self.strides = tuple(reversed(strides))
         self.owner: dict[str, int] = {v: i for i, e in enumerate(elements) for v in e.variables}
         self.initial = tuple(e.initial for e in elements)
         if rules is not None:
@@ -134,11 +137,6 @@ class Plant:
         shape[i] = v.size
         return v.reshape(shape)
 
-    def grid(self, e: Expr) -> np.ndarray:
-        """The boolean grid of states where level expression ``e`` holds."""
-        r = evaluate(e, self.values)
-        return np.broadcast_to(np.asarray(r, dtype=bool), self.shape)
-
     def valuation(self, local: tuple[int, ...]) -> dict[str, bool]:
         """Every variable's value in the state ``local`` (a tuple of local indices)."""
         out: dict[str, bool] = {}
@@ -163,7 +161,7 @@ class Plant:
         are free) agrees with some plant state: each element's inputs must match one of its
         local states. Used to keep a Grafcet's exploration to vectors the plant can produce.
 
-        >>> from synth.plant.rules import load_rules
+        >>> from synth.plant.rules_check import load_rules
         >>> ok = plant(load_rules(_plants("tri.rules"))).admissible_inputs()
         >>> ok({"cp11": True, "cp12": False}), ok({"cp11": True, "cp12": True})
         (True, False)

@@ -15,7 +15,7 @@ Only the states reachable from the initial state are kept.
 
 Example
 -------
->>> from synth.plant.rules import parse_rules
+>>> from synth.plant.rules_check import parse_rules
 >>> from synth.plant.library import library_dir
 >>> rs = parse_rules(open(library_dir() / "double_acting.rules").read() +
 ...     "element V1 = double_acting(AVANCER=AVANCER1, RECULER=RECULER1, v0=v10, v1=v11)")
@@ -33,10 +33,10 @@ from typing import Iterable
 
 import numpy as np
 
-from synth.errors import InputError
+from synth.errors import InputError, Severity
 from synth.logic.events import Event
 from synth.logic.expr import evaluate
-from synth.plant.rules import ORDER, ElementSpec
+from synth.plant.rules import ElementSpec, VarKind
 
 __all__ = ["ElementAutomaton", "element_automaton"]
 
@@ -167,12 +167,12 @@ def element_automaton(e: ElementSpec) -> ElementAutomaton:
     def uncontrollable_moves(code: int):
         val = value_of(code)
         for v in e.variables:
-            if v.kind == ORDER:
+            if v.kind == VarKind.ORDER:
                 continue
             i = index[v.name]
             bit = bool((code >> i) & 1)
             rising = not bit
-            if v.kind == "free":
+            if v.kind is VarKind.FREE:
                 yield i, ()
                 continue
             applying = []
@@ -190,7 +190,7 @@ def element_automaton(e: ElementSpec) -> ElementAutomaton:
     init = sum(1 << index[v.name] for v in e.variables if v.initial)
     if not coherent(init):  # caught with a location by the rules checker; defensive here
         raise InputError(f"the initial state of element {e.name} is incoherent", e.loc)
-    order_bits = [index[v.name] for v in e.variables if v.kind == ORDER and not v.held]
+    order_bits = [index[v.name] for v in e.variables if v.kind == VarKind.ORDER and not v.held]
     held = {v.name: v.initial for v in e.variables if v.held}  # a rule caused by the other edge never applies, by design
     seen = {init}
     queue = deque([init])
@@ -215,7 +215,7 @@ def element_automaton(e: ElementSpec) -> ElementAutomaton:
     return ElementAutomaton(
         name=e.name,
         variables=names,
-        orders=frozenset(v.name for v in e.variables if v.kind == ORDER),
+        orders=frozenset(v.name for v in e.variables if v.kind == VarKind.ORDER),
         codes=codes,
         initial=pos[init],
         src=arr(lambda t: pos[t[0]], np.int64),
@@ -229,7 +229,7 @@ def element_automaton(e: ElementSpec) -> ElementAutomaton:
                 r.loc,
                 notes=("its guard, a precedence or the incoherences rule it out everywhere: the element will never "
                        f"produce {r.consequence.text()} this way",),
-                severity="warning",
+                severity=Severity.WARNING,
             )
             for k, r in enumerate(e.rules)
             if k not in applied and not (held.get(r.cause.name) is not None and held[r.cause.name] != r.cause.rising)

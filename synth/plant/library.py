@@ -58,7 +58,7 @@ class LibraryModel:
 def library_models() -> list[LibraryModel]:
     """Every model of the installed library, by file name then model order."""
     from synth.plant.rules import VarKind
-    from synth.plant.rules_reader import _Model, rules_items
+    from synth.plant.rules_reader import Model, rules_items
     from synth.syntax import read_source
 
     out = []
@@ -66,7 +66,7 @@ def library_models() -> list[LibraryModel]:
         source = read_source(f)
         comments = [line.lstrip("# ").strip() for line in source.splitlines() if line.startswith("#")]
         for item in rules_items(source, str(f)):
-            if isinstance(item, _Model):
+            if isinstance(item, Model):
                 decls = item.body.decls
                 out.append(LibraryModel(
                     item.name,

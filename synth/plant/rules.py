@@ -1,26 +1,16 @@
-"""The rules language: plant elements, occurrence rules, precedences and constraints.
+"""The rules language as plain frozen data: plant elements, occurrence rules, precedences
+and constraints, gathered in a :class:`RuleSet`.
 
-``load_rules(path)`` reads a ``.rules`` file (and the files it ``use``-s), checks it
-and returns an immutable :class:`RuleSet`. Every mistake is an
-:class:`~synth.errors.InputError` pointing at the offending token.
+:mod:`synth.plant.rules_reader` turns the text into items; :mod:`synth.plant.rules_check`
+resolves and checks them (``load_rules`` / ``parse_rules``).
 
 Example
 -------
->>> text = '''
-... element V3 {
-...   order AVANCER3 = 0
-...   sensor v30 = 1, v31 = 0
-...   incoherent v30 & v31
-...   ↑AVANCER3 [v30] -> ↓v30
-...   ↑AVANCER3 [!v30 & !v31] -> ↑v31
-...   ↓AVANCER3 [v31] -> ↓v31
-...   ↓AVANCER3 [!v30 & !v31] -> ↑v30
-... }
-... constraint C1 "never out": v31 = 0
-... '''
->>> rs = parse_rules(text, "v3.rules")
->>> [e.name for e in rs.elements], [c.id for c in rs.constraints]
-(['V3'], ['C1'])
+>>> from synth.logic.expr import Var
+>>> v3 = ElementSpec("V3", (VarDecl("AVANCER3", VarKind.ORDER, False), VarDecl("v30", VarKind.SENSOR, True)))
+>>> rs = RuleSet((v3,), (Constraint("C1", "never out", Var("v30")),))
+>>> rs.inputs, rs.outputs, rs.constraints[0].text()
+(('v30',), ('AVANCER3',), 'v30 = 0')
 """
 
 
@@ -28,11 +18,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from enum import StrEnum
-from pathlib import Path
 
-from synth.errors import Location, location_in
+from synth.errors import Location
 from synth.logic.expr import Edge, Expr, Not
-from synth.syntax import read_source
 
 __all__ = [
     "VarKind",
@@ -42,8 +30,6 @@ __all__ = [
     "ElementSpec",
     "Constraint",
     "RuleSet",
-    "parse_rules",
-    "load_rules",
 ]
 
 
@@ -55,23 +41,20 @@ class VarKind(StrEnum):
     FREE = "free"
 
 
-ORDER, SENSOR, FREE = VarKind.ORDER, VarKind.SENSOR, VarKind.FREE
-
-
 
 @dataclass(frozen=True)
 class VarDecl:
     """A variable of an element: an order (output Z), a sensor or a free input (input E)."""
 
     name: str
-    kind: str
+    kind: VarKind
     initial: bool
     loc: Location | None = field(default=None, compare=False)
     held: bool = False
 
     @property
     def is_input(self) -> bool:
-        return self.kind != ORDER
+        return self.kind != VarKind.ORDER
 
 
 @dataclass(frozen=True)
@@ -115,11 +98,11 @@ class ElementSpec:
 
     @property
     def orders(self) -> tuple[VarDecl, ...]:
-        return tuple(v for v in self.variables if v.kind == ORDER)
+        return tuple(v for v in self.variables if v.kind == VarKind.ORDER)
 
     @property
     def inputs(self) -> tuple[VarDecl, ...]:
-        return tuple(v for v in self.variables if v.kind != ORDER)
+        return tuple(v for v in self.variables if v.kind != VarKind.ORDER)
 
     def variable(self, name: str) -> VarDecl | None:
         return next((v for v in self.variables if v.name == name), None)
@@ -177,30 +160,3 @@ class RuleSet:
 
     def element(self, name: str) -> ElementSpec | None:
         return next((e for e in self.elements if e.name == name), None)
-
-
-def parse_rules(source: str, file: str = "<rules>", base: Path | None = None) -> RuleSet:
-    """Parse and check rules text; ``base`` is the folder ``use`` paths are relative to."""
-    from synth.plant.rules_check import RulesChecker
-    from synth.plant.rules_reader import rules_items
-
-    items = rules_items(source, file)
-    checker = RulesChecker()
-    if base is not None:
-        checker.loaded.add((base / Path(file).name).resolve())  # a file that uses itself back
-    checker.collect(items, base)
-    if not checker.errors:
-        checker.check()
-    if not checker.elements and not checker.top_free and not checker.errors:
-        checker.fail(
-            "the plant is empty: no element is declared",
-            location_in(file, source, 1, 1),
-            notes=("declare elements with `element NAME { ... }` or `element NAME = MODEL(...)`",),
-        )
-    checker.raise_errors()
-    return RuleSet(tuple(checker.elements), tuple(checker.constraints), file, checker.order)
-
-
-def load_rules(path: str | Path) -> RuleSet:
-    """Read, parse and check a ``.rules`` file."""
-    return parse_rules(read_source(path), str(path), Path(path).parent)

@@ -1,9 +1,28 @@
 r"""Checking the rules language: ``use`` files, models and instances resolved, then every
-name, ownership, precedence and constraint checked, all errors of a file reported together.
+name, ownership, precedence and constraint checked, all errors of a file reported together;
+``load_rules`` / ``parse_rules``.
+
+``load_rules(path)`` reads a ``.rules`` file (and the files it ``use``-s), checks it and
+returns an immutable :class:`~synth.plant.rules.RuleSet`. Every mistake is an
+:class:`~synth.errors.InputError` pointing at the offending token.
 
 Example
 -------
->>> from synth.plant.rules_reader import rules_items
+>>> text = '''
+... element V3 {
+...   order AVANCER3 = 0
+...   sensor v30 = 1, v31 = 0
+...   incoherent v30 & v31
+...   ↑AVANCER3 [v30] -> ↓v30
+...   ↑AVANCER3 [!v30 & !v31] -> ↑v31
+...   ↓AVANCER3 [v31] -> ↓v31
+...   ↓AVANCER3 [!v30 & !v31] -> ↑v30
+... }
+... constraint C1 "never out": v31 = 0
+... '''
+>>> rs = parse_rules(text, "v3.rules")
+>>> [e.name for e in rs.elements], [c.id for c in rs.constraints]
+(['V3'], ['C1'])
 >>> c = RulesChecker()
 >>> c.collect(rules_items("element E { sensor a = 0 }\nconstraint K: b = 0", "x.rules"), None)
 >>> c.check()
@@ -17,14 +36,14 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Mapping
 
-from synth.errors import InputError, Location, close_names
+from synth.errors import InputError, Location, close_names, location_in
 from synth.logic.expr import Edge, Expr, NegatedEdge, NormalFormTooLarge, Var, disjunctive_normal_form, evaluate, names, renamed
-from synth.plant.rules import ORDER, Constraint, ElementSpec, Precedence, Rule, VarDecl, VarKind
 from synth.plant.library import library_file
-from synth.plant.rules_reader import _Hold, _Inline, _Instance, _Model, _Use, _Vector, rules_items
-from synth.syntax import Checker
+from synth.plant.rules import Constraint, ElementSpec, Precedence, Rule, RuleSet, VarDecl, VarKind
+from synth.plant.rules_reader import Hold, Inline, Instance, Item, Model, Use, Vector, rules_items
+from synth.syntax import Checker, VectorKind, read_source
 
-__all__ = ["RulesChecker"]
+__all__ = ["RulesChecker", "parse_rules", "load_rules"]
 
 
 class RulesChecker(Checker):
@@ -32,12 +51,12 @@ class RulesChecker(Checker):
 
     def __init__(self) -> None:
         super().__init__()
-        self.models: dict[str, _Model] = {}
+        self.models: dict[str, Model] = {}
         self.elements: list[ElementSpec] = []
         self.constraints: list[Constraint] = []
         self.holds: list[VarDecl] = []
         self.top_free: list[VarDecl] = []
-        self.vectors: list[_Vector] = []
+        self.vectors: list[Vector] = []
         self.order: tuple[str, ...] = ()
         self.loaded: set[Path] = set()
         # new names given by instance renamings: name -> (element, model variable, location)
@@ -46,11 +65,11 @@ class RulesChecker(Checker):
         self.unknown_uses: list[tuple[str, InputError]] = []
 
     # ---- collection
-    def collect(self, items: list, base: Path | None) -> None:
+    def collect(self, items: list[Item], base: Path | None) -> None:
         for it in items:
-            if isinstance(it, _Use):
+            if isinstance(it, Use):
                 self.use(it, base)
-            elif isinstance(it, _Model):
+            elif isinstance(it, Model):
                 if it.name in self.models:
                     self.fail(
                         f"model '{it.name}' is defined twice",
@@ -59,31 +78,32 @@ class RulesChecker(Checker):
                     )
                 else:
                     self.models[it.name] = it
-            elif isinstance(it, _Inline):
+            elif isinstance(it, Inline):
                 self.add_element(ElementSpec(it.name, it.body.decls, it.body.incoherences, it.body.rules, it.body.precedences, it.loc))
-            elif isinstance(it, _Instance):
+            elif isinstance(it, Instance):
                 self.instantiate(it)
-            elif isinstance(it, _Hold):
+            elif isinstance(it, Hold):
                 self.holds.extend(it.decls)
             elif isinstance(it, tuple):  # top-level free inputs
                 self.top_free.extend(it)
             elif isinstance(it, Constraint):
                 self.constraints.append(it)
-            elif isinstance(it, _Vector):
+            elif isinstance(it, Vector):
                 self.vectors.append(it)
 
-    def use(self, u: _Use, base: Path | None) -> None:
-        target = library_file(u.path, base)
+    def use(self, u: Use, base: Path | None) -> None:
         try:
+            target = library_file(u.path, base)
             resolved = target.resolve()
-            if resolved in self.loaded:
-                return
-            source = target.read_text(encoding="utf-8-sig")
-        except OSError as exc:
-            self.fail(f"cannot read '{u.path}': {exc.strerror or exc}", u.loc)
+        except (OSError, ValueError) as exc:  # a name too long, a NUL byte
+            self.fail(f"cannot read {u.path[:200]!r}: {getattr(exc, 'strerror', None) or exc}", u.loc)
             return
-        except UnicodeDecodeError:
-            self.fail(f"'{u.path}' is not UTF-8 text", u.loc)
+        if resolved in self.loaded:
+            return
+        try:
+            source = read_source(target, u.loc)
+        except InputError as err:
+            self.errors.append(err)
             return
         self.loaded.add(resolved)
         try:
@@ -93,7 +113,7 @@ class RulesChecker(Checker):
             return
         self.collect(items, target.parent)
 
-    def instantiate(self, inst: _Instance) -> None:
+    def instantiate(self, inst: Instance) -> None:
         model = self.models.get(inst.model)
         if model is None:
             self.fail(
@@ -160,8 +180,8 @@ class RulesChecker(Checker):
         held: dict[str, VarDecl] = {}
         for h in self.holds:
             if h.name not in owner:
-                self.fail(f"hold: unknown order '{h.name}'", h.loc, suggestions=close_names(h.name, [n for n, (_, d) in owner.items() if d.kind == ORDER]))
-            elif owner[h.name][1].kind != ORDER:
+                self.fail(f"hold: unknown order '{h.name}'", h.loc, suggestions=close_names(h.name, [n for n, (_, d) in owner.items() if d.kind == VarKind.ORDER]))
+            elif owner[h.name][1].kind != VarKind.ORDER:
                 self.fail(f"hold: '{h.name}' is an input of element {owner[h.name][0].name}; only orders can be held", h.loc)
             else:
                 held[h.name] = h
@@ -179,7 +199,7 @@ class RulesChecker(Checker):
         self.elements = final
         listed: dict[str, Location] = {}
         for vec in self.vectors:
-            want_input = vec.kind == "inputs"
+            want_input = vec.kind is VectorKind.INPUTS
             pool = [n for n, (_, d) in owner.items() if d.is_input == want_input]
             for n, loc in vec.names:
                 if n in listed:
@@ -212,14 +232,14 @@ class RulesChecker(Checker):
                     c.loc,
                     notes=("split it into several constraints",),
                 )
-            for n in names(c.expr):
-                if n.name not in all_names:
-                    what = "edge of an undeclared variable" if isinstance(n, Edge) else "undeclared variable"
-                    self.unknown_use(n.name, f"constraint {c.id} uses {what} '{n.name}'", n.loc, close_names(n.name, all_names))
-                elif isinstance(n, Edge) and owner[n.name][1].kind != ORDER:
+            for x in names(c.expr):
+                if x.name not in all_names:
+                    what = "edge of an undeclared variable" if isinstance(x, Edge) else "undeclared variable"
+                    self.unknown_use(x.name, f"constraint {c.id} uses {what} '{x.name}'", x.loc, close_names(x.name, all_names))
+                elif isinstance(x, Edge) and owner[x.name][1].kind != VarKind.ORDER:
                     self.fail(
-                        f"constraint {c.id}: edges in constraints must be edges of orders; '{n.name}' is an input of element {owner[n.name][0].name}",
-                        n.loc,
+                        f"constraint {c.id}: edges in constraints must be edges of orders; '{x.name}' is an input of element {owner[x.name][0].name}",
+                        x.loc,
                         notes=("an edge restricts the matching controllable event; inputs are written as levels",),
                     )
 
@@ -283,7 +303,7 @@ class RulesChecker(Checker):
             c, q = r.cause, r.consequence
             if c.name not in own:
                 unknown(c, "rule")
-            elif own[c.name].kind != ORDER:
+            elif own[c.name].kind != VarKind.ORDER:
                 self.fail(
                     f"the cause of a rule must be an edge of one of {e.name}'s orders; '{c.name}' is an input",
                     c.loc,
@@ -308,7 +328,7 @@ class RulesChecker(Checker):
                     )
                 else:
                     unknown(q, "rule")
-            elif own[q.name].kind == ORDER:
+            elif own[q.name].kind == VarKind.ORDER:
                 self.fail(
                     f"the consequence of a rule must be an edge of a sensor of {e.name}; '{q.name}' is an order",
                     q.loc,
@@ -320,7 +340,7 @@ class RulesChecker(Checker):
             for role, x in (("cause", p.cause), ("first", p.first), ("then", p.then)):
                 if x.name not in own:
                     unknown(x, "precedence")
-                elif (own[x.name].kind == ORDER) != (role == "cause"):
+                elif (own[x.name].kind == VarKind.ORDER) != (role == "cause"):
                     want = "an edge of one of its orders" if role == "cause" else "an edge of one of its sensors"
                     self.fail(f"in a precedence of {e.name}, the {role} must be {want}; '{x.name}' is not", x.loc)
         # the initial state must be coherent
@@ -337,20 +357,47 @@ class RulesChecker(Checker):
             self.fail(f"element {e.name} declares no variable", e.loc)
 
 
-def _rename(name: str, model: _Model, mapping: Mapping[str, str], loc: Location) -> ElementSpec:
+def _rename(name: str, model: Model, mapping: Mapping[str, str], loc: Location) -> ElementSpec:
     def r(n: str) -> str:
         return mapping.get(n, n)
 
     def rx(x: Expr) -> Expr:
         return renamed(x, r)
 
+    def re_(x: Edge) -> Edge:
+        return Edge(x.rising, r(x.name), x.loc)
+
     b = model.body
     return ElementSpec(
         name,
         tuple(replace(d, name=r(d.name)) for d in b.decls),
         tuple(rx(i) for i in b.incoherences),
-        tuple(Rule(rx(x.cause), rx(x.guard) if x.guard is not None else None, rx(x.consequence), x.loc) for x in b.rules),
-        tuple(Precedence(rx(p.cause), rx(p.first), rx(p.then), p.loc) for p in b.precedences),
+        tuple(Rule(re_(x.cause), rx(x.guard) if x.guard is not None else None, re_(x.consequence), x.loc) for x in b.rules),
+        tuple(Precedence(re_(p.cause), re_(p.first), re_(p.then), p.loc) for p in b.precedences),
         loc,
         model.name,
     )
+
+
+def parse_rules(source: str, file: str = "<rules>", base: Path | None = None) -> RuleSet:
+    """Parse and check rules text; ``base`` is the folder ``use`` paths are relative to."""
+    items = rules_items(source, file)
+    checker = RulesChecker()
+    if base is not None:
+        checker.loaded.add((base / Path(file).name).resolve())  # a file that uses itself back
+    checker.collect(items, base)
+    if not checker.errors:
+        checker.check()
+    if not checker.elements and not checker.top_free and not checker.errors:
+        checker.fail(
+            "the plant is empty: no element is declared",
+            location_in(file, source, 1, 1),
+            notes=("declare elements with `element NAME { ... }` or `element NAME = MODEL(...)`",),
+        )
+    checker.raise_errors()
+    return RuleSet(tuple(checker.elements), tuple(checker.constraints), file, checker.order)
+
+
+def load_rules(path: str | Path) -> RuleSet:
+    """Read, parse and check a ``.rules`` file."""
+    return parse_rules(read_source(path), str(path), Path(path).parent)

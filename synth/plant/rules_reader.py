@@ -5,7 +5,7 @@ What :mod:`synth.plant.rules_check` resolves (``use``, models, instances) and ch
 Example
 -------
 >>> [type(i).__name__ for i in rules_items('use "lib/a.rules"\nfree dcy = 0', "x.rules")]
-['_Use', 'tuple']
+['Use', 'tuple']
 """
 
 from __future__ import annotations
@@ -15,14 +15,14 @@ from typing import Iterable
 
 from synth.errors import Location
 from synth.logic.expr import Expr
-from synth.plant.rules import FREE, ORDER, SENSOR, Constraint, Precedence, Rule, VarDecl
-from synth.syntax import ExprTransformer, Token, parse_tree
+from synth.plant.rules import Constraint, Precedence, Rule, VarDecl, VarKind
+from synth.syntax import ExprTransformer, Token, VectorKind, parse_tree
 
-__all__ = ["rules_items"]
+__all__ = ["Body", "Model", "Instance", "Inline", "Use", "Hold", "Vector", "Item", "rules_items"]
 
 
 @dataclass(frozen=True)
-class _Body:
+class Body:
     """The items of a ``model`` or ``element`` body."""
 
     decls: tuple[VarDecl, ...]
@@ -32,16 +32,16 @@ class _Body:
 
 
 @dataclass(frozen=True)
-class _Model:
+class Model:
     """``model NAME { … }``."""
 
     name: str
-    body: _Body
+    body: Body
     loc: Location
 
 
 @dataclass(frozen=True)
-class _Instance:
+class Instance:
     """``element NAME = MODEL(a = b, …)``."""
 
     name: str
@@ -52,16 +52,16 @@ class _Instance:
 
 
 @dataclass(frozen=True)
-class _Inline:
+class Inline:
     """``element NAME { … }``."""
 
     name: str
-    body: _Body
+    body: Body
     loc: Location
 
 
 @dataclass(frozen=True)
-class _Use:
+class Use:
     """``use "FILE"``."""
 
     path: str
@@ -69,18 +69,22 @@ class _Use:
 
 
 @dataclass(frozen=True)
-class _Hold:
+class Hold:
     """``hold NAME = BIT, …``."""
 
     decls: tuple[VarDecl, ...]
 
 
 @dataclass(frozen=True)
-class _Vector:
+class Vector:
     """``inputs …`` or ``outputs …``."""
 
-    kind: str  # "inputs" | "outputs"
+    kind: VectorKind
     names: tuple[tuple[str, Location], ...]
+
+
+# a top-level item; a bare tuple is a line of top-level free inputs
+Item = Use | Model | Inline | Instance | Hold | Vector | Constraint | tuple[VarDecl, ...]
 
 
 class _ToModel(ExprTransformer):
@@ -90,20 +94,20 @@ class _ToModel(ExprTransformer):
     def decl(self, items: list) -> tuple[Token, Token]:
         return (items[0], items[1])
 
-    def _decls(self, items: list, kind: str, held: bool = False) -> tuple[VarDecl, ...]:
+    def _decls(self, items: list, kind: VarKind, held: bool = False) -> tuple[VarDecl, ...]:
         return tuple(VarDecl(str(n), kind, str(b) == "1", self._loc(n), held) for n, b in items)
 
     def orders(self, items: list) -> tuple[VarDecl, ...]:
-        return self._decls(items, ORDER)
+        return self._decls(items, VarKind.ORDER)
 
     def sensors(self, items: list) -> tuple[VarDecl, ...]:
-        return self._decls(items, SENSOR)
+        return self._decls(items, VarKind.SENSOR)
 
     def free(self, items: list) -> tuple[VarDecl, ...]:
-        return self._decls(items, FREE)
+        return self._decls(items, VarKind.FREE)
 
-    def hold(self, items: list) -> _Hold:
-        return _Hold(self._decls(items, ORDER, held=True))
+    def hold(self, items: list) -> Hold:
+        return Hold(self._decls(items, VarKind.ORDER, held=True))
 
     def incoherent(self, items: list) -> Expr:
         return items[0]
@@ -119,7 +123,7 @@ class _ToModel(ExprTransformer):
         cause, first, then = items
         return Precedence(cause, first, then, cause.loc)
 
-    def _body(self, items: Iterable) -> _Body:
+    def _body(self, items: Iterable) -> Body:
         decls: list[VarDecl] = []
         inc: list[Expr] = []
         rules: list[Rule] = []
@@ -133,32 +137,32 @@ class _ToModel(ExprTransformer):
                 precs.append(it)
             else:
                 inc.append(it)
-        return _Body(tuple(decls), tuple(inc), tuple(rules), tuple(precs))
+        return Body(tuple(decls), tuple(inc), tuple(rules), tuple(precs))
 
-    def model(self, items: list) -> _Model:
+    def model(self, items: list) -> Model:
         name, *rest = items
-        return _Model(str(name), self._body(rest), self._loc(name))
+        return Model(str(name), self._body(rest), self._loc(name))
 
-    def element_inline(self, items: list) -> _Inline:
+    def element_inline(self, items: list) -> Inline:
         name, *rest = items
-        return _Inline(str(name), self._body(rest), self._loc(name))
+        return Inline(str(name), self._body(rest), self._loc(name))
 
     def renaming(self, items: list) -> tuple[str, str, Location, Location]:
         a, b = items
         return (str(a), str(b), self._loc(a), self._loc(b))
 
-    def element_instance(self, items: list) -> _Instance:
+    def element_instance(self, items: list) -> Instance:
         name, model, *ren = items
-        ren = tuple(r for r in ren if r is not None)
-        return _Instance(str(name), str(model), ren, self._loc(name), self._loc(model))
+        renaming = tuple(r for r in ren if r is not None)
+        return Instance(str(name), str(model), renaming, self._loc(name), self._loc(model))
 
-    def vector(self, items: list) -> _Vector:
+    def vector(self, items: list) -> Vector:
         kind, *names = items
-        return _Vector(str(kind), tuple((str(n), self._loc(n)) for n in names))
+        return Vector(VectorKind(str(kind)), tuple((str(n), self._loc(n)) for n in names))
 
-    def use(self, items: list) -> _Use:
+    def use(self, items: list) -> Use:
         (tok,) = items
-        return _Use(str(tok)[1:-1], self._loc(tok))
+        return Use(str(tok)[1:-1], self._loc(tok))
 
     def constraint(self, items: list) -> Constraint:
         ident, label, expr, bit = items
@@ -169,6 +173,6 @@ class _ToModel(ExprTransformer):
         return items
 
 
-def rules_items(source: str, file: str) -> list:
+def rules_items(source: str, file: str) -> list[Item]:
     """The top-level items of a rules text, in file order."""
     return parse_tree("rules", source, file, _ToModel(file, source))

@@ -8,7 +8,7 @@ O(monomials × elements), with no plant grid: this is what on-the-fly validation
 
 Example
 -------
->>> from synth.plant.rules import load_rules
+>>> from synth.plant.rules_check import load_rules
 >>> from synth.plant.composition import plant, _plants
 >>> rs = load_rules(_plants("tri_annex.rules"))
 >>> cc = CompiledConstraints(plant(rs), rs.constraints)

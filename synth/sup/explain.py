@@ -2,7 +2,7 @@
 
 Example
 -------
->>> from synth.plant.rules import load_rules
+>>> from synth.plant.rules_check import load_rules
 >>> from synth.plant.composition import plant, _plants
 >>> from synth.sup.supervisor import supremal_controllable
 >>> rs = load_rules(_plants("tri_annex.rules"))

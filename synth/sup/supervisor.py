@@ -24,7 +24,7 @@ held in numpy arrays: the work is linear in SUP's transitions, not in the plant.
 
 Example
 -------
->>> from synth.plant.rules import load_rules
+>>> from synth.plant.rules_check import load_rules
 >>> from synth.plant.composition import plant, _plants
 >>> rs = load_rules(_plants("tri_annex.rules"))
 >>> sup = supremal_controllable(plant(rs), rs.constraints)
@@ -179,7 +179,8 @@ class Supervisor(CompiledConstraints):
         return (self.states[pos] == codes) if self.states.size else np.zeros(np.shape(codes), dtype=bool)
 
     # ------------------------------------------------------------------ grids (on demand)
-    def _grid(self, terms: Iterable[tuple[int, np.ndarray]]) -> np.ndarray:
+    def _grid(self, terms: Iterable[tuple[tuple[int, np.ndarray], ...]]) -> np.ndarray:
+        """The union of the terms, each a product of per-element factors (axis, local states)."""
         out = np.zeros(self.plant.shape, dtype=bool)
         for factors in terms:
             out |= _product(self.plant, factors)

@@ -11,7 +11,7 @@ Counts are exact Python integers (CUDD's own count is a double, wrong above 2^53
 
 Example
 -------
->>> from synth.plant.rules import load_rules
+>>> from synth.plant.rules_check import load_rules
 >>> from synth.plant.composition import plant, _plants
 >>> enc = PlantEncoding(plant(load_rules(_plants("tri_annex.rules"))))
 >>> enc.count(enc.domain)

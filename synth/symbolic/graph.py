@@ -7,9 +7,9 @@ verdicts need (pre- and post-images, backward and forward fixpoints, onion rings
 
 Example
 -------
->>> from synth.plant.rules import load_rules
+>>> from synth.plant.rules_check import load_rules
 >>> from synth.plant.composition import plant, _plants
->>> from synth.grafcet.language import load_grafcet
+>>> from synth.grafcet.language_check import load_grafcet
 >>> from synth.grafcet.machine import GrafcetMachine
 >>> from synth.symbolic.sync import symbolic_sync
 >>> rs = load_rules(_plants("tri.rules"))

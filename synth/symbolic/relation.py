@@ -13,7 +13,7 @@ instead of a relational product and a renaming.
 
 Example
 -------
->>> from synth.plant.rules import load_rules
+>>> from synth.plant.rules_check import load_rules
 >>> from synth.plant.composition import plant, _plants
 >>> from synth.symbolic.encoding import PlantEncoding
 >>> enc = PlantEncoding(plant(load_rules(_plants("tri.rules"))))

@@ -13,7 +13,7 @@ plant size (the explicit engine leaves the plant-wide counts ``null`` above
 
 Example
 -------
->>> from synth.plant.rules import load_rules
+>>> from synth.plant.rules_check import load_rules
 >>> from synth.plant.composition import plant, _plants
 >>> rs = load_rules(_plants("tri_annex.rules"))
 >>> s = symbolic_supervisor(plant(rs), rs.constraints)

@@ -22,12 +22,14 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Callable, Iterator, Sequence
 
-from synth.grafcet.language import Grafcet, load_grafcet
+from synth.grafcet.language import Grafcet
+from synth.grafcet.language_check import load_grafcet
 from synth.grafcet.machine import GrafcetMachine
 from synth.logic.bdd import Function
 from synth.logic.expr import evaluate
 from synth.plant.composition import Plant, plant
-from synth.plant.rules import RuleSet, load_rules
+from synth.plant.rules import RuleSet
+from synth.plant.rules_check import load_rules
 from synth.sup.constraints import CompiledConstraints
 from synth.symbolic.encoding import NodeBudget, live_nodes
 from synth.symbolic.reachability import (

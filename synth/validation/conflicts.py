@@ -4,7 +4,7 @@ other). Both engines note them while exploring SYNC, once per (step, transitions
 
 Example
 -------
->>> from synth.grafcet.language import parse_grafcet
+>>> from synth.grafcet.language_check import parse_grafcet
 >>> g = parse_grafcet("grafcet G { initial step 0 step 1 step 2 "
 ...                   "transition 0 -> 1 when a  transition 0 -> 2 when a }")
 >>> log = ConflictLog()

@@ -14,9 +14,9 @@ so the cost follows the reachable part of SYNC, never the size of the plant.
 
 Example
 -------
->>> from synth.plant.rules import load_rules
+>>> from synth.plant.rules_check import load_rules
 >>> from synth.plant.composition import plant, _plants
->>> from synth.grafcet.language import load_grafcet
+>>> from synth.grafcet.language_check import load_grafcet
 >>> from synth.grafcet.machine import GrafcetMachine
 >>> rs = load_rules(_plants("tri.rules"))
 >>> p = plant(rs)

@@ -16,11 +16,13 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Callable, Sequence
 
-from synth.grafcet.language import Grafcet, load_grafcet
+from synth.grafcet.language import Grafcet
+from synth.grafcet.language_check import load_grafcet
 from synth.grafcet.machine import GrafcetMachine
 from synth.logic.expr import Expr, evaluate
 from synth.plant.composition import Plant, plant
-from synth.plant.rules import RuleSet, load_rules
+from synth.plant.rules import RuleSet
+from synth.plant.rules_check import load_rules
 from synth.sup.constraints import CompiledConstraints
 from synth.validation.analysis import analyse
 from synth.validation.result import Validation, home_conditions

@@ -1,0 +1,391 @@
+"""The breadth-first search of ``synth filter verify`` over the closed loop's product
+(:class:`~synth.filter.product.Product`), one level at a time, with the first
+(shortest) occurrence of every kind of finding and its trace.
+
+Example
+-------
+>>> from synth.plant.composition import _plants
+>>> from synth.filter.from_rules import skeleton
+>>> from synth.filter.cycle import Algorithm
+>>> from synth.filter.product import Product
+>>> sk = skeleton(_plants("tri.rules"), _plants("F.filter"))  # the text only: nothing is written
+>>> ex = Explorer(Product(sk.filter, _plants("tri.rules"), None, Algorithm.ALGEBRAIC, Mode.SUPERVISOR, False), 100)
+>>> ex.run()
+>>> ex.complete, len(ex.seen_keys)
+(False, 100)
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any
+
+import numpy as np
+
+from synth.filter.cycle import ACK, Memory, Mode
+from synth.filter.outcomes import Outcome, OutcomeArrays, lane_bits, unpack
+from synth.filter.product import Product
+from synth.filter.verification import Finding, FindingKind, TraceRow
+from synth.logic.events import Event
+
+__all__ = ["Explorer"]
+
+
+_NOTES = {FindingKind.VIOLATION: "", FindingKind.EDGE: "output event forbidden",
+          FindingKind.REFUSED: "output change refused", FindingKind.FALLBACK: "fallback",
+          FindingKind.OUTSIDE_CARE: "outside the care set",
+          FindingKind.TRANSIENT: "an intermediate state of the write violates a constraint"}
+
+
+class Explorer:
+    """The breadth-first search over the product, one level at a time.
+
+    A node is the integer ``aux * plant.size + code``: ``code`` the plant state, ``aux``
+    an interned (memory of the names whose past value the filter reads, Blocked,
+    situation). The cycle's outcomes depend on the node only through a *class* (Y read,
+    aux before, situation after the Grafcet's reaction), computed once for every request
+    vector at once; the writes are then applied to whole arrays of (state, outcome) pairs.
+    """
+
+    def __init__(self, pr: Product, max_states: int) -> None:
+        self.pr, self.max_states = pr, max_states
+        self.size = pr.size
+        self.aux_of: dict[tuple, int] = {}
+        self.aux_list: list[tuple] = []
+        self.classes: dict[tuple, int] = {}
+        self.outcomes: list[Outcome] = []
+        self.outcome_of: dict[Outcome, int] = {}
+        self.flat: list[int] = []  # the outcomes of every class, class after class
+        self.n_out: list[int] = []
+        self.arrays = OutcomeArrays(len(pr.orders))
+        self.events: list[str] = ["-"] + [e for e, _ in pr.uncontrollable]
+        self.parent: dict[int, tuple[int, str, int]] = {}  # node -> (parent node, event, outcome)
+        self.seen_keys: set[int] = set()
+        self.seen_arrays: dict[int, np.ndarray] = {}
+        # kind -> (node, event, outcome, code, ids)
+        self.first: dict[FindingKind, tuple[int, str, int, int, tuple[str, ...]]] = {}
+        self.counts: dict[FindingKind, set[int]] = {k: set() for k in FindingKind}
+        self.outside_sup: set[int] = set()
+        self.first_outside_sup: int | None = None
+        self.cycles = self.corrected = self.max_distance = 0
+        self.complete = True
+        p = pr.plant
+        init = {v.name: v.initial for v in pr.rules.variables if v.is_input}
+        sit0 = pr.machine.initial({n: init[n] for n in pr.grafcet_inputs}) if pr.machine else None
+        memory = pr.cycle.initial()
+        self.key0 = self.intern((tuple(memory.previous[i] for i in pr.used_index), False, sit0)) * self.size \
+            + p.initial_index
+        self.admit_one(self.key0)
+        if pr.illegal[p.initial_index]:
+            self.counts[FindingKind.VIOLATION].add(p.initial_index)
+
+    # ------------------------------------------------------------------ bookkeeping
+    def intern(self, a: tuple) -> int:
+        k = self.aux_of.get(a)
+        if k is None:
+            k = self.aux_of[a] = len(self.aux_list)
+            self.aux_list.append(a)
+        return k
+
+    def seen_array(self, aux: int) -> np.ndarray:
+        arr = self.seen_arrays.get(aux)
+        if arr is None:
+            arr = self.seen_arrays[aux] = np.zeros(self.size, dtype=bool)
+        return arr
+
+    def admit_one(self, key: int) -> None:
+        code = key % self.size
+        self.seen_keys.add(key)
+        self.seen_array(key // self.size)[code] = True
+        if self.pr.outside_sup[code]:
+            self.outside_sup.add(code)
+            self.first_outside_sup = key if self.first_outside_sup is None else self.first_outside_sup
+
+    def record(self, kind: FindingKind, mask: np.ndarray, where: np.ndarray, node: np.ndarray, event: np.ndarray,
+               oid: np.ndarray | None, shown: np.ndarray, ids: Any = ()) -> None:
+        """Count the plant states ``where[mask]``; keep the first occurrence (its node, event,
+        outcome, the state to show and the constraints, ``ids(i)`` when callable)."""
+        if not mask.any():
+            return
+        self.counts[kind].update(np.unique(where[mask]).tolist())
+        if kind not in self.first:
+            i = int(np.argmax(mask))
+            self.first[kind] = (int(node[i]), self.events[int(event[i])], -1 if oid is None else int(oid[i]),
+                                int(shown[i]), ids(i) if callable(ids) else ids)
+
+    # ------------------------------------------------------------------ one cycle's outcomes
+    def outcomes_for(self, ybits: int, aux: int, sit: Any) -> int:
+        """The class of (Y, aux before, situation after): its distinct outcomes over every
+        request vector (and Ack), each with the first request vector giving it."""
+        key = (ybits, aux, sit)
+        k = self.classes.get(key)
+        if k is not None:
+            return k
+        pr, cyc = self.pr, self.pr.cycle
+        mem_used, blocked, _ = self.aux_list[aux]
+        values = {n: bool((ybits >> i) & 1) for i, n in enumerate(pr.ynames)}
+        fixed = {n: values[n] for n in pr.filter.inputs}
+        free: list[str] = []
+        passed: dict[str, bool] = {}
+        if sit is not None and pr.machine is not None:
+            for step in pr.steps:
+                fixed[f"X{step}"] = step in sit.steps
+            orders = pr.machine.orders(sit, {n: values[n] for n in pr.grafcet_inputs})
+            fixed.update({r: pr.held.get(o, o in orders) for o, r in zip(cyc.outputs, cyc.requests)})
+            passed = {o: pr.held.get(o, o in orders) for o in pr.passthrough}
+        else:
+            fixed.update({r: pr.held[o] for o, r in zip(cyc.outputs, cyc.requests) if o in pr.held})
+            passed = {o: pr.held[o] for o in pr.passthrough if o in pr.held}
+            free = [r for o, r in zip(cyc.outputs, cyc.requests) if o not in pr.held]
+            free += [o for o in pr.passthrough if o not in pr.held]
+        if cyc.mode is Mode.BLOCKING:
+            free.append(ACK)
+        previous = [False] * len(cyc.remembered)
+        for i, v in zip(pr.used_index, mem_used):
+            previous[i] = v
+        lanes = cyc.lanes(Memory(tuple(previous), blocked), fixed, free)
+        n = lanes.count
+        out = {o: unpack(m, n) for o, m in zip(cyc.outputs, lanes.outputs)}
+        for o in pr.passthrough:
+            out[o] = np.full(n, passed[o]) if o in passed else unpack(lane_bits(free.index(o), n), n)
+        columns = [out[o] for o in pr.orders] + [unpack(lanes.previous[i], n) for i in pr.used_index]
+        columns += [unpack(m, n) for m in (lanes.blocked, lanes.fallback, lanes.outside_care)]
+        _, firsts = np.unique(np.stack(columns, axis=1), axis=0, return_index=True)
+        found: list[int] = []
+        for j in sorted(firsts.tolist()):  # one witness lane per distinct outcome, the first
+            result, memory = lanes.lane(j)
+            targets = dict(zip(cyc.outputs, result.outputs))
+            req = dict(zip(cyc.outputs, result.requests))
+            for o in pr.passthrough:
+                targets[o] = req[o] = bool(out[o][j])
+            mem = tuple(memory.previous[i] for i in pr.used_index)
+            oc = Outcome(tuple(targets[o] for o in pr.orders), self.intern((mem, memory.blocked, sit)),
+                          result.fallback, result.outside_care, tuple(req[o] for o in pr.orders), result.violated)
+            g = self.outcome_of.get(oc)
+            if g is None:
+                g = self.outcome_of[oc] = len(self.outcomes)
+                self.outcomes.append(oc)
+            found.append(g)
+        k = self.classes[key] = len(self.n_out)
+        self.flat.extend(found)
+        self.n_out.append(len(found))
+        return k
+
+    # ------------------------------------------------------------------ one level
+    def events_from(self, frontier: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Step 1 of a cycle for every node: (state after the plant's event, node, event id),
+        the event being none, an uncontrollable event of the plant, or a Grafcet timer."""
+        pr, size = self.pr, self.size
+        codes_all, auxes_all = frontier % size, frontier // size
+        post_l, node_l, event_l = [], [], []
+
+        def add(post: np.ndarray, nodes: np.ndarray, ei: int) -> None:
+            post_l.append(post)
+            node_l.append(nodes)
+            event_l.append(np.full(post.size, ei, dtype=np.int64))
+
+        for aux in np.unique(auxes_all).tolist():
+            sel = auxes_all == aux
+            codes, nodes = codes_all[sel], frontier[sel]
+            add(codes, nodes, 0)
+            for ei, (_, nxt) in enumerate(pr.uncontrollable, 1):
+                dst = nxt[codes]
+                ok = dst >= 0
+                if ok.any():
+                    add(dst[ok], nodes[ok], ei)
+            if pr.machine is not None:
+                for tev in pr.machine.timers(self.aux_list[aux][2]):
+                    if tev not in self.events:
+                        self.events.append(tev)
+                    add(codes, nodes, self.events.index(tev))
+        return np.concatenate(post_l), np.concatenate(node_l), np.concatenate(event_l)
+
+    def classify(self, post: np.ndarray, node: np.ndarray, event: np.ndarray) -> np.ndarray:
+        """Steps 2-3: the class of each (state after the event, node, event)."""
+        pr, width = self.pr, len(self.pr.ynames)
+        ybits = np.zeros(post.size, dtype=np.int64)
+        for i, n in enumerate(pr.ynames):
+            ybits |= pr.val[n][post].astype(np.int64) << i
+        combo = ((node // self.size) * len(self.events) + event) * (1 << width) + ybits
+        uniq, inverse = np.unique(combo, return_inverse=True)
+        class_ids = np.empty(uniq.size, dtype=np.int64)
+        for u, c in enumerate(uniq.tolist()):
+            yb, rest = c % (1 << width), c >> width
+            ei, aux = rest % len(self.events), rest // len(self.events)
+            sit = self.aux_list[aux][2]
+            if pr.machine is not None:
+                sit = _react(pr, sit, self.events[ei], yb)
+            class_ids[u] = self.outcomes_for(yb, aux, sit)
+        return class_ids[inverse]
+
+    def write(self, post: np.ndarray, targets: np.ndarray
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[str], np.ndarray]:
+        """Step 5 for arrays of (state, target orders): the state after the write (-1 when
+        refused), refused, edge constraint broken (and by which events), and an
+        intermediate state violating a constraint."""
+        pr = self.pr
+        cur, before = post.copy(), post
+        bits = np.stack([pr.val[z][post] for z in pr.orders], axis=1)  # the orders now
+        refused = np.zeros(post.size, dtype=bool)
+        edge_bad = np.zeros(post.size, dtype=bool)
+        edge_events: list[str] = []
+        middle_bad = np.zeros(post.size, dtype=bool)
+        for rising in (False, True):  # falls first, then rises, each in output order
+            for z, name in enumerate(pr.orders):
+                idx = np.nonzero((targets[:, z] == rising) & (bits[:, z] != rising) & ~refused)[0]
+                if not idx.size:
+                    continue
+                ev = Event.edge(name, rising)
+                c = cur[idx]
+                if ev in pr.forbid:
+                    hit = pr.forbid[ev][before[idx] if pr.atomic else c]
+                    if hit.any():
+                        edge_bad[idx[hit]] = True
+                        edge_events.append(ev)
+                nxt = pr.toggle[ev][c]
+                no = nxt < 0
+                if no.any():
+                    refused[idx[no]] = True
+                    cur[idx[no]] = -1
+                    idx, nxt = idx[~no], nxt[~no]
+                cur[idx] = nxt
+                bits[idx, z] = rising
+                if not pr.atomic:
+                    middle_bad[idx] |= pr.illegal[nxt]
+        return cur, refused, edge_bad, edge_events, middle_bad
+
+    def level(self, frontier: np.ndarray) -> np.ndarray:
+        """Every cycle from the nodes of ``frontier``; returns the new nodes."""
+        pr, size = self.pr, self.size
+        post, node, event = self.events_from(frontier)
+        # a plant event into a violating state, before the PLC writes (a violation the
+        # node already had is reported for the node)
+        bad = (event > 0) & pr.illegal[post] & ~pr.illegal[node % size]
+        self.record(FindingKind.TRANSIENT, bad, post, node, event, None, post, lambda i: pr.violated(int(post[i])))
+        cls = self.classify(post, node, event)
+        n_out = np.array(self.n_out, dtype=np.int64)
+        self.cycles += int(n_out[cls].sum())
+        # one expansion per distinct (state, class); the first occurrence is the parent
+        _, keep = np.unique(post * len(self.n_out) + cls, return_index=True)
+        keep.sort()
+        post, node, event, cls = post[keep], node[keep], event[keep], cls[keep]
+        # one entry per (state, outcome of its class)
+        reps = n_out[cls]
+        entry = np.repeat(np.arange(post.size), reps)
+        within = np.arange(entry.size) - np.repeat(np.cumsum(reps) - reps, reps)
+        offsets = np.concatenate(([0], np.cumsum(n_out)))
+        oid = np.array(self.flat, dtype=np.int64)[offsets[cls][entry] + within]
+        targets, fallback, outside, aux_after, requests = self.arrays.update(self.outcomes)
+        post, node, event, targets = post[entry], node[entry], event[entry], targets[oid]
+        cur, refused, edge_bad, edge_events, middle_bad = self.write(post, targets)
+        ok = cur >= 0
+        final = np.where(ok, cur, 0)
+        violation = ok & pr.illegal[final]
+        middle_bad &= ~violation & ~pr.illegal[post]  # reported as a violation / before the write
+        shown = np.where(ok, final, post)
+
+        def edge_ids(i: int) -> tuple[str, ...]:
+            return tuple(dict.fromkeys(c for ev in edge_events for c in pr.sup.forbidding(ev, pr.plant.local(int(post[i])))))
+
+        self.record(FindingKind.VIOLATION, violation, final, node, event, oid, shown,
+                    lambda i: pr.violated(int(final[i])))
+        self.record(FindingKind.EDGE, edge_bad, post, node, event, oid, shown, edge_ids)
+        for kind, mask in ((FindingKind.REFUSED, refused), (FindingKind.FALLBACK, fallback[oid]),
+                           (FindingKind.OUTSIDE_CARE, outside[oid]), (FindingKind.TRANSIENT, middle_bad)):
+            self.record(kind, mask, post, node, event, oid, shown)
+        if pr.machine is not None and oid.size:
+            dist = (requests[oid] != targets).sum(axis=1)
+            self.corrected += int((dist > 0).sum())
+            self.max_distance = max(self.max_distance, int(dist.max()))
+        return self.admit(aux_after[oid][ok] * size + final[ok], node[ok], event[ok], oid[ok])
+
+    def admit(self, keys: np.ndarray, node: np.ndarray, event: np.ndarray, oid: np.ndarray) -> np.ndarray:
+        """The nodes of ``keys`` not seen before (their first occurrence is the parent)."""
+        size = self.size
+        uk, first = np.unique(keys, return_index=True)
+        fresh = np.ones(uk.size, dtype=bool)
+        uk_aux = uk // size
+        for a in np.unique(uk_aux).tolist():
+            sel = uk_aux == a
+            fresh[sel] = ~self.seen_array(a)[uk[sel] % size]
+        new: list[int] = []
+        for k, i in zip(uk[fresh].tolist(), first[fresh].tolist()):
+            if len(self.seen_keys) >= self.max_states:
+                self.complete = False
+                break
+            self.admit_one(k)
+            self.parent[k] = (int(node[i]), self.events[int(event[i])], int(oid[i]))
+            new.append(k)
+        return np.array(new, dtype=np.int64)
+
+    def run(self) -> None:
+        frontier = np.array([self.key0], dtype=np.int64)
+        while frontier.size and self.complete:
+            frontier = self.level(frontier)
+
+    # ------------------------------------------------------------------ traces
+    def trace(self, key: int) -> list[TraceRow]:
+        """The shortest path of cycles from the initial node to ``key``."""
+        rows = []
+        while key in self.parent:
+            pk, ev, g = self.parent[key]
+            rows.append(_row(self.pr, self.outcomes[g], ev, key % self.size, self.aux_list[key // self.size][2]))
+            key = pk
+        rows.append(TraceRow("initial", self.pr.label(key % self.size),
+                             _sit_text(self.aux_list[key // self.size][2]), (), ()))
+        return rows[::-1]
+
+    def findings(self) -> dict[FindingKind, Finding]:
+        out: dict[FindingKind, Finding] = {}
+        if self.pr.illegal[self.key0 % self.size]:
+            out[FindingKind.VIOLATION] = Finding(FindingKind.VIOLATION, self.pr.violated(self.key0 % self.size),
+                                       tuple(self.trace(self.key0)), len(self.counts[FindingKind.VIOLATION]))
+        for kind, (node, ev, g, code, ids) in self.first.items():
+            if kind in out:
+                continue
+            rows = self.trace(node)
+            if g < 0:  # the plant's event alone
+                rows.append(TraceRow(ev, self.pr.label(code), rows[-1].situation, (), (), "before the PLC writes",
+                                     False))
+            else:
+                oc = self.outcomes[g]
+                rows.append(_row(self.pr, oc, ev, code, self.aux_list[oc.aux][2], _NOTES[kind]))
+            out[kind] = Finding(kind, ids, tuple(rows), len(self.counts[kind]))
+        if self.first_outside_sup is not None:
+            key = self.first_outside_sup
+            rows = self.trace(key)
+            ids = tuple(self.pr.sup.threatened(self.pr.plant.local(key % self.size)))
+            rows[-1] = dataclasses.replace(rows[-1], note="; ".join(
+                n for n in (rows[-1].note, "outside SUP: uncontrollable events can lead to " + ", ".join(ids)) if n))
+            out[FindingKind.OUTSIDE_SUP] = Finding(FindingKind.OUTSIDE_SUP, ids, tuple(rows), len(self.outside_sup))
+        return {k: out[k] for k in FindingKind if k in out}
+
+
+def _react(pr: Product, sit: Any, event: str, ybits: int) -> Any:
+    """The Grafcet's stable situation after ``event`` (a plant event, a timer, or none)."""
+    assert pr.machine is not None
+    values = {n: bool((ybits >> i) & 1) for i, n in enumerate(pr.ynames)}
+    inputs = {n: values[n] for n in pr.grafcet_inputs}
+    if event == "-":
+        return sit
+    ev = Event(event)
+    if ev.kind.value == "timer":
+        return pr.machine.fire_timer(sit, ev, inputs)
+    if ev.name not in inputs:
+        return sit
+    return pr.machine.react_event(sit, ev, inputs)[0]
+
+
+def _sit_text(sit: Any) -> str:
+    return "" if sit is None else sit.text()
+
+
+def _row(pr: Product, oc: Outcome, event: str, code: int, sit: Any, note: str = "") -> TraceRow:
+    req = tuple(o for o, v in zip(pr.orders, oc.requests) if v)
+    out = tuple(o for o, v in zip(pr.orders, oc.targets) if v)
+    extra = []
+    if oc.violated:
+        extra.append("requests violate " + ", ".join(oc.violated))
+    if note:
+        extra.append(note)
+    return TraceRow(event, pr.label(code), _sit_text(sit), req, out, "; ".join(extra))

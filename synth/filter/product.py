@@ -1,0 +1,108 @@
+"""The closed loop's parts for ``synth filter verify``: the plant of a rules file as flat
+arrays over its state codes (variables, controllable and uncontrollable moves), the
+filter cycle, the Grafcet that makes the requests (if any), and the constraints' grids
+from :class:`~synth.sup.supervisor.Supervisor` (illegal states, states outside SUP,
+edge events forbidden).
+
+Example
+-------
+>>> from synth.plant.composition import _plants
+>>> from synth.filter.from_rules import skeleton
+>>> sk = skeleton(_plants("tri.rules"), _plants("F.filter"))  # the text only: nothing is written
+>>> pr = Product(sk.filter, _plants("tri.rules"), None, Algorithm.ALGEBRAIC, Mode.SUPERVISOR, False)
+>>> pr.size == pr.plant.size, bool(pr.illegal[pr.plant.initial_index])
+(True, False)
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from synth.errors import InputError, LimitExceeded
+from synth.filter.cycle import Algorithm, FilterCycle, Mode
+from synth.filter.language import Filter
+from synth.logic.events import Event
+
+TYPE_CHECKING = False  # typing.TYPE_CHECKING: the Grafcet modules load only with --grafcet
+if TYPE_CHECKING:
+    from synth.grafcet.language import Grafcet
+    from synth.grafcet.machine import GrafcetMachine
+
+__all__ = ["PLANT_LIMIT", "Product"]
+
+PLANT_LIMIT = 20_000_000
+"""verify keeps flat arrays over the plant's states; above this many it stops."""
+
+
+class Product:
+    """The filter, the plant of ``rules_path`` and the Grafcet of ``grafcet_path`` (or
+    none: any control), checked against each other and laid out as arrays."""
+
+    def __init__(self, f: Filter, rules_path: str, grafcet_path: str | None, algorithm: Algorithm,
+                 mode: Mode, atomic: bool) -> None:
+        from synth.plant.composition import plant
+        from synth.plant.rules_check import load_rules
+        from synth.sup.supervisor import Supervisor
+
+        rs = load_rules(rules_path)
+        p = plant(rs)
+        if p.size > PLANT_LIMIT:
+            raise LimitExceeded(f"the plant of {rules_path} has {p.size} states; verify keeps arrays over the "
+                                f"plant's states and stops above {PLANT_LIMIT}")
+        self.plant, self.rules = p, rs
+        self.cycle = FilterCycle(f, algorithm, mode)
+        self.filter, self.atomic = f, atomic
+        for kind, names, have in (("input", f.inputs, p.inputs), ("output", f.outputs, p.outputs)):
+            missing = [n for n in names if n not in have]
+            if missing:
+                raise InputError(f"{f.file}: the filter's {kind} {', '.join(missing)} is not an "
+                                 f"{kind} of the plant {rules_path}", None)
+        self.machine: GrafcetMachine | None = None
+        self.grafcet: Grafcet | None = None
+        if grafcet_path is not None:
+            from synth.grafcet.language_check import load_grafcet
+            from synth.grafcet.machine import GrafcetMachine
+
+            self.grafcet = load_grafcet(grafcet_path, inputs=rs.inputs, outputs=rs.outputs)
+            self.machine = GrafcetMachine(self.grafcet)
+        self.grafcet_inputs: tuple[str, ...] = () if self.grafcet is None else tuple(self.grafcet.inputs)
+        self.steps: tuple[str, ...] = () if self.grafcet is None else tuple(s.name for s in self.grafcet.steps)
+        observable = {f"X{s}" for s in self.steps}
+        for d in f.observers:
+            if d.name not in observable:
+                raise InputError(f"observer {d.name} has no value in verify: only step variables of the "
+                                 "--grafcet Grafcet can be observed", d.loc)
+        size, shape = p.size, p.shape
+        self.size = size
+        self.val = {v: np.broadcast_to(p.values(v), shape).ravel().copy() for v in p.variables}
+        self.orders = p.outputs
+        self.passthrough = tuple(o for o in p.outputs if o not in f.outputs)
+        self.held = {v.name: v.initial for v in rs.variables if v.held}  # requested at their held value
+        self.ynames = tuple(dict.fromkeys([*f.inputs, *self.grafcet_inputs]))
+        if len(self.ynames) > 40:
+            raise LimitExceeded(f"{len(self.ynames)} inputs are read; verify codes an input vector in 40 bits")
+        self.toggle: dict[str, np.ndarray] = {}
+        self.uncontrollable: list[tuple[str, np.ndarray]] = []
+        for t, src, dst in p.transition_arrays():
+            if t.controllable:
+                arr = self.toggle.setdefault(t.event, np.full(size, -1, dtype=np.int64))
+            else:
+                found = [a for e, a in self.uncontrollable if e == t.event]
+                arr = found[0] if found else np.full(size, -1, dtype=np.int64)
+                if not found:
+                    self.uncontrollable.append((t.event, arr))
+            arr[src] = dst
+        for z in self.orders:
+            for edge in (Event.rise(z), Event.fall(z)):
+                self.toggle.setdefault(edge, np.full(size, -1, dtype=np.int64))
+        self.sup = Supervisor(p, rs.constraints)  # its grids: no SUP exploration
+        self.illegal: np.ndarray = self.sup.illegal.ravel()
+        self.outside_sup: np.ndarray = self.sup.removed.ravel()
+        self.forbid: dict[str, np.ndarray] = {ev: g.ravel() for ev, g in self.sup.forbid.items()}
+        self.used_index = [self.cycle.remembered.index(n) for n in self.cycle.used]
+
+    def label(self, code: int) -> str:
+        return self.plant.label(self.plant.local(code))
+
+    def violated(self, code: int) -> tuple[str, ...]:
+        return tuple(self.sup.violated(self.plant.local(code)))

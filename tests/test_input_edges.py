@@ -1,0 +1,110 @@
+"""Inputs at the edges (issue 24): expressions nested deeper than the readers can follow
+(~500 consecutive ``!`` ended in a RecursionError traceback in every language), bad ``use``
+paths, very many elements: a located error with exit 2, or an answer, never a traceback."""
+
+from __future__ import annotations
+
+import pytest
+
+from conftest import ROOT
+from synth.cli.main import main
+from synth.syntax import MAX_DEPTH
+
+DEEP = "!" * 600
+
+
+def _run(argv: list[str], capsys) -> tuple[int, str]:
+    code = main(argv)
+    return code, capsys.readouterr().err
+
+
+def test_deep_negation_in_rules(tmp_path, capsys):
+    text = (ROOT / "tests/data/home/cylinder.rules").read_text().replace("↑AVANCER [v0]", f"↑AVANCER [{DEEP}v0]")
+    (tmp_path / "deep.rules").write_text(text)
+    code, err = _run(["plant", str(tmp_path / "deep.rules")], capsys)
+    line = next(i for i, t in enumerate(text.splitlines(), 1) if DEEP in t)
+    assert code == 2
+    assert f"deep.rules:{line}:" in err and "nested too deeply" in err and "Traceback" not in err
+
+
+def test_deep_negation_in_grafcet(tmp_path, capsys):
+    text = (ROOT / "tests/data/home/production_loop.g7").read_text().replace("when v1", f"when {DEEP}v1")
+    (tmp_path / "deep.g7").write_text(text)
+    code, err = _run(["validate", str(tmp_path / "deep.g7"), "--plant", str(ROOT / "tests/data/home/cylinder.rules")], capsys)
+    assert code == 2
+    assert "deep.g7:8:" in err and "nested too deeply" in err
+
+
+def test_deep_negation_in_filter(tmp_path, capsys):
+    (tmp_path / "deep.filter").write_text(f"outputs o1, o2\n\nsafety CSc1: {DEEP}o1 & o2   keep o1\n")
+    code, err = _run(["filter", "check", str(tmp_path / "deep.filter")], capsys)
+    assert code == 2
+    assert "deep.filter:3:" in err and "nested too deeply" in err
+
+
+@pytest.mark.parametrize("home", [DEEP + "X1", "X1 & (" * 300 + "X1" + ")" * 300])
+def test_deep_home_condition(home, capsys):
+    code, err = _run(["validate", str(ROOT / "tests/data/home/production_loop.g7"), "--plant",
+                      str(ROOT / "tests/data/home/cylinder.rules"), "--home", home], capsys)
+    assert code == 2
+    assert "--home:1:" in err and f"more than {MAX_DEPTH} levels" in err
+
+
+def test_nesting_within_the_limit_and_redundant_parentheses_are_read(capsys):
+    for home in ("!" * 150 + "X1", "(" * 5000 + "X1" + ")" * 5000):
+        code, _ = _run(["validate", str(ROOT / "tests/data/home/production_loop.g7"), "--plant",
+                        str(ROOT / "tests/data/home/cylinder.rules"), "--home", home, "--json"], capsys)
+        assert code in (0, 1)
+
+
+@pytest.mark.parametrize("use,message", [
+    ('"a\x00b"', "embedded null byte"),
+    ('"/dev/zero"', "not a regular file"),
+    ('"' + "a" * 5000 + '"', "cannot read"),
+    ('"."', "Is a directory"),
+])
+def test_bad_use_paths_are_located(use, message, tmp_path, capsys):
+    """A NUL byte, a device that never ends (it hung and grew to 3.4 GB), a name longer than
+    the system allows (it said "cannot write" with no location), a folder."""
+    (tmp_path / "p.rules").write_text(f"use {use}\nfree x = 0\n")
+    code, err = _run(["plant", str(tmp_path / "p.rules")], capsys)
+    assert code == 2
+    assert "p.rules:1:5: error: " in err and message in err and "Traceback" not in err
+
+
+def test_ten_thousand_free_inputs(tmp_path):
+    """The plant's strides are computed in one pass (they were quadratic in the elements:
+    24 s for 10 000 free inputs); the mixed-radix code still reads back its local indices."""
+    from synth.plant.composition import plant
+    from synth.plant.rules_check import parse_rules
+
+    p = plant(parse_rules("".join(f"free i{k} = {k % 2}\n" for k in range(10_000))))
+    assert p.size == 2**10_000 and len(p.elements) == 10_000
+    local = tuple(k % 2 for k in range(10_000))
+    assert p.strides[-1] == 1 and p.strides[0] == 2**9_999
+    assert p.local(p.index(local)) == local
+
+
+@pytest.mark.parametrize("argv,note", [
+    (["validate", "grafcets/tri.g7", "--plant", "grafcets/tri.g7"],
+     "grafcets/tri.g7 is a Grafcet file (.g7), not a plant's rules file (.rules)"),
+    (["validate", "plants/tri.rules", "--plant", "plants/tri.rules"],
+     "plants/tri.rules is a plant's rules file (.rules), not a Grafcet file (.g7)"),
+    (["filter", "check", "plants/tri.rules"],
+     "plants/tri.rules is a plant's rules file (.rules), not a safety filter file (.filter)"),
+])
+def test_a_file_of_another_language_says_which(argv, note, capsys, monkeypatch):
+    monkeypatch.chdir(ROOT)
+    code, err = _run(argv, capsys)
+    assert code == 2
+    assert f"= note: {note}: check the order of the arguments" in err
+    assert ",," not in err  # the comma is quoted in the expected list, not a stray ",,"
+
+
+def test_an_unclosed_parenthesis_is_reported_where_it_opens(tmp_path, capsys):
+    (tmp_path / "p.g7").write_text("grafcet G {\n  initial step 0\n  step 1\n"
+                                   "  transition 0 -> 1 when (dcy & v0\n  transition 1 -> 0 when v1\n}\n")
+    code, err = _run(["validate", str(tmp_path / "p.g7"), "--plant", str(ROOT / "tests/data/home/cylinder.rules")], capsys)
+    assert code == 2
+    assert "p.g7:4:26: error: syntax error: '(' is never closed" in err
+    assert "  4 |   transition 0 -> 1 when (dcy & v0" in err
