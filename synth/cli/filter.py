@@ -75,7 +75,7 @@ def _order(text: str | None) -> list[str] | None:
 
 
 def cmd_check(args: argparse.Namespace) -> int:
-    from synth.cli.plant import print_json
+    from synth.output.summary import print_json
     from synth.filter.coherence import check
     from synth.output.filter_text import check_json, check_text
 
@@ -93,7 +93,7 @@ def cmd_check(args: argparse.Namespace) -> int:
 
 
 def cmd_solve(args: argparse.Namespace) -> int:
-    from synth.cli.plant import print_json
+    from synth.output.summary import print_json
     from synth.filter.solve import synthesis
     from synth.output.filter_text import synthesis_json, synthesis_text
 
@@ -146,7 +146,7 @@ def register_run(commands: "argparse._SubParsersAction") -> None:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    from synth.cli.plant import print_json
+    from synth.output.summary import print_json
     from synth.filter.cycle import Algorithm, Mode
     from synth.filter.run import run_trace
     from synth.output.filter_text import run_json, run_text
@@ -200,7 +200,7 @@ def register_verify(commands: "argparse._SubParsersAction") -> None:
 
 
 def cmd_verify(args: argparse.Namespace) -> int:
-    from synth.cli.plant import print_json
+    from synth.output.summary import print_json
     from synth.filter.closed_loop import verify
     from synth.filter.cycle import Algorithm, Mode
     from synth.output.filter_text import verification_json, verification_text

@@ -9,7 +9,7 @@ TYPE_CHECKING = False  # typing.TYPE_CHECKING, without importing typing (fast --
 if TYPE_CHECKING:
     from typing import Any
 
-__all__ = ["register", "print_warnings", "print_json"]
+__all__ = ["register", "print_warnings"]
 
 MAX_DRAWN_STATES = 400
 DEFAULT_MAX_STATES = 2**36
@@ -45,13 +45,6 @@ def print_warnings(p: Any) -> None:
     """Warnings about the plant model (rules that never apply), on stderr."""
     for w in p.warnings:
         print(w.render(), file=sys.stderr)
-
-
-def print_json(data: Any) -> None:
-    import json
-
-    json.dump(data, sys.stdout, indent=2, ensure_ascii=False)
-    sys.stdout.write("\n")
 
 
 def _written(*outputs: tuple[str, str | None]) -> None:
@@ -94,7 +87,7 @@ def cmd_plant(args: argparse.Namespace) -> int:
     if args.export:
         write_atomic(args.export, gen)
     if args.json:
-        print_json(data)
+        summary.print_json(data)
         return 0
     sys.stdout.write(text)
     _written(("DOT", args.dot), ("SVG", args.svg), ("libFAUDES", args.export))
@@ -102,89 +95,30 @@ def cmd_plant(args: argparse.Namespace) -> int:
 
 
 def cmd_sup(args: argparse.Namespace) -> int:
-    from synth.errors import LimitExceeded
-    from synth.output import summary
+    from synth.engines import supervisor
     from synth.output.faudes import supervisor_generator
     from synth.output.files import write_atomic
     from synth.output.progress import clear_progress, tty_progress
-    from synth.plant.composition import plant
-    from synth.plant.rules_check import load_rules
-    from synth.sup.explain import explain
-    from synth.sup.supervisor import supremal_controllable
+    from synth.output.summary import print_json
 
-    rs = load_rules(args.rules)
-    p = plant(rs)
-    print_warnings(p)
-    if _sup_engine(args, p.size) == "symbolic":
-        return _cmd_sup_symbolic(args, rs, p)
-    if p.size > args.max_states:
-        raise LimitExceeded(
-            f"the plant of {args.rules} has {p.size} states, more than --max-states {args.max_states}; "
-            "the explicit exploration lists every SUP state. Raise --max-states, use --engine symbolic "
-            "(counts on BDDs, any size), or validate a Grafcet with `synth validate`"
-        )
     show = tty_progress(not args.quiet and sys.stderr.isatty())
-    sup = supremal_controllable(p, rs.constraints, progress=show)
+    run = supervisor(args.rules, engine=args.engine, needs_listing=bool(args.export or args.why),
+                     max_states=args.max_states, max_nodes=args.max_nodes, progress=show, loaded=print_warnings)
     clear_progress(show)
-    labels = {c.id: c.label for c in rs.constraints}
     if args.why:
-        ex = explain(sup, p.parse_state(args.why))
+        ex = run.why(args.why)
         if args.json:
             print_json(ex.as_dict())
         else:
-            print(ex.text(labels))
+            print(ex.text(run.labels))
         return 0
-    data = summary.sup_summary(rs, sup, args.rules)
     if args.export:
-        write_atomic(args.export, supervisor_generator(sup, "sup"))
+        write_atomic(args.export, supervisor_generator(run.listed(), "sup"))
     if args.json:
-        print_json(data)
+        print_json(run.summary())
     else:
-        sys.stdout.write(summary.sup_text(data, labels, explain(sup, p.initial).text(labels) if sup.empty else ""))
+        sys.stdout.write(run.text())
+        if run.bdd_nodes is not None and not args.quiet:
+            print(f"symbolic engine: {run.bdd_nodes} BDD nodes", file=sys.stderr)
     _written(("libFAUDES", args.export))
-    return 0
-
-
-def _sup_engine(args: argparse.Namespace, size: int) -> str:
-    """``--engine`` for ``sup``: ``auto`` is symbolic above 10^6 plant states unless
-    ``--export`` or ``--why`` needs the explicit listing (synth.symbolic.engine)."""
-    from synth.symbolic.engine import SUP_THRESHOLD, choose
-
-    return str(choose(args.engine, size, threshold=SUP_THRESHOLD, needs_listing=bool(args.export or args.why),
-                      listing_option="--export/--why"))
-
-
-def _cmd_sup_symbolic(args: argparse.Namespace, rs: Any, p: Any) -> int:
-    """SUP's counts on BDDs: the same summary as the explicit engine (the plant-wide
-    counts included, at any size), plus the key ``symbolic`` with the BDD node count."""
-    from synth.output import summary
-    from synth.output.progress import clear_progress, tty_progress
-    from synth.sup.explain import explain
-    from synth.symbolic.encoding import NodeBudget
-    from synth.symbolic.supervisor import symbolic_supervisor
-
-    show = tty_progress(not args.quiet and sys.stderr.isatty())
-    sup = symbolic_supervisor(p, rs.constraints, budget=NodeBudget(args.max_nodes), progress=show)
-    clear_progress(show)
-    labels = {c.id: c.label for c in rs.constraints}
-    data = {
-        "file": args.rules,
-        "plant": summary._sizes(p),
-        **sup.summary(),
-        "forbidden_by_constraint": sup.forbidden_counts(),
-        "constraints": [{"id": c.id, "label": c.label, "expr": c.text()} for c in rs.constraints],
-        "empty": sup.empty,
-        "symbolic": {"bdd_nodes": sup.nodes},
-    }
-    if args.json:
-        print_json(data)
-        return 0
-    why = ""
-    if sup.empty:
-        from synth.sup.supervisor import Supervisor
-
-        why = explain(Supervisor(p, rs.constraints), p.initial).text(labels)
-    sys.stdout.write(summary.sup_text(data, labels, why))
-    if not args.quiet:
-        print(f"symbolic engine: {sup.nodes} BDD nodes", file=sys.stderr)
     return 0

@@ -37,31 +37,28 @@ def cmd_validate(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     from synth.cli.plant import print_warnings
+    from synth.engines import validate
     from synth.errors import SynthError
     from synth.output.files import write_atomic
     from synth.output.html import write_report
     from synth.output.progress import clear_progress, tty_progress
     from synth.output.result import cor_dot, cor_json, validation_json, validation_text
-    from synth.validation.validate import reduced_controller, validate
+    from synth.output.summary import json_text, print_json
+    from synth.validation.result import reduced_controller
 
     if args.cor and Path(args.cor).suffix == ".dot":
         raise SynthError(f"--cor {args.cor}: the JSON file must not end in .dot, the DOT file is written beside it")
     show = tty_progress(not args.quiet and sys.stderr.isatty())
-    if args.engine != "explicit" and (args.report is not None or args.cor):
-        from synth.symbolic.engine import choose
-
-        choose(args.engine, 0, needs_listing=True)  # --engine symbolic with a listing: an error
-        args.engine = "explicit"
     result = validate(
         args.grafcet,
         args.plant,
+        engine=args.engine,
+        needs_listing=args.report is not None or bool(args.cor),
         expert=args.expert,
         homes=args.home,
         max_states=args.max_states,
-        progress=None if show is None else lambda n, pending: show(f"exploring SYNC: {n} aggregated states, {pending} to visit"),
-        engine=args.engine,
         max_nodes=args.max_nodes,
-        symbolic_progress=show,
+        progress=show,
     )
     clear_progress(show)
     if result.engine_stats is not None and not args.quiet:
@@ -69,26 +66,21 @@ def cmd_validate(args: argparse.Namespace) -> int:
               f"{result.engine_stats['situations']} stable situations", file=sys.stderr)
     print_warnings(result.plant)
     if args.cor:
-        import json
-
         cor = cor_json(result, reduced_controller(result))
         path = Path(args.cor)
-        write_atomic(path, json.dumps(cor, indent=2, ensure_ascii=False) + "\n")
+        write_atomic(path, json_text(cor))
         write_atomic(path.with_suffix(".dot"), cor_dot(cor))
     report_path = None
     if args.report is not None:
         directory = args.report or str(Path("reports") / Path(args.grafcet).stem)
         report_path = write_report(directory, result)
     if args.json:
-        import json
-
         data = validation_json(result)
         if report_path is not None:
             data["report"] = str(report_path)
         if result.engine_stats is not None:
             data["symbolic"] = dict(result.engine_stats)
-        json.dump(data, sys.stdout, indent=2, ensure_ascii=False)
-        sys.stdout.write("\n")
+        print_json(data)
     else:
         print(validation_text(result))
         if report_path is not None:
@@ -96,4 +88,3 @@ def cmd_validate(args: argparse.Namespace) -> int:
         if args.cor:
             print(f"reduced controller: {args.cor} and {Path(args.cor).with_suffix('.dot')}")
     return 0 if result.passed else 1
-

@@ -10,12 +10,14 @@ from __future__ import annotations
 
 from collections import deque
 from dataclasses import dataclass, field
+from functools import partial
 from typing import Callable, Mapping
 
 from synth.errors import LimitExceeded
 from synth.logic.cubes import Cubes, condition_text
 from synth.logic.events import Event, EventKind
 from synth.grafcet.machine import GrafcetMachine, Situation
+from synth.grafcet.recorder import InputRecorder
 
 __all__ = ["ASSState", "ASSTransition", "ASS", "stable_situation_automaton", "MAX_INPUTS"]
 
@@ -63,25 +65,6 @@ class ASS:
 
     def successors(self, state: int) -> tuple[ASSTransition, ...]:
         return tuple(t for t in self.transitions if t.source == state)
-
-
-class _Reader:
-    """Input values from a vector, remembering which inputs were read (for memoisation)."""
-
-    __slots__ = ("mask", "index", "base", "read")
-
-    def __init__(self, mask: int, index: Mapping[str, int], base: Mapping[str, bool]) -> None:
-        self.mask = mask
-        self.index = index
-        self.base = base
-        self.read = 0
-
-    def __getitem__(self, name: str) -> bool:
-        i = self.index.get(name)
-        if i is None:
-            return self.base[name]
-        self.read |= 1 << i
-        return bool(self.mask >> i & 1)
 
 
 MAX_INPUTS = 20
@@ -174,13 +157,13 @@ def stable_situation_automaton(
                 rest &= ~covered
         while rest:
             v = (rest & -rest).bit_length() - 1
-            reader = _Reader(v, index, base)
+            reader = InputRecorder(partial(valuation, v))
             if event.kind is EventKind.TIMER:
-                result = machine.fire_timer_with_trace(sits[k], event, reader)[0]  # type: ignore[arg-type]
+                result = machine.fire_timer_with_trace(sits[k], event, reader)[0]
             else:
-                result = machine.react_event(sits[k], event, reader)[0]  # type: ignore[arg-type]
+                result = machine.react_event(sits[k], event, reader)[0]
             target = known(result)
-            covered = cubes.cube({i: bool(v >> i & 1) for i in range(n_in) if reader.read >> i & 1})
+            covered = cubes.cube({index[n]: x for n, x in reader.cell().items() if n in index})
             entries.append((covered, target))
             out[target] = out.get(target, 0) | (rest & covered)
             rest &= ~covered

@@ -17,7 +17,7 @@ from synth.errors import SynthError
 from synth.output.files import write_atomic
 
 if TYPE_CHECKING:
-    from synth.validation.validate import Validation
+    from synth.validation.result import Validation
 
 __all__ = ["svg", "write_svg", "dot_available", "report_html", "write_report"]
 

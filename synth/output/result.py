@@ -11,7 +11,7 @@ from synth.grafcet.language import step_variable
 from synth.output.dot import dot_graph
 
 if TYPE_CHECKING:  # pragma: no cover
-    from synth.validation.validate import ReducedController, Validation
+    from synth.validation.result import ReducedController, Validation
 
 __all__ = ["state_json", "state_names", "prohibited_json", "validation_json", "validation_text", "cor_json", "cor_dot"]
 
@@ -46,10 +46,8 @@ def state_names(state: dict[str, Any]) -> tuple[list[str], list[str], str]:
 
 def prohibited_json(v: Validation, i: int) -> list[dict[str, Any]]:
     """One entry per order change SUP refuses in aggregated state ``i``."""
-    from synth.validation.diagnosis import diagnose_prohibition
-
     out = []
-    for pr in v.sync.nodes[i].proh:
+    for pr, diagnosis in zip(v.sync.nodes[i].proh, v.prohibitions[i]):
         d = state_json(v, i)
         d.update(
             {
@@ -57,7 +55,7 @@ def prohibited_json(v: Validation, i: int) -> list[dict[str, Any]]:
                 "event": pr.event,
                 "constraints": list(pr.constraints),
                 "trace": list(v.analysis.traces[i].events),
-                "diagnosis": diagnose_prohibition(v.sync, i, pr),
+                "diagnosis": diagnosis,
             }
         )
         out.append(d)
@@ -152,11 +150,8 @@ def validation_text(v: Validation) -> str:
         lines.append(f"  diagnosis [{d.verdict}]: {d.summary}")
         lines += [f"    {x}" for x in d.details]
     for k, i in enumerate(a.prohibited, 1):
-        from synth.validation.diagnosis import diagnose_prohibition
-
         lines += [""] + _problem_lines(v, f"Prohibited {k}", i)
-        for pr in v.sync.nodes[i].proh:
-            lines.append(f"  diagnosis: {diagnose_prohibition(v.sync, i, pr)}")
+        lines += [f"  diagnosis: {d}" for d in v.prohibitions[i]]
     return "\n".join(lines)
 
 

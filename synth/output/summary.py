@@ -38,6 +38,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from synth.plant.element import ElementAutomaton
     from synth.plant.rules import RuleSet
     from synth.sup.supervisor import Supervisor
+    from synth.symbolic.supervisor import SymbolicSupervisor
 
 __all__ = [
     "element_summary",
@@ -51,6 +52,8 @@ __all__ = [
     "run_text",
     "library_json",
     "library_text",
+    "json_text",
+    "print_json",
 ]
 
 
@@ -130,7 +133,7 @@ def plant_text(data: Mapping[str, Any]) -> str:
     return "\n".join(lines) + "\n"
 
 
-def sup_summary(rs: "RuleSet", sup: "Supervisor", path: str) -> dict[str, Any]:
+def sup_summary(rs: "RuleSet", sup: "Supervisor | SymbolicSupervisor", path: str) -> dict[str, Any]:
     """SUP's sizes, what it removed and why, and the constraints it enforces."""
     return {
         "file": path,
@@ -238,3 +241,17 @@ def library_text(models: "Sequence[LibraryModel]", where: "Path") -> str:
             + ", ".join(f"{v}={v}1" for v in m.orders + m.sensors) + ")",
         ]
     return "\n".join(lines) + "\n"
+
+
+def json_text(data: Any) -> str:
+    """``data`` as synth writes JSON: indented by 2, UTF-8 kept, a final newline."""
+    import json
+
+    return json.dumps(data, indent=2, ensure_ascii=False) + "\n"
+
+
+def print_json(data: Any) -> None:
+    """Print ``data`` on stdout as :func:`json_text` (every ``--json`` output)."""
+    import sys
+
+    sys.stdout.write(json_text(data))

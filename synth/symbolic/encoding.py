@@ -174,6 +174,13 @@ class PlantEncoding:
                 f = hi
         return values
 
+    def one(self, u: Function) -> tuple[int, ...]:
+        """The state :meth:`pick` chooses in ``u``, as local indices (``u`` not empty)."""
+        values = self.pick(u)
+        if values is None:
+            raise ValueError("no state to pick in an empty set")
+        return self.local(values)
+
     def local(self, values: Mapping[str, bool]) -> tuple[int, ...]:
         """Local indices of the state whose variables have ``values``."""
         out = []

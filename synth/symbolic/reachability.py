@@ -22,12 +22,13 @@ Example
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable
+from typing import Callable, TypeVar
 
 from synth.errors import LimitExceeded
 from synth.logic.bdd import Function
 from synth.logic.events import Event
-from synth.symbolic.sync import Bundle, NodeSet, SymbolicSync
+from synth.symbolic.graph import Bundle, NodeSet
+from synth.symbolic.sync import SymbolicSync
 
 __all__ = ["Path", "coreachable", "stuck_nodes", "held_nodes", "terminal_components", "first_node", "shortest_trace",
            "prohibited_nodes", "listed", "MAX_LISTED", "node_held"]
@@ -47,7 +48,8 @@ class Path:
 def _minus(a: NodeSet, b: NodeSet, false: Function) -> NodeSet:
     out = {}
     for s, u in a.items():
-        r = u & ~b.get(s, false)
+        other: Function = b.get(s, false)
+        r = u & ~other
         if r != false:
             out[s] = r
     return out
@@ -94,7 +96,7 @@ def node_held(sync: SymbolicSync, s: int, local: tuple[int, ...]) -> bool:
                 continue
             if sync.situations[link.target].steps != steps:
                 return False
-            old = reached.get(link.target, sync.false)
+            old: Function = reached.get(link.target, sync.false)
             if (u & ~old) != sync.false:
                 reached[link.target] = old | u
                 if link.target not in work:
@@ -124,7 +126,7 @@ def _deepest(sync: SymbolicSync, u: NodeSet) -> NodeSet:
         for s in sorted(ring):
             v = u.get(s, sync.false) & ring[s]
             if v != sync.false:
-                return {s: sync.enc.state(sync.enc.local(sync.enc.pick(v)))}
+                return {s: sync.enc.state(sync.enc.one(v))}
     raise ValueError("no node of the set is reachable")
 
 
@@ -179,16 +181,19 @@ def _layers(sync: SymbolicSync, target: NodeSet, depth: int) -> list[NodeSet]:
     return layers
 
 
-def _greedy(sync: SymbolicSync, layers: list[NodeSet], order: Callable[[Bundle], object]
-            ) -> tuple[list[NodeSet], list[Event], list[object]]:
+Key = TypeVar("Key", tuple[int, int, int], Event)  # how events are ordered: by plant transition, or by name
+
+
+def _greedy(sync: SymbolicSync, layers: list[NodeSet], order: Callable[[Bundle], Key]
+            ) -> tuple[list[NodeSet], list[Event], list[Key]]:
     """Forward through ``layers``, taking at each step the smallest event (by ``order``):
     the nodes chosen per layer, the events and their keys."""
     current = layers[0]
     chosen = [current]
     events: list[Event] = []
-    keys: list[object] = []
+    keys: list[Key] = []
     for k in range(1, len(layers)):
-        options: dict[object, tuple[Event, NodeSet]] = {}
+        options: dict[Key, tuple[Event, NodeSet]] = {}
         for s, u in current.items():
             for b in sync.out_bundles(s):
                 if b.target not in layers[k]:
@@ -210,10 +215,10 @@ def _greedy(sync: SymbolicSync, layers: list[NodeSet], order: Callable[[Bundle],
 
 def _pick(sync: SymbolicSync, u: NodeSet) -> tuple[int, tuple[int, ...]]:
     s = min(s for s, v in u.items() if v != sync.false)
-    return s, sync.enc.local(sync.enc.pick(u[s]))
+    return s, sync.enc.one(u[s])
 
 
-def first_node(sync: SymbolicSync, candidates: NodeSet) -> tuple[int, tuple[int, ...], int, tuple]:
+def first_node(sync: SymbolicSync, candidates: NodeSet) -> tuple[int, tuple[int, ...], int, tuple[tuple[int, int, int], ...]]:
     """The candidate the explicit engine numbers first: smallest distance, then smallest
     path in exploration order. Returns (situation, plant state, distance, path key)."""
     rings = sync.onion_rings()
@@ -256,7 +261,7 @@ def shortest_trace(sync: SymbolicSync, s: int, local: tuple[int, ...]) -> Path:
 
 def listed(sync: SymbolicSync, u: NodeSet, limit: int = MAX_LISTED) -> list[tuple[int, tuple[int, ...]]]:
     """The nodes of ``u``, situation by situation."""
-    out = []
+    out: list[tuple[int, tuple[int, ...]]] = []
     for s in sorted(u):
         for local in sync.enc.states(u[s], limit - len(out)):
             out.append((s, local))

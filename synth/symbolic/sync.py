@@ -44,132 +44,44 @@ False
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-from typing import Callable, Iterable, Mapping, Sequence
+from functools import partial
+from typing import Callable, Sequence, TypeVar
 
-from synth.logic.bdd import Function
 from synth.grafcet.language import ON_EVENT, Transition
 from synth.grafcet.machine import GrafcetMachine, Situation
+from synth.grafcet.recorder import InputRecorder
+from synth.logic.bdd import Function
 from synth.logic.events import Event
 from synth.logic.expr import Edge as ExprEdge, names
 from synth.plant.composition import Plant
 from synth.plant.rules import Constraint
 from synth.symbolic.encoding import Copy, NodeBudget, live_nodes
+from synth.symbolic.graph import Bundle, NodeSet, Region, SyncGraph
 from synth.symbolic.relation import Move, image, pair_preimage, preimage
 from synth.symbolic.supervisor import SymbolicSupervisor
+from synth.validation.conflicts import ConflictLog
 
-__all__ = ["Bundle", "Link", "Region", "SymbolicSync", "symbolic_sync"]
+__all__ = ["SymbolicSync", "symbolic_sync"]
 
-NodeSet = dict[int, Function]  # situation index -> plant states (current copy)
-
-
-class _Recorder(dict):
-    """Input values that remember which names were read (the machine is deterministic,
-    so its answer holds for every valuation agreeing on them). The values are fetched
-    (a state picked from a BDD) only when the machine first looks at them: a situation
-    whose orders do not depend on the inputs costs no pick."""
-
-    def __init__(self, fetch: Callable[[], Mapping[str, bool]]) -> None:
-        super().__init__()
-        self.read: set[str] = set()
-        self._fetch: Callable[[], Mapping[str, bool]] | None = fetch
-
-    def _load(self) -> None:
-        if self._fetch is not None:
-            dict.update(self, self._fetch())
-            self._fetch = None
-
-    def __getitem__(self, name: str) -> bool:
-        self._load()
-        self.read.add(name)
-        return dict.__getitem__(self, name)
-
-    def __contains__(self, name: object) -> bool:
-        self._load()
-        return dict.__contains__(self, name)
-
-    def __iter__(self):  # type: ignore[no-untyped-def]
-        self._load()
-        return dict.__iter__(self)
-
-    def __len__(self) -> int:
-        self._load()
-        return dict.__len__(self)
-
-    def keys(self):  # type: ignore[no-untyped-def]
-        self._load()
-        return dict.keys(self)
-
-    def get(self, name: str, default: object = None) -> object:
-        return self[name] if name in self else default
-
-    def items(self):  # type: ignore[no-untyped-def]
-        self.read.update(self)
-        return dict.items(self)
-
-    def values(self):  # type: ignore[no-untyped-def]
-        self.read.update(self)
-        return dict.values(self)
+R = TypeVar("R")  # what the machine answers
+Rounds = tuple[tuple[Transition, ...], ...]  # the transitions fired, round by round
 
 
-@dataclass(frozen=True)
-class Bundle:
-    """Edges ``source --event--> target``: from the nodes of situation ``source`` whose
-    move (or timer) leads to an entry in ``entries``, to the settled states of those
-    entries' regions in situation ``target``. ``move`` is None for a timer."""
 
-    source: int
-    event: Event
-    target: int
-    entries: Function  # freed (false) once ``edges`` is computed
-    move: Move | None
-    key: tuple[int, int]  # exploration order of the event: (0, plant transition) or (1, timer rank)
-    edges: Function | None = None  # (x, x'): node x of source --event--> node x' of target, once explored
-
-
-@dataclass(frozen=True)
-class Link:
-    """Every edge from situation ``source`` to situation ``target``, whatever the event,
-    as one pair relation ``edges(x, x')``."""
-
-    source: int
-    target: int
-    edges: Function
-
-
-@dataclass
-class Region:
-    """A situation's region relation and its sets (grown as new entries arrive)."""
-
-    entered: Function
-    pairs: Function  # reg(x, x'): entry x settles in x'
-    members: Function
-    nodes: Function
-    by_orders: dict[frozenset[str], Function] = field(default_factory=dict)  # nodes per emitted orders
-
-
-class SymbolicSync:
-    """The explored SYNC (see module docstring)."""
+class SymbolicSync(SyncGraph):
+    """The explored SYNC (see module docstring): the aggregated graph it fills, and the
+    exploration's own state (regions' relations, caches, the conflicts met)."""
 
     def __init__(self, sup: SymbolicSupervisor, machine: GrafcetMachine, *, progress: Callable[[str], None] | None = None) -> None:
+        super().__init__(sup.enc)
         self.sup = sup
-        self.enc = sup.enc
         self.plant: Plant = sup.plant
         self.machine = machine
-        self.engine = sup.enc.engine
-        self.false = self.engine.false
-        self.true = self.engine.true
-        self.situations: list[Situation] = []
         self._index: dict[Situation, int] = {}
-        self.regions: list[Region] = []
-        self.bundles: list[Bundle] = []
-        self.links: list[Link] = []
         self._bundles: dict[tuple[int, tuple[int, int], int], Bundle] = {}
         self._batch: NodeSet = {}
-        self.rings: list[NodeSet] = []
-        self.edge_count = 0
         self.conflicts: list[tuple[int, Function, Event, str, tuple[str, ...]]] = []
-        self._conflict_keys: set[tuple[str, tuple[str, ...]]] = set()
+        self._conflict_log = ConflictLog()
         self._inputs = tuple(n for n in machine.inputs if n in self.plant.owner)
         self._intra: dict[frozenset[str], tuple[tuple[Function, ...], Function, dict[Event, Function]]] = {}
         self._eq: Function | None = None
@@ -185,8 +97,6 @@ class SymbolicSync:
             frozenset(o + Copy.NEXT.value for b, e in enumerate(self.plant.elements) if b != a for o in e.orders)
             for a in range(self.plant.ndim))
         self.progress = progress
-        self.initial: NodeSet = {}
-        self._sync_states = 0
 
     # ------------------------------------------------------------------ helpers
     def situation(self, sit: Situation) -> int:
@@ -204,18 +114,15 @@ class SymbolicSync:
         assert val is not None
         return {n: val[n] for n in self._inputs}
 
-    def _cell(self, rec: _Recorder) -> Function:
-        return self.engine.cube({n: dict.__getitem__(rec, n) for n in sorted(rec.read)})
-
-    def partition(self, states: Function, answer: Callable[[_Recorder], object]) -> list[tuple[object, Function]]:
+    def partition(self, states: Function, answer: Callable[[InputRecorder], R]) -> list[tuple[R, Function]]:
         """``states`` cut into cells on which ``answer`` (a call of the machine on recorded
         inputs) gives one result; results in the order first met."""
-        out: list[tuple[object, Function]] = []
+        out: list[tuple[R, Function]] = []
         rest = states
         while rest != self.false:
-            rec = _Recorder(lambda rest=rest: self.values(rest))
+            rec = InputRecorder(partial(self.values, rest))
             result = answer(rec)
-            part = rest & self._cell(rec)
+            part = rest & self.engine.cube(rec.cell())
             rest = rest & ~part
             for k, (r, u) in enumerate(out):
                 if r == result:
@@ -376,7 +283,6 @@ class SymbolicSync:
         sit = self.situations[s]
         fresh = self.false
         for wanted, part in self.partition(new_entries, lambda rec: self.machine.orders(sit, rec)):
-            assert isinstance(wanted, frozenset)
             pairs, members, settled = self.region_pairs(part, wanted)
             reg.pairs |= pairs
             reg.members |= members
@@ -387,29 +293,6 @@ class SymbolicSync:
         return fresh
 
     # ------------------------------------------------------------------ exploration
-    def _new_conflicts(self, rounds: Sequence[Sequence[Transition]]) -> bool:
-        """Whether ``rounds`` fire several transitions of one step not reported yet."""
-        for fired in rounds:
-            by_step: dict[str, list[str]] = {}
-            for tr in fired:
-                for st in tr.sources:
-                    by_step.setdefault(st, []).append(tr.name)
-            if any(len(v) > 1 and (st, tuple(v)) not in self._conflict_keys for st, v in by_step.items()):
-                return True
-        return False
-
-    def _note_conflicts(self, s: int, sources: Function, event: Event, rounds: Sequence[Sequence[Transition]]) -> None:
-        for fired in rounds:
-            by_step: dict[str, list[str]] = {}
-            for tr in fired:
-                for st in tr.sources:
-                    by_step.setdefault(st, []).append(tr.name)
-            for st, fired_names in by_step.items():
-                key = (st, tuple(fired_names))
-                if len(fired_names) > 1 and key not in self._conflict_keys:
-                    self._conflict_keys.add(key)
-                    self.conflicts.append((s, sources, event, st, tuple(fired_names)))
-
     def _successors(self, s: int, nodes: Function, pending: NodeSet) -> None:
         sit = self.situations[s]
         machine = self.machine
@@ -425,22 +308,24 @@ class SymbolicSync:
                 continue
             event = m.event if m.variable in self._inputs else None
 
-            def react(rec: _Recorder, event: Event | None = event) -> tuple[Situation, tuple]:
+            def react(rec: InputRecorder, event: Event | None = event) -> tuple[Situation, Rounds]:
                 return machine.react_event(sit, event, rec)
 
             for (target, rounds), part in self.partition(entries, react):
                 t = self.situation(target)
-                if rounds and self._new_conflicts(rounds):
-                    self._note_conflicts(s, preimage(self.enc, part, m) & nodes, m.event, rounds)
+                found = self._conflict_log.fresh(rounds) if rounds else []
+                if found:
+                    sources = preimage(self.enc, part, m) & nodes
+                    self.conflicts += [(s, sources, m.event, st, fired) for st, fired in found]
                 self._bundle(s, m.event, t, part, m, (0, m.key), pending)
         for rank, timer in enumerate(machine.timers(sit)):
-            def fire(rec: _Recorder, timer: Event = timer) -> tuple[Situation, tuple]:
+            def fire(rec: InputRecorder, timer: Event = timer) -> tuple[Situation, Rounds]:
                 return machine.fire_timer_with_trace(sit, timer, rec)
 
             for (target, rounds), part in self.partition(nodes, fire):
                 t = self.situation(target)
-                if rounds and self._new_conflicts(rounds):
-                    self._note_conflicts(s, part, timer, rounds)
+                found = self._conflict_log.fresh(rounds) if rounds else []
+                self.conflicts += [(s, part, timer, st, fired) for st, fired in found]
                 self._bundle(s, timer, t, part, None, (1, rank), pending)
 
     def _unread(self, sit: Situation) -> frozenset[str]:
@@ -497,37 +382,12 @@ class SymbolicSync:
             if self.progress is not None and turns % 50 == 0:
                 self.progress(f"exploring SYNC symbolically: {len(self.situations)} situations, "
                               f"{len(pending)} pending, {live_nodes(self.engine)} BDD nodes")
-        self.bundles = [self._edges(b) for b in sorted(self._bundles.values(), key=lambda b: (b.source, b.key, b.target))]
+        bundles = [self._edges(b) for b in sorted(self._bundles.values(), key=lambda b: (b.source, b.key, b.target))]
         self._sync_states = sum(self.enc.count(r.members) for r in self.regions)
         for r in self.regions:  # only the nodes are read from here on: free the rest
             r.entered = r.pairs = r.members = self.false
         self._bundles = {}
-        links: dict[tuple[int, int], Function] = {}
-        overlapping: set[tuple[int, int]] = set()  # links whose bundles share a pair of nodes
-        for b in self.bundles:
-            key = (b.source, b.target)
-            old = links.get(key)
-            if old is None:
-                links[key] = b.edges
-            else:
-                if key not in overlapping and (old & b.edges) != self.false:
-                    overlapping.add(key)
-                links[key] = old | b.edges
-        self.links = [Link(a, t, e) for (a, t), e in sorted(links.items())]
-        # a transition per bundle and pair of nodes: one count per link whose bundles are disjoint
-        self.edge_count = sum(self.enc.count(e, (Copy.CURRENT, Copy.NEXT)) for k, e in links.items() if k not in overlapping)
-        self.edge_count += sum(self.enc.count(b.edges, (Copy.CURRENT, Copy.NEXT)) for b in self.bundles
-                               if (b.source, b.target) in overlapping)
-        self._into: dict[int, list[Link]] = {}
-        self._out: dict[int, list] = {}
-        self._from: dict[int, list[Link]] = {}
-        for link in self.links:
-            self._into.setdefault(link.target, []).append(link)
-            self._from.setdefault(link.source, []).append(link)
-        self._in: dict[int, list[Bundle]] = {}
-        for b in self.bundles:
-            self._out.setdefault(b.source, []).append(b)
-            self._in.setdefault(b.target, []).append(b)
+        self.link(bundles)
         return self
 
     def _edges(self, b: Bundle) -> Bundle:
@@ -538,124 +398,6 @@ class SymbolicSync:
         else:  # n is x moved: the preimage on the current copy
             pairs = pair_preimage(self.enc, b.entries, self.regions[b.target].pairs, b.move)
         return Bundle(b.source, b.event, b.target, self.false, b.move, b.key, pairs)  # entries no longer needed
-
-    def onion_rings(self) -> list[NodeSet]:
-        """The nodes by distance from the initial nodes (breadth-first over the links),
-        computed once, on demand: only traces need them."""
-        if self.rings or not self.initial:
-            return self.rings
-        seen: NodeSet = dict(self.initial)
-        ring: NodeSet = dict(self.initial)
-        while ring:
-            self.rings.append(ring)
-            new: NodeSet = {}  # targets in the next copy, renamed once per situation below
-            for s in sorted(ring):
-                for link in self.out_links(s):
-                    u = self.enc.and_exists(link.edges, ring[s], Copy.CURRENT)
-                    if u != self.false:
-                        new[link.target] = new.get(link.target, self.false) | u
-            ring = {}
-            for s, u in new.items():
-                u = self.enc.rename(u, Copy.NEXT, Copy.CURRENT) & ~seen.get(s, self.false)
-                if u != self.false:
-                    ring[s] = u
-                    seen[s] = seen.get(s, self.false) | u
-        return self.rings
-
-    # ------------------------------------------------------------------ counts
-    @property
-    def sync_states(self) -> int:
-        return self._sync_states
-
-    @property
-    def aggregated_states(self) -> int:
-        return sum(self.enc.count(r.nodes) for r in self.regions)
-
-    @property
-    def aggregated_transitions(self) -> int:
-        return self.edge_count
-
-    # ------------------------------------------------------------------ the aggregated graph
-    def pre(self, targets: NodeSet, arcs: Iterable[Link | Bundle] | None = None) -> NodeSet:
-        """Nodes with an edge (of ``arcs``: links or bundles, default every link) into ``targets``."""
-        out: NodeSet = {}
-        if arcs is None:
-            arcs = [link for t in targets for link in self._into.get(t, ())]
-        primed: NodeSet = {}  # each target renamed once, whatever the number of arcs into it
-        for a in arcs:
-            t = primed.get(a.target)
-            if t is None:
-                t = targets.get(a.target)
-                if t is None or t == self.false:
-                    continue
-                t = primed[a.target] = self.enc.rename(t, Copy.CURRENT, Copy.NEXT)
-            src = self.enc.and_exists(a.edges, t, Copy.NEXT)
-            if src != self.false:
-                out[a.source] = out.get(a.source, self.false) | src
-        return out
-
-    def post(self, sources: NodeSet, a: Link | Bundle) -> Function:
-        """Targets (nodes of ``a.target``) of the edges of ``a`` from ``sources``."""
-        src = sources.get(a.source)
-        if src is None or src == self.false:
-            return self.false
-        return self.post_pairs(src, a.edges)
-
-    def into(self, target: int) -> list[Link]:
-        return self._into.get(target, [])
-
-    def out_bundles(self, source: int) -> list[Bundle]:
-        return self._out.get(source, [])
-
-    def in_bundles(self, target: int) -> list[Bundle]:
-        return self._in.get(target, [])
-
-    def out_links(self, source: int) -> list[Link]:
-        return self._from.get(source, [])
-
-    def backward(self, targets: NodeSet, within: NodeSet | None = None) -> NodeSet:
-        """Nodes from which ``targets`` can be reached (targets included): a worklist
-        fixpoint over the situations whose set grew."""
-        reached: NodeSet = {s: u for s, u in targets.items() if u != self.false}
-        work = sorted(reached)
-        while work:
-            s = work.pop()
-            for t, u in self.pre({s: reached[s]}, self.into(s)).items():
-                if within is not None:
-                    u &= within.get(t, self.false)
-                old = reached.get(t, self.false)
-                grown = u & ~old
-                if grown != self.false:
-                    reached[t] = old | grown
-                    if t not in work:
-                        work.append(t)
-        return reached
-
-    def forward(self, sources: NodeSet) -> NodeSet:
-        """Nodes reachable from ``sources`` (included)."""
-        reached: NodeSet = {s: u for s, u in sources.items() if u != self.false}
-        work = sorted(reached)
-        while work:
-            s = work.pop()
-            for link in self.out_links(s):
-                u = self.post({s: reached[s]}, link)
-                old = reached.get(link.target, self.false)
-                grown = u & ~old
-                if grown != self.false:
-                    reached[link.target] = old | grown
-                    if link.target not in work:
-                        work.append(link.target)
-        return reached
-
-    def nodes(self) -> NodeSet:
-        return {s: r.nodes for s, r in enumerate(self.regions) if r.nodes != self.false}
-
-    def depth(self, s: int, u: Function) -> int | None:
-        """The ring of the first node of ``u`` (in situation ``s``)."""
-        for k, ring in enumerate(self.onion_rings()):
-            if (ring.get(s, self.false) & u) != self.false:
-                return k
-        return None
 
 
 def symbolic_sync(

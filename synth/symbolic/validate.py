@@ -25,6 +25,7 @@ from typing import Callable, Iterator, Sequence
 from synth.grafcet.language import Grafcet
 from synth.grafcet.language_check import load_grafcet
 from synth.grafcet.machine import GrafcetMachine
+from synth.logic.bdd import Function
 from synth.logic.expr import evaluate
 from synth.plant.composition import Plant, plant
 from synth.plant.rules import RuleSet
@@ -44,15 +45,18 @@ from synth.symbolic.reachability import (
     terminal_components,
 )
 from synth.symbolic.supervisor import SymbolicSupervisor
-from synth.symbolic.sync import NodeSet, SymbolicSync
+from synth.symbolic.graph import NodeSet
+from synth.symbolic.sync import SymbolicSync
 from synth.validation.analysis import Analysis, Trace
-from synth.validation.diagnosis import diagnose, diagnose_never_starts
-from synth.validation.sync import Conflict, Edge, Node, Prohibition, Sync, _order_moves
-from synth.validation.validate import Validation, home_conditions
+from synth.validation.diagnosis import diagnose_all
+from synth.validation.conflicts import Conflict
+from synth.validation.sync import Edge, Node, Prohibition, Sync, _order_moves
+from synth.validation.result import Validation, home_conditions
 
 __all__ = ["validate_symbolic", "validate_loaded"]
 
-Key = tuple[int, tuple[int, ...]]
+Key = tuple[int, tuple[int, ...]]  # a node: situation, plant state
+PathKey = tuple[tuple[int, int, int], ...]  # a shortest path, in the explicit exploration's order
 
 
 class _Explicit:
@@ -103,7 +107,7 @@ class _Explicit:
         return Trace(tuple(ids), tuple(path.events))
 
 
-def _homes(ssync: SymbolicSync, texts: Sequence[str], p: Plant, g) -> NodeSet:
+def _homes(ssync: SymbolicSync, texts: Sequence[str], p: Plant, g: Grafcet) -> NodeSet:
     homes: NodeSet = dict(ssync.initial)
     conditions = home_conditions(texts, p, g)
     if not conditions:
@@ -112,7 +116,7 @@ def _homes(ssync: SymbolicSync, texts: Sequence[str], p: Plant, g) -> NodeSet:
     for s, r in enumerate(ssync.regions):
         steps = set(ssync.situations[s].step_variables)
 
-        def value(name: str, steps: set[str] = steps):
+        def value(name: str, steps: set[str] = steps) -> Function:
             return engine.var(name) if name in p.owner else (engine.true if name in steps else engine.false)
 
         hit = engine.false
@@ -207,7 +211,7 @@ def _validate_loaded(
     held: NodeSet | None = held_nodes(ssync) if proh_sets else None  # else only the listed nodes are asked
 
     # blocking: held with a prohibited order, once per set of steps; terminal components
-    found: list[tuple[int, tuple, Key, list[Key]]] = []
+    found: list[tuple[int, PathKey, Key, list[Key]]] = []
     by_steps: dict[tuple[str, ...], NodeSet] = {}
     for (steps, _), u in proh_sets.items():
         for s, v in u.items():
@@ -237,7 +241,7 @@ def _validate_loaded(
         keys = {v: k for k, v in ex.index.items()}
         no_return[b] = next((n for n in traces[b].nodes if not _is_in(ssync, back, keys[n])), b)
     # prohibited orders: the first node meeting each (steps, event)
-    firsts: dict[Key, tuple] = {}
+    firsts: dict[Key, tuple[int, PathKey]] = {}
     for u in proh_sets.values():
         s, local, depth, path = first_node(ssync, u)
         firsts[(s, local)] = (depth, path)
@@ -265,10 +269,9 @@ def _validate_loaded(
         _held_listed(ssync, held, ex, keys),
         never,
     )
-    diagnoses = {b: diagnose(sync, b, expert=expert, component=analysis.components[b]) for b in analysis.blocking}
-    never_d = diagnose_never_starts(sync, expert=expert) if never else None
+    diagnoses, never_d, prohibitions = diagnose_all(sync, analysis, expert=expert)
     reached = frozenset(st for sit in ssync.situations for st in sit.steps)
-    return Validation(rs, p, g, sync, analysis, diagnoses, expert, sup_empty, tuple(homes), never_d,
+    return Validation(rs, p, g, sync, analysis, diagnoses, expert, sup_empty, tuple(homes), never_d, prohibitions,
                       counts=stats, reached_steps=reached, engine_stats=_stats(ssync))
 
 
@@ -294,7 +297,7 @@ def _is_in(ssync: SymbolicSync, u: NodeSet, key: Key) -> bool:
 def _one_per_situation(ssync: SymbolicSync, ex: _Explicit) -> None:
     for s, r in enumerate(ssync.regions):
         if r.nodes != ssync.false:
-            ex.node((s, ssync.enc.local(ssync.enc.pick(r.nodes))))
+            ex.node((s, ssync.enc.one(r.nodes)))
 
 
 def _stats(ssync: SymbolicSync) -> dict[str, int]:

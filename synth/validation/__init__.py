@@ -8,8 +8,8 @@ from synth._lazy import lazy_exports
 __getattr__, __all__ = lazy_exports(
     __name__,
     {
-        "Validation": "validate",
+        "Validation": "result",
         "validate": "validate",
-        "reduced_controller": "validate",
+        "reduced_controller": "result",
     },
 )

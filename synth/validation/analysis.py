@@ -189,7 +189,7 @@ def analyse(sync: Sync, homes: Iterable[int] | None = None) -> Analysis:
     no_return = {b: next((n for n in traces[b].nodes if n not in back), b) for b in blocking}
     first_steps = sync.nodes[sync.initial[0]].situation.steps if sync.initial else ()
     never_starts = bool(sync.initial) and all(n.situation.steps == first_steps for n in sync.nodes)
-    seen: set[tuple] = set()
+    seen: set[tuple[tuple[str, ...], str]] = set()
     prohibited: list[int] = []
     for i in sorted(dist, key=lambda i: (dist[i], i)):
         n = sync.nodes[i]

@@ -32,9 +32,11 @@ from synth.logic.events import Event
 from synth.plant.composition import Plant
 from synth.plant.element import ElementAutomaton
 from synth.plant.rules import VarKind
+from synth.validation.analysis import Analysis
 from synth.validation.sync import Node, Prohibition, Sync
 
-__all__ = ["Verdict", "Cause", "Awaited", "Diagnosis", "diagnose", "diagnose_never_starts", "diagnose_prohibition"]
+__all__ = ["Verdict", "Cause", "Awaited", "Diagnosis", "diagnose", "diagnose_never_starts", "diagnose_prohibition",
+           "diagnose_all"]
 
 
 class Verdict(StrEnum):
@@ -240,10 +242,10 @@ def _verdict(
 ) -> tuple[Verdict, str]:
     p = sync.plant
     if not awaited:
-        steps = ", ".join(node.situation.step_variables)
+        active = ", ".join(node.situation.step_variables)
         return (
             Verdict.DEAD_END,
-            f"no transition leaves the active steps {{{steps}}}: the Grafcet stops here and never returns "
+            f"no transition leaves the active steps {{{active}}}: the Grafcet stops here and never returns "
             "to its initial situation",
         )
     free = [(a, c) for a in awaited for c in a.causes if c.free]
@@ -278,8 +280,8 @@ def _verdict(
     # the awaited event comes by itself: the Grafcet moves on, in a loop that never meets a home
     for a, c in items:
         if c.producible_now:
-            sits = sorted({sync.nodes[i].situation.steps for i in component} or {node.situation.steps})
-            loop = " → ".join("{" + ", ".join(step_variable(x) for x in steps) + "}" for steps in sits)
+            step_sets = sorted({sync.nodes[i].situation.steps for i in component} or {node.situation.steps})
+            loop = " → ".join("{" + ", ".join(step_variable(x) for x in st) + "}" for st in step_sets)
             home = " & ".join(step_variable(x) for x in node.situation.steps)
             return (
                 Verdict.LIVELOCK,
@@ -398,3 +400,14 @@ def diagnose_prohibition(sync: Sync, node_index: int, pr: Prohibition) -> str:
         f"{_named(sync, pr.constraints)}: SUP forbids {pr.event} there"
     )
 
+
+
+def diagnose_all(sync: Sync, analysis: Analysis, *, expert: bool = False
+                 ) -> tuple[dict[int, Diagnosis], Diagnosis | None, dict[int, tuple[str, ...]]]:
+    """Every diagnosis a validation shows, computed once: each blocking state's, the
+    never-starts one (None when the Grafcet starts), and for each prohibited node the
+    words for each order change refused there (in the order of ``proh``)."""
+    blocking = {b: diagnose(sync, b, expert=expert, component=analysis.components[b]) for b in analysis.blocking}
+    never = diagnose_never_starts(sync, expert=expert) if analysis.never_starts else None
+    prohibitions = {i: tuple(diagnose_prohibition(sync, i, pr) for pr in sync.nodes[i].proh) for i in analysis.prohibited}
+    return blocking, never, prohibitions

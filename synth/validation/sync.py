@@ -40,8 +40,9 @@ from synth.logic.events import Event
 from synth.plant.composition import LocalTransition, Plant
 from synth.plant.rules import Constraint
 from synth.sup.constraints import CompiledConstraints
+from synth.validation.conflicts import Conflict, ConflictLog
 
-__all__ = ["Prohibition", "Node", "Edge", "Conflict", "Sync", "synchronous_product", "region"]
+__all__ = ["Prohibition", "Node", "Edge", "Sync", "synchronous_product", "region"]
 
 Local = tuple[int, ...]
 
@@ -76,17 +77,6 @@ class Edge:
     source: int
     event: Event  # ↑v11, ↓dcy, 2s/X101
     target: int
-
-
-@dataclass(frozen=True)
-class Conflict:
-    """Transitions leaving the same step fired together (an OR divergence whose
-    receptivities were true at once): every branch became active."""
-
-    node: int  # the aggregated state the event left
-    event: Event
-    step: str
-    transitions: tuple[str, ...]
 
 
 @dataclass(frozen=True)
@@ -233,18 +223,10 @@ def synchronous_product(
             out.append(index[nk])
         return out
 
-    seen_conflicts: set[tuple[str, tuple[str, ...]]] = set()
+    log = ConflictLog()
 
     def note_conflicts(i: int, event: Event, rounds: Sequence[Sequence[Transition]]) -> None:
-        for fired in rounds:
-            by_step: dict[str, list[str]] = {}
-            for tr in fired:
-                for st in tr.sources:
-                    by_step.setdefault(st, []).append(tr.name)
-            for st, names in by_step.items():
-                if len(names) > 1 and (st, tuple(names)) not in seen_conflicts:
-                    seen_conflicts.add((st, tuple(names)))
-                    conflicts.append(Conflict(i, event, st, tuple(names)))
+        conflicts.extend(Conflict(i, event, st, names) for st, names in log.fresh(rounds))
 
     queue: deque[int] = deque()
     if not oracle.kept(p.initial):

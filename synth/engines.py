@@ -1,0 +1,202 @@
+"""Which engine runs, and running it: ``--engine {auto,explicit,symbolic}`` for
+``synth validate`` and ``synth sup``, above both engines (:mod:`synth.validation`,
+:mod:`synth.symbolic`), which know nothing of each other.
+
+``auto`` estimates the explicit engine's work before running anything:
+
+- ``validate``: the product of the element state counts (the plant's size) times the
+  number of Grafcet steps (a stand-in for the situations); symbolic above
+  :data:`VALIDATE_THRESHOLD` (10^7). The explicit engine's cost follows the reachable
+  SYNC, which this bounds from above; at 10^7 the explicit engine still answers in well
+  under a second on sequential machines, and the symbolic engine costs a few tenths of a
+  second more at most (see docs/symbolic.md for the measurements behind the choice);
+  ``--report`` and ``--cor`` need every aggregated state, so ``auto`` keeps them explicit.
+- ``sup``: symbolic above :data:`SUP_THRESHOLD` (10^6) plant states, unless ``--export``
+  or ``--why`` ask for the explicit listing.
+
+The engines themselves are imported only once chosen: a passing box-sorting
+validation never imports the BDD library.
+
+Example
+-------
+>>> choose(EngineChoice.AUTO, 10**8)
+<EngineChoice.SYMBOLIC: 'symbolic'>
+>>> choose(EngineChoice.AUTO, 10**8, needs_listing=True)
+<EngineChoice.EXPLICIT: 'explicit'>
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import StrEnum
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Callable, Sequence
+
+from synth.errors import LimitExceeded, SynthError
+
+if TYPE_CHECKING:  # pragma: no cover - the engines are imported once chosen
+    from synth.plant.composition import Plant
+    from synth.plant.rules import RuleSet
+    from synth.sup.explain import Explanation
+    from synth.sup.supervisor import Supervisor
+    from synth.symbolic.supervisor import SymbolicSupervisor
+    from synth.validation.result import Validation
+
+__all__ = ["EngineChoice", "choose", "VALIDATE_THRESHOLD", "SUP_THRESHOLD", "validate", "SupRun", "supervisor"]
+
+VALIDATE_THRESHOLD = 10**7
+"""``validate --engine auto``: symbolic when plant states × Grafcet steps exceed this."""
+
+SUP_THRESHOLD = 10**6
+"""``sup --engine auto``: symbolic when the plant has more states than this."""
+
+
+class EngineChoice(StrEnum):
+    AUTO = "auto"
+    EXPLICIT = "explicit"
+    SYMBOLIC = "symbolic"
+
+
+def choose(asked: EngineChoice | str, estimate: int, *, threshold: int = VALIDATE_THRESHOLD,
+           needs_listing: bool = False, listing_option: str = "--report/--cor") -> EngineChoice:
+    """The engine to run for an estimated size; ``needs_listing``: an option needs every
+    state explicitly (the symbolic engine cannot serve it)."""
+    asked = EngineChoice(asked)
+    if asked == EngineChoice.AUTO:
+        return EngineChoice.EXPLICIT if needs_listing or estimate <= threshold else EngineChoice.SYMBOLIC
+    if asked == EngineChoice.SYMBOLIC and needs_listing:
+        raise SynthError(f"{listing_option} lists every state: use --engine explicit (or auto)")
+    return asked
+
+
+def validate(
+    grafcet_path: str | Path,
+    rules_path: str | Path,
+    *,
+    engine: EngineChoice | str = EngineChoice.AUTO,
+    needs_listing: bool = False,
+    expert: bool = False,
+    homes: Sequence[str] = (),
+    max_states: int | None = None,
+    max_nodes: int | None = None,
+    progress: Callable[[str], None] | None = None,
+) -> Validation:
+    """``synth validate``: load, choose the engine, run it. ``needs_listing``: ``--report``
+    or ``--cor`` will list every aggregated state (explicit engine only; with ``--engine
+    symbolic`` an error before any input is read); ``max_states`` bounds the explicit
+    engine, ``max_nodes`` the symbolic one; ``progress`` receives progress lines."""
+    from synth.grafcet.language_check import load_grafcet
+    from synth.plant.composition import plant
+    from synth.plant.rules_check import load_rules
+
+    asked = choose(engine, 0, needs_listing=True) if needs_listing else EngineChoice(engine)
+    rs = load_rules(rules_path)
+    p = plant(rs)
+    g = load_grafcet(grafcet_path, inputs=p.inputs, outputs=p.outputs)
+    if asked != EngineChoice.EXPLICIT and choose(asked, p.size * max(1, len(g.steps))) == EngineChoice.SYMBOLIC:
+        from synth.symbolic.validate import validate_loaded as symbolic
+
+        return symbolic(rs, p, g, expert=expert, homes=homes, max_nodes=max_nodes, progress=progress)
+    from synth.validation.validate import validate_loaded
+
+    explored = None
+    if progress is not None:
+        def explored(n: int, pending: int, show: Callable[[str], None] = progress) -> None:
+            show(f"exploring SYNC: {n} aggregated states, {pending} to visit")
+
+    return validate_loaded(rs, p, g, expert=expert, homes=homes, max_states=max_states, progress=explored)
+
+
+@dataclass(frozen=True)
+class SupRun:
+    """One run of ``synth sup``: the rule set, its plant, and SUP from the engine chosen
+    (a :class:`~synth.sup.supervisor.Supervisor` listing its states, or a
+    :class:`~synth.symbolic.supervisor.SymbolicSupervisor` with counts only)."""
+
+    path: str
+    rules: RuleSet
+    plant: Plant
+    sup: Supervisor | SymbolicSupervisor
+
+    @property
+    def bdd_nodes(self) -> int | None:
+        """The symbolic engine's BDD node count; None when the explicit engine ran."""
+        from synth.sup.supervisor import Supervisor
+
+        return None if isinstance(self.sup, Supervisor) else self.sup.nodes
+
+    def listed(self) -> Supervisor:
+        """SUP with its states listed, for ``--export``: the explicit engine's
+        (``needs_listing`` chose it)."""
+        from synth.sup.supervisor import Supervisor
+
+        if not isinstance(self.sup, Supervisor):
+            raise SynthError("the symbolic engine lists no state: use --engine explicit")
+        return self.sup
+
+    @property
+    def labels(self) -> dict[str, str]:
+        return {c.id: c.label for c in self.rules.constraints}
+
+    def summary(self) -> dict[str, Any]:
+        """The JSON of ``synth sup`` (the key ``symbolic`` when the symbolic engine ran)."""
+        from synth.output.summary import sup_summary
+
+        data = sup_summary(self.rules, self.sup, self.path)
+        if self.bdd_nodes is not None:
+            data["symbolic"] = {"bdd_nodes": self.bdd_nodes}
+        return data
+
+    def why(self, state: str | None = None) -> Explanation:
+        """Why ``state`` (its true variables; default the initial state) is in SUP or not."""
+        from synth.sup.explain import explain
+        from synth.sup.supervisor import Supervisor
+
+        sup = self.sup if isinstance(self.sup, Supervisor) else Supervisor(self.plant, self.rules.constraints)
+        return explain(sup, self.plant.initial if state is None else self.plant.parse_state(state))
+
+    def text(self) -> str:
+        """The terminal listing of :meth:`summary`, with why SUP is empty when it is."""
+        from synth.output.summary import sup_text
+
+        labels = self.labels
+        return sup_text(self.summary(), labels, self.why().text(labels) if self.sup.empty else "")
+
+
+def supervisor(
+    rules_path: str | Path,
+    *,
+    engine: EngineChoice | str = EngineChoice.AUTO,
+    needs_listing: bool = False,
+    max_states: int | None = None,
+    max_nodes: int | None = None,
+    progress: Callable[[str], None] | None = None,
+    loaded: Callable[[Plant], None] | None = None,
+) -> SupRun:
+    """``synth sup``: load, choose the engine, run it. ``needs_listing``: ``--export`` or
+    ``--why`` will list states (explicit engine only); ``max_states`` refuses larger
+    plants in the explicit engine; ``loaded(plant)`` is called once the plant is built,
+    before anything can fail on its size (the CLI prints the plant's warnings)."""
+    from synth.plant.composition import plant
+    from synth.plant.rules_check import load_rules
+
+    rs = load_rules(rules_path)
+    p = plant(rs)
+    if loaded is not None:
+        loaded(p)
+    chosen = choose(engine, p.size, threshold=SUP_THRESHOLD, needs_listing=needs_listing, listing_option="--export/--why")
+    if chosen == EngineChoice.SYMBOLIC:
+        from synth.symbolic.encoding import NodeBudget
+        from synth.symbolic.supervisor import symbolic_supervisor
+
+        return SupRun(str(rules_path), rs, p, symbolic_supervisor(p, rs.constraints, budget=NodeBudget(max_nodes),
+                                                                  progress=progress))
+    if max_states is not None and p.size > max_states:
+        raise LimitExceeded(
+            f"the plant of {rules_path} has {p.size} states, more than --max-states {max_states}; "
+            "the explicit exploration lists every SUP state. Raise --max-states, use --engine symbolic "
+            "(counts on BDDs, any size), or validate a Grafcet with `synth validate`"
+        )
+    from synth.sup.supervisor import supremal_controllable
+
+    return SupRun(str(rules_path), rs, p, supremal_controllable(p, rs.constraints, progress=progress))
