@@ -83,3 +83,44 @@ def test_filter_verify_traces_and_a_pass(tmp_path, capsys):
     assert events[-1] == "↑cp11"
     (suite,) = list(JUnitXml.fromfile(str(junit)))
     assert (suite.tests, suite.failures) == (1, 0)
+
+
+def test_validate_locates_the_blocking_situation_at_the_awaited_transition(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(ROOT)
+    junit, sarif = tmp_path / "v.xml", tmp_path / "v.sarif"
+    code = main(["validate", "grafcets/tri_missing_order.g7", "--plant", "plants/tri.rules",
+                 "--junit", str(junit), "--sarif", str(sarif)])
+    capsys.readouterr()
+    assert code == 1
+    log = json.loads(sarif.read_text(encoding="utf-8"))
+    assert_sarif(log)
+    (result,) = log["runs"][0]["results"]
+    assert result["ruleId"] == "missing_order" and result["message"]["text"].startswith("missing order AVANCER2 in step 103")
+    assert result["locations"][0]["physicalLocation"] == {
+        "artifactLocation": {"uri": "grafcets/tri_missing_order.g7"}, "region": {"startLine": 29, "startColumn": 14}}
+    line = (ROOT / "grafcets/tri_missing_order.g7").read_text(encoding="utf-8").splitlines()[28]
+    assert line[13:].startswith("103 -> 104")
+    events = [s["location"]["message"]["text"] for s in result["codeFlows"][0]["threadFlows"][0]["locations"]]
+    assert events == ["↑dcy", "↑cp12", "2s/X101", "↓v10", "↑v11"]
+    (suite,) = list(JUnitXml.fromfile(str(junit)))
+    (case,) = list(suite)
+    assert (suite.tests, suite.failures) == (1, 1) and case.result[0].type == "missing_order"
+    # the symbolic engine writes the same files
+    junit2, sarif2 = tmp_path / "s.xml", tmp_path / "s.sarif"
+    assert main(["validate", "grafcets/tri_missing_order.g7", "--plant", "plants/tri.rules", "--engine", "symbolic",
+                 "--quiet", "--junit", str(junit2), "--sarif", str(sarif2)]) == 1
+    capsys.readouterr()
+    assert sarif2.read_bytes() == sarif.read_bytes() and junit2.read_bytes() == junit.read_bytes()
+
+
+def test_validate_pass_is_one_passing_case(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(ROOT)
+    junit, sarif = tmp_path / "v.xml", tmp_path / "v.sarif"
+    assert main(["validate", "grafcets/tri.g7", "--plant", "plants/tri.rules", "--junit", str(junit), "--sarif", str(sarif)]) == 0
+    capsys.readouterr()
+    log = json.loads(sarif.read_text(encoding="utf-8"))
+    assert_sarif(log)
+    assert log["runs"][0]["results"] == []
+    assert log["runs"][0]["invocations"][0]["properties"]["verdicts"] == {"validate grafcets/tri.g7": "pass"}
+    (suite,) = list(JUnitXml.fromfile(str(junit)))
+    assert (suite.tests, suite.failures) == (1, 0)

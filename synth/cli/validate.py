@@ -30,6 +30,8 @@ def register(sub: "argparse._SubParsersAction") -> None:
                         "estimated size (default; docs/symbolic.md)")
     v.add_argument("--max-nodes", metavar="N", type=int, help="stop when the symbolic engine needs more than N BDD nodes")
     v.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    v.add_argument("--junit", metavar="FILE", help="also write the findings as JUnit XML (one test case per finding)")
+    v.add_argument("--sarif", metavar="FILE", help="also write the findings as SARIF 2.1.0 (one result per finding)")
     v.set_defaults(handler=cmd_validate)
 
 
@@ -70,6 +72,10 @@ def cmd_validate(args: argparse.Namespace) -> int:
         path = Path(args.cor)
         write_atomic(path, json_text(cor))
         write_atomic(path.with_suffix(".dot"), cor_dot(cor))
+    if args.junit or args.sarif:
+        from synth.output.ci import validation_report, write_ci
+
+        write_ci([validation_report(result)], args.junit, args.sarif)
     report_path = None
     if args.report is not None:
         directory = args.report or str(Path("reports") / Path(args.grafcet).stem)

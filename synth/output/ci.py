@@ -30,9 +30,10 @@ if TYPE_CHECKING:  # pragma: no cover
     from synth.filter.coherence import Check
     from synth.filter.language import Filter
     from synth.filter.verification import Verification
+    from synth.validation.result import Validation
 
 __all__ = ["Level", "Verdict", "CiFinding", "CiReport", "junit_xml", "sarif_json", "SARIF_SCHEMA",
-           "filter_check_report", "filter_verify_report", "located", "write_ci"]
+           "filter_check_report", "filter_verify_report", "validation_report", "located", "write_ci"]
 
 SARIF_SCHEMA = "https://docs.oasis-open.org/sarif/sarif/v2.1.0/errata01/os/schemas/sarif-schema-2.1.0.json"
 
@@ -182,6 +183,56 @@ def filter_verify_report(f: Filter, v: Verification) -> CiReport:
                                 _constraint_location(f, x.constraints), f.file, [r.event for r in x.trace]))
     verdict = Verdict.PASS if v.safe and v.coherent else Verdict.FAIL
     return CiReport("filter verify", f.file, verdict, tuple(findings))
+
+
+def validation_report(v: Validation) -> CiReport:
+    """``synth validate``: one error per blocking situation (its diagnosis, at the awaited
+    transition it names), per prohibited order (at the step that emits it) and for a
+    Grafcet that never starts; a warning per OR conflict. Read from the validation's JSON,
+    so both engines give the same file."""
+    from synth.grafcet.language import step_variable
+    from synth.output.result import validation_json
+
+    data = validation_json(v)
+    g, file = v.grafcet, str(data["grafcet"])
+    transitions = {(t.grafcet, f"{','.join(t.sources)}->{','.join(t.targets)}"): t.loc for t in g.transitions}
+    steps = {step_variable(s.name): s for s in g.steps}
+
+    def awaited_location(diagnosis: dict[str, Any]) -> Location | None:
+        awaited = diagnosis.get("awaited") or []
+        named = [a for a in awaited if f"transition {a['transition']} of {a['grafcet']}" in diagnosis.get("summary", "")]
+        for a in named + awaited:
+            loc = transitions.get((a["grafcet"], a["transition"]))
+            if loc is not None:
+                return loc
+        return None
+
+    def emitting_step(state: dict[str, Any], order: str) -> Location | None:
+        for x in state["situation"]:
+            step = steps.get(x)
+            if step is not None and any(a.order == order for a in step.actions):
+                return step.loc
+        return None
+
+    findings = []
+    if data["never_starts"] is not None:
+        d = data["never_starts"]
+        findings.append(located(str(d["verdict"]), Level.ERROR, d["summary"], awaited_location(d), file))
+    for b in data["blocking"]:
+        d = b["diagnosis"]
+        findings.append(located(str(d["verdict"]), Level.ERROR, d["summary"], awaited_location(d), file, b["trace"]))
+    for pr in data["prohibited"]:
+        findings.append(located("prohibited_order", Level.ERROR, pr["diagnosis"], emitting_step(pr, pr["order"]),
+                                file, pr["trace"]))
+    for c in data["conflicts"]:
+        loc = steps[step_variable(c["step"])].loc if step_variable(c["step"]) in steps else None
+        findings.append(located("or_conflict", Level.WARNING,
+                                f"OR divergence of step {c['step']}: {', '.join(c['transitions'])} fire together on {c['event']}",
+                                loc, file, c["trace"]))
+    if data["sup_empty"]:
+        findings.append(located("sup_empty", Level.ERROR, "SUP is empty: the initial plant state is illegal or defended",
+                                None, str(data["plant"])))
+    return CiReport("validate", file, Verdict.PASS if v.passed else Verdict.FAIL, tuple(findings))
 
 
 def write_ci(reports: Sequence[CiReport], junit: str | None = None, sarif: str | None = None) -> None:
