@@ -34,3 +34,16 @@ def test_help_still_exits_0(capsys):
     assert e.value.code == 0
     out = capsys.readouterr().out
     assert all(c in out for c in COMMANDS), out
+
+
+def test_validate_help_explains_the_words_of_a_state(capsys):
+    """Sit, E, Z, ORD and PROH are explained in ``validate --help`` as in the report's legend."""
+    import pytest
+
+    with pytest.raises(SystemExit) as done:
+        main(["validate", "--help"])
+    assert done.value.code == 0
+    out = capsys.readouterr().out
+    for term in ("Sit ", "E ", "Z ", "ORD ", "PROH "):
+        assert f"\n  {term}" in out
+    assert "SUP forbids" in out and "SUP authorises" in out

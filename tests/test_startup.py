@@ -53,7 +53,9 @@ def test_help_imports_only_argparse_and_the_cli() -> None:
         # nor the standard library's slower modules, nor synth's library
         slow = {"typing", "dataclasses", "inspect", "json", "pathlib", "difflib", "fractions"}
         assert sorted(loaded & slow) == [], key
-        assert [m for m in loaded if m.startswith("synth.") and not m.startswith("synth.cli") and m != "synth.version"] == [], key
+        # the glossary the validate --help epilog shows is text with no import behind it
+        text_only = {"synth.version", "synth.output", "synth.output.glossary"}
+        assert [m for m in loaded if m.startswith("synth.") and not m.startswith("synth.cli") and m not in text_only] == [], key
 
 
 VALIDATE = """

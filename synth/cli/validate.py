@@ -9,10 +9,14 @@ __all__ = ["register", "cmd_validate"]
 
 
 def register(sub: "argparse._SubParsersAction") -> None:
+    from synth.output.glossary import GLOSSARY  # text only: no import behind it
+
     v = sub.add_parser(
         "validate",
         help="validate a Grafcet against a plant: blocking situations, prohibited orders, diagnoses",
         description="Exit 0 when nothing is found, 1 when problems are found, 2 for bad input.",
+        epilog="A state of the results (text, JSON, report) is written in these words:\n" + GLOSSARY,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     v.add_argument("grafcet", metavar="GRAFCET.g7", help="the control program")
     v.add_argument("--plant", metavar="RULES", required=True, help="the plant (.rules, with its constraints)")
