@@ -38,7 +38,7 @@ def test_help_still_exits_0(capsys):
 
 def test_validate_help_explains_the_words_of_a_state(capsys):
     """Sit, E, Z, ORD and PROH are explained in ``validate --help`` as in the report's legend."""
-    import pytest
+    from synth.cli.main import main
 
     with pytest.raises(SystemExit) as done:
         main(["validate", "--help"])
