@@ -135,3 +135,28 @@ def test_verdict(tmp_path, name):
     assert list(v.analysis.traces[b].events) == trace
     d = v.diagnoses[b]
     assert (d.verdict, d.summary) == (verdict, summary)
+
+
+def test_an_edge_and_a_level_name_the_missing_order():
+    """No single input event makes ``↑dcy & v1`` true with ``v1`` false: the diagnosis looks
+    for the fewest changes (``↓dcy``, ``↑v1``, then ``↑dcy``) and blames the order behind
+    ``↑v1`` (it said ``unknown``, "waiting on steps" with no step involved)."""
+    import json
+
+    from conftest import ROOT
+    from schemas import assert_valid
+    from synth.output.result import validation_json
+    from test_symbolic import validate_symbolic
+
+    g7, rules = ROOT / "tests/data/home/edge_and_level.g7", ROOT / "tests/data/home/cylinder.rules"
+    v = validate(g7, rules)
+    (d,) = [v.diagnoses[i] for i in v.analysis.blocking]
+    assert d.verdict is Verdict.MISSING_ORDER
+    assert d.summary.startswith("missing order AVANCER in step 1: transition 1->2 of G awaits ↑dcy & v1, which needs ↑v1")
+    assert "it needs ↓dcy, ↑v1 first, then ↑dcy" in d.details[0]
+    assert not any("waiting on steps" in line for line in d.details)
+    data = validation_json(v)
+    assert_valid("validate", data)
+    awaited = data["blocking"][0]["diagnosis"]["awaited"][0]
+    assert (awaited["events"], awaited["first"], awaited["then"]) == ([], ["↓dcy", "↑v1"], "↑dcy")
+    assert json.dumps(validation_json(validate_symbolic(g7, rules)), ensure_ascii=False) == json.dumps(data, ensure_ascii=False)

@@ -309,6 +309,43 @@ class GrafcetMachine:
                 out.append(event)
         return tuple(out)
 
+    def first_events(self, sit: Situation, t: Transition, inputs: Mapping[str, bool],
+                     limit: int = 12) -> tuple[tuple[Event, ...], Event | None]:
+        """When no single input change makes ``t`` fireable: the fewest input changes
+        needed first, and the change that then fires it (``↑a & b`` with ``a`` true and
+        ``b`` false needs ``↓a`` and ``↑b``, then ``↑a``); ``((), None)`` when none does
+        or the receptivity reads more than ``limit`` inputs. Ties go to the first in
+        input-name order.
+
+        >>> from synth.grafcet.language_check import parse_grafcet
+        >>> m = GrafcetMachine(parse_grafcet("grafcet G { initial step 0 step 1 "
+        ...                    "transition 0 -> 1 when ↑a & b }"))
+        >>> s0 = m.initial({"a": True, "b": False})
+        >>> m.enabling_events(s0, m.transitions[0], {"a": True, "b": False})
+        ()
+        >>> m.first_events(s0, m.transitions[0], {"a": True, "b": False})
+        (('↓a', '↑b'), '↑a')
+        """
+        from itertools import product
+
+        i = self._index[t]
+        active, elapsed = frozenset(sit.steps), frozenset(sit.elapsed)
+        names = sorted(self._rec_inputs[i] & inputs.keys())
+        best: tuple[int, tuple[Event, ...], Event] | None = None
+        if len(names) > limit:
+            return (), None
+        for values in product((False, True), repeat=len(names)):
+            before = dict(zip(names, values))
+            changes = tuple(Event.edge(x, v) for x, v in before.items() if v != inputs[x])
+            if best is not None and len(changes) + 1 >= best[0]:
+                continue
+            for y in names:
+                after = {**inputs, **before, y: not before[y]}
+                if self._rec[i](after, active, elapsed, Event.edge(y, after[y])):
+                    best = (len(changes) + 1, changes, Event.edge(y, after[y]))
+                    break
+        return ((), None) if best is None else (best[1], best[2])
+
     def waiting_steps(self, sit: Situation, t: Transition) -> tuple[str, ...]:
         """Step variables read by ``t``'s receptivity whose step is not active in ``sit``."""
         return tuple(sorted(step_variable(s) for s in self._rec_steps[self._index[t]] if s not in sit.steps))

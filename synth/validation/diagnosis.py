@@ -93,6 +93,8 @@ class Awaited:
     steps: tuple[str, ...] = ()  # step variables it waits on, not active
     causes: tuple[Cause, ...] = ()
     sources: tuple[str, ...] = ()  # the transition's source steps
+    first: tuple[Event, ...] = ()  # no single event suffices: the changes needed first (causes are theirs)
+    last: Event | None = None  # ... and the change that then makes it true
 
     def as_dict(self) -> dict[str, Any]:
         return {
@@ -103,6 +105,7 @@ class Awaited:
             "events": list(self.events),
             "waits_on_steps": list(self.steps),
             "causes": [c.as_dict() for c in self.causes],
+            **({"first": list(self.first), "then": self.last} if self.first else {}),
         }
 
 
@@ -206,15 +209,26 @@ def diagnose(sync: Sync, node_index: int, *, expert: bool = False, component: Se
     for t in machine.awaited(node.situation):
         events = machine.enabling_events(node.situation, t, inputs)
         steps = machine.waiting_steps(node.situation, t)
-        causes = tuple(_element_cause(sync, node, e) for e in events)
-        awaited.append(Awaited(t.name, t.grafcet, t.receptivity.text(), events, steps, causes, tuple(t.sources)))
+        first, last = ((), None) if events else machine.first_events(node.situation, t, inputs)
+        causes = tuple(_element_cause(sync, node, e) for e in events or first)
+        awaited.append(Awaited(t.name, t.grafcet, t.receptivity.text(), events, steps, causes, tuple(t.sources),
+                               first, last))
     details = []
     waiting = []
+    stuck = []
     for a in awaited:
-        if not a.events:
-            waiting.append(f"{a.grafcet} {a.transition}" + (f" ({', '.join(a.steps)})" if a.steps else f" ({a.receptivity})"))
+        if a.first:
+            details.append(f"transition {a.transition} of {a.grafcet} awaits {a.receptivity}: no single input change "
+                           f"makes it true; it needs {', '.join(a.first)} first, then {a.last}")
+        elif not a.events:
+            if a.steps:
+                waiting.append(f"{a.grafcet} {a.transition} ({', '.join(a.steps)})")
+            else:
+                stuck.append(f"{a.grafcet} {a.transition} ({a.receptivity})")
             continue
-        details.append(f"transition {a.transition} of {a.grafcet} awaits {a.receptivity}: it becomes true with {' or '.join(a.events)}")
+        else:
+            details.append(f"transition {a.transition} of {a.grafcet} awaits {a.receptivity}: "
+                           f"it becomes true with {' or '.join(a.events)}")
         for c in a.causes:
             if c.element is None:
                 details.append(f"  {c.event}: no plant element drives {c.event.name}")
@@ -233,6 +247,8 @@ def diagnose(sync: Sync, node_index: int, *, expert: bool = False, component: Se
                 details.append(f"  {c.event} (element {c.element}) cannot be produced from its current state; rules: {rules}")
     if waiting:
         details.append("waiting on steps: " + "; ".join(waiting))
+    if stuck:
+        details.append("no input change can make true: " + "; ".join(stuck))
     verdict, summary = _verdict(sync, node, awaited, expert, component)
     return Diagnosis(verdict, summary, tuple(awaited), tuple(details))
 
