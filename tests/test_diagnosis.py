@@ -160,3 +160,15 @@ def test_an_edge_and_a_level_name_the_missing_order():
     awaited = data["blocking"][0]["diagnosis"]["awaited"][0]
     assert (awaited["events"], awaited["first"], awaited["then"]) == ([], ["↓dcy", "↑v1"], "↑dcy")
     assert json.dumps(validation_json(validate_symbolic(g7, rules)), ensure_ascii=False) == json.dumps(data, ensure_ascii=False)
+
+
+def test_an_input_with_the_initial_steps_timer_names_the_missing_order():
+    """``v1 & 2s/X0``: on the initial state the timer has not elapsed, so no input event
+    alone makes it true; read once time has passed, ``↑v1`` does, and AVANCER is missing."""
+    from conftest import ROOT
+
+    v = validate(ROOT / "tests/data/home/timer_and_level.g7", ROOT / "tests/data/home/cylinder.rules")
+    assert v.never_starts is not None
+    assert v.never_starts.summary.startswith(
+        "the Grafcet never leaves its initial steps {X0}: missing order AVANCER in step 0: "
+        "transition 0->1 of G awaits v1 & 2s/X0, which needs ↑v1")

@@ -287,9 +287,18 @@ class GrafcetMachine:
             if all(s in active for s in t.sources) and self._rec[i](inputs, active, elapsed, None)
         ]
 
-    def enabling_events(self, sit: Situation, t: Transition, inputs: Mapping[str, bool]) -> tuple[Event, ...]:
+    def _elapsed(self, sit: Situation, after_time: bool) -> frozenset[str]:
+        """The elapsed timers of ``sit``; with ``after_time``, every timer of its active steps
+        too (time passes while the Grafcet waits)."""
+        if not after_time:
+            return frozenset(sit.elapsed)
+        return frozenset(sit.elapsed).union(*(self._timers_of_step.get(s, ()) for s in sit.steps))
+
+    def enabling_events(self, sit: Situation, t: Transition, inputs: Mapping[str, bool],
+                        after_time: bool = False) -> tuple[Event, ...]:
         """The single input changes that would make ``t`` fireable in ``sit`` (inputs at
-        ``inputs``), in input-name order.
+        ``inputs``; with ``after_time``, once the timers of its active steps have elapsed),
+        in input-name order.
 
         >>> from synth.grafcet.language_check import parse_grafcet
         >>> m = GrafcetMachine(parse_grafcet("grafcet G { initial step 0 step 1 "
@@ -299,7 +308,7 @@ class GrafcetMachine:
         ('↑a',)
         """
         i = self._index[t]
-        active, elapsed = frozenset(sit.steps), frozenset(sit.elapsed)
+        active, elapsed = frozenset(sit.steps), self._elapsed(sit, after_time)
         out = []
         for x in sorted(self._rec_inputs[i] & inputs.keys()):
             after = dict(inputs)
@@ -310,7 +319,7 @@ class GrafcetMachine:
         return tuple(out)
 
     def first_events(self, sit: Situation, t: Transition, inputs: Mapping[str, bool],
-                     limit: int = 12) -> tuple[tuple[Event, ...], Event | None]:
+                     limit: int = 12, after_time: bool = False) -> tuple[tuple[Event, ...], Event | None]:
         """When no single input change makes ``t`` fireable: the fewest input changes
         needed first, and the change that then fires it (``↑a & b`` with ``a`` true and
         ``b`` false needs ``↓a`` and ``↑b``, then ``↑a``); ``((), None)`` when none does
@@ -329,7 +338,7 @@ class GrafcetMachine:
         from itertools import product
 
         i = self._index[t]
-        active, elapsed = frozenset(sit.steps), frozenset(sit.elapsed)
+        active, elapsed = frozenset(sit.steps), self._elapsed(sit, after_time)
         names = sorted(self._rec_inputs[i] & inputs.keys())
         best: tuple[int, tuple[Event, ...], Event] | None = None
         if len(names) > limit:

@@ -208,8 +208,10 @@ def diagnose(sync: Sync, node_index: int, *, expert: bool = False, component: Se
     inputs = sync.inputs(node.plant)
     for t in machine.awaited(node.situation):
         events = machine.enabling_events(node.situation, t, inputs)
+        if not events:  # an input together with a timer of an active step: once time has passed
+            events = machine.enabling_events(node.situation, t, inputs, after_time=True)
         steps = machine.waiting_steps(node.situation, t)
-        first, last = ((), None) if events else machine.first_events(node.situation, t, inputs)
+        first, last = ((), None) if events else machine.first_events(node.situation, t, inputs, after_time=True)
         causes = tuple(_element_cause(sync, node, e) for e in events or first)
         awaited.append(Awaited(t.name, t.grafcet, t.receptivity.text(), events, steps, causes, tuple(t.sources),
                                first, last))
