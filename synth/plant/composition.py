@@ -22,6 +22,7 @@ Example
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from functools import cached_property
@@ -51,6 +52,19 @@ class LocalTransition:
     dst: int
     event: Event
     controllable: bool
+
+
+class _LocalValues(dict[int, dict[str, bool]]):
+    """Local state index → its variables' values, for one element, filled on first use."""
+
+    def __init__(self, element: ElementAutomaton) -> None:
+        super().__init__()
+        self.element = element
+
+    def __missing__(self, k: int) -> dict[str, bool]:
+        code = int(self.element.codes[k])
+        values = self[k] = {v: bool((code >> b) & 1) for b, v in enumerate(self.element.variables)}
+        return values
 
 
 class Plant:
@@ -140,11 +154,16 @@ class Plant:
     def valuation(self, local: tuple[int, ...]) -> dict[str, bool]:
         """Every variable's value in the state ``local`` (a tuple of local indices)."""
         out: dict[str, bool] = {}
-        for e, k in zip(self.elements, local):
-            code = int(e.codes[k])
-            for b, v in enumerate(e.variables):
-                out[v] = bool((code >> b) & 1)
+        for values, k in zip(self._local_values, local):
+            out.update(values[k])
         return out
+
+    @functools.cached_property
+    def _local_values(self) -> tuple[_LocalValues, ...]:
+        """Per element, the variables' values of its local states, each decoded once, when
+        first met (decoding bit by bit on every call was a quarter of an explicit
+        validation's time; a large element is never decoded whole)."""
+        return tuple(_LocalValues(e) for e in self.elements)
 
     def label(self, local: tuple[int, ...]) -> str:
         """``{TAPIS,v10,...}``: the true variables in E-then-Z order."""
