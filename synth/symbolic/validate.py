@@ -23,13 +23,11 @@ from pathlib import Path
 from typing import Callable, Iterator, Sequence
 
 from synth.grafcet.language import Grafcet
-from synth.grafcet.language_check import load_grafcet
 from synth.grafcet.machine import GrafcetMachine
 from synth.logic.bdd import Function
 from synth.logic.expr import evaluate
-from synth.plant.composition import Plant, plant
+from synth.plant.composition import Plant
 from synth.plant.rules import RuleSet
-from synth.plant.rules_check import load_rules
 from synth.sup.constraints import CompiledConstraints
 from synth.symbolic.encoding import NodeBudget, live_nodes
 from synth.symbolic.reachability import (
@@ -51,7 +49,7 @@ from synth.validation.analysis import Analysis, Trace
 from synth.validation.diagnosis import diagnose_all
 from synth.validation.conflicts import Conflict
 from synth.validation.sync import Edge, Node, Prohibition, Sync, _order_moves
-from synth.validation.result import Validation, home_conditions
+from synth.validation.result import Validation, home_conditions, load_model
 
 __all__ = ["validate_symbolic", "validate_loaded"]
 
@@ -138,9 +136,7 @@ def validate_symbolic(
     progress: Callable[[str], None] | None = None,
 ) -> Validation:
     """Run the whole method with the symbolic engine (see module docstring)."""
-    rs = load_rules(rules_path)
-    p = plant(rs)
-    g = load_grafcet(grafcet_path, inputs=p.inputs, outputs=p.outputs)
+    rs, p, g = load_model(grafcet_path, rules_path)
     return validate_loaded(rs, p, g, expert=expert, homes=homes, max_nodes=max_nodes, progress=progress)
 
 

@@ -17,12 +17,13 @@ Example
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import TYPE_CHECKING, Sequence
 
 from synth.errors import InputError, close_names
 from synth.grafcet.language import Grafcet
 from synth.logic.expr import Edge as ExprEdge, Expr, names
-from synth.plant.composition import Plant
+from synth.plant.composition import Plant, plant
 from synth.plant.rules import RuleSet
 from synth.syntax import parse_expression
 from synth.validation.analysis import Analysis
@@ -31,7 +32,7 @@ from synth.validation.sync import Edge, Sync
 if TYPE_CHECKING:  # pragma: no cover - imported by the engines when there is something to diagnose
     from synth.validation.diagnosis import Diagnosis
 
-__all__ = ["Validation", "ReducedController", "reduced_controller", "home_conditions"]
+__all__ = ["Validation", "ReducedController", "reduced_controller", "home_conditions", "load_model"]
 
 
 @dataclass(frozen=True)
@@ -116,3 +117,14 @@ def home_conditions(texts: Sequence[str], p: Plant, g: Grafcet) -> tuple[Expr, .
                                  notes=("a home condition reads step variables (X1) and plant variables (E, Z)",))
         out.append(e)
     return tuple(out)
+
+
+def load_model(grafcet_path: str | Path, rules_path: str | Path) -> tuple[RuleSet, Plant, Grafcet]:
+    """What both engines validate: the rules, their plant, and the Grafcet checked against
+    the plant's inputs and outputs (the rules first: the Grafcet's names are checked by them)."""
+    from synth.grafcet.language_check import load_grafcet
+    from synth.plant.rules_check import load_rules
+
+    rs = load_rules(rules_path)
+    p = plant(rs)
+    return rs, p, load_grafcet(grafcet_path, inputs=p.inputs, outputs=p.outputs)

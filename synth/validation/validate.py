@@ -17,15 +17,13 @@ from pathlib import Path
 from typing import Callable, Sequence
 
 from synth.grafcet.language import Grafcet
-from synth.grafcet.language_check import load_grafcet
 from synth.grafcet.machine import GrafcetMachine
 from synth.logic.expr import Expr, evaluate
-from synth.plant.composition import Plant, plant
+from synth.plant.composition import Plant
 from synth.plant.rules import RuleSet
-from synth.plant.rules_check import load_rules
 from synth.sup.constraints import CompiledConstraints
 from synth.validation.analysis import analyse
-from synth.validation.result import Validation, home_conditions
+from synth.validation.result import Validation, home_conditions, load_model
 from synth.validation.sync import Sync, synchronous_product
 
 __all__ = ["validate", "validate_loaded", "home_states"]
@@ -57,9 +55,7 @@ def validate(
     progress: Callable[[int, int], None] | None = None,
 ) -> Validation:
     """Run the whole method on a Grafcet and a plant; ``homes`` are ``--home`` conditions."""
-    rs = load_rules(rules_path)
-    p = plant(rs)
-    g = load_grafcet(grafcet_path, inputs=p.inputs, outputs=p.outputs)
+    rs, p, g = load_model(grafcet_path, rules_path)
     return validate_loaded(rs, p, g, expert=expert, homes=homes, max_states=max_states, progress=progress)
 
 
