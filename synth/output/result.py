@@ -186,5 +186,6 @@ def cor_dot(cor: dict[str, Any]) -> str:
     """DOT text of :func:`cor_json`'s data: one box per state (situation, orders)."""
     nodes = [(str(s["id"]), "{" + ", ".join(s["situation"]) + "}\n" + ", ".join(s["orders"]), {"shape": "box"})
              for s in cor["states"]]
-    edges = [(str(t["source"]), str(t["target"]), t["event"], {}) for t in cor["transitions"]]
+    plain: dict[str, str] = {}
+    edges = [(str(t["source"]), str(t["target"]), str(t["event"]), plain) for t in cor["transitions"]]
     return dot_graph("COR", nodes, edges)
