@@ -107,10 +107,17 @@ class _Explicit:
 
 def _homes(ssync: SymbolicSync, texts: Sequence[str], p: Plant, g: Grafcet) -> NodeSet:
     homes: NodeSet = dict(ssync.initial)
+    engine = ssync.engine
+    for s0, u in ssync.initial.items():  # the initial situation after waiting: its timers elapsed
+        key = (ssync.situations[s0].steps, ssync.situations[s0].stored)
+        for s, r in enumerate(ssync.regions):
+            if s != s0 and (ssync.situations[s].steps, ssync.situations[s].stored) == key:
+                hit = u & r.nodes
+                if hit != engine.false:
+                    homes[s] = homes.get(s, engine.false) | hit
     conditions = home_conditions(texts, p, g)
     if not conditions:
         return homes
-    engine = ssync.engine
     for s, r in enumerate(ssync.regions):
         steps = set(ssync.situations[s].step_variables)
 

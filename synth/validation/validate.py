@@ -30,9 +30,13 @@ __all__ = ["validate", "validate_loaded", "home_states"]
 
 
 def home_states(sync: Sync, conditions: Sequence[Expr]) -> frozenset[int]:
-    """The home states: the initial aggregated states, and every state where one of
-    ``conditions`` holds (read on its active steps and its plant values)."""
+    """The home states: the initial aggregated states, the states that differ from one only
+    by elapsed timers (the initial situation after waiting: docs/method.md, "Home states"),
+    and every state where one of ``conditions`` holds (read on its active steps and its
+    plant values)."""
     homes = set(sync.initial)
+    start = {(n.situation.steps, n.situation.stored, n.plant) for n in (sync.nodes[i] for i in sync.initial)}
+    homes.update(i for i, n in enumerate(sync.nodes) if (n.situation.steps, n.situation.stored, n.plant) in start)
     for i, n in enumerate(sync.nodes if conditions else ()):
         val = sync.plant.valuation(n.plant)
         steps = set(n.situation.step_variables)
