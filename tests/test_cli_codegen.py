@@ -8,7 +8,7 @@ import pytest
 
 from synth.cli.main import main
 from synth.codegen.grafcet_st import synth_version
-from synth.codegen.plcopen import validation_errors
+from synth.codegen.plcopen_xml import validation_errors
 
 ROOT = Path(__file__).resolve().parent.parent
 

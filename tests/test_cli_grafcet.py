@@ -58,11 +58,11 @@ def test_run_missing_order_blocks_with_only_tapis(capsys):
 
 
 def test_run_without_plant_and_initial_values(capsys):
-    code, out, _ = run(capsys, "run", "grafcets/conditional.g7", "--initial", "high=1", "--events", "↑on,↓high")
+    code, out, _ = run(capsys, "run", "grafcets/conditional.g7", "--initial", "high=1", "--events", "↑go,↓high")
     assert code == 0
     assert out.splitlines() == [
         "0  initial  {X0}  orders: -",
-        "1  ↑on      {X1}  orders: LIGHT   fired: 0->1",
+        "1  ↑go      {X1}  orders: LIGHT   fired: 0->1",
         "2  ↓high    {X1}  orders: PUMP, LIGHT",
     ]
 
@@ -105,12 +105,12 @@ def test_ass_text(capsys):
         "    ↑r -> S2\n"
         "\n"
         "S1  {X1}\n"
-        "    orders: LEFT\n"
+        "    orders: GO_LEFT\n"
         "    ↓l  [!r] -> S0\n"
         "    ↓l  [r] -> S2\n"
         "\n"
         "S2  {X2}\n"
-        "    orders: RIGHT\n"
+        "    orders: GO_RIGHT\n"
         "    ↓r  [!l] -> S0\n"
         "    ↓r  [l] -> S1\n"
     )

@@ -7,8 +7,10 @@ from pathlib import Path
 
 import pytest
 
-from synth.codegen.grafcet_st import grafcet_program, synth_version
-from synth.codegen.plcopen import import_sfc, sfc_project_xml, st_project_xml, validation_errors
+from synth.codegen.grafcet_st import generate_program, grafcet_program, synth_version
+from synth.codegen.plcopen_export import sfc_project_xml, st_project_xml
+from synth.codegen.plcopen_import import import_sfc
+from synth.codegen.plcopen_xml import validation_errors
 from synth.errors import InputError
 from synth.grafcet.ass import stable_situation_automaton
 from synth.grafcet.language_check import load_grafcet, parse_grafcet
@@ -42,7 +44,7 @@ def test_sfc_round_trip_keeps_the_ass_and_the_xml_is_valid(path: Path):
 
 @pytest.mark.parametrize("path", BUNDLED, ids=lambda p: str(p.relative_to(ROOT)))
 def test_st_program_as_plcopen_xml_is_valid(path: Path):
-    xml = st_project_xml(grafcet_program(load_grafcet(path), version="test"), name="p", version="test")
+    xml = st_project_xml(generate_program(load_grafcet(path), version="test").pous, name="p", version="test")
     assert validation_errors(xml) == []
     assert xml.count(b"<pou ") == 1 and b"<ST>" in xml
 

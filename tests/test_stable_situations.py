@@ -268,11 +268,11 @@ def test_stored_actions_on_events_and_reset_wins():
 def test_conditional_actions_depend_on_inputs_and_steps():
     m = GrafcetMachine(load_grafcet(ROOT / "grafcets/conditional.g7"))
     sim = Sim(m)
-    sim("↑on")
+    sim("↑go")
     assert sim.orders == ["LIGHT", "PUMP"]
     sim("↑high")
     assert sim.orders == ["LIGHT"]
-    assert m.orders(S("1"), {"on": True, "high": False}) == frozenset({"LIGHT", "PUMP"})
+    assert m.orders(S("1"), {"go": True, "high": False}) == frozenset({"LIGHT", "PUMP"})
     tri = GrafcetMachine(load_grafcet(ROOT / "grafcets/tri.g7"))
     ins = {n: False for n in tri.inputs}
     assert tri.orders(S("1", "100", "200", "300"), ins) == frozenset({"TAPIS"})
@@ -371,7 +371,7 @@ def test_ass_edges():
 
 def test_ass_or_divergence():
     assert ass_of("grafcets/or_divergence.g7") == (
-        [(0, "{X0}", (), ()), (1, "{X1}", ("LEFT",), ()), (2, "{X2}", ("RIGHT",), ())],
+        [(0, "{X0}", (), ()), (1, "{X1}", ("GO_LEFT",), ()), (2, "{X2}", ("GO_RIGHT",), ())],
         [
             (0, "↑l", "any", 1),
             (0, "↑r", "any", 2),

@@ -118,9 +118,9 @@ def cmd_st(args: argparse.Namespace) -> int:
         print(f"note: {n}", file=sys.stderr)
     text: str | bytes = block.text
     if args.xml:
-        from synth.codegen.plcopen import st_project_xml
+        from synth.codegen.plcopen_export import st_project_xml
 
-        text = st_project_xml(block.text, name=block.name, comment=f"safety logic filter from {args.filter}")
+        text = st_project_xml([block.pou], name=block.name, comment=f"safety logic filter from {args.filter}")
     write_or_print(args.output, text)
     return 0
 

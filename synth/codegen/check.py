@@ -34,7 +34,8 @@ from dataclasses import dataclass, field
 from enum import StrEnum
 from typing import Mapping, Sequence
 
-from synth.codegen.grafcet_st import StProgram, generate_program
+from synth.codegen.grafcet_st import generate_program
+from synth.codegen.program import StProgram
 from synth.errors import InputError
 from synth.grafcet.language import Grafcet
 from synth.grafcet.machine import GrafcetMachine, Situation

@@ -41,7 +41,18 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from synth.codegen.st import Declaration, header, indent, st_expression, st_identifier_problem, var_block
+from synth.codegen.st import (
+    Declaration,
+    Pou,
+    PouKind,
+    SectionKind,
+    VarSection,
+    header,
+    indent,
+    pou_lines,
+    st_expression,
+    st_identifier_problem,
+)
 from synth.errors import InputError, ModelError
 from synth.filter.cycle import Algorithm, Mode
 from synth.filter.language import Filter, request_name
@@ -69,6 +80,7 @@ class FilterBlock:
     inputs: tuple[str, ...]  # VAR_INPUT, in order
     outputs: tuple[str, ...]  # VAR_OUTPUT, in order
     text: str
+    pou: Pou  # the block as data (what the PLCopen writer renders)
     notes: list[str] = field(default_factory=list)
 
 
@@ -171,10 +183,11 @@ def filter_block(f: Filter, algorithm: Algorithm | str = Algorithm.ALGEBRAIC, mo
     if blocking:
         outputs.append(Declaration(BLOCKED, comment="a request violated a constraint; cleared by Ack"))
     details = [f"Algorithm {algorithm.value}, mode {mode.value}."] + [f"Note: {n}" for n in notes]
-    lines = header(f"Safety logic filter {fb}", [f.file], details)
-    lines += [f"FUNCTION_BLOCK {fb}", *var_block("VAR_INPUT", inputs), *var_block("VAR_OUTPUT", outputs),
-              *var_block("VAR", local), *body, "END_FUNCTION_BLOCK", ""]
-    return FilterBlock(fb, tuple(d.name for d in inputs), tuple(d.name for d in outputs), "\n".join(lines), notes)
+    sections = tuple(VarSection(kind, tuple(decls)) for kind, decls in
+                     ((SectionKind.INPUT, inputs), (SectionKind.OUTPUT, outputs), (SectionKind.LOCAL, local)) if decls)
+    pou = Pou(PouKind.FUNCTION_BLOCK, fb, sections, tuple(body))
+    lines = [*header(f"Safety logic filter {fb}", [f.file], details), *pou_lines(pou), ""]
+    return FilterBlock(fb, tuple(d.name for d in inputs), tuple(d.name for d in outputs), "\n".join(lines), pou, notes)
 
 
 def filter_function_block(f: Filter, algorithm: Algorithm | str = Algorithm.ALGEBRAIC,

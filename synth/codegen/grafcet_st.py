@@ -38,13 +38,27 @@ Example
 
 from __future__ import annotations
 
-import re
-from dataclasses import dataclass, field
-from fractions import Fraction
-from pathlib import Path
 from typing import Sequence
 
-from synth.codegen.st import st_expr
+from synth.codegen.program import (
+    FilterCall,
+    StProgram,
+    check_variable_name,
+    compact,
+    first_location,
+    program_name,
+)
+from synth.codegen.st import (
+    Declaration,
+    Pou,
+    PouKind,
+    SectionKind,
+    VarSection,
+    name_problem,
+    pou_lines,
+    st_expr,
+    timer_literal,
+)
 from synth.errors import InputError, Location
 from synth.version import version as synth_version
 from synth.grafcet.language import (
@@ -59,90 +73,9 @@ from synth.grafcet.language import (
 )
 from synth.logic.expr import Edge, Expr, Var, names
 
-__all__ = [
-    "DEFAULT_MAX_ROUNDS",
-    "IEC_KEYWORDS",
-    "FilterCall",
-    "filter_call",
-    "StProgram",
-    "generate_program",
-    "grafcet_program",
-    "program_name",
-    "st_expr",
-    "synth_version",
-    "time_literal",
-]
+__all__ = ["DEFAULT_MAX_ROUNDS", "generate_program", "grafcet_program"]
 
 DEFAULT_MAX_ROUNDS = 100
-
-# IEC 61131-3 Structured Text keywords, elementary types and standard function blocks: not
-# variable names (the textual SFC and configuration words, e.g. ON, STEP, are allowed)
-IEC_KEYWORDS = frozenset("""
-AND ANY ARRAY AT BOOL BY BYTE CASE CONSTANT DATE DINT DO DT DWORD ELSE ELSIF END_CASE END_FOR
-END_FUNCTION END_FUNCTION_BLOCK END_IF END_PROGRAM END_REPEAT END_STRUCT END_TYPE END_VAR END_WHILE
-EXIT F_TRIG FALSE FOR FUNCTION FUNCTION_BLOCK IF INT LINT LREAL MOD NOT OF OR PROGRAM R_TRIG REAL
-REPEAT RETURN RS SINT SR STRING STRUCT THEN TIME TO TOD TOF TON TP TRUE TYPE UDINT UINT ULINT UNTIL
-USINT VAR VAR_EXTERNAL VAR_GLOBAL VAR_IN_OUT VAR_INPUT VAR_OUTPUT VAR_TEMP WHILE WORD WSTRING XOR
-""".split())
-
-_IDENT = re.compile(r"^[A-Za-z]([A-Za-z0-9]|_(?=[A-Za-z0-9]))*$|^_[A-Za-z0-9]([A-Za-z0-9]|_(?=[A-Za-z0-9]))*$")
-
-
-@dataclass(frozen=True)
-class FilterCall:
-    """A safety filter run after the Grafcet: the text of its function block, its type and
-    instance names, and which of its inputs are requests (``R_<order>``).
-
-    The program passes the Grafcet's order ``o`` as ``R_o`` (``FALSE`` for an output the Grafcet
-    never orders) and every other name as the program's input of that name (declared when the
-    Grafcet does not read it), then copies the block's outputs to its own ``VAR_OUTPUT``.
-    """
-
-    fb_text: str
-    fb_type: str
-    inputs: tuple[str, ...]
-    outputs: tuple[str, ...]
-    instance: str = "_Filter"
-
-
-@dataclass(frozen=True)
-class StProgram:
-    """Generated Structured Text: the whole file, the ``PROGRAM``'s name, and the ST name of
-    every plant input/output and step variable that had to be renamed (case clashes)."""
-
-    text: str
-    program: str
-    renamed: tuple[tuple[str, str], ...] = field(default=())
-
-    def st_name(self, name: str) -> str:
-        """The ST variable of a plant input/output or step variable ``X<step>``."""
-        return dict(self.renamed).get(name, name)
-
-
-def time_literal(seconds: Fraction, loc: Location | None = None) -> str:
-    """An IEC ``TIME`` literal for a timer duration, in whole milliseconds.
-
-    >>> time_literal(Fraction(2)), time_literal(Fraction(3, 2)), time_literal(Fraction(120))
-    ('T#2s', 'T#1500ms', 'T#120s')
-    """
-    ms = seconds * 1000
-    if ms.denominator != 1 or ms <= 0:
-        raise InputError(f"a timer of {float(seconds)} s cannot be written in whole milliseconds", loc)
-    n = int(ms)
-    return f"T#{n // 1000}s" if n % 1000 == 0 else f"T#{n}ms"
-
-
-def program_name(path: str) -> str:
-    """The default ``PROGRAM`` name for a ``.g7`` file: its stem as an IEC identifier.
-
-    >>> program_name("grafcets/tri.g7"), program_name("x/2-axes.g7")
-    ('tri', 'G_2_axes')
-    """
-    stem = re.sub(r"[^A-Za-z0-9]+", "_", Path(path).stem).strip("_") or "Grafcet"
-    if not stem[0].isalpha():
-        stem = "G_" + stem
-    return stem
-
 
 def _or(terms: Sequence[str]) -> str:
     return " OR ".join(terms) if terms else "FALSE"
@@ -156,6 +89,7 @@ class _Writer:
     """Builds the program text, one declaration/statement per line."""
 
     def __init__(self, g: Grafcet, name: str, max_rounds: int, filt: FilterCall | None) -> None:
+        self.sections: tuple[VarSection, ...] = ()
         self.g = g
         self.name = name
         self.max_rounds = max_rounds
@@ -203,7 +137,7 @@ class _Writer:
         g = self.g
         user: dict[str, Location | None] = {}
         for n in (*g.inputs, *self.extra_inputs, *self.outputs):
-            user.setdefault(n, _first_loc(g, n))
+            user.setdefault(n, first_location(g, n))
         for s in self.steps:
             user.setdefault(s.variable, s.loc)
         internal = {"_Fire", "_Leave", "_Enter", "_Fired", "_Rounds", "Unstable", "_FirstCycle", "_InputEvent",
@@ -214,16 +148,10 @@ class _Writer:
         if self.filt is not None:
             internal |= {self.filt.fb_type} | {f"_Order_{o}" for o in g.outputs}
         for n, loc in user.items():
-            why = None
-            if not _IDENT.match(n):
-                why = "is not an IEC 61131-3 identifier (letters, digits, single underscores)"
-            elif n.upper() in IEC_KEYWORDS:
-                why = "is an IEC 61131-3 keyword or standard name"
-            elif n in internal:
-                why = "is a name the generated program uses itself"
-            if why:
-                raise InputError(f"'{n}' {why}: Structured Text cannot use it as a variable", loc,
-                                 notes=("rename it in the Grafcet (and the plant)",))
+            check_variable_name(n, loc)
+            if n in internal:
+                raise InputError(f"'{n}' is a name the generated program uses itself: Structured Text cannot use "
+                                 "it as a variable", loc, notes=("rename it in the Grafcet (and the plant)",))
         # ST is case-insensitive: of two user names differing in case only, the later one
         # (inputs, then outputs, then steps) is renamed <name>_<k>; the header lists it
         taken = {n.upper() for n in internal}
@@ -252,52 +180,37 @@ class _Writer:
             self.emit()
             self.lines.extend(self.filt.fb_text.rstrip("\n").split("\n"))
         self.emit()
-        self.emit(f"PROGRAM {self.name}")
-        self.emit("VAR_INPUT")
-        for i in g.inputs:
-            self.emit(f"{self.st(i)} : BOOL;", 1)
-        for i in self.extra_inputs:
-            self.emit(f"{self.st(i)} : BOOL; (* read by the filter only *)", 1)
-        self.emit("END_VAR")
-        self.emit("VAR_OUTPUT")
-        for o in self.outputs:
-            self.emit(f"{self.st(o)} : BOOL;" + ("" if o in g.outputs else " (* written by the filter only *)"), 1)
-        self.emit("Unstable : BOOL; (* a transient evolution did not stabilise within _MAX_ROUNDS rounds; latched *)", 1)
-        self.emit("END_VAR")
-        self.emit("VAR")
-        for s in self.steps:
-            init = " := TRUE" if s.initial else ""
-            self.emit(f"{self.st(s.variable)} : BOOL{init}; (* step {s.name} of {s.grafcet} *)", 1)
+        D = Declaration
+        inputs = [D(self.st(i)) for i in g.inputs]
+        inputs += [D(self.st(i), comment="read by the filter only") for i in self.extra_inputs]
+        outputs = [D(self.st(o), comment="" if o in g.outputs else "written by the filter only") for o in self.outputs]
+        outputs.append(D("Unstable", comment="a transient evolution did not stabilise within _MAX_ROUNDS rounds; latched"))
+        local = [D(self.st(s.variable), init="TRUE" if s.initial else None, comment=f"step {s.name} of {s.grafcet}")
+                 for s in self.steps]
         for t in g.timers:
             k = self.timer_index[t.id]
-            self.emit(f"_Tmr{k} : TON; (* {t.id} *)", 1)
-            self.emit(f"_TE{k} : BOOL; (* {t.id} has elapsed *)", 1)
-        for o in self.stored:
-            self.emit(f"_Mem_{self.st(o)} : BOOL; (* stored action memory of {self.st(o)} *)", 1)
-        for i in self.prev:
-            self.emit(f"_Prev_{self.st(i)} : BOOL; (* {self.st(i)} in the previous cycle *)", 1)
-        for i in self.rising:
-            self.emit(f"_RE_{self.st(i)} : BOOL; (* \u2191{self.st(i)} *)", 1)
-        for i in self.falling:
-            self.emit(f"_FE_{self.st(i)} : BOOL; (* \u2193{self.st(i)} *)", 1)
+            local += [D(f"_Tmr{k}", "TON", comment=t.id), D(f"_TE{k}", comment=f"{t.id} has elapsed")]
+        local += [D(f"_Mem_{self.st(o)}", comment=f"stored action memory of {self.st(o)}") for o in self.stored]
+        local += [D(f"_Prev_{self.st(i)}", comment=f"{self.st(i)} in the previous cycle") for i in self.prev]
+        local += [D(f"_RE_{self.st(i)}", comment=f"\u2191{self.st(i)}") for i in self.rising]
+        local += [D(f"_FE_{self.st(i)}", comment=f"\u2193{self.st(i)}") for i in self.falling]
         if g.transitions:
-            self.emit(f"_Fire : ARRAY[1..{len(g.transitions)}] OF BOOL; (* fireable transitions of the round *)", 1)
+            local.append(D("_Fire", f"ARRAY[1..{len(g.transitions)}] OF BOOL", comment="fireable transitions of the round"))
         if self.steps and self.needs_flags:
-            self.emit(f"_Leave : ARRAY[1..{len(self.steps)}] OF BOOL; (* steps deactivated (and not activated) *)", 1)
-            self.emit(f"_Enter : ARRAY[1..{len(self.steps)}] OF BOOL; (* steps activated (and not active) *)", 1)
-        self.emit("_Fired : BOOL;", 1)
-        self.emit("_Rounds : INT;", 1)
+            n = len(self.steps)
+            local += [D("_Leave", f"ARRAY[1..{n}] OF BOOL", comment="steps deactivated (and not activated)"),
+                      D("_Enter", f"ARRAY[1..{n}] OF BOOL", comment="steps activated (and not active)")]
+        local += [D("_Fired"), D("_Rounds", "INT")]
         if self.event_actions:
-            self.emit("_InputEvent : BOOL;", 1)
-        self.emit("_FirstCycle : BOOL := TRUE;", 1)
+            local.append(D("_InputEvent"))
+        local.append(D("_FirstCycle", init="TRUE"))
         if self.filt is not None:
-            self.emit(f"{self.filt.instance} : {self.filt.fb_type};", 1)
-            for o in g.outputs:
-                self.emit(f"_Order_{self.st(o)} : BOOL; (* the Grafcet's order, the filter's request R_{self.st(o)} *)", 1)
-        self.emit("END_VAR")
-        self.emit("VAR CONSTANT")
-        self.emit(f"_MAX_ROUNDS : INT := {self.max_rounds};", 1)
-        self.emit("END_VAR")
+            local.append(D(self.filt.instance, self.filt.fb_type))
+            local += [D(f"_Order_{self.st(o)}", comment=f"the Grafcet's order, the filter's request R_{self.st(o)}")
+                      for o in g.outputs]
+        self.sections = (VarSection(SectionKind.INPUT, tuple(inputs)), VarSection(SectionKind.OUTPUT, tuple(outputs)),
+                         VarSection(SectionKind.LOCAL, tuple(local)),
+                         VarSection(SectionKind.CONSTANT, (D("_MAX_ROUNDS", "INT", str(self.max_rounds)),)))
 
     def stored_update(self, o: str, sets: list[str], resets: list[str], indent: int) -> None:
         """``o``'s memory after one phase: sets, then resets (reset wins)."""
@@ -337,7 +250,7 @@ class _Writer:
         e("END_IF")
         for t in g.timers:
             k = self.timer_index[t.id]
-            e(f"_Tmr{k}(IN := {self.st('X' + t.step)}, PT := {time_literal(t.seconds, t.loc)});")
+            e(f"_Tmr{k}(IN := {self.st('X' + t.step)}, PT := {timer_literal(t.id, t.seconds, t.loc)});")
             e(f"_TE{k} := _Tmr{k}.Q;")
         for i in self.rising:
             e(f"_RE_{self.st(i)} := {self.st(i)} AND NOT _Prev_{self.st(i)};")
@@ -403,7 +316,7 @@ class _Writer:
             if any(t.step in tr.sources for tr in g.transitions):
                 k = self.timer_index[t.id]
                 e(f"IF _Leave[{self.step_index[t.step]}] THEN (* the step is left: {t.id} restarts *)", 3)
-                e(f"_Tmr{k}(IN := FALSE, PT := {time_literal(t.seconds, t.loc)});", 4)
+                e(f"_Tmr{k}(IN := FALSE, PT := {timer_literal(t.id, t.seconds, t.loc)});", 4)
                 e(f"_TE{k} := FALSE;", 4)
                 e("END_IF", 3)
         if self.stored:
@@ -457,30 +370,7 @@ class _Writer:
             e(f"_Prev_{self.st(i)} := {self.st(i)};")
         for t in g.timers:
             k = self.timer_index[t.id]
-            e(f"_Tmr{k}(IN := {self.st('X' + t.step)}, PT := {time_literal(t.seconds, t.loc)});")
-        e("END_PROGRAM")
-
-
-def filter_call(block: object) -> FilterCall:
-    """The :class:`FilterCall` of a :class:`synth.codegen.filter_st.FilterBlock`."""
-    return FilterCall(block.text, block.name, tuple(block.inputs), tuple(block.outputs))  # type: ignore[attr-defined]
-
-
-def _first_loc(g: Grafcet, name: str) -> Location | None:
-    """Where ``name`` first appears in the Grafcet (a receptivity, condition or action), if anywhere."""
-    for t in g.transitions:
-        for n in names(t.receptivity):
-            if n.name == name:
-                return n.loc or t.loc
-    for s in g.steps:
-        for a in s.actions:
-            if a.order == name:
-                return a.loc
-            if a.condition is not None:
-                for n in names(a.condition):
-                    if n.name == name:
-                        return n.loc or a.loc
-    return None
+            e(f"_Tmr{k}(IN := {self.st('X' + t.step)}, PT := {timer_literal(t.id, t.seconds, t.loc)});")
 
 
 def grafcet_program(g: Grafcet, **options: object) -> str:
@@ -511,34 +401,17 @@ def generate_program(
     if version is None:
         version = synth_version()
     w = _Writer(g, name or program_name(g.path), max_rounds, filter_call)
-    if not _IDENT.match(w.name) or w.name.upper() in IEC_KEYWORDS:
+    if name_problem(w.name) is not None:
         raise InputError(f"'{w.name}' cannot name a PROGRAM (an IEC 61131-3 identifier, not a keyword)", None)
     w.check_names()
     w.declarations(sources, version)
+    preamble = len(w.lines)
     w.body()
-    lines = w.lines
+    pou = Pou(PouKind.PROGRAM, w.name, w.sections, tuple(w.lines[preamble:]))
+    lines = [*w.lines[:preamble], *pou_lines(pou, "  ")]
+    pous = (pou,) if filter_call is None else (filter_call.fb_pou, pou)
     if not comments:
-        lines = _compact([c for c in (_COMMENT.sub("", line).strip() for line in lines) if c])
-    return StProgram("\n".join(lines) + "\n", w.name, tuple(w.alias.items()))
+        lines = compact([c for c in (_COMMENT.sub("", line).strip() for line in lines) if c])
+    return StProgram("\n".join(lines) + "\n", w.name, tuple(w.alias.items()), pous)
 
 
-_COMMENT = re.compile(r"\s*\(\*.*?\*\)")
-_SHORT = {"Fired": "Fd", "Fire": "F", "Leave": "L", "Enter": "E", "Rounds": "N", "FirstCycle": "I",
-          "InputEvent": "V", "MAX_ROUNDS": "M", "Prev_": "P_", "RE_": "R_", "FE_": "D_", "Mem_": "S_",
-          "Order_": "O_", "Tmr": "T", "TE": "Q", "Filter": "Fl"}
-_INTERNAL = re.compile(r"(?<![A-Za-z0-9_])_(" + "|".join(_SHORT) + ")")
-_BOOL_DECL = re.compile(r"^(\w+) : BOOL;$")
-_BOOL_LIST = re.compile(r"^\w+(, \w+)* : BOOL;$")
-
-
-def _compact(lines: list[str]) -> list[str]:
-    """Shorter internal names (they all start with ``_``, plant names never do) and one
-    declaration line per run of plain ``BOOL`` variables: the same program in fewer characters."""
-    out: list[str] = []
-    for line in (_INTERNAL.sub(lambda m: "_" + _SHORT[m[1]], x) for x in lines):
-        m = _BOOL_DECL.match(line)
-        if m and out and _BOOL_LIST.match(out[-1]):
-            out[-1] = out[-1][: -len(" : BOOL;")] + ", " + m[1] + " : BOOL;"
-        else:
-            out.append(line)
-    return out

@@ -16,8 +16,11 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
+from enum import StrEnum
+from fractions import Fraction
 from typing import Callable, Iterable, Sequence
 
+from synth.errors import InputError, Location
 from synth.logic.expr import And, Const, Edge, Expr, Not, Or, Var
 from synth.logic.past import pre_name, st_past_name
 
@@ -25,41 +28,102 @@ __all__ = [
     "st_expr",
     "st_expression",
     "st_identifier_problem",
+    "name_problem",
+    "NameProblem",
+    "time_literal",
+    "timer_literal",
     "Declaration",
-    "var_block",
+    "PouKind",
+    "SectionKind",
+    "VarSection",
+    "Pou",
+    "pou_lines",
     "header",
     "indent",
 ]
 
 
-# IEC 61131-3 keywords and the standard function blocks/functions a variable may not shadow.
+# IEC 61131-3 keywords, standard functions and standard function blocks a variable may not be
+# named (case does not matter), and IN and PT, which the generated code passes to its timers
+# (``_Tmr1(IN := X1, PT := T#2s)``). The one-letter formal parameters S, R and Q stay usable.
 _RESERVED = frozenset("""
-ABS ACOS ACTION ADD AND ANY ARRAY ASIN AT ATAN BOOL BY BYTE CASE CONCAT CONFIGURATION CONSTANT
-COS CTD CTU CTUD DATE DATE_AND_TIME DELETE DINT DIV DO DT DWORD ELSE ELSIF EN ENO END_ACTION
-END_CASE END_CONFIGURATION END_FOR END_FUNCTION END_FUNCTION_BLOCK END_IF END_PROGRAM END_REPEAT
-END_RESOURCE END_STEP END_STRUCT END_TRANSITION END_TYPE END_VAR END_WHILE EQ EXIT EXP EXPT
-F_EDGE F_TRIG FALSE FIND FOR FROM FUNCTION FUNCTION_BLOCK GE GT IF IN INITIAL_STEP INSERT INT
-INTERVAL LD LE LEFT LEN LIMIT LINT LN LOG LREAL LT LWORD MAX MID MIN MOD MOVE MUL MUX NE NOT OF
-ON OR PROGRAM PT Q R R_EDGE R_TRIG READ_ONLY READ_WRITE REAL REPEAT REPLACE RESOURCE RETAIN RETURN
-RIGHT ROL ROR RS S SEL SHL SHR SIN SINT SQRT SR STEP STRING STRUCT SUB TAN TASK THEN TIME
-TIME_OF_DAY TO TOD TOF TON TP TRANSITION TRUE TRUNC TYPE UDINT UINT ULINT UNTIL USINT VAR
-VAR_ACCESS VAR_CONFIG VAR_EXTERNAL VAR_GLOBAL VAR_IN_OUT VAR_INPUT VAR_OUTPUT VAR_TEMP WHILE WITH
-WORD WSTRING XOR
+ABS ACOS ACTION ADD AND ANY ARRAY ASIN AT ATAN BOOL BY BYTE CASE CONCAT CONFIGURATION CONSTANT COS
+CTD CTU CTUD DATE DATE_AND_TIME DELETE DINT DIV DO DT DWORD ELSE ELSIF EN END_ACTION END_CASE
+END_CONFIGURATION END_FOR END_FUNCTION END_FUNCTION_BLOCK END_IF END_PROGRAM END_REPEAT
+END_RESOURCE END_STEP END_STRUCT END_TRANSITION END_TYPE END_VAR END_WHILE ENO EQ EXIT EXP EXPT
+FALSE FIND FOR FROM FUNCTION FUNCTION_BLOCK F_EDGE F_TRIG GE GT IF IN INITIAL_STEP INSERT INT
+INTERVAL LE LEFT LEN LIMIT LINT LN LOG LREAL LT LWORD MAX MID MIN MOD MOVE MUL MUX NE NOT OF ON OR
+PROGRAM PT READ_ONLY READ_WRITE REAL REPEAT REPLACE RESOURCE RETAIN RETURN RIGHT ROL ROR RS R_EDGE
+R_TRIG SEL SHL SHR SIN SINT SQRT SR STEP STRING STRUCT SUB TAN TASK THEN TIME TIME_OF_DAY TO TOD
+TOF TON TP TRANSITION TRUE TRUNC TYPE UDINT UINT ULINT UNTIL USINT VAR VAR_ACCESS VAR_CONFIG
+VAR_EXTERNAL VAR_GLOBAL VAR_INPUT VAR_IN_OUT VAR_OUTPUT VAR_TEMP WHILE WITH WORD WSTRING XOR
 """.split())
 _IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
 
 
-def st_identifier_problem(name: str) -> str | None:
-    """Why ``name`` cannot be an IEC 61131-3 identifier, or ``None`` when it can."""
+class NameProblem(StrEnum):
+    """Why a name cannot be an IEC 61131-3 variable: the one rule every generator applies
+    (``synth st``, ``synth sfc``, ``synth filter st``), each saying it in its own sentence."""
+
+    NOT_IDENTIFIER = "is not an IEC 61131-3 identifier (letters, digits and _ only)"
+    RESERVED = "is a reserved word of IEC 61131-3"
+    DOUBLE_UNDERSCORE = "has two underscores in a row"
+    TRAILING_UNDERSCORE = "ends with an underscore"
+
+
+def name_problem(name: str) -> NameProblem | None:
+    """Why ``name`` cannot be an IEC 61131-3 variable (a keyword, a standard function or
+    function block, a malformed identifier), or ``None`` when it can.
+
+    >>> [str(name_problem(n)) for n in ("ON", "left", "TON", "a__b")]
+    ['is a reserved word of IEC 61131-3', 'is a reserved word of IEC 61131-3', 'is a reserved word of IEC 61131-3', 'has two underscores in a row']
+    >>> name_problem("S"), name_problem("V1")
+    (None, None)
+    """
     if not _IDENTIFIER.match(name):
-        return f"{name} is not an IEC 61131-3 identifier (letters, digits and _ only)"
+        return NameProblem.NOT_IDENTIFIER
     if name.upper() in _RESERVED:
-        return f"{name} is a reserved word of IEC 61131-3"
+        return NameProblem.RESERVED
     if "__" in name:
-        return f"{name} has two underscores in a row"
+        return NameProblem.DOUBLE_UNDERSCORE
     if name.endswith("_"):
-        return f"{name} ends with an underscore"
+        return NameProblem.TRAILING_UNDERSCORE
     return None
+
+
+def st_identifier_problem(name: str) -> str | None:
+    """Why ``name`` cannot be an IEC 61131-3 identifier, as a sentence, or ``None`` when it can."""
+    problem = name_problem(name)
+    return None if problem is None else f"{name} {problem}"
+
+
+_DURATION = re.compile(r"([0-9]+(?:\.[0-9]+)?)(ms|s|min|h)")
+
+
+def time_literal(seconds: Fraction, loc: Location | None = None, written: str | None = None) -> str:
+    """The one IEC ``TIME`` literal of a timer duration, for every generated file (ST program,
+    SFC, PLCopen XML): as the Grafcet writes it when ``written`` (``2min`` is ``T#2m``, ``2000ms``
+    ``T#2000ms``, so an SFC imported back keeps its timers), else in whole seconds or
+    milliseconds. A duration that is not a whole number of milliseconds is refused.
+
+    >>> time_literal(Fraction(120), written="2min"), time_literal(Fraction(2), written="2000ms")
+    ('T#2m', 'T#2000ms')
+    >>> time_literal(Fraction(2)), time_literal(Fraction(3, 2)), time_literal(Fraction(120))
+    ('T#2s', 'T#1500ms', 'T#120s')
+    """
+    ms = seconds * 1000
+    if ms.denominator != 1 or ms <= 0:
+        raise InputError(f"a timer of {float(seconds)} s cannot be written in whole milliseconds", loc)
+    found = _DURATION.fullmatch(written) if written else None
+    if found:
+        return f"T#{found[1]}{'m' if found[2] == 'min' else found[2]}"
+    n = int(ms)
+    return f"T#{n // 1000}s" if n % 1000 == 0 else f"T#{n}ms"
+
+
+def timer_literal(timer_id: str, seconds: Fraction, loc: Location | None = None) -> str:
+    """:func:`time_literal` of a timer ``2s/X1`` as the Grafcet writes it."""
+    return time_literal(seconds, loc, timer_id.split("/", 1)[0])
 
 
 def _edge_default(e: Edge, name: Callable[[str], str]) -> str:
@@ -123,11 +187,59 @@ class Declaration:
         return f"{self.name} : {self.type}{init};{comment}"
 
 
-def var_block(keyword: str, declarations: Sequence[Declaration]) -> list[str]:
-    """``VAR_INPUT … END_VAR`` (empty list when there is nothing to declare)."""
-    if not declarations:
-        return []
-    return [keyword, *indent([d.text() for d in declarations]), "END_VAR"]
+class PouKind(StrEnum):
+    """The kinds of program organisation unit synth writes."""
+
+    PROGRAM = "PROGRAM"
+    FUNCTION_BLOCK = "FUNCTION_BLOCK"
+
+
+class SectionKind(StrEnum):
+    """A variable section, as its keyword reads."""
+
+    INPUT = "VAR_INPUT"
+    OUTPUT = "VAR_OUTPUT"
+    IN_OUT = "VAR_IN_OUT"
+    LOCAL = "VAR"
+    CONSTANT = "VAR CONSTANT"
+    TEMP = "VAR_TEMP"
+
+
+@dataclass(frozen=True)
+class VarSection:
+    """``VAR_INPUT … END_VAR``: a section's kind and its declarations."""
+
+    kind: SectionKind
+    declarations: tuple[Declaration, ...]
+
+
+@dataclass(frozen=True)
+class Pou:
+    """A generated ``PROGRAM`` or ``FUNCTION_BLOCK`` as data: what every writer renders
+    (the ST text, the PLCopen XML project), so no writer reads another's text.
+
+    >>> pou = Pou(PouKind.PROGRAM, "P", (VarSection(SectionKind.INPUT, (Declaration("a"),)),), ("y := a;",))
+    >>> print("\\n".join(pou_lines(pou)))
+    PROGRAM P
+    VAR_INPUT
+        a : BOOL;
+    END_VAR
+    y := a;
+    END_PROGRAM
+    """
+
+    kind: PouKind
+    name: str
+    sections: tuple[VarSection, ...]
+    body: tuple[str, ...]
+
+
+def pou_lines(pou: Pou, pad: str = "    ") -> list[str]:
+    """The ST lines of ``pou``, its declarations indented by ``pad`` (every section given is written)."""
+    lines = [f"{pou.kind} {pou.name}"]
+    for section in pou.sections:
+        lines += [str(section.kind), *(pad + d.text() for d in section.declarations), "END_VAR"]
+    return [*lines, *pou.body, f"END_{pou.kind}"]
 
 
 def indent(lines: Iterable[str], level: int = 1) -> list[str]:

@@ -288,8 +288,7 @@ class GrafcetMachine:
         ]
 
     def _elapsed(self, sit: Situation, after_time: bool) -> frozenset[str]:
-        """The elapsed timers of ``sit``; with ``after_time``, every timer of its active steps
-        too (time passes while the Grafcet waits)."""
+        """The elapsed timers of ``sit``, with ``after_time`` all of its active steps' (time passes)."""
         if not after_time:
             return frozenset(sit.elapsed)
         return frozenset(sit.elapsed).union(*(self._timers_of_step.get(s, ()) for s in sit.steps))
@@ -320,19 +319,13 @@ class GrafcetMachine:
 
     def first_events(self, sit: Situation, t: Transition, inputs: Mapping[str, bool],
                      limit: int = 12, after_time: bool = False) -> tuple[tuple[Event, ...], Event | None]:
-        """When no single input change makes ``t`` fireable: the fewest input changes
-        needed first, and the change that then fires it (``↑a & b`` with ``a`` true and
-        ``b`` false needs ``↓a`` and ``↑b``, then ``↑a``); ``((), None)`` when none does
-        or the receptivity reads more than ``limit`` inputs. Ties go to the first in
-        input-name order.
+        """When no single input change makes ``t`` fireable: the fewest input changes needed
+        first and the one that then fires it (``↑a & b``, ``a`` true, ``b`` false: ``↓a``, ``↑b``,
+        then ``↑a``); ``((), None)`` when none does or it reads over ``limit`` inputs.
 
         >>> from synth.grafcet.language_check import parse_grafcet
-        >>> m = GrafcetMachine(parse_grafcet("grafcet G { initial step 0 step 1 "
-        ...                    "transition 0 -> 1 when ↑a & b }"))
-        >>> s0 = m.initial({"a": True, "b": False})
-        >>> m.enabling_events(s0, m.transitions[0], {"a": True, "b": False})
-        ()
-        >>> m.first_events(s0, m.transitions[0], {"a": True, "b": False})
+        >>> m = GrafcetMachine(parse_grafcet("grafcet G { initial step 0 step 1 transition 0 -> 1 when ↑a & b }"))
+        >>> m.first_events(m.initial({"a": True, "b": False}), m.transitions[0], {"a": True, "b": False})
         (('↓a', '↑b'), '↑a')
         """
         from itertools import product
@@ -341,9 +334,7 @@ class GrafcetMachine:
         active, elapsed = frozenset(sit.steps), self._elapsed(sit, after_time)
         names = sorted(self._rec_inputs[i] & inputs.keys())
         best: tuple[int, tuple[Event, ...], Event] | None = None
-        if len(names) > limit:
-            return (), None
-        for values in product((False, True), repeat=len(names)):
+        for values in product((False, True), repeat=len(names) if len(names) <= limit else 0):
             before = dict(zip(names, values))
             changes = tuple(Event.edge(x, v) for x, v in before.items() if v != inputs[x])
             if best is not None and len(changes) + 1 >= best[0]:

@@ -1,0 +1,125 @@
+"""A generated program as data, and its names: the filter block a program calls, the
+result of ``synth st`` (text, POUs, renamings), the ``PROGRAM``'s default name, the one
+name check of the generated variables (ST program and SFC alike), where a name is first
+used in a Grafcet, and the compact form of the text (for blark's Earley parser).
+
+Example
+-------
+>>> program_name("grafcets/tri.g7"), program_name("x/2-axes.g7")
+('tri', 'G_2_axes')
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from synth.codegen.st import NameProblem, Pou, name_problem
+from synth.errors import InputError, Location
+from synth.grafcet.language import Grafcet
+from synth.logic.expr import names
+
+__all__ = ["FilterCall", "StProgram", "program_name", "filter_call", "check_variable_name", "first_location",
+           "compact"]
+
+
+@dataclass(frozen=True)
+class FilterCall:
+    """A safety filter run after the Grafcet: the text of its function block, its type and
+    instance names, and which of its inputs are requests (``R_<order>``).
+
+    The program passes the Grafcet's order ``o`` as ``R_o`` (``FALSE`` for an output the Grafcet
+    never orders) and every other name as the program's input of that name (declared when the
+    Grafcet does not read it), then copies the block's outputs to its own ``VAR_OUTPUT``.
+    """
+
+    fb_text: str
+    fb_type: str
+    inputs: tuple[str, ...]
+    outputs: tuple[str, ...]
+    fb_pou: Pou
+    instance: str = "_Filter"
+
+
+@dataclass(frozen=True)
+class StProgram:
+    """Generated Structured Text: the whole file, the ``PROGRAM``'s name, and the ST name of
+    every plant input/output and step variable that had to be renamed (case clashes)."""
+
+    text: str
+    program: str
+    renamed: tuple[tuple[str, str], ...] = field(default=())
+    pous: tuple[Pou, ...] = ()  # the filter's block (when called) and the program, as data
+
+    def st_name(self, name: str) -> str:
+        """The ST variable of a plant input/output or step variable ``X<step>``."""
+        return dict(self.renamed).get(name, name)
+
+
+def program_name(path: str) -> str:
+    """The default ``PROGRAM`` name for a ``.g7`` file: its stem as an IEC identifier.
+
+    """
+    stem = re.sub(r"[^A-Za-z0-9]+", "_", Path(path).stem).strip("_") or "Grafcet"
+    if not stem[0].isalpha():
+        stem = "G_" + stem
+    return stem
+
+
+def filter_call(block: object) -> FilterCall:
+    """The :class:`FilterCall` of a :class:`synth.codegen.filter_st.FilterBlock`."""
+    return FilterCall(block.text, block.name, tuple(block.inputs), tuple(block.outputs), block.pou)  # type: ignore[attr-defined]
+
+
+def check_variable_name(n: str, loc: Location | None) -> None:
+    """A plant or step name the generated program (ST or SFC) declares: the one rule of
+    :func:`~synth.codegen.st.name_problem`, the same located error from ``synth st`` and ``synth sfc``."""
+    problem = name_problem(n)
+    if problem is NameProblem.RESERVED:
+        why = "is an IEC 61131-3 keyword or standard name"
+    elif problem is not None:
+        why = "is not an IEC 61131-3 identifier (letters, digits, single underscores)"
+    else:
+        return
+    raise InputError(f"'{n}' {why}: Structured Text cannot use it as a variable", loc,
+                     notes=("rename it in the Grafcet (and the plant)",))
+
+
+def first_location(g: Grafcet, name: str) -> Location | None:
+    """Where ``name`` first appears in the Grafcet (a receptivity, condition or action), if anywhere."""
+    for t in g.transitions:
+        for n in names(t.receptivity):
+            if n.name == name:
+                return n.loc or t.loc
+    for s in g.steps:
+        for a in s.actions:
+            if a.order == name:
+                return a.loc
+            if a.condition is not None:
+                for n in names(a.condition):
+                    if n.name == name:
+                        return n.loc or a.loc
+    return None
+
+
+_COMMENT = re.compile(r"\s*\(\*.*?\*\)")
+_SHORT = {"Fired": "Fd", "Fire": "F", "Leave": "L", "Enter": "E", "Rounds": "N", "FirstCycle": "I",
+          "InputEvent": "V", "MAX_ROUNDS": "M", "Prev_": "P_", "RE_": "R_", "FE_": "D_", "Mem_": "S_",
+          "Order_": "O_", "Tmr": "T", "TE": "Q", "Filter": "Fl"}
+_INTERNAL = re.compile(r"(?<![A-Za-z0-9_])_(" + "|".join(_SHORT) + ")")
+_BOOL_DECL = re.compile(r"^(\w+) : BOOL;$")
+_BOOL_LIST = re.compile(r"^\w+(, \w+)* : BOOL;$")
+
+
+def compact(lines: list[str]) -> list[str]:
+    """Shorter internal names (they all start with ``_``, plant names never do) and one
+    declaration line per run of plain ``BOOL`` variables: the same program in fewer characters."""
+    out: list[str] = []
+    for line in (_INTERNAL.sub(lambda m: "_" + _SHORT[m[1]], x) for x in lines):
+        m = _BOOL_DECL.match(line)
+        if m and out and _BOOL_LIST.match(out[-1]):
+            out[-1] = out[-1][: -len(" : BOOL;")] + ", " + m[1] + " : BOOL;"
+        else:
+            out.append(line)
+    return out

@@ -1,0 +1,129 @@
+"""The ST of an imported SFC's conditions and actions, read into ``.g7`` expressions: a
+small recursive-descent reader for NOT, AND/&, OR, parentheses, TRUE/FALSE, names,
+``S12.X``, ``S12.T >= T#2s`` and the edge flags ``_RE_x``/``_FE_x``, each error located
+in the XML file.
+
+Why not blark: its Earley parser takes seconds on a project's worth of conditions and its
+tree would need a second mapping; this reader knows exactly the subset ``.g7`` can hold
+and says where the rest is.
+"""
+
+from __future__ import annotations
+
+import re
+
+from synth.errors import InputError, close_names
+
+__all__ = ["st_text", "ExprReader"]
+
+
+def st_text(el) -> str:
+    """The text of a formattedText-like element (``<ST><xhtml:p>…</xhtml:p></ST>`` or plain text)."""
+    return "".join(el.itertext())
+
+
+# A tiny reader for the ST expressions of conditions: NOT, AND/&, OR, parentheses, TRUE/FALSE,
+# names, S12.X, S12.T >= T#2s, _RE_x/_FE_x.
+_TOKEN = re.compile(r"\s*(?:(?P<dur>T#[0-9A-Za-z_.]+)|(?P<name>[A-Za-z_]\w*(?:\.[A-Za-z_]\w*)?)|(?P<num>\d+)"
+                    r"|(?P<op>>=|<=|<>|:=|[()&>=<;+\-*/]))", re.I)
+_UNIT = {"ms": "ms", "s": "s", "m": "min", "h": "h"}
+
+
+class ExprReader:
+    def __init__(self, text: str, where, steps: dict[str, str]) -> None:
+        # comments become spaces, so that offsets still point into the original text
+        text = re.sub(r"\(\*.*?\*\)|//[^\n]*", lambda m: re.sub(r"[^\n]", " ", m[0]), text, flags=re.S)
+        self.text, self.where, self.steps = text, where, steps
+        self.tokens: list[tuple[str, str, int]] = []
+        pos = 0
+        while pos < len(text):
+            if not text[pos:].strip():
+                break
+            m = _TOKEN.match(text, pos)
+            if not m or m.end() == pos:
+                raise self.error(len(text) - len(text[pos:].lstrip()), "unexpected character in an ST condition")
+            kind = m.lastgroup or ""
+            self.tokens.append((kind, m[kind], m.start(kind)))
+            pos = m.end()
+        self.i = 0
+
+    def error(self, offset: int, message: str, width: int = 1, **kw) -> InputError:
+        return InputError(message, self.where(offset, width), **kw)
+
+    def peek(self) -> tuple[str, str, int]:
+        return self.tokens[self.i] if self.i < len(self.tokens) else ("end", "", len(self.text.rstrip()))
+
+    def take(self) -> tuple[str, str, int]:
+        tok = self.peek()
+        self.i += 1
+        return tok
+
+    def expr(self) -> str:
+        parts = [self.conj()]
+        while self.peek()[1].upper() == "OR":
+            self.take()
+            parts.append(self.conj())
+        return " | ".join(parts)
+
+    def conj(self) -> str:
+        parts = [self.unary()]
+        while self.peek()[1].upper() in ("AND", "&"):
+            self.take()
+            parts.append(self.unary())
+        return " & ".join(f"({p})" if " | " in p else p for p in parts)
+
+    def unary(self) -> str:
+        if self.peek()[1].upper() == "NOT":
+            self.take()
+            inner = self.unary()
+            return "!" + (inner if re.fullmatch(r"[!\w↑↓/.]+", inner) else f"({inner})")
+        return self.primary()
+
+    def primary(self) -> str:
+        kind, value, offset = self.take()
+        if value == "(":
+            inner = self.expr()
+            k, v, o = self.take()
+            if v != ")":
+                raise self.error(o, "expected ')' in an ST condition", expected=("')'",))
+            return inner if re.fullmatch(r"[!\w↑↓/.]+", inner) else f"({inner})"
+        if kind == "num" and value in ("0", "1"):
+            return value
+        if kind == "name":
+            up = value.upper()
+            if up in ("TRUE", "FALSE"):
+                return "1" if up == "TRUE" else "0"
+            if up in ("AND", "OR", "NOT", "XOR", "MOD"):
+                raise self.error(offset, f"{up} is not supported in a .g7 receptivity" if up in ("XOR", "MOD")
+                                 else f"expected a variable, not {up}", width=len(value))
+            if "." in value:
+                step_name, member = value.split(".")
+                step = self.steps.get(step_name)
+                if step is None:
+                    raise self.error(offset, f"unknown step '{step_name}'", width=len(step_name),
+                                     suggestions=close_names(step_name, self.steps))
+                if member.upper() == "X":
+                    return f"X{step}"
+                if member.upper() == "T":
+                    k, v, o = self.take()
+                    if v != ">=":
+                        raise self.error(o, f"a step time {value} is read as '{value} >= T#…' (a timer)",
+                                         expected=("'>='",))
+                    k, dur, o = self.take()
+                    m = re.fullmatch(r"T#(\d+(?:\.\d+)?)(ms|s|m|h)", dur, re.I)
+                    if not m:
+                        raise self.error(o, "expected a duration such as T#2s or T#500ms", width=max(1, len(dur)))
+                    return f"{m[1]}{_UNIT[m[2].lower()]}/X{step}"
+                raise self.error(offset, f"unsupported step member .{member} (use .X or .T)", width=len(value))
+            if value.startswith("_RE_") or value.startswith("_FE_"):
+                return ("↑" if value.startswith("_RE_") else "↓") + value[4:]
+            return value
+        raise self.error(offset, f"expected a variable, a step flag or '(' in an ST condition, not '{value or 'end'}'",
+                         width=max(1, len(value)))
+
+    def whole(self) -> str:
+        out = self.expr()
+        kind, value, offset = self.peek()
+        if kind != "end":
+            raise self.error(offset, f"unexpected '{value}' in an ST condition", width=len(value))
+        return out
