@@ -120,8 +120,8 @@ class _Checker:
         self.ms = {t.id: int(t.seconds * 1000) for t in g.timers}
         self.step_of = {t.id: t.step for t in g.timers}
         self.memo_base = {id(self.module): self.module}
-        for pou in self.module.pous.values():
-            self.memo_base[id(pou)] = pou
+        for unit in self.module.pous.values():
+            self.memo_base[id(unit)] = unit
 
     # ------------------------------------------------------------------ both sides
     def compare(self, events: tuple[str, ...], side: _Side | None) -> bool:

@@ -411,7 +411,7 @@ def generate_program(
     lines = [*w.lines[:preamble], *pou_lines(pou, "  ")]
     pous = (pou,) if filter_call is None else (filter_call.fb_pou, pou)
     if not comments:
-        lines = compact([c for c in (_COMMENT.sub("", line).strip() for line in lines) if c])
+        lines = compact(lines)
     return StProgram("\n".join(lines) + "\n", w.name, tuple(w.alias.items()), pous)
 
 

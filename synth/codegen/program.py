@@ -113,10 +113,12 @@ _BOOL_LIST = re.compile(r"^\w+(, \w+)* : BOOL;$")
 
 
 def compact(lines: list[str]) -> list[str]:
-    """Shorter internal names (they all start with ``_``, plant names never do) and one
-    declaration line per run of plain ``BOOL`` variables: the same program in fewer characters."""
+    """No comments, no indentation, shorter internal names (they all start with ``_``, plant
+    names never do) and one declaration line per run of plain ``BOOL`` variables: the same
+    program in fewer characters."""
+    bare = [c for c in (_COMMENT.sub("", line).strip() for line in lines) if c]
     out: list[str] = []
-    for line in (_INTERNAL.sub(lambda m: "_" + _SHORT[m[1]], x) for x in lines):
+    for line in (_INTERNAL.sub(lambda m: "_" + _SHORT[m[1]], x) for x in bare):
         m = _BOOL_DECL.match(line)
         if m and out and _BOOL_LIST.match(out[-1]):
             out[-1] = out[-1][: -len(" : BOOL;")] + ", " + m[1] + " : BOOL;"
