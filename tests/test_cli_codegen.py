@@ -142,3 +142,16 @@ def test_help_lists_the_commands(capsys):
         main(["--help"])
     out = capsys.readouterr().out
     assert "st " in out and "sfc" in out and "import" in out
+
+
+def test_st_check_without_blark_says_how_to_install_it(capsys, monkeypatch):
+    """blark is a test extra: without it, ``st --check`` stops with exit 2 and the extra to
+    install, never a traceback."""
+    import importlib.util
+
+    real = importlib.util.find_spec
+    monkeypatch.setattr(importlib.util, "find_spec", lambda name, *a: None if name == "blark" else real(name, *a))
+    code, out, err = run(capsys, "st", "--check", "grafcets/tri.g7", "--plant", "plants/tri.rules")
+    assert (code, out) == (2, "")
+    assert err == ("error: synth st --check needs blark, the IEC 61131-3 parser it runs the generated code with: "
+                   "pip install 'synth[test]' (or pip install blark)\n")

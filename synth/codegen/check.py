@@ -36,12 +36,12 @@ from typing import Mapping, Sequence
 
 from synth.codegen.grafcet_st import generate_program
 from synth.codegen.program import StProgram
-from synth.errors import InputError
+from synth.errors import InputError, SynthError
 from synth.grafcet.language import Grafcet
 from synth.grafcet.machine import GrafcetMachine, Situation
 from synth.logic.events import Event
 
-__all__ = ["Aspect", "Mismatch", "DifferentialReport", "differential_check"]
+__all__ = ["Aspect", "Mismatch", "DifferentialReport", "differential_check", "require_blark"]
 
 
 class Aspect(StrEnum):
@@ -242,8 +242,20 @@ def differential_check(
     """Play every event sequence of length ``depth`` on ``synth run``'s machine and on the
     generated program (``program``, else :func:`generate_program` of ``g``), comparing active
     steps, outputs and stability after every cycle. ``initial``: the input values at start
-    (missing ones are 0)."""
+    (missing ones are 0). Without blark (a test extra), a :class:`~synth.errors.SynthError`
+    that says how to install it."""
+    require_blark("synth st --check")
     program = program or generate_program(g, version="check")
     checker = _Checker(g, initial or {}, depth, program, max_mismatches)
     checker.run()
     return DifferentialReport(g.path, depth, checker.sequences, checker.cycles, tuple(checker.mismatches))
+
+
+def require_blark(what: str) -> None:
+    """``what`` runs generated Structured Text through blark (the IEC 61131-3 parser the ST
+    interpreter reads): stop with a message naming the extra when it is not installed."""
+    import importlib.util
+
+    if importlib.util.find_spec("blark") is None:
+        raise SynthError(f"{what} needs blark, the IEC 61131-3 parser it runs the generated code with: "
+                         "pip install 'synth[test]' (or pip install blark)")
