@@ -58,15 +58,26 @@ def test_a_never_stabilising_grafcet_sets_the_unstable_flag():
     assert (report.sequences, report.cycles) == (1, 2)  # initial, then ↑a: both sides never stable
 
 
-@pytest.mark.slow  # about 3 min on 2 cores: 200 programs for blark to parse
-def test_random_grafcets():
+def _random_programs(seeds: range) -> list[tuple[int, int, int, str]]:
     workers = min(2, os.cpu_count() or 1)
     with ProcessPoolExecutor(max_workers=workers) as pool:
-        results = list(pool.map(check_seed, RANDOM_SEEDS, chunksize=4))
-    failures = [text for _, _, _, text in results if text]
-    assert failures == []
-    assert len(results) == 200
+        results = list(pool.map(check_seed, seeds, chunksize=4))
+    assert [text for _, _, _, text in results if text] == []
+    assert len(results) == len(seeds)
+    return results
+
+
+@pytest.mark.slow  # about 70 s on 2 cores: 200 programs for blark to parse
+def test_random_grafcets():
+    results = _random_programs(RANDOM_SEEDS)
     assert sum(cycles for _, _, cycles, _ in results) > 5000
+
+
+@pytest.mark.nightly  # about 6 min on 2 cores: pytest -m nightly
+def test_random_grafcets_nightly():
+    """The same differential on 1 000 more random Grafcets (seeds 200 to 1 199)."""
+    results = _random_programs(range(200, 1200))
+    assert sum(cycles for _, _, cycles, _ in results) > 25000
 
 
 def test_random_grafcets_cover_every_construct():
