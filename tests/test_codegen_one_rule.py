@@ -48,3 +48,12 @@ def test_a_plain_name_passes_every_generator(name, tmp_path, capsys):
     for argv in (["st", g7], ["sfc", g7]):
         assert main([*argv, "-o", str(tmp_path / "out")]) == 0
     capsys.readouterr()
+
+
+def test_a_reserved_name_no_constraint_reads_is_located_at_its_declaration(tmp_path, capsys):
+    """It pointed at the first constraint (another token), or nowhere without constraints."""
+    f = tmp_path / "f.filter"
+    f.write_text("inputs i, ON\noutputs o1, o2\n\nsafety S1: i & o1\n")
+    assert main(["filter", "st", str(f)]) == 2
+    assert capsys.readouterr().err.startswith(f"{f}:1:11: error: cannot write the filter as Structured Text: "
+                                              "ON is a reserved word of IEC 61131-3\n  1 | inputs i, ON\n")

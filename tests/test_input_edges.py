@@ -108,3 +108,20 @@ def test_an_unclosed_parenthesis_is_reported_where_it_opens(tmp_path, capsys):
     assert code == 2
     assert "p.g7:4:26: error: syntax error: '(' is never closed" in err
     assert "  4 |   transition 0 -> 1 when (dcy & v0" in err
+
+
+@pytest.mark.parametrize("bad", ['refLocalId="x1"', 'refLocalId="²"', 'refLocalId=""'])
+def test_a_non_numeric_reference_in_plcopen_xml_is_located(bad, tmp_path, capsys):
+    """A connection's refLocalId that is no number (it was a ValueError traceback)."""
+    from synth.codegen.plcopen_export import sfc_project_xml
+    from synth.grafcet.language_check import parse_grafcet
+
+    g = parse_grafcet("grafcet G { initial step 0 step 1: A transition 0 -> 1 when a transition 1 -> 0 when !a }", "g.g7")
+    xml = sfc_project_xml(g, version="test").decode()
+    first = xml.index('refLocalId="')
+    xml = xml[:first] + bad + xml[xml.index('"', first + len('refLocalId="')) + 1:]
+    (tmp_path / "p.xml").write_text(xml, encoding="utf-8")
+    line = xml[:first].count("\n") + 1
+    code, err = _run(["import", str(tmp_path / "p.xml"), "-o", str(tmp_path / "g.g7")], capsys)
+    assert code == 2 and not (tmp_path / "g.g7").exists()
+    assert f"p.xml:{line}:" in err and "refLocalId must be a number" in err and "Traceback" not in err

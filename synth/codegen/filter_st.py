@@ -53,7 +53,7 @@ from synth.codegen.st import (
     st_expression,
     st_identifier_problem,
 )
-from synth.errors import InputError, ModelError
+from synth.errors import InputError, Location, ModelError
 from synth.filter.cycle import Algorithm, Mode
 from synth.filter.language import Filter, request_name
 from synth.logic.past import base_name, is_pre, pre_name, st_past_name
@@ -131,12 +131,14 @@ def _check_names(f: Filter, extra: tuple[str, ...]) -> None:
         seen[n.upper()] = n
 
 
-def _location(f: Filter, n: str):
+def _location(f: Filter, n: str) -> Location | None:
+    """Where the name ``n`` (or the variable whose past value it is) is first used in a
+    constraint, else where it is declared (a name no constraint reads)."""
     for s in f.safeties:
         for v in names(s.expr):
             if v.name in (n, pre_name(n), base_name(n)) and getattr(v, "loc", None) is not None:
                 return v.loc
-    return f.safeties[0].loc if f.safeties else None
+    return next((d.loc for d in f.declarations if d.name in (n, base_name(n)) and d.loc is not None), None)
 
 
 def filter_block(f: Filter, algorithm: Algorithm | str = Algorithm.ALGEBRAIC, mode: Mode | str = Mode.SUPERVISOR,

@@ -151,7 +151,7 @@ def import_sfc(data: bytes | str, file: str = "<xml>") -> str:
         if local == "comment":
             continue
         lid = el.get("localId")
-        if lid is None or not lid.isdigit():
+        if lid is None or not re.fullmatch(r"[0-9]+", lid):
             raise InputError(f"<{local}> without a numeric localId", src.at(el))
         elements[int(lid)] = el
 
@@ -164,7 +164,10 @@ def import_sfc(data: bytes | str, file: str = "<xml>") -> str:
             if cp.find(q("expression")) is not None:
                 raise InputError("a connection given as an expression cannot be read", src.at(cp))
             for c in cp.iterfind(q("connection")):
-                ref = int(c.get("refLocalId", "-1"))
+                text = c.get("refLocalId", "")
+                if not re.fullmatch(r"\s*-?[0-9]+\s*", text):
+                    raise InputError(f"a connection's refLocalId must be a number, not '{text[:40]}'", src.at(c))
+                ref = int(text)
                 if ref not in elements:
                     raise InputError(f"connection to unknown localId {c.get('refLocalId')}", src.at(c))
                 out.append((ref, c))

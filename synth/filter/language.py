@@ -161,6 +161,7 @@ class Filter:
     equations: tuple[Equation, ...] = ()
     plant: str | None = None
     warnings: tuple[InputError, ...] = ()
+    declarations: tuple[Declared, ...] = field(default=(), compare=False)  # inputs, outputs, observers, with locations
 
     @property
     def requests(self) -> tuple[str, ...]:

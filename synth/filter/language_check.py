@@ -285,6 +285,7 @@ class _FilterChecker(Checker):
             tuple(q for q in equations if q is not None),
             self.plant,
             tuple(self.warnings),
+            tuple(d for d in self.declared.values() if d.kind is not VarKind.REQUEST),
         )
 
 
