@@ -124,3 +124,27 @@ def test_validate_pass_is_one_passing_case(tmp_path, capsys, monkeypatch):
     assert log["runs"][0]["invocations"][0]["properties"]["verdicts"] == {"validate grafcets/tri.g7": "pass"}
     (suite,) = list(JUnitXml.fromfile(str(junit)))
     assert (suite.tests, suite.failures) == (1, 0)
+
+
+def test_st_check_writes_one_failure_per_mismatch(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(ROOT)
+    junit, sarif = tmp_path / "s.xml", tmp_path / "s.sarif"
+    assert main(["st", "--check", "grafcets/timers.g7", "--depth", "2", "--junit", str(junit), "--sarif", str(sarif)]) == 0
+    assert_sarif(json.loads(sarif.read_text(encoding="utf-8")))
+    (suite,) = list(JUnitXml.fromfile(str(junit)))
+    assert (suite.tests, suite.failures) == (1, 0)
+    from synth.codegen import grafcet_st
+
+    emit = grafcet_st._Writer.emit  # a broken generator: HEAT in the wrong step
+    monkeypatch.setattr(grafcet_st._Writer, "emit", lambda self, line="", indent=0: emit(
+        self, line.replace("HEAT := NOT Unstable AND X1", "HEAT := NOT Unstable AND X0"), indent))
+    assert main(["st", "--check", "grafcets/timers.g7", "--depth", "2", "--junit", str(junit), "--sarif", str(sarif)]) == 1
+    capsys.readouterr()
+    log = json.loads(sarif.read_text(encoding="utf-8"))
+    assert_sarif(log)
+    first = log["runs"][0]["results"][0]
+    assert first["ruleId"] == "outputs" and first["message"]["text"] == (
+        "initially: outputs of synth run {}, of the ST program {HEAT}")
+    assert first["locations"][0]["physicalLocation"]["artifactLocation"]["uri"] == "grafcets/timers.g7"
+    (suite,) = list(JUnitXml.fromfile(str(junit)))
+    assert suite.failures == len(log["runs"][0]["results"]) >= 1

@@ -64,6 +64,10 @@ def cmd_st(args: argparse.Namespace) -> int:
 
         report = differential_check(grafcet, initial, depth=args.depth,
                                     program=generate_program(grafcet, name=args.name, sources=sources))
+        if args.junit or args.sarif:
+            from synth.output.ci import st_check_report, write_ci
+
+            write_ci([st_check_report(grafcet, report)], args.junit, args.sarif)
         sys.stdout.write(report.text())
         return 0 if report.ok else 1
     call = None
@@ -118,6 +122,8 @@ def register(sub: "argparse._SubParsersAction") -> None:
     p.add_argument("--check", action="store_true",
                    help="run the program in the ST interpreter against synth run on every event sequence")
     p.add_argument("--depth", type=int, default=3, metavar="N", help="--check: events per sequence (default 3)")
+    p.add_argument("--junit", metavar="FILE", help="--check: also write the result as JUnit XML (one test case per mismatch)")
+    p.add_argument("--sarif", metavar="FILE", help="--check: also write the result as SARIF 2.1.0 (one result per mismatch)")
     p.set_defaults(handler=cmd_st)
     p = sub.add_parser("sfc", help="a Grafcet as a PLCopen XML SFC",
                        description="Export the Grafcet as a PLCopen TC6 XML SFC program.")

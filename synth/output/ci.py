@@ -30,10 +30,13 @@ if TYPE_CHECKING:  # pragma: no cover
     from synth.filter.coherence import Check
     from synth.filter.language import Filter
     from synth.filter.verification import Verification
+    from synth.codegen.check import DifferentialReport
+    from synth.grafcet.language import Grafcet
     from synth.validation.result import Validation
 
 __all__ = ["Level", "Verdict", "CiFinding", "CiReport", "junit_xml", "sarif_json", "SARIF_SCHEMA",
-           "filter_check_report", "filter_verify_report", "validation_report", "located", "write_ci"]
+           "filter_check_report", "filter_verify_report", "validation_report", "st_check_report", "located",
+           "write_ci"]
 
 SARIF_SCHEMA = "https://docs.oasis-open.org/sarif/sarif/v2.1.0/errata01/os/schemas/sarif-schema-2.1.0.json"
 
@@ -233,6 +236,15 @@ def validation_report(v: Validation) -> CiReport:
         findings.append(located("sup_empty", Level.ERROR, "SUP is empty: the initial plant state is illegal or defended",
                                 None, str(data["plant"])))
     return CiReport("validate", file, Verdict.PASS if v.passed else Verdict.FAIL, tuple(findings))
+
+
+def st_check_report(g: Grafcet, report: DifferentialReport) -> CiReport:
+    """``synth st --check``: one error per mismatch between the generated program and
+    ``synth run`` (at the Grafcet's first step, with the events that lead to it)."""
+    loc = next((s.loc for s in g.steps if s.loc is not None), None)
+    findings = tuple(located(m.aspect.name.lower(), Level.ERROR, m.text(), loc, report.grafcet, m.events)
+                     for m in report.mismatches)
+    return CiReport("st --check", report.grafcet, Verdict.PASS if report.ok else Verdict.FAIL, findings)
 
 
 def write_ci(reports: Sequence[CiReport], junit: str | None = None, sarif: str | None = None) -> None:
