@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from synth.codegen.interpreter import Array, load_st
+from synth.codegen.interp_runtime import Array
+from synth.codegen.interpreter import load_st
 from synth.errors import InputError
 
 PROGRAM = """
