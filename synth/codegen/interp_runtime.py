@@ -27,8 +27,8 @@ __all__ = ["Value", "Thunk", "Action", "VarSection", "Array", "Variable", "Pou",
            "LoopExit", "BodyReturn"]
 
 Value = Any  # bool | int | Array | Instance
-Thunk = Callable[["Instance"], Value]
-Action = Callable[["Instance"], None]
+Thunk = Callable[["Instance"], Value]  # an expression compiled
+Action = Callable[["Instance"], None]  # a statement compiled
 
 
 class VarSection(StrEnum):
@@ -74,7 +74,7 @@ class Array:
     def __setitem__(self, index: tuple[int, ...], value: Value) -> None:
         self.items[self.offset(index)] = value
 
-    def copy(self) -> "Array":
+    def copy(self) -> Array:
         return Array(self.bounds, list(self.items))
 
     def __eq__(self, other: object) -> bool:
@@ -90,12 +90,12 @@ class Host(Protocol):
     @property
     def clock_ms(self) -> int: ...
 
-    def instance(self, name: str) -> "Instance": ...
+    def instance(self, name: str) -> Instance: ...
 
 
 @dataclass(frozen=True)
 class Variable:
-    """A declared variable: its section, type name (``BOOL``, ``TON``, ``FB_X``, ``ARRAY``) and a maker of its initial value."""
+    """A declared variable: its section, type name (``BOOL``, ``TON``, ``FB_X``, ``ARRAY``), initial value maker."""
 
     name: str
     section: VarSection
@@ -149,7 +149,7 @@ class Instance:
     def __contains__(self, name: str) -> bool:
         return name.upper() in self._keys
 
-    def cycle(self, inputs: Mapping[str, Value] | None = None) -> "Instance":
+    def cycle(self, inputs: Mapping[str, Value] | None = None) -> Instance:
         """Set the given variables (inputs, usually), then run the body once."""
         for k, v in (inputs or {}).items():
             self[k] = v
