@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from synth.codegen.interpreter import Array, load_st
+from synth.codegen.interp_runtime import Array
+from synth.codegen.interpreter import load_st
 from synth.errors import InputError
 
 PROGRAM = """
@@ -123,3 +124,19 @@ def test_unknown_variable_is_reported_where_it_is_read() -> None:
     with pytest.raises(InputError) as e:
         m.instance("P").cycle()
     assert (str(e.value.location), e.value.message) == ("u.st:3:6", "unknown variable y")
+
+
+@pytest.mark.parametrize(("text", "where", "message"), [
+    ("PROGRAM P\nVAR x : INT; END_VAR\nx := 16#FF;\nEND_PROGRAM\n",
+     "n.st:3:6", "HexInteger is outside the subset synth executes"),  # a subclass of Integer is not Integer
+    ("PROGRAM P\nVAR x : REAL; END_VAR\nx := 1.5;\nEND_PROGRAM\n",
+     "n.st:3:6", "Real is outside the subset synth executes"),
+    ("PROGRAM P\nVAR_TEMP x : INT; END_VAR\nx := 1;\nEND_PROGRAM\n",
+     "n.st:2:1", "TemporaryVariableDeclarations is outside the subset synth executes"),
+    ("PROGRAM P\nEND_PROGRAM\nFUNCTION F : INT\nF := 1;\nEND_FUNCTION\n",
+     "n.st:3:1", "Function is outside the subset synth executes (PROGRAM, FUNCTION_BLOCK)"),
+])
+def test_node_types_outside_the_subset_are_located(text: str, where: str, message: str) -> None:
+    with pytest.raises(InputError) as e:
+        load_st(text, "n.st")
+    assert (str(e.value.location), e.value.message) == (where, message)
