@@ -119,7 +119,7 @@ class _Checker:
         self.cycles = 0
         self.ms = {t.id: int(t.seconds * 1000) for t in g.timers}
         self.step_of = {t.id: t.step for t in g.timers}
-        self.memo_base = {id(self.module): self.module}
+        self.memo_base: dict[int, object] = {id(self.module): self.module}
         for unit in self.module.pous.values():
             self.memo_base[id(unit)] = unit
 

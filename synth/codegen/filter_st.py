@@ -214,7 +214,7 @@ def _algebraic(f: Filter, w: _Writer, notes: list[str], order: list[str] | None)
         free = "; ".join(f"{o} is free when {cube_text(c)}" for o, c in s.free.items())
         raise ModelError(f"{f.file}: the synthesis is not functional ({free}); add a criterion that decides it")
     if not s.consistent:
-        notes.append(f"no safe output vector exists when {s.inconsistent_text or cube_text(s.inconsistent)}; "
+        notes.append(f"no safe output vector exists when {s.inconsistent_text or cube_text(s.inconsistent or {})}; "
                      "the equations are those of the care set")
     lines = []
     for o, text in s.chained.items():

@@ -224,7 +224,8 @@ class _Writer:
     def phase(self, when: str, flags: str, indent: int) -> None:
         """Stored actions ``on when`` of the steps flagged in ``flags`` (``Leave``/``Enter``)."""
         for o in self.stored:
-            sets, resets = [], []
+            sets: list[str] = []
+            resets: list[str] = []
             for s in self.steps:
                 for a in s.actions:
                     if a.kind == STORED and a.when == when and a.order == o:
@@ -261,25 +262,26 @@ class _Writer:
             e("IF _InputEvent AND NOT Unstable THEN")
             e("(* stored actions on events, in the stable situation before the event *)", 1)
             for o in self.stored:
-                sets, resets = [], []
+                event_sets: list[str] = []
+                event_resets: list[str] = []
                 for s in self.steps:
                     for a in s.actions:
                         if a.kind == STORED and a.when == ON_EVENT and a.order == o:
                             assert a.condition is not None
                             cond = f"{self.st(s.variable)} AND {st_expr(a.condition, self.ref, 2)}"
-                            (sets if a.value else resets).append(cond)
-                self.stored_update(o, sets, resets, 1)
+                            (event_sets if a.value else event_resets).append(cond)
+                self.stored_update(o, event_sets, event_resets, 1)
             e("END_IF")
         e()
         e("(* 2. evolve to stability: rounds of simultaneous firing until no transition is fireable *)")
         e("_Rounds := 0;")
         e("_Fired := NOT Unstable;")
         e("WHILE _Fired DO")
-        for k, t in enumerate(g.transitions, 1):
-            rec = st_expr(t.receptivity, self.ref, 2)
-            enabled = [self.st("X" + s) for s in t.sources]
-            terms = enabled + ([rec] if rec != "TRUE" or not enabled else [])
-            e(f"_Fire[{k}] := {' AND '.join(terms)}; (* {' '.join(t.text().split())} *)", 1)
+        for k, tr in enumerate(g.transitions, 1):
+            rec = st_expr(tr.receptivity, self.ref, 2)
+            enabled = [self.st("X" + s) for s in tr.sources]
+            fire = enabled + ([rec] if rec != "TRUE" or not enabled else [])
+            e(f"_Fire[{k}] := {' AND '.join(fire)}; (* {' '.join(tr.text().split())} *)", 1)
         e("_Fired := " + _or([f"_Fire[{k}]" for k in range(1, len(g.transitions) + 1)]) + ";", 1)
         e("IF _Fired THEN", 1)
         e("_Rounds := _Rounds + 1;", 2)
@@ -348,8 +350,8 @@ class _Writer:
                         terms.append(f"{self.st(s.variable)} AND {st_expr(a.condition, self.ref, 2)}")
             if o in self.stored:
                 terms.append(f"_Mem_{self.st(o)}")
-            value = f"NOT Unstable AND {_paren(_or(list(dict.fromkeys(terms))))}" if terms else "FALSE"
-            e(f"{orders}{self.st(o)} := {value};")
+            order = f"NOT Unstable AND {_paren(_or(list(dict.fromkeys(terms))))}" if terms else "FALSE"
+            e(f"{orders}{self.st(o)} := {order};")
         if self.filt is not None:
             f = self.filt
             e()

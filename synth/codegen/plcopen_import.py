@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
+from typing import Any
 
 from synth.codegen.plcopen_xml import NS, SYNTH_DATA, Qualifier
 from synth.codegen.st_condition import ExprReader, st_text
@@ -137,7 +138,7 @@ def import_sfc(data: bytes | str, file: str = "<xml>") -> str:
             raise InputError("a named transition whose body is not ST", src.at(t))
         named_conditions[t.get("name")] = (st, st_text(st))
 
-    elements: dict[int, object] = {}
+    elements: dict[int, Any] = {}  # localId -> lxml element
     for el in sfc:
         if not isinstance(el.tag, str):
             continue  # an XML comment or processing instruction

@@ -167,6 +167,7 @@ def st_expression(
     def ref(x: Expr) -> str:
         if isinstance(x, Var):
             return name(x.name)
+        assert isinstance(x, Edge)  # st_expr asks ref for variables and edges only
         return edge(x) if edge is not None else _edge_default(x, name)
 
     return st_expr(e, ref)
