@@ -125,3 +125,19 @@ def test_a_non_numeric_reference_in_plcopen_xml_is_located(bad, tmp_path, capsys
     code, err = _run(["import", str(tmp_path / "p.xml"), "-o", str(tmp_path / "g.g7")], capsys)
     assert code == 2 and not (tmp_path / "g.g7").exists()
     assert f"p.xml:{line}:" in err and "refLocalId must be a number" in err and "Traceback" not in err
+
+
+def test_running_out_of_memory_stops_with_exit_2(tmp_path, capsys, monkeypatch):
+    """A closed loop larger than the machine (it ended in a traceback with exit 1, the
+    'unsafe' code): exit 2 and a message naming the budget options."""
+    import synth.filter.closed_loop as closed_loop
+
+    def exhausted(*args: object, **kwargs: object) -> None:
+        raise MemoryError
+
+    monkeypatch.setattr(closed_loop, "verify", exhausted)
+    skeleton = tmp_path / "F.filter"
+    assert main(["filter", "from-rules", str(ROOT / "plants/tri.rules"), "-o", str(skeleton)]) == 0
+    code, err = _run(["filter", "verify", str(skeleton), "--plant", str(ROOT / "plants/tri.rules"), "--any-control"], capsys)
+    assert code == 2
+    assert err.endswith("stopped: out of memory; bound the exploration with --max-states (or --max-nodes)\n")
