@@ -129,15 +129,15 @@ def _cache_file(name: str, start: str, text: str) -> Path | None:
     """Where lark keeps the tables of one grammar: ``$XDG_CACHE_HOME/synth`` (by default
     ``~/.cache/synth``), one file per grammar text, start rule and lark version (never the
     shared temporary folder); ``None`` when there is no home to cache in."""
-    import hashlib
     import os
+    import zlib  # a checksum for the file name (hashlib loads OpenSSL: 3 ms of every command)
 
     import lark
 
     base = os.environ.get("XDG_CACHE_HOME") or (os.path.join(os.path.expanduser("~"), ".cache") if os.path.expanduser("~") != "~" else "")
     if not base:
         return None
-    key = hashlib.sha256(f"{lark.__version__}\0{start}\0{text}".encode()).hexdigest()[:16]
+    key = f"{zlib.crc32(text.encode()):08x}-{lark.__version__}"
     folder = Path(base) / "synth"
     try:
         folder.mkdir(parents=True, exist_ok=True)
