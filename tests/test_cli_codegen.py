@@ -48,7 +48,7 @@ def test_st_with_the_filter_gives_one_program_in_which_the_filter_runs_last(caps
     assert lines.index("FUNCTION_BLOCK FB_tri_box_Filter") < lines.index("PROGRAM tri")
     call = next(i for i, line in enumerate(lines) if line.startswith("_Filter("))
     assert lines[call].startswith("_Filter(R_TAPIS := _Order_TAPIS, R_AVANCER1 := _Order_AVANCER1,")
-    assert lines.index("END_WHILE") < call  # after the Grafcet's evolution
+    assert lines.index("END_WHILE;") < call  # after the Grafcet's evolution
     program = lines.index("PROGRAM tri")
     writes = [i for i, line in enumerate(lines) if i > program and line.startswith(("TAPIS :=", "AVANCER1 :=", "AVANCER4 :="))]
     assert writes and all(i > call for i in writes)  # outputs written from the filter, after it ran
@@ -70,7 +70,7 @@ def test_st_with_the_box_sorting_benchmark_filter(capsys, tmp_path):
     assert lines[call].startswith("_Filter(R_A0 := FALSE, ")  # the Grafcet never orders A0
     assert "C0 : BOOL; (* read by the filter only *)" in lines
     assert "A0 : BOOL; (* written by the filter only *)" in lines
-    assert lines.index("END_WHILE") < call < lines.index("A0 := _Filter.A0;")
+    assert lines.index("END_WHILE;") < call < lines.index("A0 := _Filter.A0;")
 
 
 def test_st_xml_is_valid_plcopen(capsys, tmp_path):

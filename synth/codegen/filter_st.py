@@ -250,7 +250,7 @@ def _loop(f: Filter, w: _Writer) -> tuple[list[str], list[Declaration]]:
     lines += [f"g1[{k}] := {w.name(request_name(o))};" for k, o in enumerate(outs, 1)]
     update = "SI[k] := (NOT fs0[k] AND ((NOT fc0[k] AND g1[k]) OR fc1[k])) OR fs1[k];"
     if nc == 0:
-        lines += ["FOR k := 1 TO %d DO" % no, "    " + update, "END_FOR;", f"{FALLBACK} := FALSE;"]
+        lines += [*for_loop("k", no, ["    " + update]), f"{FALLBACK} := FALSE;"]
         decls.append(Declaration("k", "INT"))
     else:
         def matrix(value: bool) -> str:
@@ -266,17 +266,32 @@ def _loop(f: Filter, w: _Writer) -> tuple[list[str], list[Declaration]]:
                   Declaration("Cpt", "INT", comment="iterations"),
                   Declaration("k", "INT"), Declaration("i", "INT")]
         at_t = {o: f"SI[{k}]" for k, o in enumerate(outs, 1)}
-        lines += [f"FOR k := 1 TO {no} DO", "    fc0[k] := FALSE;", "    fc1[k] := FALSE;", "END_FOR;",
+        lines += [*for_loop("k", no, ["    fc0[k] := FALSE;", "    fc1[k] := FALSE;"]),
                   "Flag := TRUE;", "Cpt := 0;",
                   f"WHILE Flag AND Cpt <= {nc} DO",
-                  f"    FOR k := 1 TO {no} DO", "        " + update, "    END_FOR;"]
+                  *indent(for_loop("k", no, ["    " + update]))]
         lines += indent([f"V[{i}] := {w.expression(s.expr, at_t)}; (* {s.id} *)" for i, s in enumerate(csc, 1)])
+        relief = for_loop("i", nc, ["    fc0[k] := fc0[k] OR (MC0[k, i] AND V[i]);",
+                                    "    fc1[k] := fc1[k] OR (MC1[k, i] AND V[i]);"])
         lines += indent(["Flag := " + " OR ".join(f"V[{i}]" for i in range(1, nc + 1)) + ";", "Cpt := Cpt + 1;",
-                         f"FOR k := 1 TO {no} DO", f"    FOR i := 1 TO {nc} DO",
-                         "        fc0[k] := fc0[k] OR (MC0[k, i] AND V[i]);",
-                         "        fc1[k] := fc1[k] OR (MC1[k, i] AND V[i]);", "    END_FOR;", "END_FOR;"])
+                         *for_loop("k", no, indent(relief))])
         lines += ["END_WHILE;", f"{FALLBACK} := Flag;", "IF Flag THEN",
-                  f"    FOR k := 1 TO {no} DO", "        SI[k] := NOT fs0[k] AND fs1[k];", "    END_FOR;", "END_IF;"]
+                  *indent(for_loop("k", no, ["    SI[k] := NOT fs0[k] AND fs1[k];"])), "END_IF;"]
     lines += [f"{o} := SI[{k}];" for k, o in enumerate(outs, 1)]
     return lines, decls
 
+
+def for_loop(var: str, bound: int, body: list[str]) -> list[str]:
+    """``FOR var := 1 TO bound DO body END_FOR;``, or the body alone with ``var`` as ``1``
+    when the loop would run once: MATIEC's releases of June to November 2024 run a
+    ``FOR i := 1 TO 1`` loop zero times, so no generated loop has a single pass.
+
+    >>> for_loop("k", 1, ["    SI[k] := g1[k];"])
+    ['SI[1] := g1[1];']
+    >>> for_loop("k", 2, ["    SI[k] := g1[k];"])
+    ['FOR k := 1 TO 2 DO', '    SI[k] := g1[k];', 'END_FOR;']
+    """
+    if bound == 1:
+        pattern = re.compile(rf"(?<![A-Za-z0-9_]){var}(?![A-Za-z0-9_])")
+        return [pattern.sub("1", line[4:] if line.startswith("    ") else line) for line in body]
+    return [f"FOR {var} := 1 TO {bound} DO", *body, "END_FOR;"]

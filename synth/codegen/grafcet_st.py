@@ -248,7 +248,7 @@ class _Writer:
         for i in self.prev:
             e(f"_Prev_{self.st(i)} := {self.st(i)}; (* no edge in the first cycle *)", 1)
         e("_FirstCycle := FALSE;", 1)
-        e("END_IF")
+        e("END_IF;")
         for t in g.timers:
             k = self.timer_index[t.id]
             e(f"_Tmr{k}(IN := {self.st('X' + t.step)}, PT := {timer_literal(t.id, t.seconds, t.loc)});")
@@ -271,7 +271,7 @@ class _Writer:
                             cond = f"{self.st(s.variable)} AND {st_expr(a.condition, self.ref, 2)}"
                             (event_sets if a.value else event_resets).append(cond)
                 self.stored_update(o, event_sets, event_resets, 1)
-            e("END_IF")
+            e("END_IF;")
         e()
         e("(* 2. evolve to stability: rounds of simultaneous firing until no transition is fireable *)")
         e("_Rounds := 0;")
@@ -320,20 +320,20 @@ class _Writer:
                 e(f"IF _Leave[{self.step_index[t.step]}] THEN (* the step is left: {t.id} restarts *)", 3)
                 e(f"_Tmr{k}(IN := FALSE, PT := {timer_literal(t.id, t.seconds, t.loc)});", 4)
                 e(f"_TE{k} := FALSE;", 4)
-                e("END_IF", 3)
+                e("END_IF;", 3)
         if self.stored:
             e("(* stored actions: on deactivation, then on activation; reset wins *)", 3)
             self.phase(ON_DEACTIVATION, "_Leave", 3)
             self.phase(ON_ACTIVATION, "_Enter", 3)
-        e("END_IF", 2)
-        e("END_IF", 1)
+        e("END_IF;", 2)
+        e("END_IF;", 1)
         if self.rising or self.falling:
             e("(* edges hold in the first round only *)", 1)
         for i in self.rising:
             e(f"_RE_{self.st(i)} := FALSE;", 1)
         for i in self.falling:
             e(f"_FE_{self.st(i)} := FALSE;", 1)
-        e("END_WHILE")
+        e("END_WHILE;")
         e()
         orders = "_Order_" if self.filt is not None else ""
         e("(* 3. orders of the stable situation: continuous and conditional actions, stored outputs *)")

@@ -1,0 +1,101 @@
+"""Generated Structured Text as a real IEC 61131-3 compiler reads it (issue 22).
+
+blark, the parser the execution proof uses, accepts an ``END_IF`` without its ``;``; MATIEC's
+``iec2c`` (the compiler of Beremiz and OpenPLC) refuses it ("';' missing at the end of
+statement"). So:
+
+* a strict check that always runs: every structured statement ends with ``;`` and no ``FOR``
+  loop has a single pass (MATIEC's releases of June to November 2024 run ``FOR i := 1 TO 1``
+  zero times); it is shown failing on the old output;
+* with ``iec2c`` on PATH (``SYNTH_IEC2C`` may name it, with its ``lib`` folder beside it or in
+  ``SYNTH_IEC2C_LIB``), every bundled Grafcet's program and every bundled filter block compiles;
+  skipped otherwise (CI has no MATIEC: it is built from its public sources, never committed).
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import shutil
+import subprocess
+from pathlib import Path
+
+import pytest
+
+from conftest import ROOT
+from synth.codegen.filter_st import filter_block
+from synth.codegen.grafcet_st import grafcet_program
+from synth.errors import SynthError
+from synth.filter.language_check import load_filter
+from synth.grafcet.language_check import load_grafcet
+
+GRAFCETS = sorted((ROOT / "grafcets").glob("*.g7"))
+FILTERS = sorted((ROOT / "plants").glob("*.filter")) + sorted((ROOT / "tests/data/codegen").glob("*.filter"))
+CLOSERS = re.compile(r"^\s*(END_IF|END_WHILE|END_FOR|END_REPEAT|END_CASE)\b(.*)$")
+SINGLE_PASS = re.compile(r"\bFOR\s+\w+\s*:=\s*(\d+)\s+TO\s+(\d+)\s+DO\b")
+
+
+def conformance_problems(text: str) -> list[str]:
+    """Lines a strict IEC 61131-3 compiler refuses or misruns: a structured statement not
+    closed by ``;``, a ``FOR`` loop whose bounds make one pass."""
+    problems = []
+    for n, line in enumerate(text.splitlines(), 1):
+        code = re.sub(r"\(\*.*?\*\)", "", line)
+        m = CLOSERS.match(code)
+        if m and not m[2].strip().startswith(";"):
+            problems.append(f"{n}: {m[1]} without ';'")
+        for lo, hi in SINGLE_PASS.findall(code):
+            if lo == hi:
+                problems.append(f"{n}: a FOR loop with a single pass")
+    return problems
+
+
+def generated() -> list[tuple[str, str]]:
+    out = [(str(g.relative_to(ROOT)), grafcet_program(load_grafcet(g), version="test")) for g in GRAFCETS]
+    for f in FILTERS:
+        for algorithm in ("algebraic", "loop"):
+            for mode in ("supervisor", "blocking"):
+                try:
+                    block = filter_block(load_filter(f), algorithm, mode)
+                except SynthError:  # not functional, or a loop without priorities: nothing is written
+                    continue
+                out.append((f"{f.relative_to(ROOT)} {algorithm} {mode}", block.text))
+    return out
+
+
+def test_the_strict_check_refuses_what_iec2c_refuses():
+    text = grafcet_program(load_grafcet(ROOT / "grafcets/tri.g7"), version="test")
+    old = text.replace("END_IF;", "END_IF").replace("END_WHILE;", "END_WHILE")  # the output before issue 22
+    assert conformance_problems(text) == []
+    assert len(conformance_problems(old)) >= 6 and conformance_problems(old)[0].endswith("without ';'")
+    assert conformance_problems("FOR i := 1 TO 1 DO\n    x := TRUE;\nEND_FOR;") == ["1: a FOR loop with a single pass"]
+
+
+def test_every_generated_file_passes_the_strict_check():
+    files = generated()
+    assert len(files) >= 40
+    assert {name: conformance_problems(text) for name, text in files if conformance_problems(text)} == {}
+
+
+def _iec2c() -> tuple[str, Path] | None:
+    exe = os.environ.get("SYNTH_IEC2C") or shutil.which("iec2c")
+    if not exe:
+        return None
+    lib = Path(os.environ.get("SYNTH_IEC2C_LIB") or Path(exe).resolve().parent / "lib")
+    return (exe, lib) if lib.is_dir() else None
+
+
+@pytest.mark.skipif(_iec2c() is None, reason="MATIEC's iec2c is not on PATH")
+def test_every_generated_file_compiles_with_iec2c(tmp_path):
+    found = _iec2c()
+    assert found is not None
+    exe, lib = found
+    failures = {}
+    for k, (name, text) in enumerate(generated()):
+        src, out = tmp_path / f"p{k}.st", tmp_path / f"p{k}"
+        src.write_text(text, encoding="utf-8")
+        out.mkdir()
+        done = subprocess.run([exe, "-I", str(lib), "-T", str(out), str(src)], capture_output=True, text=True, timeout=120)
+        if done.returncode != 0 or not (out / "POUS.c").exists():
+            failures[name] = (done.stdout + done.stderr)[-400:]
+    assert failures == {}
