@@ -181,3 +181,20 @@ def test_steps_that_would_share_an_sfc_name_are_a_located_error():
     with pytest.raises(InputError) as info:
         sfc_project_xml(g, version="test")
     assert info.value.render().splitlines()[0] == "s.g7:1:35: error: steps 12 and S12 would both be the SFC step S12"
+
+
+@pytest.mark.parametrize("path", BUNDLED, ids=lambda p: str(p.relative_to(ROOT)))
+def test_each_converging_branch_has_its_own_connection_point(path: Path):
+    """As the TC6 example and Beremiz wire them (issue 22): Beremiz silently dropped an AND
+    convergence, and everything after it, when one connectionPointIn held several connections."""
+    from lxml import etree
+
+    g = load_grafcet(path)
+    root = etree.fromstring(sfc_project_xml(g, version="test"))
+    ns = {"t": "http://www.plcopen.org/xml/tc6_0201"}
+    convergences = root.findall(".//t:selectionConvergence", ns) + root.findall(".//t:simultaneousConvergence", ns)
+    branches = sum(len(t.sources) for t in g.transitions if len(t.sources) > 1)
+    branches += sum(len(in_) for in_ in ([t for t in g.transitions if s.name in t.targets] for s in g.steps) if len(in_) > 1)
+    points = [cp for c in convergences for cp in c.findall("t:connectionPointIn", ns)]
+    assert len(points) == branches
+    assert all(len(cp.findall("t:connection", ns)) == 1 for cp in points)

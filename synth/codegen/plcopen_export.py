@@ -96,7 +96,14 @@ class _Ids:
         return self.n
 
 
-def _conn_in(*producers: tuple[int, str | None]):
+def _branches(producers: Sequence[tuple[int, str | None]]) -> list[Any]:
+    """A convergence's inputs: one ``connectionPointIn`` per converging branch, as the TC6
+    example and Beremiz write them (Beremiz drops the branches of a convergence whose one
+    ``connectionPointIn`` holds several connections)."""
+    return [_conn_in(p) for p in producers]
+
+
+def _conn_in(*producers: tuple[int, str | None]) -> Any:
     cp = element("connectionPointIn")
     for ref, formal in producers:
         attrib = {"refLocalId": str(ref)}
@@ -165,7 +172,7 @@ def sfc_project_xml(g: Grafcet, *, name: str | None = None, version: str | None 
         if s.name in sel_conv:
             producers = [producer_of_transition(i, s.name) for i in incoming[s.name]]
             body.append(element("selectionConvergence", {"localId": str(sel_conv[s.name])}, position(x, y - 30),
-                           _conn_in(*producers), element("connectionPointOut")))
+                                *_branches(producers), element("connectionPointOut")))
         if s.name in sel_div:
             div = element("selectionDivergence", {"localId": str(sel_div[s.name])}, position(x, y + 50),
                      _conn_in((step_id[s.name], None)))
@@ -185,7 +192,7 @@ def sfc_project_xml(g: Grafcet, *, name: str | None = None, version: str | None 
         y = 40 + 160 * (row.get(first, 0) if first else 0) + 90
         if i in sim_conv:
             body.append(element("simultaneousConvergence", {"localId": str(sim_conv[i])}, position(x, y - 20),
-                           _conn_in(*[producer_of_step(s, i) for s in t.sources]), element("connectionPointOut")))
+                                *_branches([producer_of_step(s, i) for s in t.sources]), element("connectionPointOut")))
         el = element("transition", {"localId": str(trans_id[i])}, position(x, y))
         if i in sim_conv:
             el.append(_conn_in((sim_conv[i], None)))
