@@ -51,7 +51,11 @@ def conformance_problems(text: str) -> list[str]:
 
 
 def generated() -> list[tuple[str, str]]:
+    from synth.codegen.program import configuration
+
     out = [(str(g.relative_to(ROOT)), grafcet_program(load_grafcet(g), version="test")) for g in GRAFCETS]
+    tri = grafcet_program(load_grafcet(ROOT / "grafcets/tri.g7"), version="test")
+    out.append(("grafcets/tri.g7 --task 10ms", tri + "\n".join(configuration("tri", "10ms")) + "\n"))
     for f in FILTERS:
         for algorithm in ("algebraic", "loop"):
             for mode in ("supervisor", "blocking"):
@@ -99,3 +103,18 @@ def test_every_generated_file_compiles_with_iec2c(tmp_path):
         if done.returncode != 0 or not (out / "POUS.c").exists():
             failures[name] = (done.stdout + done.stderr)[-400:]
     assert failures == {}
+
+
+def test_task_adds_a_configuration_and_a_bad_period_is_located(tmp_path, capsys):
+    from synth.cli.main import main
+
+    out = tmp_path / "tri.st"
+    assert main(["st", str(ROOT / "grafcets/tri.g7"), "--plant", str(ROOT / "plants/tri.rules"), "--task", "10ms",
+                 "-o", str(out)]) == 0
+    assert out.read_text().endswith("CONFIGURATION Config0\n  RESOURCE Res0 ON PLC\n"
+                                    "    TASK MainTask(INTERVAL := T#10ms, PRIORITY := 0);\n"
+                                    "    PROGRAM Inst0 WITH MainTask : tri;\n  END_RESOURCE\nEND_CONFIGURATION\n")
+    assert main(["st", str(ROOT / "grafcets/tri.g7"), "--task", "10", "-o", str(tmp_path / "x.st")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("--task:1:1: error: not a period\n  1 | 10\n") and "a period such as 10ms" in err
+    assert not (tmp_path / "x.st").exists()

@@ -21,7 +21,7 @@ from synth.grafcet.language import Grafcet
 from synth.logic.expr import names
 
 __all__ = ["FilterCall", "StProgram", "program_name", "filter_call", "check_variable_name", "first_location",
-           "compact"]
+           "compact", "configuration"]
 
 
 @dataclass(frozen=True)
@@ -125,3 +125,30 @@ def compact(lines: list[str]) -> list[str]:
         else:
             out.append(line)
     return out
+
+
+def configuration(program: str, task: str) -> list[str]:
+    """``--task 10ms``: the ``CONFIGURATION`` that runs ``program`` cyclically, so the file
+    builds as it is in Beremiz and OpenPLC (one resource, one periodic task, one instance).
+
+    >>> print("\\n".join(configuration("tri", "10ms")))
+    CONFIGURATION Config0
+      RESOURCE Res0 ON PLC
+        TASK MainTask(INTERVAL := T#10ms, PRIORITY := 0);
+        PROGRAM Inst0 WITH MainTask : tri;
+      END_RESOURCE
+    END_CONFIGURATION
+    """
+    from fractions import Fraction
+
+    from synth.codegen.st import time_literal
+
+    found = re.fullmatch(r"([0-9]+(?:\.[0-9]+)?)(ms|s|min|h)", task.strip())
+    if found is None:
+        raise InputError("not a period", Location("--task", 1, 1, task, max(1, len(task))),
+                         expected=("a period such as 10ms, 0.5s or 1min",))
+    unit = {"ms": Fraction(1, 1000), "s": Fraction(1), "min": Fraction(60), "h": Fraction(3600)}[found[2]]
+    literal = time_literal(Fraction(found[1]) * unit, None, found[0])
+    return ["CONFIGURATION Config0", "  RESOURCE Res0 ON PLC",
+            f"    TASK MainTask(INTERVAL := {literal}, PRIORITY := 0);",
+            f"    PROGRAM Inst0 WITH MainTask : {program};", "  END_RESOURCE", "END_CONFIGURATION"]
