@@ -19,7 +19,7 @@ Example
 from __future__ import annotations
 
 import operator
-from typing import Any, Callable
+from typing import Any, Callable, Mapping, TypeVar
 
 from blark import transform as tf
 
@@ -27,6 +27,8 @@ from synth.codegen.interp_runtime import Instance, Thunk, Value
 from synth.errors import InputError, location_in
 
 __all__ = ["ExpressionCompiler", "Store", "as_bool", "name_of"]
+
+T = TypeVar("T")
 
 Node = Any  # a blark.transform dataclass (blark ships no type information)
 Store = Callable[[Instance, Value], None]
@@ -62,12 +64,16 @@ class ExpressionCompiler:
     def outside(self, node: Node) -> InputError:
         return self.error(node, f"{type(node).__name__} is outside the subset synth executes")
 
-    # expressions
-    def expr(self, node: Node) -> Thunk:
-        handler = _EXPRESSIONS.get(type(node))
+    def dispatch(self, table: Mapping[type, Callable[[Any, Any], T]], node: Node) -> T:
+        """The handler of ``node``'s exact blark type in ``table``; any other type is outside the subset."""
+        handler = table.get(type(node))
         if handler is None:
             raise self.outside(node)
         return handler(self, node)
+
+    # expressions
+    def expr(self, node: Node) -> Thunk:
+        return self.dispatch(_EXPRESSIONS, node)
 
     def constant(self, node: Node) -> Value:
         """The value of a constant expression (an initialiser, an array bound)."""
@@ -117,10 +123,7 @@ class ExpressionCompiler:
     # places
     def reference(self, node: Node) -> Thunk:
         """Read a variable, an array element or a field of an instance."""
-        handler = _REFERENCES.get(type(node))
-        if handler is None:
-            raise self.outside(node)
-        return handler(self, node)
+        return self.dispatch(_REFERENCES, node)
 
     def _read_simple(self, node: Node) -> Thunk:
         name = name_of(node.name)
@@ -147,10 +150,7 @@ class ExpressionCompiler:
 
     def element(self, e: Node) -> tuple[_Get, _Put]:
         """Read and write one step of a path: a subscript list ``[i, j]`` or a field ``.Q``."""
-        handler = _ELEMENTS.get(type(e))
-        if handler is None:
-            raise self.outside(e)
-        return handler(self, e)
+        return self.dispatch(_ELEMENTS, e)
 
     def _subscripts(self, e: Node) -> tuple[_Get, _Put]:
         subs = [self.expr(s) for s in e.subscripts]

@@ -54,10 +54,7 @@ class StatementCompiler(ExpressionCompiler):
         return run
 
     def statement(self, node: Node) -> Action:
-        handler = _STATEMENTS.get(type(node))
-        if handler is None:
-            raise self.outside(node)
-        return handler(self, node)
+        return self.dispatch(_STATEMENTS, node)
 
     def _body(self, node: Node) -> Action:
         """The action of a nested statement list (blark gives ``None`` for an empty one)."""

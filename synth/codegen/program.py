@@ -139,16 +139,14 @@ def configuration(program: str, task: str) -> list[str]:
       END_RESOURCE
     END_CONFIGURATION
     """
-    from fractions import Fraction
-
     from synth.codegen.st import time_literal
+    from synth.grafcet.language import DURATION_RE, duration_seconds
 
-    found = re.fullmatch(r"([0-9]+(?:\.[0-9]+)?)(ms|s|min|h)", task.strip())
+    where = Location("--task", 1, 1, task, max(1, len(task)))
+    found = DURATION_RE.fullmatch(task.strip())
     if found is None:
-        raise InputError("not a period", Location("--task", 1, 1, task, max(1, len(task))),
-                         expected=("a period such as 10ms, 0.5s or 1min",))
-    unit = {"ms": Fraction(1, 1000), "s": Fraction(1), "min": Fraction(60), "h": Fraction(3600)}[found[2]]
-    literal = time_literal(Fraction(found[1]) * unit, None, found[0])
+        raise InputError("not a period", where, expected=("a period such as 10ms, 0.5s or 1min",))
+    literal = time_literal(duration_seconds(found[1], found[2]), where, found[0])
     return ["CONFIGURATION Config0", "  RESOURCE Res0 ON PLC",
             f"    TASK MainTask(INTERVAL := {literal}, PRIORITY := 0);",
             f"    PROGRAM Inst0 WITH MainTask : {program};", "  END_RESOURCE", "END_CONFIGURATION"]

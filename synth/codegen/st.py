@@ -21,6 +21,7 @@ from fractions import Fraction
 from typing import Callable, Iterable, Sequence
 
 from synth.errors import InputError, Location
+from synth.grafcet.language import DURATION_RE
 from synth.logic.expr import And, Const, Edge, Expr, Not, Or, Var
 from synth.logic.past import pre_name, st_past_name
 
@@ -97,9 +98,6 @@ def st_identifier_problem(name: str) -> str | None:
     return None if problem is None else f"{name} {problem}"
 
 
-_DURATION = re.compile(r"([0-9]+(?:\.[0-9]+)?)(ms|s|min|h)")
-
-
 def time_literal(seconds: Fraction, loc: Location | None = None, written: str | None = None) -> str:
     """The one IEC ``TIME`` literal of a timer duration, for every generated file (ST program,
     SFC, PLCopen XML): as the Grafcet writes it when ``written`` (``2min`` is ``T#2m``, ``2000ms``
@@ -114,7 +112,7 @@ def time_literal(seconds: Fraction, loc: Location | None = None, written: str | 
     ms = seconds * 1000
     if ms.denominator != 1 or ms <= 0:
         raise InputError(f"a timer of {float(seconds)} s cannot be written in whole milliseconds", loc)
-    found = _DURATION.fullmatch(written) if written else None
+    found = DURATION_RE.fullmatch(written) if written else None
     if found:
         return f"T#{found[1]}{'m' if found[2] == 'min' else found[2]}"
     n = int(ms)

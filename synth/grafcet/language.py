@@ -36,6 +36,7 @@ __all__ = [
     "STEP_PREFIX",
     "TIMER_RE",
     "duration_seconds",
+    "DURATION_RE",
     "step_variable",
     "step_of",
     "ActionKind",
@@ -78,7 +79,10 @@ CONTINUOUS, CONDITIONAL, STORED = ActionKind.CONTINUOUS, ActionKind.CONDITIONAL,
 ON_ACTIVATION, ON_DEACTIVATION, ON_EVENT = StoredWhen.ACTIVATION, StoredWhen.DEACTIVATION, StoredWhen.EVENT
 
 # a timer atom: duration, unit and step, e.g. ``2s/X101``
-TIMER_RE = re.compile(r"^([0-9]+(?:\.[0-9]+)?)(ms|s|min|h)/X([A-Za-z0-9_]+)$")
+DURATION = r"([0-9]+(?:\.[0-9]+)?)(ms|s|min|h)"
+"""A duration as ``.g7`` writes it (``2s``, ``700ms``, ``1.5min``): its number and its unit."""
+DURATION_RE = re.compile(DURATION)
+TIMER_RE = re.compile(rf"^{DURATION}/X([A-Za-z0-9_]+)$")
 _SECONDS = {"ms": Fraction(1, 1000), "s": Fraction(1), "min": Fraction(60), "h": Fraction(3600)}
 
 

@@ -19,6 +19,7 @@ True
 
 from __future__ import annotations
 
+import operator
 from dataclasses import dataclass, field
 from functools import reduce
 from itertools import product
@@ -146,28 +147,26 @@ def _not(r: Any) -> Any:
     return ~r  # a BDD (or any value with Boolean operators)
 
 
-def _and(a: Any, b: Any) -> Any:
+def _combine(a: Any, b: Any, absorbing: bool, ufunc: str, op: Callable[[Any, Any], Any]) -> Any:
+    """``a & b`` (``absorbing`` False) or ``a | b`` (True) for booleans, numpy arrays and BDDs:
+    a Python boolean next to another value is absorbing or neutral."""
     if isinstance(a, bool):
-        return b if a else False
+        return absorbing if a == absorbing else b
     if isinstance(b, bool):
-        return a if b else False
+        return absorbing if b == absorbing else a
     if type(a).__module__ == "numpy" or type(b).__module__ == "numpy":
         import numpy as np
 
-        return np.logical_and(a, b)
-    return a & b
+        return getattr(np, ufunc)(a, b)
+    return op(a, b)
+
+
+def _and(a: Any, b: Any) -> Any:
+    return _combine(a, b, False, "logical_and", operator.and_)
 
 
 def _or(a: Any, b: Any) -> Any:
-    if isinstance(a, bool):
-        return True if a else b
-    if isinstance(b, bool):
-        return True if b else a
-    if type(a).__module__ == "numpy" or type(b).__module__ == "numpy":
-        import numpy as np
-
-        return np.logical_or(a, b)
-    return a | b
+    return _combine(a, b, True, "logical_or", operator.or_)
 
 
 def _evaluate(e: Expr, value: Callable[[str], Any], edge: Callable[[Edge], Any]) -> Any:

@@ -249,13 +249,10 @@ def st_check_report(g: Grafcet, report: DifferentialReport) -> CiReport:
 
 def write_ci(reports: Sequence[CiReport], junit: str | None = None, sarif: str | None = None) -> None:
     """``--junit FILE`` and ``--sarif FILE``: the files, written whole or not at all."""
-    if junit:
-        from synth.output.files import write_atomic
+    from synth.output.files import write_atomic
+    from synth.output.summary import json_text
 
+    if junit:
         write_atomic(junit, junit_xml(reports))
     if sarif:
-        import json
-
-        from synth.output.files import write_atomic
-
-        write_atomic(sarif, json.dumps(sarif_json(reports), indent=2, ensure_ascii=False) + "\n")
+        write_atomic(sarif, json_text(sarif_json(reports)))
