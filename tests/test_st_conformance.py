@@ -14,15 +14,12 @@ statement"). So:
 
 from __future__ import annotations
 
-import os
 import re
-import shutil
-import subprocess
-from pathlib import Path
 
 import pytest
 
 from conftest import ROOT
+from iec2c import compile_st, find_iec2c
 from synth.codegen.filter_st import filter_block
 from synth.codegen.grafcet_st import grafcet_program
 from synth.errors import SynthError
@@ -81,26 +78,12 @@ def test_every_generated_file_passes_the_strict_check():
     assert {name: conformance_problems(text) for name, text in files if conformance_problems(text)} == {}
 
 
-def _iec2c() -> tuple[str, Path] | None:
-    exe = os.environ.get("SYNTH_IEC2C") or shutil.which("iec2c")
-    if not exe:
-        return None
-    lib = Path(os.environ.get("SYNTH_IEC2C_LIB") or Path(exe).resolve().parent / "lib")
-    return (exe, lib) if lib.is_dir() else None
-
-
-@pytest.mark.skipif(_iec2c() is None, reason="MATIEC's iec2c is not on PATH")
+@pytest.mark.skipif(find_iec2c() is None, reason="MATIEC's iec2c is not on PATH")
 def test_every_generated_file_compiles_with_iec2c(tmp_path):
-    found = _iec2c()
-    assert found is not None
-    exe, lib = found
     failures = {}
     for k, (name, text) in enumerate(generated()):
-        src, out = tmp_path / f"p{k}.st", tmp_path / f"p{k}"
-        src.write_text(text, encoding="utf-8")
-        out.mkdir()
-        done = subprocess.run([exe, "-I", str(lib), "-T", str(out), str(src)], capture_output=True, text=True, timeout=120)
-        if done.returncode != 0 or not (out / "POUS.c").exists():
+        done = compile_st(text, tmp_path / f"p{k}")
+        if done.returncode != 0 or not (tmp_path / f"p{k}" / "POUS.c").exists():
             failures[name] = (done.stdout + done.stderr)[-400:]
     assert failures == {}
 

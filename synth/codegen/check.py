@@ -32,7 +32,7 @@ from __future__ import annotations
 import copy
 from dataclasses import dataclass, field
 from enum import StrEnum
-from typing import Mapping, Sequence
+from typing import Callable, Mapping, Protocol, Sequence
 
 from synth.codegen.grafcet_st import generate_program
 from synth.codegen.program import StProgram
@@ -41,7 +41,8 @@ from synth.grafcet.language import Grafcet
 from synth.grafcet.machine import GrafcetMachine, Situation
 from synth.logic.events import Event
 
-__all__ = ["Aspect", "Mismatch", "DifferentialReport", "differential_check", "require_blark"]
+__all__ = ["Aspect", "Mismatch", "DifferentialReport", "ProgramRunner", "InterpretedProgram", "differential_check",
+           "require_blark"]
 
 
 class Aspect(StrEnum):
@@ -101,17 +102,62 @@ class _Side:
     since: dict[str, int]  # active step -> clock (ms) of its last activation
 
 
-class _Checker:
-    def __init__(self, g: Grafcet, initial: Mapping[str, bool], depth: int, program: StProgram,
-                 max_mismatches: int) -> None:
+class ProgramRunner(Protocol):
+    """One side of the check: a PLC program that runs cycles on a clock, whose state can be
+    saved and restored (the exploration backtracks). Names are the program's ST names."""
+
+    def cycle(self, inputs: Mapping[str, bool]) -> None:
+        """Set ``inputs`` (the others keep their values) and run one PLC cycle."""
+
+    def value(self, name: str) -> bool:
+        """A Boolean variable of the program after the last cycle."""
+
+    def advance(self, ms: int) -> None:
+        """Move the PLC clock on by ``ms`` milliseconds."""
+
+    def save(self) -> object:
+        """The program's whole state (variables, timers, clock)."""
+
+    def restore(self, saved: object) -> None:
+        """Go back to a state :meth:`save` returned."""
+
+
+class InterpretedProgram:
+    """The generated program parsed by blark and run by :mod:`synth.codegen.interpreter`."""
+
+    def __init__(self, program: StProgram, file: str) -> None:
         from synth.codegen.interpreter import load_st
 
+        self.module = load_st(program.text, file)
+        self.inst = self.module.instance(program.program)
+        self.memo_base: dict[int, object] = {id(self.module): self.module}
+        for unit in self.module.pous.values():
+            self.memo_base[id(unit)] = unit
+
+    def cycle(self, inputs: Mapping[str, bool]) -> None:
+        self.inst.cycle(dict(inputs))
+
+    def value(self, name: str) -> bool:
+        return bool(self.inst[name])
+
+    def advance(self, ms: int) -> None:
+        self.module.advance(ms)
+
+    def save(self) -> object:
+        return copy.deepcopy(self.inst, dict(self.memo_base)), self.module.clock_ms
+
+    def restore(self, saved: object) -> None:
+        self.inst, self.module.clock_ms = saved  # type: ignore[misc]
+
+
+class _Checker:
+    def __init__(self, g: Grafcet, initial: Mapping[str, bool], depth: int, program: StProgram,
+                 runner: ProgramRunner, max_mismatches: int) -> None:
         self.g = g
         self.depth = depth
         self.program = program
         self.machine = GrafcetMachine(g)
-        self.module = load_st(program.text, f"{g.path}.st")
-        self.inst = self.module.instance(program.program)
+        self.runner = runner
         self.initial = {n: bool(initial.get(n, False)) for n in g.inputs}
         self.max_mismatches = max_mismatches
         self.mismatches: list[Mismatch] = []
@@ -119,16 +165,13 @@ class _Checker:
         self.cycles = 0
         self.ms = {t.id: int(t.seconds * 1000) for t in g.timers}
         self.step_of = {t.id: t.step for t in g.timers}
-        self.memo_base: dict[int, object] = {id(self.module): self.module}
-        for unit in self.module.pous.values():
-            self.memo_base[id(unit)] = unit
 
     # ------------------------------------------------------------------ both sides
     def compare(self, events: tuple[str, ...], side: _Side | None) -> bool:
         """Compare after a cycle; False when the branch must stop (a mismatch or instability)."""
-        inst, p = self.inst, self.program
+        run, p = self.runner, self.program
         self.cycles += 1
-        unstable = bool(inst["Unstable"])
+        unstable = run.value("Unstable")
         if side is None:  # the machine found a transient cycle that never stabilises
             if not unstable:
                 self.mismatch(events, Aspect.STABILITY, "never stabilises", "stable (Unstable = FALSE)")
@@ -137,13 +180,13 @@ class _Checker:
             self.mismatch(events, Aspect.STABILITY, "stable", "Unstable = TRUE")
             return False
         want = tuple(side.sit.step_variables)
-        got = tuple(s.variable for s in self.g.steps if inst[p.st_name(s.variable)])
+        got = tuple(s.variable for s in self.g.steps if run.value(p.st_name(s.variable)))
         if sorted(want) != sorted(got):
             self.mismatch(events, Aspect.STEPS, _set_text(want), _set_text(got))
             return False
         orders = self.machine.orders(side.sit, side.inputs)
         want_o = tuple(o for o in self.g.outputs if o in orders)
-        got_o = tuple(o for o in self.g.outputs if inst[p.st_name(o)])
+        got_o = tuple(o for o in self.g.outputs if run.value(p.st_name(o)))
         if want_o != got_o:
             self.mismatch(events, Aspect.OUTPUTS, _set_text(want_o), _set_text(got_o))
             return False
@@ -159,7 +202,7 @@ class _Checker:
             side: _Side | None = _Side(sit, dict(self.initial), 0, {s: 0 for s in sit.steps})
         except InputError:
             side = None
-        self.inst.cycle({self.program.st_name(n): v for n, v in self.initial.items()})
+        self.runner.cycle({self.program.st_name(n): v for n, v in self.initial.items()})
         if self.compare((), side) and side is not None:
             self.explore(side, ())
         else:
@@ -209,26 +252,20 @@ class _Checker:
             self.sequences += 1
             return
         for event, delay in self.events(side):
-            saved = self.save()
+            saved = self.runner.save()
             nxt = self.step(side, event, delay)
             if delay:
-                self.module.advance(delay)
+                self.runner.advance(delay)
             if event.is_edge:
-                self.inst.cycle({self.program.st_name(event.name): event.rising})
+                self.runner.cycle({self.program.st_name(event.name): event.rising})
             else:
-                self.inst.cycle({})
+                self.runner.cycle({})
             seq = events + (str(event),)
             if self.compare(seq, nxt) and nxt is not None:
                 self.explore(nxt, seq)
             else:
                 self.sequences += 1
-            self.restore(saved)
-
-    def save(self) -> tuple[object, int]:
-        return copy.deepcopy(self.inst, dict(self.memo_base)), self.module.clock_ms
-
-    def restore(self, saved: tuple[object, int]) -> None:
-        self.inst, self.module.clock_ms = saved  # type: ignore[assignment]
+            self.runner.restore(saved)
 
 
 def differential_check(
@@ -238,15 +275,21 @@ def differential_check(
     depth: int = 4,
     program: StProgram | None = None,
     max_mismatches: int = 10,
+    runner: Callable[[StProgram], ProgramRunner] | None = None,
 ) -> DifferentialReport:
     """Play every event sequence of length ``depth`` on ``synth run``'s machine and on the
     generated program (``program``, else :func:`generate_program` of ``g``), comparing active
     steps, outputs and stability after every cycle. ``initial``: the input values at start
-    (missing ones are 0). Without blark (a test extra), a :class:`~synth.errors.SynthError`
-    that says how to install it."""
-    require_blark("synth st --check")
+    (missing ones are 0). ``runner`` runs the program (default: :class:`InterpretedProgram`;
+    the tests also plug in the C that MATIEC's ``iec2c`` compiles). Without blark (a test
+    extra), a :class:`~synth.errors.SynthError` that says how to install it."""
     program = program or generate_program(g, version="check")
-    checker = _Checker(g, initial or {}, depth, program, max_mismatches)
+    if runner is None:
+        require_blark("synth st --check")
+        side: ProgramRunner = InterpretedProgram(program, f"{g.path}.st")
+    else:
+        side = runner(program)
+    checker = _Checker(g, initial or {}, depth, program, side, max_mismatches)
     checker.run()
     return DifferentialReport(g.path, depth, checker.sequences, checker.cycles, tuple(checker.mismatches))
 
