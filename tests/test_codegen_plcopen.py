@@ -19,7 +19,7 @@ from synth.output.summary import ass_json
 
 ROOT = Path(__file__).resolve().parent.parent
 BUNDLED = [p for p in sorted(ROOT.glob("grafcets/*.g7")) + sorted(ROOT.glob("tests/data/**/*.g7"))
-           if "codegen" not in p.parts]
+           if "codegen" not in p.parts and p.name != "source_sink.g7"]
 DATA = ROOT / "tests/data/codegen"
 
 
@@ -47,6 +47,16 @@ def test_st_program_as_plcopen_xml_is_valid(path: Path):
     xml = st_project_xml(generate_program(load_grafcet(path), version="test").pous, name="p", version="test")
     assert validation_errors(xml) == []
     assert xml.count(b"<pou ") == 1 and b"<ST>" in xml
+
+
+def test_source_and_sink_transitions_have_no_sfc(tmp_path, capsys):
+    from synth.cli.main import main
+
+    out = tmp_path / "s.xml"
+    assert main(["sfc", str(ROOT / "grafcets/source_sink.g7"), "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "source_sink.g7:4:14: error: a source transition cannot be written as IEC 61131-3 SFC" in err
+    assert not out.exists()
 
 
 def test_written_xml_is_deterministic_and_has_no_time_of_day():

@@ -83,7 +83,7 @@ def test_bounded_search_for_stability_with_an_error_flag():
 
 
 def test_names_differing_in_case_only_are_renamed_and_listed():
-    text = grafcet_program(load_grafcet(ROOT / "grafcets/and_divergence.g7"), version="test")
+    text = grafcet_program(load_grafcet(ROOT / "tests/data/codegen/case_clash.g7"), version="test")
     assert "(* renamed (Structured Text ignores case): A -> A_1, B -> B_1 *)" in text
     assert "A_1 := NOT Unstable AND X1;" in _lines(text)
 

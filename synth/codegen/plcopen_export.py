@@ -18,11 +18,15 @@ step ``12`` / ``wait``                  ``<step name="S12">`` / ``name="wait"``
 ``2s/X12``                              ``(S12.T >= T#2s)`` (the TIME literal of ``synth st``)
 ``↑x`` / ``↓x``                         ``_RE_x`` / ``_FE_x`` (edge flags, see docs/codegen.md)
 ``A`` (continuous)                      qualifier ``N``, reference ``A``
-``A if c``                              qualifier ``N``, inline ST ``A := c;``
+``A if c``                              qualifier ``N``, inline ST ``A := c;``, and ``P0``,
+                                        inline ST ``A := FALSE;`` (reset when the step is left)
 ``set A`` / ``reset A`` on activation   qualifier ``S`` / ``R``, reference ``A``
 ``set A on deactivation``               qualifier ``P0``, inline ST ``A := TRUE;``
 ``set A on ↑p``                         qualifier ``N``, inline ``IF _RE_p THEN A := TRUE; END_IF;``
 =====================================  ==========================================
+
+Plant names differing only in case (``a`` and ``A``) are renamed as ``synth st`` renames
+them (:func:`~synth.codegen.program.case_aliases`); the project's comment lists the renames.
 
 Example
 -------
@@ -48,10 +52,19 @@ from synth.codegen.plcopen_xml import (
     sfc_step_name,
     xhtml,
 )
-from synth.codegen.program import check_variable_name, first_location, program_name
+from synth.codegen.program import case_aliases, check_variable_name, first_location, program_name, renamed_note
 from synth.codegen.st import Pou, PouKind, st_expr, timer_literal
 from synth.errors import InputError
-from synth.grafcet.language import CONDITIONAL, CONTINUOUS, ON_ACTIVATION, ON_DEACTIVATION, ON_EVENT, Grafcet, Timer
+from synth.grafcet.language import (
+    CONDITIONAL,
+    CONTINUOUS,
+    ON_ACTIVATION,
+    ON_DEACTIVATION,
+    ON_EVENT,
+    Action,
+    Grafcet,
+    Timer,
+)
 from synth.logic.expr import Edge, Expr, Var, names as expr_names
 from synth.version import version as synth_version
 
@@ -69,20 +82,33 @@ def st_project_xml(pous: Sequence[Pou], *, name: str = "synth", version: str | N
     return project(name, version or synth_version(), comment, out)
 
 
-def _sfc_expr(e: Expr, steps: set[str], timers: dict[str, Timer]) -> str:
+class _Names:
+    """The SFC's names: steps ``S12``, timers, and the plant names after :func:`case_aliases`."""
+
+    def __init__(self, g: Grafcet) -> None:
+        self.steps = {s.name for s in g.steps}
+        self.timers = {t.id: t for t in g.timers}
+        self.alias = case_aliases([*g.inputs, *g.outputs], [sfc_step_name(s.name) for s in g.steps])
+
+    def __call__(self, n: str) -> str:
+        return self.alias.get(n, n)
+
+
+def _sfc_expr(e: Expr, names: _Names) -> str:
     """A receptivity or condition in the SFC's ST: steps ``S12.X``, timers ``(S12.T >= T#2s)``,
     edges the flags ``_RE_x``/``_FE_x`` (the one ST expression printer, :func:`~synth.codegen.st.st_expr`)."""
+    steps, timers = names.steps, names.timers
 
     def ref(x: Expr) -> str:
         if isinstance(x, Edge):
-            return ("_RE_" if x.rising else "_FE_") + x.name
+            return ("_RE_" if x.rising else "_FE_") + names(x.name)
         assert isinstance(x, Var)
         if x.name in timers:
             t = timers[x.name]
             return f"({sfc_step_name(t.step)}.T >= {timer_literal(t.id, t.seconds, t.loc)})"
         if x.name.startswith("X") and x.name[1:] in steps:
             return f"{sfc_step_name(x.name[1:])}.X"
-        return x.name
+        return names(x.name)
 
     return st_expr(e, ref)
 
@@ -119,8 +145,14 @@ def sfc_project_xml(g: Grafcet, *, name: str | None = None, version: str | None 
         check_variable_name(n, first_location(g, n))
     for s in g.steps:
         check_variable_name(sfc_step_name(s.name), s.loc)
-    steps = {s.name for s in g.steps}
-    timers = {t.id: t for t in g.timers}
+    for t in g.transitions:
+        if not t.sources or not t.targets:
+            kind = "source" if not t.sources else "sink"
+            raise InputError(f"a {kind} transition cannot be written as IEC 61131-3 SFC: there a transition "
+                             f"always goes from steps to steps", t.loc,
+                             notes=(f"Beremiz fails on it; model the {kind} with a step of its own, or use synth st",))
+    names = _Names(g)
+    steps = names.steps
     seen: dict[str, str] = {}
     for s in g.steps:  # step 12 is S12 in the SFC: a step named S12 as well would be the same
         other = seen.setdefault(sfc_step_name(s.name).upper(), s.name)
@@ -182,7 +214,7 @@ def sfc_project_xml(g: Grafcet, *, name: str | None = None, version: str | None 
         if s.actions:
             block = element("actionBlock", {"localId": str(ids())}, position(x + 120, y), _conn_in((step_id[s.name], None)))
             for k, a in enumerate(s.actions):
-                block.append(_action(a, ids(), k, steps, timers))
+                block.extend(_actions(a, ids, k, names))
             body.append(block)
     for i, t in enumerate(g.transitions):
         col = column[t.grafcet]
@@ -200,7 +232,7 @@ def sfc_project_xml(g: Grafcet, *, name: str | None = None, version: str | None 
             el.append(_conn_in(producer_of_step(t.sources[0], i)))
         el.append(element("connectionPointOut"))
         label = t.label or ""
-        inline = element("inline", {"name": label}, element("ST", None, xhtml(_sfc_expr(t.receptivity, steps, timers))))
+        inline = element("inline", {"name": label}, element("ST", None, xhtml(_sfc_expr(t.receptivity, names))))
         el.append(element("condition", None, inline))
         body.append(el)
         if i in sim_div:
@@ -211,43 +243,52 @@ def sfc_project_xml(g: Grafcet, *, name: str | None = None, version: str | None 
             body.append(div)
     pou_name = name or program_name(g.path)
     iface = element("interface")
-    for key, names in (("inputVars", g.inputs), ("outputVars", g.outputs)):
+    for key, declared in (("inputVars", g.inputs), ("outputVars", g.outputs)):
         vl = element(key)
-        for n in names:
-            vl.append(element("variable", {"name": n}, element("type", None, element("BOOL"))))
+        for n in declared:
+            vl.append(element("variable", {"name": names(n)}, element("type", None, element("BOOL"))))
         iface.append(vl)
     edges = sorted({(n.rising, n.name) for x in g.expressions() for n in expr_names(x) if isinstance(n, Edge)}, key=lambda e: (e[1], not e[0]))
     if edges:
         vl = element("localVars")
         for rising, n in edges:
-            v = element("variable", {"name": ("_RE_" if rising else "_FE_") + n}, element("type", None, element("BOOL")),
+            v = element("variable", {"name": ("_RE_" if rising else "_FE_") + names(n)}, element("type", None, element("BOOL")),
                    element("documentation", None, xhtml(f"{'rising' if rising else 'falling'} edge of {n}, computed "
                                                     "by the caller each cycle (R_TRIG/F_TRIG)", cdata=False)))
             vl.append(v)
         iface.append(vl)
     pou = element("pou", {"name": pou_name, "pouType": "program"}, iface, element("body", None, body))
+    if names.alias:
+        comment = "\n".join(c for c in (comment, renamed_note(names.alias)) if c)
     return project(pou_name, version or synth_version(), comment, [pou])
 
 
-def _action(a, local_id: int, k: int, steps: set[str], timers: dict[str, Timer]) -> Any:
-    el = element("action", {"localId": str(local_id)})
-    el.append(position(0, 30 * k, "relPosition"))
+def _actions(a: Action, ids: _Ids, k: int, names: _Names) -> list[Any]:
+    """The SFC action(s) of one ``.g7`` action, with its IEC 61131-3 meaning: ``A if c`` is an
+    ST body under ``N`` (run while the step is active) and a ``P0`` body ``A := FALSE;`` (run
+    once when it is left), since a PLC does not run an action body again after its step is
+    left (MATIEC, hence Beremiz and OpenPLC, run it only while the action is active)."""
+    order = names(a.order)
+
+    def new(qualifier: Qualifier, body: Any, row: int = 0) -> Any:
+        el = element("action", {"localId": str(ids()), "qualifier": qualifier})
+        el.append(position(0, 30 * (k + row), "relPosition"))
+        el.append(body)
+        return el
+
+    def st(text: str) -> Any:
+        return element("inline", None, element("ST", None, xhtml(text)))
+
     value = "TRUE" if a.value else "FALSE"
     if a.kind == CONTINUOUS:
-        el.set("qualifier", Qualifier.N)
-        el.append(element("reference", {"name": a.order}))
-    elif a.kind == CONDITIONAL:
-        el.set("qualifier", Qualifier.N)
-        el.append(element("inline", None, element("ST", None, xhtml(f"{a.order} := {_sfc_expr(a.condition, steps, timers)};"))))
-    elif a.when == ON_ACTIVATION:
-        el.set("qualifier", Qualifier.S if a.value else Qualifier.R)
-        el.append(element("reference", {"name": a.order}))
-    elif a.when == ON_DEACTIVATION:
-        el.set("qualifier", Qualifier.P0)
-        el.append(element("inline", None, element("ST", None, xhtml(f"{a.order} := {value};"))))
-    else:
-        assert a.when == ON_EVENT and a.condition is not None
-        el.set("qualifier", Qualifier.N)
-        text = f"IF {_sfc_expr(a.condition, steps, timers)} THEN {a.order} := {value}; END_IF;"
-        el.append(element("inline", None, element("ST", None, xhtml(text))))
-    return el
+        return [new(Qualifier.N, element("reference", {"name": order}))]
+    if a.kind == CONDITIONAL:
+        assert a.condition is not None
+        return [new(Qualifier.N, st(f"{order} := {_sfc_expr(a.condition, names)};")),
+                new(Qualifier.P0, st(f"{order} := FALSE;"), 1)]
+    if a.when == ON_ACTIVATION:
+        return [new(Qualifier.S if a.value else Qualifier.R, element("reference", {"name": order}))]
+    if a.when == ON_DEACTIVATION:
+        return [new(Qualifier.P0, st(f"{order} := {value};"))]
+    assert a.when == ON_EVENT and a.condition is not None
+    return [new(Qualifier.N, st(f"IF {_sfc_expr(a.condition, names)} THEN {order} := {value}; END_IF;"))]

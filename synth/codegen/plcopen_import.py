@@ -9,15 +9,15 @@ Example
 -------
 >>> from synth.grafcet.language_check import parse_grafcet
 >>> from synth.codegen.plcopen_export import sfc_project_xml
->>> g = parse_grafcet("grafcet G { initial step 0 step 1: A "
+>>> g = parse_grafcet("grafcet G { initial step 0 step 1: A if b "
 ...                   "transition 0 -> 1 when ↑a transition 1 -> 0 when !a }", "g.g7")
 >>> print(import_sfc(sfc_project_xml(g, version="0.1.0"), "g.xml").split("\\n", 1)[1])
-inputs a
-outputs A
+inputs a, b
+outputs A_1
 <BLANKLINE>
 grafcet G {
   initial step 0
-  step 1: A
+  step 1: A_1 if b
   transition 0 -> 1 when ↑a
   transition 1 -> 0 when !a
 }
@@ -319,7 +319,8 @@ def import_sfc(data: bytes | str, file: str = "<xml>") -> str:
         lines.append(f"grafcet {gname} {{")
         for s in members:
             head = ("initial " if s.initial else "") + f"step {s.name}"
-            lines.append("  " + head + (": " + ", ".join(s.actions) if s.actions else ""))
+            actions = _paired(s.actions)
+            lines.append("  " + head + (": " + ", ".join(actions) if actions else ""))
         names_in = {s.name for s in members}
         for label, sources, targets, expr, _ in transitions:
             if set(sources + targets) & names_in:
@@ -327,6 +328,14 @@ def import_sfc(data: bytes | str, file: str = "<xml>") -> str:
                 lines.append(f"  transition {lab}{', '.join(sources)} -> {', '.join(targets)} when {expr}")
         lines.append("}")
     return "\n".join(lines) + "\n"
+
+
+def _paired(actions: list[str]) -> list[str]:
+    """``A if c`` is exported as an ``N`` body and a ``P0`` body ``A := FALSE;`` (its IEC
+    meaning: reset when the step is left); read back, the pair is ``A if c`` alone."""
+    conditional = {a.split(" if ", 1)[0] for a in actions if " if " in a}
+    return [a for a in actions if not (a.startswith("reset ") and a.endswith(" on deactivation")
+                                       and a[len("reset "):-len(" on deactivation")] in conditional)]
 
 
 def _read_action(a, src: _Source, steps: dict[str, str], q) -> str:

@@ -14,6 +14,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Iterable, Mapping
 
 from synth.codegen.st import NameProblem, Pou, name_problem
 from synth.errors import InputError, Location
@@ -21,7 +22,7 @@ from synth.grafcet.language import Grafcet
 from synth.logic.expr import names
 
 __all__ = ["FilterCall", "StProgram", "program_name", "filter_call", "check_variable_name", "first_location",
-           "compact", "configuration"]
+           "compact", "configuration", "case_aliases", "renamed_note"]
 
 
 @dataclass(frozen=True)
@@ -84,6 +85,31 @@ def check_variable_name(n: str, loc: Location | None) -> None:
         return
     raise InputError(f"'{n}' {why}: Structured Text cannot use it as a variable", loc,
                      notes=("rename it in the Grafcet (and the plant)",))
+
+
+def case_aliases(names: Iterable[str], taken: Iterable[str] = ()) -> dict[str, str]:
+    """IEC 61131-3 ignores case: of user names differing in case only (or from a name in
+    ``taken``, the generated code's own), the later one is renamed ``<name>_<k>``. The one
+    rule of ``synth st`` and ``synth sfc``; the result maps each renamed name to its new name.
+
+    >>> case_aliases(["a", "A", "x"], taken=["X"])
+    {'A': 'A_1', 'x': 'x_1'}
+    """
+    used = {n.upper() for n in taken}
+    out: dict[str, str] = {}
+    for n in names:
+        alias, k = n, 1
+        while alias.upper() in used:
+            alias, k = f"{n}_{k}", k + 1
+        used.add(alias.upper())
+        if alias != n:
+            out[n] = alias
+    return out
+
+
+def renamed_note(aliases: Mapping[str, str]) -> str:
+    """The header line that lists :func:`case_aliases`' renames."""
+    return "renamed (Structured Text ignores case): " + ", ".join(f"{a} -> {b}" for a, b in aliases.items())
 
 
 def first_location(g: Grafcet, name: str) -> Location | None:
