@@ -94,3 +94,36 @@ def test_on_the_plc_the_pump_stops_when_its_step_is_left(tmp_path):
     finally:
         plc.close()
     assert pump == [False, True, True, False, False]
+
+
+def test_st_xml_with_a_task_carries_the_configuration(tmp_path):
+    from synth.cli.main import main
+    from synth.codegen.plcopen_xml import validation_errors
+
+    out = tmp_path / "plc.xml"
+    assert main(["st", str(ROOT / "grafcets/tri.g7"), "--xml", "--task", "10ms", "-o", str(out)]) == 0
+    xml = out.read_bytes()
+    assert validation_errors(xml) == []
+    assert re.sub(rb"\s+", b" ", xml).count(
+        b'<configuration name="Config0"> <resource name="Res0"> <task name="MainTask" interval="T#10ms" '
+        b'priority="0"> <pouInstance name="Inst0" typeName="tri"/> </task> </resource> </configuration>') == 1
+
+
+@pytest.mark.skipif(find_beremiz() is None or find_iec2c() is None
+                    or not (find_beremiz()[1].parent / "matiec" / "iec2c").exists(),  # type: ignore[index]
+                    reason="Beremiz with MATIEC beside it (its layout: <dir>/beremiz, <dir>/matiec) is not here")
+def test_beremiz_cli_builds_the_st_project(tmp_path):
+    import subprocess
+
+    from synth.cli.main import main
+
+    python, home = find_beremiz()  # type: ignore[misc]
+    assert main(["st", str(ROOT / "grafcets/tri.g7"), "--plant", str(ROOT / "plants/tri.rules"), "--filter",
+                 str(ROOT / "tests/data/codegen/tri_box.filter"), "--xml", "--task", "10ms",
+                 "-o", str(tmp_path / "plc.xml")]) == 0
+    (tmp_path / "beremiz.xml").write_text('<?xml version="1.0" encoding="utf-8"?>\n<BeremizRoot '
+                                          'xmlns:xsd="http://www.w3.org/2001/XMLSchema" URI_location="LOCAL://">'
+                                          '<TargetType/><Libraries Enable_Python_Library="false"/></BeremizRoot>\n')
+    done = subprocess.run([python, "Beremiz_cli.py", "--project-home", str(tmp_path), "build"], cwd=home,
+                          capture_output=True, text=True, timeout=600)
+    assert "Successfully built." in done.stdout + done.stderr, (done.stdout + done.stderr)[-2000:]

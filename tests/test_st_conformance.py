@@ -52,7 +52,7 @@ def generated() -> list[tuple[str, str]]:
 
     out = [(str(g.relative_to(ROOT)), grafcet_program(load_grafcet(g), version="test")) for g in GRAFCETS]
     tri = grafcet_program(load_grafcet(ROOT / "grafcets/tri.g7"), version="test")
-    out.append(("grafcets/tri.g7 --task 10ms", tri + "\n".join(configuration("tri", "10ms")) + "\n"))
+    out.append(("grafcets/tri.g7 --task 10ms", tri + "\n".join(configuration("tri", "10ms").lines()) + "\n"))
     for f in FILTERS:
         for algorithm in ("algebraic", "loop"):
             for mode in ("supervisor", "blocking"):

@@ -52,7 +52,7 @@ from synth.codegen.plcopen_xml import (
     sfc_step_name,
     xhtml,
 )
-from synth.codegen.program import case_aliases, check_variable_name, first_location, program_name, renamed_note
+from synth.codegen.program import Configuration, case_aliases, check_variable_name, first_location, program_name, renamed_note
 from synth.codegen.st import Pou, PouKind, st_expr, timer_literal
 from synth.errors import InputError
 from synth.grafcet.language import (
@@ -73,13 +73,21 @@ __all__ = ["st_project_xml", "sfc_project_xml"]
 _POU_TYPE = {PouKind.PROGRAM: "program", PouKind.FUNCTION_BLOCK: "functionBlock"}
 
 
-def st_project_xml(pous: Sequence[Pou], *, name: str = "synth", version: str | None = None, comment: str = "") -> bytes:
-    """PLCopen XML of generated POUs: their interfaces from their declarations, their ST bodies."""
+def st_project_xml(pous: Sequence[Pou], *, name: str = "synth", version: str | None = None, comment: str = "",
+                   config: Configuration | None = None) -> bytes:
+    """PLCopen XML of generated POUs: their interfaces from their declarations, their ST bodies;
+    with ``config`` (``--task``), the configuration that runs the program (TC6 ``<task>``)."""
     out = []
     for p in pous:
         body = element("body", None, element("ST", None, xhtml("\n".join(p.body).strip("\n") + "\n")))
         out.append(element("pou", {"name": p.name, "pouType": _POU_TYPE[p.kind]}, interface(p.sections), body))
-    return project(name, version or synth_version(), comment, out)
+    configs = []
+    if config is not None:
+        task = element("task", {"name": config.task, "interval": config.interval, "priority": str(config.priority)},
+                       element("pouInstance", {"name": config.instance, "typeName": config.program}))
+        configs.append(element("configuration", {"name": config.name},
+                               element("resource", {"name": config.resource}, task)))
+    return project(name, version or synth_version(), comment, out, configs)
 
 
 class _Names:

@@ -83,7 +83,7 @@ def position(x: int, y: int, tag: str = "position"):
     return element(tag, {"x": str(x), "y": str(y)})
 
 
-def project(name: str, version: str, comment: str, pous: list) -> bytes:
+def project(name: str, version: str, comment: str, pous: list, configurations: Sequence[Any] = ()) -> bytes:
     from lxml import etree
 
     root = etree.Element(f"{{{NS}}}project", nsmap={None: NS, "xhtml": XHTML})
@@ -97,7 +97,7 @@ def project(name: str, version: str, comment: str, pous: list) -> bytes:
     header.append(coord)
     root.append(header)
     root.append(element("types", None, element("dataTypes"), element("pous", None, *pous)))
-    root.append(element("instances", None, element("configurations")))
+    root.append(element("instances", None, element("configurations", None, *configurations)))
     return etree.tostring(root, xml_declaration=True, encoding="UTF-8", pretty_print=True)
 
 

@@ -22,7 +22,7 @@ from synth.grafcet.language import Grafcet
 from synth.logic.expr import names
 
 __all__ = ["FilterCall", "StProgram", "program_name", "filter_call", "check_variable_name", "first_location",
-           "compact", "configuration", "case_aliases", "renamed_note"]
+           "compact", "Configuration", "configuration", "case_aliases", "renamed_note"]
 
 
 @dataclass(frozen=True)
@@ -153,11 +153,31 @@ def compact(lines: list[str]) -> list[str]:
     return out
 
 
-def configuration(program: str, task: str) -> list[str]:
-    """``--task 10ms``: the ``CONFIGURATION`` that runs ``program`` cyclically, so the file
-    builds as it is in Beremiz and OpenPLC (one resource, one periodic task, one instance).
+@dataclass(frozen=True)
+class Configuration:
+    """``--task 10ms``: one resource, one periodic task, one instance of the program, so the
+    file builds as it is in Beremiz and OpenPLC. Written as ST (:meth:`lines`) or as TC6 XML
+    (:func:`synth.codegen.plcopen_export.st_project_xml`)."""
 
-    >>> print("\\n".join(configuration("tri", "10ms")))
+    program: str
+    interval: str  # the TIME literal, T#10ms
+    name: str = "Config0"
+    resource: str = "Res0"
+    task: str = "MainTask"
+    instance: str = "Inst0"
+    priority: int = 0
+
+    def lines(self) -> list[str]:
+        return [f"CONFIGURATION {self.name}", f"  RESOURCE {self.resource} ON PLC",
+                f"    TASK {self.task}(INTERVAL := {self.interval}, PRIORITY := {self.priority});",
+                f"    PROGRAM {self.instance} WITH {self.task} : {self.program};", "  END_RESOURCE",
+                "END_CONFIGURATION"]
+
+
+def configuration(program: str, task: str) -> Configuration:
+    """The :class:`Configuration` of ``--task PERIOD`` (a located error for a bad period).
+
+    >>> print("\\n".join(configuration("tri", "10ms").lines()))
     CONFIGURATION Config0
       RESOURCE Res0 ON PLC
         TASK MainTask(INTERVAL := T#10ms, PRIORITY := 0);
@@ -172,7 +192,4 @@ def configuration(program: str, task: str) -> list[str]:
     found = DURATION_RE.fullmatch(task.strip())
     if found is None:
         raise InputError("not a period", where, expected=("a period such as 10ms, 0.5s or 1min",))
-    literal = time_literal(duration_seconds(found[1], found[2]), where, found[0])
-    return ["CONFIGURATION Config0", "  RESOURCE Res0 ON PLC",
-            f"    TASK MainTask(INTERVAL := {literal}, PRIORITY := 0);",
-            f"    PROGRAM Inst0 WITH MainTask : {program};", "  END_RESOURCE", "END_CONFIGURATION"]
+    return Configuration(program, time_literal(duration_seconds(found[1], found[2]), where, found[0]))
