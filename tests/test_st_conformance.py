@@ -52,6 +52,17 @@ def generated() -> list[tuple[str, str]]:
 
     out = [(str(g.relative_to(ROOT)), grafcet_program(load_grafcet(g), version="test")) for g in GRAFCETS]
     tri = grafcet_program(load_grafcet(ROOT / "grafcets/tri.g7"), version="test")
+    from synth.codegen.grafcet_st import generate_program
+    from synth.codegen.program import filter_call
+    from synth.plant.rules_check import load_rules
+
+    rs = load_rules(ROOT / "plants/tri.rules")
+    with_plant = load_grafcet(ROOT / "grafcets/tri.g7", inputs=rs.inputs, outputs=rs.outputs)
+    out.append(("grafcets/tri.g7 --plant plants/tri.rules", generate_program(with_plant, version="test").text))
+    for f in ("plants/tri.filter", "tests/data/codegen/tri_box.filter"):
+        call = filter_call(filter_block(load_filter(ROOT / f)))
+        out.append((f"grafcets/tri.g7 --plant plants/tri.rules --filter {f}",
+                    generate_program(with_plant, version="test", filter_call=call).text))
     out.append(("grafcets/tri.g7 --task 10ms", tri + "\n".join(configuration("tri", "10ms").lines()) + "\n"))
     for f in FILTERS:
         for algorithm in ("algebraic", "loop"):
