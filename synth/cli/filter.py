@@ -27,6 +27,8 @@ def register(sub: "argparse._SubParsersAction") -> None:
     c = commands.add_parser("check", help="P1-P4, GO cycles, pair conditions, global consistency, equations")
     c.add_argument("filter", metavar="F.filter", help="the .filter file")
     c.add_argument("--json", action="store_true", help="print JSON instead of text")
+    c.add_argument("--plant", metavar="P.rules",
+                   help="judge on the valuations this plant can reach under any control (printed as assume lines)")
     ci_options(c)
     c.set_defaults(handler=cmd_check)
 
@@ -80,14 +82,26 @@ def cmd_check(args: argparse.Namespace) -> int:
     from synth.output.filter_text import check_json, check_text
 
     f = _load(args.filter)
+    inv = None
+    if args.plant:
+        from synth.filter.invariants import assumed, invariants
+
+        inv = invariants(f, args.plant)
+        f = assumed(f, inv)
     c = check(f)
     if args.junit or args.sarif:
         from synth.output.ci import filter_check_report, write_ci
 
         write_ci([filter_check_report(f, c)], args.junit, args.sarif)
     if args.json:
-        print_json(check_json(args.filter, c))
+        out = check_json(args.filter, c)
+        if inv is not None:
+            out["invariants"] = {"rules": inv.rules, "states": inv.states, "variables": list(inv.variables),
+                                 "valuations": inv.valuations, "assume": list(inv.lines)}
+        print_json(out)
     else:
+        if inv is not None:
+            sys.stdout.write(inv.text())
         sys.stdout.write(check_text(c))
     return 0 if c.holds else 1
 
