@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -37,6 +38,9 @@ from synth.filter.language import Assumption, Filter
 from synth.filter.model import functions
 from synth.logic.expr import And, Expr, Not, Var
 from synth.logic.past import base_name, pre_name
+
+if TYPE_CHECKING:
+    from synth.plant.composition import Plant
 
 __all__ = ["Invariants", "invariants", "assumed"]
 
@@ -75,7 +79,7 @@ def _conjunction(cube: tuple[tuple[str, bool], ...]) -> Expr:
     return literals[0] if len(literals) == 1 else And(tuple(literals))
 
 
-def _reachable(p) -> np.ndarray:
+def _reachable(p: Plant) -> np.ndarray:
     """Every plant state reachable from the initial one by any event (any control): a flat
     boolean array, by whole-grid images per local transition until nothing is added."""
     grid = np.zeros(p.shape, dtype=bool)
