@@ -64,7 +64,7 @@ if TYPE_CHECKING:
 from synth.logic.past import base_name, is_pre, pre_name, st_past_name
 from synth.logic.expr import Edge, Expr, names
 
-__all__ = ["filter_function_block", "filter_block_name", "FilterBlock", "filter_block"]
+__all__ = ["filter_function_block", "filter_block_name", "FilterBlock", "filter_block", "split_blocks"]
 
 ACK, BLOCKED, FALLBACK = "Ack", "Blocked", "Fallback"
 _GATED = "G_"  # the request after the blocking latch
@@ -197,6 +197,19 @@ def filter_block(f: Filter, algorithm: Algorithm | str = Algorithm.ALGEBRAIC, mo
     pou = Pou(PouKind.FUNCTION_BLOCK, fb, sections, tuple(body))
     lines = [*header(f"Safety logic filter {fb}", [f.file], details), *pou_lines(pou), ""]
     return FilterBlock(fb, tuple(d.name for d in inputs), tuple(d.name for d in outputs), "\n".join(lines), pou, notes)
+
+
+def split_blocks(f: Filter, algorithm: Algorithm | str = Algorithm.ALGEBRAIC, mode: Mode | str = Mode.SUPERVISOR,
+                 name: str | None = None, order: list[str] | None = None) -> list[FilterBlock]:
+    """One block per independent cluster of outputs (:mod:`synth.filter.clusters`), each
+    solved alone: ``FB_<name>_<k>_Filter``, k from 1 in the order of the clusters' first outputs."""
+    from synth.filter.clusters import cluster_filter, clusters, solve_clusters
+
+    groups = clusters(f)
+    solved = solve_clusters(f, order) if Algorithm(algorithm) is Algorithm.ALGEBRAIC else [None] * len(groups)
+    stem = name or Path(f.file).stem
+    return [filter_block(cluster_filter(f, g), algorithm, mode, f"{stem}_{k}", synthesis=s)
+            for k, (g, s) in enumerate(zip(groups, solved), 1)]
 
 
 def filter_function_block(f: Filter, algorithm: Algorithm | str = Algorithm.ALGEBRAIC,

@@ -19,7 +19,7 @@ from synth.filter.language import Criterion, Filter
 from synth.logic.past import base_name, pre_name
 from synth.logic.expr import Edge, Expr, Var, names
 
-__all__ = ["FilterFunctions", "functions", "variable_order", "bdd_order", "edge_rule", "equation_functions"]
+__all__ = ["FilterFunctions", "functions", "variable_order", "bdd_order", "expr_names", "edge_rule", "equation_functions"]
 
 
 def variable_order(f: Filter) -> list[str]:
@@ -37,7 +37,8 @@ def variable_order(f: Filter) -> list[str]:
     return order + list(f.outputs)
 
 
-def _support(e: Expr) -> set[str]:
+def expr_names(e: Expr) -> set[str]:
+    """The BDD variables of ``e``: its names, and ``x^-1`` for an edge of ``x``."""
     return {n for v in names(e) for n in ((v.name, pre_name(v.name)) if isinstance(v, Edge) else (v.name,))}
 
 
@@ -48,8 +49,8 @@ def bdd_order(f: Filter) -> list[str]:
     S(O,Y) never carries every output's constraints across one cut."""
     exprs = [s.expr for s in f.safeties] + [a.expr for a in f.assumptions] + [q.expr for q in f.equations]
     exprs += [c.expr for c in f.criteria if isinstance(c, Criterion)]
-    supports = [_support(e) for e in exprs]
-    supports += [{o for o in f.outputs if any(c.output == o for c in s.forced)} | _support(s.expr) for s in f.combined]
+    supports = [expr_names(e) for e in exprs]
+    supports += [{o for o in f.outputs if any(c.output == o for c in s.forced)} | expr_names(s.expr) for s in f.combined]
     owner = {r: o for r, o in zip(f.requests, f.outputs)} | {pre_name(o): o for o in f.outputs}
     return interleaved_order(f.outputs, supports, variable_order(f), owner)
 

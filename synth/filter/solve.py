@@ -187,13 +187,15 @@ class Synthesis:
         return m.engine.exists(m.outputs, self.admissible & m.engine.var(o))
 
 
-def synthesis(f: Filter | FilterFunctions, order: Sequence[str] | None = None, *, flat: bool = False) -> Synthesis:
+def synthesis(f: Filter | FilterFunctions, order: Sequence[str] | None = None, *, flat: bool = False,
+              applied: Sequence[Criterion] | None = None) -> Synthesis:
     """Solve the filter's constraints with its criteria (the relational semantics of 004).
     ``flat``: write every Y-only equation (:class:`LimitExceeded` past FLAT_LIMIT cubes),
-    not only those of at most FLAT_PROBE cubes."""
+    not only those of at most FLAT_PROBE cubes. ``applied``: the criteria to apply instead
+    of :func:`criteria` (a cluster's share of its whole filter's, :mod:`synth.filter.clusters`)."""
     m = f if isinstance(f, FilterFunctions) else functions(f)
     e, outs = m.engine, m.outputs
-    steps = [(c, e.expr(c.expr)) for c in criteria(m.filter, order)]
+    steps = [(c, e.expr(c.expr)) for c in (criteria(m.filter, order) if applied is None else applied)]
 
     def narrowed(admissible: Function, c: Criterion, u: Function) -> Function:
         if c.sense is Sense.MAX:
@@ -206,10 +208,10 @@ def synthesis(f: Filter | FilterFunctions, order: Sequence[str] | None = None, *
     for c, u in steps:
         states.append(narrowed(states[-1], c, u))
     admissible = states[-1]
-    applied = [Applied(c, states[i + 1] != states[i], _effect(i, steps, states, narrowed, e.false))
-               for i, (c, _) in enumerate(steps)]
+    verdicts = [Applied(c, states[i + 1] != states[i], _effect(i, steps, states, narrowed, e.false))
+                for i, (c, _) in enumerate(steps)]
     care = e.exists(outs, admissible)
-    result = Synthesis(m, admissible, care, applied)
+    result = Synthesis(m, admissible, care, verdicts)
     stated = any(isinstance(c, Criterion) for c in m.filter.criteria)
     if stated and any(s.has_priority for s in m.filter.combined):
         result.notes.append("the file states its criteria: the priorities of the combined constraints are not "
