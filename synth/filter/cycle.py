@@ -153,7 +153,10 @@ class FilterCycle:
         from synth.filter.solve import Synthesis, synthesis
 
         solved = f if isinstance(f, Synthesis) else None
-        m = solved.functions if solved is not None else f if isinstance(f, FilterFunctions) else functions(f)
+        if isinstance(f, Synthesis):
+            m = f.functions
+        else:
+            m = f if isinstance(f, FilterFunctions) else functions(f)
         self.functions, self.filter = m, m.filter
         self.algorithm, self.mode, self.literal = Algorithm(algorithm), Mode(mode), literal
         e, flt = m.engine, m.filter
