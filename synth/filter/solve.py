@@ -265,12 +265,13 @@ def _effect(i: int, steps: Sequence[tuple[Criterion, Function]], states: Sequenc
 def chained_equations(s: Synthesis) -> dict[str, str]:
     """The equations in an evaluation order where each may use the outputs computed before
     it, as 004's (30) does (``A0 = R_A0 & !P01 & (!C0 | A1)``): outputs with the shortest
-    flat equations first (those not written last); each keeps its flat text unless using
-    earlier outputs is shorter."""
+    flat equations first (those not written last, smallest BDD first); each keeps its flat
+    text unless using earlier outputs is shorter."""
     m = s.functions
     e = m.engine
     width = 1 + max((len(t) for t in s.equations.values()), default=0)
-    order = sorted(s.outputs, key=lambda o: (len(s.equations.get(o, "")) or width, m.outputs.index(o)))
+    order = sorted(s.outputs, key=lambda o: (len(s.equations.get(o, "")) or width + len(s.outputs[o]),
+                                             m.outputs.index(o)))
     chained: dict[str, str] = {}
     agree = e.true  # the earlier outputs equal their functions
     for o in order:
