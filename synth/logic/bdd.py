@@ -147,6 +147,7 @@ class Engine:
         self._outer: dict[str, str] = {}
         self._rank: dict[str, int] | None = None if text_order is None else {
             n: i for i, n in enumerate(dict.fromkeys(text_order))}
+        self._ranks_by_inner: dict[str, int] = {}
         for n in order:
             self.declare(n)
 
@@ -207,15 +208,19 @@ class Engine:
         for u in us:
             first = None if cache is None else cache.get(u)
             if first is None and u.var is not None:
-                first = min(self.bdd.support(u), key=self._inner_rank)
+                ranks = self._inner_ranks()
+                first = min(self.bdd.support(u), key=ranks.__getitem__)
                 if cache is not None:
                     cache[u] = first
             if first is not None:
                 firsts.append(first)
-        return min(firsts, key=self._inner_rank)
+        return min(firsts, key=self._inner_ranks().__getitem__)
 
-    def _inner_rank(self, inner: str) -> int:
-        return self.rank(self._outer[inner])
+    def _inner_ranks(self) -> dict[str, int]:
+        """Internal name -> rank in the text order, rebuilt when variables were declared."""
+        if len(self._ranks_by_inner) != len(self._outer):
+            self._ranks_by_inner = {i: self.rank(n) for i, n in self._outer.items()}
+        return self._ranks_by_inner
 
     # ---- translation
     def expr(self, e: Expr) -> Function:
