@@ -53,10 +53,7 @@ t = time.perf_counter(); s = synthesis(m); out["solve"] = time.perf_counter() - 
 out["functional"], out["consistent"] = s.functional, s.consistent
 out["equation_chars"] = sum(len(x) for x in s.chained.values())
 t = time.perf_counter()
-try:  # the block reuses the synthesis where filter_block accepts it
-    fb = filter_block(f, "algebraic", synthesis=s); lp = filter_block(f, "loop", synthesis=s)
-except TypeError:
-    fb = filter_block(f, "algebraic"); lp = filter_block(f, "loop")
+fb = filter_block(f, "algebraic", synthesis=s); lp = filter_block(f, "loop", synthesis=s)  # the solve reused
 out["st"] = time.perf_counter() - t
 out["st_lines"] = fb.text.count("\n") + lp.text.count("\n")
 out["bdd_nodes"] = len(m.engine.bdd)
