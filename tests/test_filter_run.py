@@ -193,13 +193,15 @@ def test_run_helper_uses_fresh_memory():
 
 
 def test_algebraic_is_the_printed_equations_everywhere():
-    """Outside the care set too, the outputs are those of the Y-only equations `solve`
-    prints (the text the function block implements), read back as `equation` lines."""
+    """Outside the care set too, the outputs are those of the chained equations `solve`
+    prints and the function block implements, read back as `equation` lines (substituted
+    in dependency order, as the block assigns them). Before issue 22's "verified =
+    deployed" this test read the flat Y-only equations, which differ off the care set."""
     from synth.filter.model import equation_functions, functions
 
     text = (PLANTS / "tri.filter").read_text()
     s = synthesis(parse_filter(text, "tri.filter"))
-    printed = parse_filter(text + "".join(f"\nequation {o} = {t}" for o, t in s.equations.items()), "tri.filter")
+    printed = parse_filter(text + "".join(f"\nequation {o} = {t}" for o, t in s.chained.items()), "tri.filter")
     m = functions(printed)
     eqs = equation_functions(m)
     c = FilterCycle(s.functions)

@@ -1,6 +1,6 @@
 """``synth filter st``: run by the ST interpreter, the block computes what ``solve`` computed
 (algebraic) or what FILTER.md §1.4 specifies (loop). That blark parses every bundled filter's
-blocks is the business of ``test_filter_st_cycle.py``."""
+blocks is the business of ``test_filter_deployed.py``."""
 
 from __future__ import annotations
 

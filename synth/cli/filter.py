@@ -36,6 +36,8 @@ def register(sub: "argparse._SubParsersAction") -> None:
     s.add_argument("filter", metavar="F.filter", help="the .filter file")
     s.add_argument("--json", action="store_true", help="print JSON instead of text")
     s.add_argument("--order", metavar="O1,O2,...", help="the order of the Sim criteria (default: the file's)")
+    s.add_argument("--flat", action="store_true",
+                   help="print every equation over Y only (flat ISOP; refused past a size limit) instead of chained")
     s.set_defaults(handler=cmd_solve)
     register_st(commands)
 
@@ -48,6 +50,8 @@ def register_st(commands: "argparse._SubParsersAction") -> None:
     t.add_argument("--xml", action="store_true", help="write PLCopen TC6 XML instead of Structured Text")
     t.add_argument("--name", metavar="NAME", help="the block is FB_NAME_Filter (default: the file's stem)")
     t.add_argument("--order", metavar="O1,O2,...", help="the order of the Sim criteria (algebraic)")
+    t.add_argument("--split", action="store_true",
+                   help="one FUNCTION_BLOCK per independent cluster of outputs (FB_NAME_<k>_Filter)")
     t.set_defaults(handler=cmd_st)
 
     register_run(commands)
@@ -111,11 +115,12 @@ def cmd_solve(args: argparse.Namespace) -> int:
     from synth.filter.solve import synthesis
     from synth.output.filter_text import synthesis_json, synthesis_text
 
-    s = synthesis(_load(args.filter), _order(args.order))
+    s = synthesis(_load(args.filter), _order(args.order), flat=args.flat)
     if args.json:
         print_json(synthesis_json(args.filter, s))
     else:
-        sys.stdout.write(synthesis_text(s))
+        sys.stdout.write(synthesis_text(s, flat=args.flat))
+        print(f"note: BDD variable order: {', '.join(s.variable_order)}", file=sys.stderr)
         for n in s.notes:
             print(f"note: {n}", file=sys.stderr)
         for w in s.warnings:
@@ -127,6 +132,9 @@ def cmd_st(args: argparse.Namespace) -> int:
     from synth.codegen.filter_st import filter_block
     from synth.output.files import write_or_print
 
+    if args.split:
+        return _st_split(args)
+
     block = filter_block(_load(args.filter), args.algorithm, args.mode, args.name, _order(args.order))
     for n in block.notes:
         print(f"note: {n}", file=sys.stderr)
@@ -135,6 +143,24 @@ def cmd_st(args: argparse.Namespace) -> int:
         from synth.codegen.plcopen_export import st_project_xml
 
         text = st_project_xml([block.pou], name=block.name, comment=f"safety logic filter from {args.filter}")
+    write_or_print(args.output, text)
+    return 0
+
+
+def _st_split(args: argparse.Namespace) -> int:
+    """``filter st --split``: one block per independent cluster of outputs, in one file."""
+    from synth.codegen.filter_st import split_blocks
+    from synth.output.files import write_or_print
+
+    blocks = split_blocks(_load(args.filter), args.algorithm, args.mode, args.name, _order(args.order))
+    for n in (n for b in blocks for n in b.notes):
+        print(f"note: {n}", file=sys.stderr)
+    text: str | bytes = "\n".join(b.text for b in blocks)
+    if args.xml:
+        from synth.codegen.plcopen_export import st_project_xml
+
+        text = st_project_xml([b.pou for b in blocks], name=blocks[0].name,
+                              comment=f"safety logic filter from {args.filter}")
     write_or_print(args.output, text)
     return 0
 

@@ -6,8 +6,9 @@ for the loop, ``Blocked`` in blocking mode); ``VAR``: the previous cycle's value
 ``x_1`` of every name the filter reads as ``x^-1`` or through an edge, stored at the
 end of the body.
 
-- *algebraic*: the equations of ``synth filter solve`` in dependency order (an output may
-  use the outputs computed before it, as seed 004's eq. (30) does);
+- *algebraic*: the chained equations of ``synth filter solve`` in their order (an output
+  may use the outputs computed before it, as seed 004's eq. (30) does), from the model
+  :mod:`synth.filter.block` that ``filter run`` and ``verify`` evaluate too;
 - *loop*: the detection/correction loop of 000 Fig. 7 with its two defects corrected
   (FILTER.md §1.4: the reliefs accumulate, and the fallback is decided by ``Flag``, not by
   the counter); at most ``Ncsc + 1`` iterations, so the PLC watchdog never fires;
@@ -56,10 +57,14 @@ from synth.codegen.st import (
 from synth.errors import InputError, Location, ModelError
 from synth.filter.cycle import Algorithm, Mode
 from synth.filter.language import Filter, request_name
+
+TYPE_CHECKING = False
+if TYPE_CHECKING:
+    from synth.filter.solve import Synthesis
 from synth.logic.past import base_name, is_pre, pre_name, st_past_name
 from synth.logic.expr import Edge, Expr, names
 
-__all__ = ["filter_function_block", "filter_block_name", "FilterBlock", "filter_block"]
+__all__ = ["filter_function_block", "filter_block_name", "FilterBlock", "filter_block", "split_blocks"]
 
 ACK, BLOCKED, FALLBACK = "Ack", "Blocked", "Fallback"
 _GATED = "G_"  # the request after the blocking latch
@@ -142,8 +147,10 @@ def _location(f: Filter, n: str) -> Location | None:
 
 
 def filter_block(f: Filter, algorithm: Algorithm | str = Algorithm.ALGEBRAIC, mode: Mode | str = Mode.SUPERVISOR,
-                 name: str | None = None, order: list[str] | None = None) -> FilterBlock:
-    """The ``FUNCTION_BLOCK`` of a checked filter (see the module docstring)."""
+                 name: str | None = None, order: list[str] | None = None, *,
+                 synthesis: "Synthesis | None" = None) -> FilterBlock:
+    """The ``FUNCTION_BLOCK`` of a checked filter (see the module docstring); ``synthesis``,
+    when given, is that of ``f`` (solved with ``order``) and is not computed again."""
     algorithm, mode = Algorithm(algorithm), Mode(mode)
     fb = filter_block_name(f, name)
     blocking = mode is Mode.BLOCKING
@@ -166,9 +173,9 @@ def filter_block(f: Filter, algorithm: Algorithm | str = Algorithm.ALGEBRAIC, mo
         body += [f"{_GATED}{o} := R_{o} AND NOT {BLOCKED};" for o in f.outputs]
         local += [Declaration(_GATED + o, comment=f"request of {o} after the blocking latch") for o in f.outputs]
     if algorithm is Algorithm.ALGEBRAIC:
-        body += _algebraic(f, w, notes, order)
+        body += _algebraic(f, w, notes, order, synthesis)
     else:
-        lines, decls = _loop(f, w)
+        lines, decls = _loop(f, w, synthesis)
         body += lines
         local += decls
     stored = [x for x in (*f.inputs, *f.observer_names, *f.outputs) if x in w.past]
@@ -192,6 +199,19 @@ def filter_block(f: Filter, algorithm: Algorithm | str = Algorithm.ALGEBRAIC, mo
     return FilterBlock(fb, tuple(d.name for d in inputs), tuple(d.name for d in outputs), "\n".join(lines), pou, notes)
 
 
+def split_blocks(f: Filter, algorithm: Algorithm | str = Algorithm.ALGEBRAIC, mode: Mode | str = Mode.SUPERVISOR,
+                 name: str | None = None, order: list[str] | None = None) -> list[FilterBlock]:
+    """One block per independent cluster of outputs (:mod:`synth.filter.clusters`), each
+    solved alone: ``FB_<name>_<k>_Filter``, k from 1 in the order of the clusters' first outputs."""
+    from synth.filter.clusters import cluster_filter, clusters, solve_clusters
+
+    groups = clusters(f)
+    solved = solve_clusters(f, order) if Algorithm(algorithm) is Algorithm.ALGEBRAIC else [None] * len(groups)
+    stem = name or Path(f.file).stem
+    return [filter_block(cluster_filter(f, g), algorithm, mode, f"{stem}_{k}", synthesis=s)
+            for k, (g, s) in enumerate(zip(groups, solved), 1)]
+
+
 def filter_function_block(f: Filter, algorithm: Algorithm | str = Algorithm.ALGEBRAIC,
                           mode: Mode | str = Mode.SUPERVISOR, name: str | None = None) -> str:
     """The ST text of :func:`filter_block`."""
@@ -204,40 +224,33 @@ def _requested(e: Expr, outputs: tuple[str, ...]) -> Expr:
     return requested(e, outputs)
 
 
-def _algebraic(f: Filter, w: _Writer, notes: list[str], order: list[str] | None) -> list[str]:
-    from synth.filter.language_reader import filter_expression
+def _algebraic(f: Filter, w: _Writer, notes: list[str], order: list[str] | None,
+               solved: "Synthesis | None") -> list[str]:
+    from synth.filter.block import algebraic_equations
     from synth.filter.solve import synthesis
     from synth.logic.bdd import cube_text
 
-    s = synthesis(f, order)
+    s = solved if solved is not None else synthesis(f, order)
     if not s.functional:
         free = "; ".join(f"{o} is free when {cube_text(c)}" for o, c in s.free.items())
         raise ModelError(f"{f.file}: the synthesis is not functional ({free}); add a criterion that decides it")
     if not s.consistent:
         notes.append(f"no safe output vector exists when {s.inconsistent_text or cube_text(s.inconsistent or {})}; "
                      "the equations are those of the care set")
-    lines = []
-    for o, text in s.chained.items():
-        e = filter_expression(text, f"equation {o}")
-        lines.append(f"{o} := {w.expression(e)};")
-    return lines
+    return [f"{o} := {w.expression(e)};" for o, e in algebraic_equations(s)]
 
 
-def _loop(f: Filter, w: _Writer) -> tuple[list[str], list[Declaration]]:
+def _loop(f: Filter, w: _Writer, solved: "Synthesis | None") -> tuple[list[str], list[Declaration]]:
+    from synth.filter.block import loop_model
     from synth.filter.model import functions
 
-    m = functions(f)
     outs, csc = f.outputs, f.combined
     missing = [s for s in csc if not s.forced]
     if missing:
         raise InputError(f"{missing[0].id} has no priority: the loop algorithm needs `keep` or `force` on every "
                          "combined constraint", missing[0].loc)
+    model = loop_model(solved.functions if solved is not None else functions(f))
     no, nc = len(outs), len(csc)
-    from synth.filter.language_reader import filter_expression
-
-    def fs(u) -> str:
-        return w.expression(filter_expression(m.engine.text(u), "fs"))
-
     arr = f"ARRAY[1..{no}] OF BOOL"
     decls = [Declaration("fs0", arr, comment="a simple constraint forces o[k] to 0"),
              Declaration("fs1", arr, comment="a simple constraint forces o[k] to 1"),
@@ -245,22 +258,21 @@ def _loop(f: Filter, w: _Writer) -> tuple[list[str], list[Declaration]]:
              Declaration("fc1", arr, comment="a relieved combined constraint forces o[k] to 1"),
              Declaration("g1", arr, comment="the requests"),
              Declaration("SI", arr, comment="the outputs being corrected")]
-    lines = [f"fs0[{k}] := {fs(m.fs0[o])};" for k, o in enumerate(outs, 1)]
-    lines += [f"fs1[{k}] := {fs(m.fs1[o])};" for k, o in enumerate(outs, 1)]
+    lines = [f"fs0[{k}] := {w.expression(x)};" for k, x in enumerate(model.fs0, 1)]
+    lines += [f"fs1[{k}] := {w.expression(x)};" for k, x in enumerate(model.fs1, 1)]
     lines += [f"g1[{k}] := {w.name(request_name(o))};" for k, o in enumerate(outs, 1)]
     update = "SI[k] := (NOT fs0[k] AND ((NOT fc0[k] AND g1[k]) OR fc1[k])) OR fs1[k];"
     if nc == 0:
         lines += [*for_loop("k", no, ["    " + update]), f"{FALLBACK} := FALSE;"]
         decls.append(Declaration("k", "INT"))
     else:
-        def matrix(value: bool) -> str:
-            bits = [any(c.output == o and c.value == value for c in s.forced) for o in outs for s in csc]
-            return "[" + ", ".join("TRUE" if b else "FALSE" for b in bits) + "]"
+        def matrix(rows: tuple[tuple[bool, ...], ...]) -> str:
+            return "[" + ", ".join("TRUE" if b else "FALSE" for row in rows for b in row) + "]"
 
         decls += [Declaration("V", f"ARRAY[1..{nc}] OF BOOL", comment="combined constraint i violated"),
-                  Declaration("MC0", f"ARRAY[1..{no}, 1..{nc}] OF BOOL", matrix(False),
+                  Declaration("MC0", f"ARRAY[1..{no}, 1..{nc}] OF BOOL", matrix(model.mc0),
                               comment="relieving constraint i forces o[k] to 0"),
-                  Declaration("MC1", f"ARRAY[1..{no}, 1..{nc}] OF BOOL", matrix(True),
+                  Declaration("MC1", f"ARRAY[1..{no}, 1..{nc}] OF BOOL", matrix(model.mc1),
                               comment="relieving constraint i forces o[k] to 1"),
                   Declaration("Flag", comment="some combined constraint is violated"),
                   Declaration("Cpt", "INT", comment="iterations"),
@@ -270,7 +282,7 @@ def _loop(f: Filter, w: _Writer) -> tuple[list[str], list[Declaration]]:
                   "Flag := TRUE;", "Cpt := 0;",
                   f"WHILE Flag AND Cpt <= {nc} DO",
                   *indent(for_loop("k", no, ["    " + update]))]
-        lines += indent([f"V[{i}] := {w.expression(s.expr, at_t)}; (* {s.id} *)" for i, s in enumerate(csc, 1)])
+        lines += indent([f"V[{i}] := {w.expression(x, at_t)}; (* {cid} *)" for i, (cid, x) in enumerate(model.combined, 1)])
         relief = for_loop("i", nc, ["    fc0[k] := fc0[k] OR (MC0[k, i] AND V[i]);",
                                     "    fc1[k] := fc1[k] OR (MC1[k, i] AND V[i]);"])
         lines += indent(["Flag := " + " OR ".join(f"V[{i}]" for i in range(1, nc + 1)) + ";", "Cpt := Cpt + 1;",

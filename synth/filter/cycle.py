@@ -12,16 +12,18 @@ Semantics (docs/filter.md, "One PLC cycle"):
   :attr:`Mode.BLOCKING` adds the input ``Ack`` and a latch ``Blocked``: at the start of
   the cycle ``IF Ack THEN Blocked := FALSE``; if the raw requests violate a constraint
   (``O := R`` with the current Y and memory) then ``Blocked := TRUE``; ``g1 = R & !Blocked``;
-- :attr:`Algorithm.ALGEBRAIC`: ``O`` is given by the equations ``synth filter solve``
-  prints (on the care set they are the synthesis; ``outside_care`` says when the
+- :attr:`Algorithm.ALGEBRAIC`: ``O`` is given by the block's chained equations
+  (:mod:`synth.filter.block`, what ``synth filter st`` emits), assigned in their order,
+  each reading the outputs assigned before it; on the care set they are the synthesis,
+  off it they are still exactly what the block computes (``outside_care`` says when the
   cycle's Y is not in it, i.e. breaks an assumption or admits no safe vector);
 - :attr:`Algorithm.LOOP`: the specified loop of FILTER.md §1.4 (fc0/fc1 accumulate, at
   most Ncsc+1 iterations, ``Fallback`` when a combined constraint is still violated);
   ``literal=True`` runs the published code instead (fc reset at each iteration, final
   test ``Cpt > Ncsc``), to show its two defects.
 
-Every function (constraints, fs0/fs1, equations, care set) is taken from the filter's
-BDDs as a cover of cubes. A cycle is evaluated on *lanes*: each value is a Python int
+Every function (constraints, the block's fs0/fs1 and equations, care set) is taken as an
+exact cover of cubes of its BDD. A cycle is evaluated on *lanes*: each value is a Python int
 whose bit ``j`` is the value in lane ``j``, so :meth:`FilterCycle.lanes` evaluates the
 cycle for every valuation of some names at once (``verify --any-control`` uses it for
 the 2^|O| request vectors); :meth:`FilterCycle.step` is one lane.
@@ -49,6 +51,10 @@ from synth.logic.bdd import Cube
 from synth.filter.language import Filter
 from synth.logic.past import base_name, is_pre, pre_name
 from synth.filter.model import FilterFunctions, functions
+
+TYPE_CHECKING = False
+if TYPE_CHECKING:
+    from synth.filter.solve import Synthesis
 
 __all__ = ["Algorithm", "Mode", "ACK", "Memory", "CycleResult", "Lanes", "FilterCycle", "Cover"]
 
@@ -141,9 +147,16 @@ def _cover(cubes: Iterable[Cube]) -> Cover:
 class FilterCycle:
     """The cycle evaluator of one filter (see the module docstring)."""
 
-    def __init__(self, f: Filter | FilterFunctions, algorithm: Algorithm = Algorithm.ALGEBRAIC,
+    def __init__(self, f: "Filter | FilterFunctions | Synthesis", algorithm: Algorithm = Algorithm.ALGEBRAIC,
                  mode: Mode = Mode.SUPERVISOR, *, literal: bool = False) -> None:
-        m = f if isinstance(f, FilterFunctions) else functions(f)
+        from synth.filter.block import algebraic_equations, loop_model
+        from synth.filter.solve import Synthesis, synthesis
+
+        solved = f if isinstance(f, Synthesis) else None
+        if isinstance(f, Synthesis):
+            m = f.functions
+        else:
+            m = f if isinstance(f, FilterFunctions) else functions(f)
         self.functions, self.filter = m, m.filter
         self.algorithm, self.mode, self.literal = Algorithm(algorithm), Mode(mode), literal
         e, flt = m.engine, m.filter
@@ -151,34 +164,29 @@ class FilterCycle:
         self.requests: tuple[str, ...] = flt.requests
         self.constraint: dict[str, Cover] = {i: _cover(e.cover(u)) for i, u in m.constraint.items()}
         self.combined: tuple[str, ...] = tuple(s.id for s in flt.combined)
-        self.fs0 = {o: _cover(e.cover(m.fs0[o])) for o in self.outputs}
-        self.fs1 = {o: _cover(e.cover(m.fs1[o])) for o in self.outputs}
+        loop = loop_model(m)
+        self.fs0 = {o: _cover(e.cover(e.expr(x))) for o, x in zip(self.outputs, loop.fs0)}
+        self.fs1 = {o: _cover(e.cover(e.expr(x))) for o, x in zip(self.outputs, loop.fs1)}
         # MC0/MC1 as lists: output -> the combined constraints whose relief forces it to 0 / 1
-        self.mc0 = {o: tuple(s.id for s in flt.combined if any(c.output == o and not c.value for c in s.forced))
-                    for o in self.outputs}
-        self.mc1 = {o: tuple(s.id for s in flt.combined if any(c.output == o and c.value for c in s.forced))
-                    for o in self.outputs}
-        self.equations: dict[str, Cover] = {}
+        self.mc0 = {o: tuple(i for i, on in zip(self.combined, row) if on) for o, row in zip(self.outputs, loop.mc0)}
+        self.mc1 = {o: tuple(i for i, on in zip(self.combined, row) if on) for o, row in zip(self.outputs, loop.mc1)}
+        self.equations: tuple[tuple[str, Cover], ...] = ()  # the block's assignments, in order
         self.care: Cover = ((),)
         if self.algorithm is Algorithm.ALGEBRAIC:
-            from synth.filter.solve import synthesis
-
-            s = synthesis(m)
+            s = solved if solved is not None else synthesis(m)
             if s.free:
                 o = next(iter(s.free))
                 raise InputError(f"the algebraic filter of {flt.file} is not functional: {o} is free "
                                  f"(solve reports the witness); add criteria or use --algorithm loop", None)
-            for o in self.outputs:
-                one = s.output(o)
-                self.equations[o] = _cover(e.cover(one, one | ~s.care))
+            self.equations = tuple((o, _cover(e.cover(e.expr(x)))) for o, x in algebraic_equations(s))
             self.care = _cover(e.cover(s.care))
         else:
             for c in flt.combined:
                 if not c.has_priority:
                     raise InputError(f"{c.id} is a combined constraint without priority: the loop needs "
                                      "`keep L` or `force o=v, ...` to relieve it", c.loc)
-        covers = [*self.constraint.values(), *self.fs0.values(), *self.fs1.values(), *self.equations.values(),
-                  self.care]
+        covers = [*self.constraint.values(), *self.fs0.values(), *self.fs1.values(),
+                  *(c for _, c in self.equations), self.care]
         used = sorted({n for cover in covers for cube in cover for n, _ in cube if is_pre(n)})
         base = [*flt.inputs, *flt.observer_names, *self.outputs]
         base += [b for b in (base_name(n) for n in used) if b not in base]
@@ -248,8 +256,10 @@ class FilterCycle:
         if self.algorithm is Algorithm.ALGEBRAIC:
             with_g1 = dict(values)
             with_g1.update(zip(self.requests, g1))
-            outputs = tuple(ev(self.equations[o], with_g1) for o in self.outputs)
             outside = full ^ ev(self.care, with_g1)
+            for o, cover in self.equations:  # in the block's order: each reads the outputs before it
+                with_g1[o] = ev(cover, with_g1)
+            outputs = tuple(with_g1[o] for o in self.outputs)
         else:
             outputs, fallback = self._loop(values, g1, full, ev, iterations, rounds)
         with_outputs = dict(values)

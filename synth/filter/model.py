@@ -14,17 +14,18 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from synth.logic.bdd import Engine, Function
+from synth.logic.bdd import Engine, Function, interleaved_order
 from synth.filter.language import Criterion, Filter
 from synth.logic.past import base_name, pre_name
-from synth.logic.expr import Var, names
+from synth.logic.expr import Edge, Expr, Var, names
 
-__all__ = ["FilterFunctions", "functions", "variable_order", "edge_rule", "equation_functions"]
+__all__ = ["FilterFunctions", "functions", "variable_order", "bdd_order", "expr_names", "edge_rule", "equation_functions"]
 
 
 def variable_order(f: Filter) -> list[str]:
-    """Requests, then read-only variables with their past values, then past outputs, then
-    the outputs at t last (quantified first, cheapest at the bottom)."""
+    """The text order: requests, then read-only variables with their past values, then
+    past outputs, then the outputs at t. Every equation and counterexample is built and
+    printed in this order, whatever the BDDs' variable order (:func:`bdd_order`)."""
     order = list(f.requests)
     for x in (*f.observer_names, *f.inputs):
         order += [pre_name(x), x]
@@ -34,6 +35,24 @@ def variable_order(f: Filter) -> list[str]:
     mentioned = [v.name for e in exprs for v in names(e) if isinstance(v, Var)]
     order += [n for n in mentioned if n not in order and base_name(n) not in f.outputs]
     return order + list(f.outputs)
+
+
+def expr_names(e: Expr) -> set[str]:
+    """The BDD variables of ``e``: its names, and ``x^-1`` for an edge of ``x``."""
+    return {n for v in names(e) for n in ((v.name, pre_name(v.name)) if isinstance(v, Edge) else (v.name,))}
+
+
+def bdd_order(f: Filter) -> list[str]:
+    """The BDDs' variable order: each output next to the signals of its constraints
+    (:func:`~synth.logic.bdd.interleaved_order` over the constraints, assumptions, stated
+    criteria and equations; ``R_o`` and ``o^-1`` belong to ``o``), so the admissible set
+    S(O,Y) never carries every output's constraints across one cut."""
+    exprs = [s.expr for s in f.safeties] + [a.expr for a in f.assumptions] + [q.expr for q in f.equations]
+    exprs += [c.expr for c in f.criteria if isinstance(c, Criterion)]
+    supports = [expr_names(e) for e in exprs]
+    supports += [{o for o in f.outputs if any(c.output == o for c in s.forced)} | expr_names(s.expr) for s in f.combined]
+    owner = {r: o for r, o in zip(f.requests, f.outputs)} | {pre_name(o): o for o in f.outputs}
+    return interleaved_order(f.outputs, supports, variable_order(f), owner)
 
 
 @dataclass
@@ -79,7 +98,7 @@ class FilterFunctions:
 
 def functions(f: Filter) -> FilterFunctions:
     """The BDDs of a checked filter."""
-    e = Engine(variable_order(f))
+    e = Engine(bdd_order(f), text_order=variable_order(f))
     m = FilterFunctions(f, e, {s.id: e.expr(s.expr) for s in f.safeties},
                         e.conjunction(e.expr(a.expr) for a in f.assumptions))
     for o in f.outputs:

@@ -26,20 +26,24 @@ Example (004 eqs. 4-13)
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Sequence
+from typing import Callable, Sequence
 
-from synth.errors import InputError
-from synth.logic.bdd import Cube, Function, cube_text
+from synth.errors import InputError, LimitExceeded
+from synth.logic.bdd import CoverTooLarge, Cube, Function, cube_text
 from synth.filter.language import Criterion, Filter, Sense, SimCriterion, request_name
 from synth.logic.past import pre_name
 from synth.filter.model import FilterFunctions, equation_functions, functions
 from synth.logic.expr import And, Const, Edge, Expr, Not, Or, Var
 
-__all__ = ["IMPLICIT", "Applied", "Synthesis", "synthesis", "chained_equations", "criteria", "priority_criteria", "requested", "sim_expr",
+__all__ = ["IMPLICIT", "FLAT_PROBE", "FLAT_LIMIT", "Applied", "Synthesis", "synthesis", "chained_equations", "criteria", "priority_criteria", "requested", "sim_expr",
            "differences"]
 
 
 IMPLICIT = "implicit"
+FLAT_PROBE = 64
+"""Cubes: a Y-only (flat) equation is written only when its cover is this small, unless asked."""
+FLAT_LIMIT = 4096
+"""Cubes: past this, a flat equation asked for (``solve --flat``) is refused (exit 2)."""
 
 
 def sim_expr(output: str) -> Expr:
@@ -145,8 +149,9 @@ class Synthesis:
     admissible: Function
     care: Function
     applied: list[Applied]
-    equations: dict[str, str] = field(default_factory=dict)
+    equations: dict[str, str] = field(default_factory=dict)  # flat: Y only (FLAT_PROBE cubes at most unless asked)
     chained: dict[str, str] = field(default_factory=dict)  # evaluation order; may use earlier outputs
+    outputs: dict[str, Function] = field(default_factory=dict)  # the determined outputs as functions of Y
     free: dict[str, Cube] = field(default_factory=dict)  # output -> Y witness with two choices
     inconsistent: Cube | None = None
     inconsistent_text: str = ""
@@ -155,6 +160,16 @@ class Synthesis:
     @property
     def functional(self) -> bool:
         return not self.free
+
+    @property
+    def variable_order(self) -> tuple[str, ...]:
+        """The BDDs' variable order the synthesis ran with (model.bdd_order)."""
+        return self.functions.engine.variable_order
+
+    @property
+    def flat_omitted(self) -> tuple[str, ...]:
+        """The determined outputs whose flat equation was not written (larger than FLAT_PROBE cubes)."""
+        return tuple(o for o in self.outputs if o not in self.equations)
 
     @property
     def consistent(self) -> bool:
@@ -166,15 +181,21 @@ class Synthesis:
 
     def output(self, o: str) -> Function:
         """The synthesised output ``o`` as a function of Y."""
+        if o in self.outputs:
+            return self.outputs[o]
         m = self.functions
         return m.engine.exists(m.outputs, self.admissible & m.engine.var(o))
 
 
-def synthesis(f: Filter | FilterFunctions, order: Sequence[str] | None = None) -> Synthesis:
-    """Solve the filter's constraints with its criteria (the relational semantics of 004)."""
+def synthesis(f: Filter | FilterFunctions, order: Sequence[str] | None = None, *, flat: bool = False,
+              applied: Sequence[Criterion] | None = None) -> Synthesis:
+    """Solve the filter's constraints with its criteria (the relational semantics of 004).
+    ``flat``: write every Y-only equation (:class:`LimitExceeded` past FLAT_LIMIT cubes),
+    not only those of at most FLAT_PROBE cubes. ``applied``: the criteria to apply instead
+    of :func:`criteria` (a cluster's share of its whole filter's, :mod:`synth.filter.clusters`)."""
     m = f if isinstance(f, FilterFunctions) else functions(f)
     e, outs = m.engine, m.outputs
-    steps = [(c, e.expr(c.expr)) for c in criteria(m.filter, order)]
+    steps = [(c, e.expr(c.expr)) for c in (criteria(m.filter, order) if applied is None else applied)]
 
     def narrowed(admissible: Function, c: Criterion, u: Function) -> Function:
         if c.sense is Sense.MAX:
@@ -187,16 +208,10 @@ def synthesis(f: Filter | FilterFunctions, order: Sequence[str] | None = None) -
     for c, u in steps:
         states.append(narrowed(states[-1], c, u))
     admissible = states[-1]
-    applied = []
-    for i, (c, u) in enumerate(steps):
-        narrows = states[i + 1] != states[i]
-        without = states[i]
-        if narrows:  # the same filter without it?
-            for later, v in steps[i + 1:]:
-                without = narrowed(without, later, v)
-        applied.append(Applied(c, narrows, narrows and without != admissible))
+    verdicts = [Applied(c, states[i + 1] != states[i], _effect(i, steps, states, narrowed, e.false))
+                for i, (c, _) in enumerate(steps)]
     care = e.exists(outs, admissible)
-    result = Synthesis(m, admissible, care, applied)
+    result = Synthesis(m, admissible, care, verdicts)
     stated = any(isinstance(c, Criterion) for c in m.filter.criteria)
     if stated and any(s.has_priority for s in m.filter.combined):
         result.notes.append("the file states its criteria: the priorities of the combined constraints are not "
@@ -215,25 +230,55 @@ def synthesis(f: Filter | FilterFunctions, order: Sequence[str] | None = None) -
             free = e.minimal_cube(one & zero)
             assert free is not None  # one & zero is not false
             result.free[o] = free
-        else:
-            result.equations[o] = e.text(one, one | ~care)
+            continue
+        result.outputs[o] = one
+        try:
+            result.equations[o] = e.text(one, one | ~care, FLAT_LIMIT if flat else FLAT_PROBE)
+        except CoverTooLarge as too_large:
+            if flat:
+                raise LimitExceeded(f"{m.filter.file}: the flat equation of {o} needs more than {too_large.limit} "
+                                    "terms; the chained equations (solve without --flat) are the filter") from None
     result.chained = chained_equations(result)
     return result
+
+
+def _effect(i: int, steps: Sequence[tuple[Criterion, Function]], states: Sequence[Function],
+            narrowed: Callable[[Function, Criterion, Function], Function], false: Function) -> bool:
+    """Whether the final filter differs without criterion ``i`` (which narrows it where it
+    stands): the later criteria are re-applied from ``states[i]``, reusing the chain — it
+    has no effect as soon as the re-narrowed set rejoins the chain (the rest is the chain's
+    own computation), and has one as soon as it lost part of the final set (narrowing only
+    removes), so most criteria are decided within a few steps instead of all the later ones."""
+    if states[i + 1] == states[i]:
+        return False
+    final = states[-1]
+    without = states[i]
+    for j in range(i + 1, len(steps)):
+        without = narrowed(without, *steps[j])
+        if without == states[j + 1]:
+            return False
+        if (final & ~without) != false:
+            return True
+    return True
 
 
 def chained_equations(s: Synthesis) -> dict[str, str]:
     """The equations in an evaluation order where each may use the outputs computed before
     it, as 004's (30) does (``A0 = R_A0 & !P01 & (!C0 | A1)``): outputs with the shortest
-    equations first; each keeps its Y-only text unless using earlier outputs is shorter."""
+    flat equations first (those not written last, smallest BDD first); each keeps its flat
+    text unless using earlier outputs is shorter."""
     m = s.functions
     e = m.engine
-    order = sorted(s.equations, key=lambda o: (len(s.equations[o]), m.outputs.index(o)))
+    width = 1 + max((len(t) for t in s.equations.values()), default=0)
+    order = sorted(s.outputs, key=lambda o: (len(s.equations.get(o, "")) or width + len(s.outputs[o]),
+                                             m.outputs.index(o)))
     chained: dict[str, str] = {}
     agree = e.true  # the earlier outputs equal their functions
     for o in order:
         f = s.output(o)
         text = e.text(f & agree & s.care, f | ~agree | ~s.care)
-        chained[o] = text if len(text) < len(s.equations[o]) else s.equations[o]
+        flat = s.equations.get(o)
+        chained[o] = text if flat is None or len(text) < len(flat) else flat
         agree &= e.var(o).equiv(f)
     return chained
 

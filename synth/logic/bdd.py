@@ -6,7 +6,11 @@ edges recognised and common literals factored out).
 
 Variables keep the callers' names (``A2``, ``A2^-1``, ``R_A2``); the manager uses
 internal names ``v0``, ``v1``, … in a fixed order (no dynamic reordering, so every
-printed result is deterministic).
+printed result is deterministic). Two orders may differ: the manager's *variable order*
+(what the BDDs' sizes depend on; :func:`interleaved_order` keeps each output next to the
+signals of its constraints) and the *text order* in which covers, cubes and counterexamples
+are built and printed, so a text depends on the function and the text order only, never on
+the variable order.
 
 Example
 -------
@@ -53,12 +57,20 @@ def _dd_backend() -> Any:
 
 _backend = _dd_backend()
 
-__all__ = ["Engine", "Function", "Cube", "cube_text", "BACKEND", "CUDD"]
+__all__ = ["Engine", "Function", "Cube", "CoverTooLarge", "cube_text", "interleaved_order", "BACKEND", "CUDD"]
 
 BACKEND: str = _backend.__name__
 CUDD: bool = BACKEND == "dd.cudd"  # whether the fast native operations (and-abstract, node counts) exist
 Function = Any  # a dd Function of the active backend
 Cube = dict[str, bool]  # filter name -> value
+
+
+class CoverTooLarge(Exception):
+    """An irredundant cover needs more cubes than the caller's limit (:meth:`Engine.cover`)."""
+
+    def __init__(self, limit: int) -> None:
+        super().__init__(f"more than {limit} terms")
+        self.limit = limit
 
 
 def cube_text(cube: Mapping[str, bool]) -> str:
@@ -70,16 +82,72 @@ def cube_text(cube: Mapping[str, bool]) -> str:
     return " & ".join(n if v else "!" + n for n, v in cube.items()) or "1"
 
 
+def interleaved_order(anchors: Sequence[str], supports: Iterable[Iterable[str]], base: Sequence[str],
+                      owner: Mapping[str, str]) -> list[str]:
+    """A variable order that keeps each anchor (an output) with the names of the constraints
+    it takes part in, so that no relation carries every anchor's constraints across one cut.
+
+    ``supports`` are the constraints' names; ``owner`` maps a name to the anchor it belongs
+    to (``R_o`` and ``o^-1`` to ``o``); ``base`` is every name in a reference order (ties and
+    leftovers). Anchors sharing a support are neighbours; they are visited breadth-first from
+    the first anchor of each connected part, neighbours in ``anchors`` order (Cuthill–McKee),
+    and each brings, in ``base`` order, the names it owns and the unowned names of its
+    constraints not placed yet, then itself.
+
+    >>> interleaved_order(["p", "q", "r"], [{"p", "a"}, {"p", "r"}, {"q", "b"}],
+    ...                   ["R_p", "R_q", "R_r", "a", "b"], {"R_p": "p", "R_q": "q", "R_r": "r"})
+    ['R_p', 'a', 'p', 'R_r', 'r', 'R_q', 'b', 'q']
+    """
+    index = {a: i for i, a in enumerate(anchors)}
+
+    def anchor(n: str) -> str | None:
+        a = owner.get(n, n)
+        return a if a in index else None
+
+    touching: dict[str, set[str]] = {a: set() for a in anchors}  # anchor -> unowned names of its constraints
+    neighbours: dict[str, set[str]] = {a: set() for a in anchors}
+    for support in supports:
+        names = set(support)
+        mine = {a for a in (anchor(n) for n in names) if a is not None}
+        for a in mine:
+            touching[a] |= {n for n in names if anchor(n) is None}
+            neighbours[a] |= mine - {a}
+    visited: list[str] = []
+    seen: set[str] = set()
+    for start in anchors:
+        if start in seen:
+            continue
+        seen.add(start)
+        queue = [start]
+        while queue:
+            a = queue.pop(0)
+            visited.append(a)
+            for b in sorted(neighbours[a] - seen, key=index.__getitem__):
+                seen.add(b)
+                queue.append(b)
+    order: list[str] = []
+    placed: set[str] = set()
+    for a in visited:
+        group = [n for n in base if n not in placed and n != a and (owner.get(n) == a or n in touching[a])]
+        order += group + [a]
+        placed.update(group, (a,))
+    return order + [n for n in base if n not in placed]
+
+
 class Engine:
     """A BDD manager whose variables are filter names, in a fixed order (``order`` first,
-    any other name is appended when first used)."""
+    any other name is appended when first used). ``text_order`` (default: the variable
+    order) is the order covers, cubes and counterexamples are built and printed in."""
 
-    def __init__(self, order: Iterable[str] = ()) -> None:
+    def __init__(self, order: Iterable[str] = (), text_order: Iterable[str] | None = None) -> None:
         self.bdd = _backend.BDD()
         self.cudd = _backend.__name__ == "dd.cudd"
         self.bdd.configure(reordering=False)
         self._inner: dict[str, str] = {}
         self._outer: dict[str, str] = {}
+        self._rank: dict[str, int] | None = None if text_order is None else {
+            n: i for i, n in enumerate(dict.fromkeys(text_order))}
+        self._ranks_by_inner: dict[str, int] = {}
         for n in order:
             self.declare(n)
 
@@ -116,6 +184,43 @@ class Engine:
 
     def level(self, name: str) -> int:
         return self.bdd.level_of_var(self.declare(name))
+
+    def rank(self, name: str) -> int:
+        """The position of ``name`` in the text order (names it does not list come after,
+        in their variable order)."""
+        if self._rank is None:
+            return self.level(name)
+        r = self._rank.get(name)
+        return r if r is not None else len(self._rank) + self.level(name)
+
+    @property
+    def variable_order(self) -> tuple[str, ...]:
+        """Every declared name, in the manager's variable order (top first)."""
+        return tuple(self._outer[self.bdd.var_at_level(i)] for i in range(len(self._inner)))
+
+    def _first(self, us: Sequence[Function], cache: dict[Function, str] | None = None) -> str:
+        """The internal name of the first variable, in the text order, that one of ``us``
+        (not all constant) depends on: the top variable when both orders agree. ``cache``
+        keeps each function's first variable (one cover's recursion meets them repeatedly)."""
+        if self._rank is None:
+            return self.bdd.var_at_level(min(self.bdd.level_of_var(u.var) for u in us if u.var is not None))
+        firsts = []
+        for u in us:
+            first = None if cache is None else cache.get(u)
+            if first is None and u.var is not None:
+                ranks = self._inner_ranks()
+                first = min(self.bdd.support(u), key=ranks.__getitem__)
+                if cache is not None:
+                    cache[u] = first
+            if first is not None:
+                firsts.append(first)
+        return min(firsts, key=self._inner_ranks().__getitem__)
+
+    def _inner_ranks(self) -> dict[str, int]:
+        """Internal name -> rank in the text order, rebuilt when variables were declared."""
+        if len(self._ranks_by_inner) != len(self._outer):
+            self._ranks_by_inner = {i: self.rank(n) for i, n in self._outer.items()}
+        return self._ranks_by_inner
 
     # ---- translation
     def expr(self, e: Expr) -> Function:
@@ -179,7 +284,7 @@ class Engine:
     def support(self, u: Function) -> list[str]:
         """The names ``u`` depends on, in variable order."""
         inner = self.bdd.support(u)
-        return [n for n, i in self._inner.items() if i in inner]
+        return sorted((self._outer[i] for i in inner), key=self.rank)
 
     def cube(self, values: Mapping[str, bool]) -> Function:
         return self.conjunction(self.var(n) if v else ~self.var(n) for n, v in values.items())
@@ -199,16 +304,17 @@ class Engine:
             return None
         cube: Cube = {}
         while u != self.true:  # cofactors by let: dd.cudd's low/high ignore complement edges
-            name = self.name_of(u.var)
-            low = self.bdd.let({u.var: False}, u)
+            inner = self._first((u,))
+            name = self.name_of(inner)
+            low = self.bdd.let({inner: False}, u)
             if low != self.false:
                 cube[name], u = False, low
             else:
-                cube[name], u = True, self.bdd.let({u.var: True}, u)
+                cube[name], u = True, self.bdd.let({inner: True}, u)
         return self.ordered(cube)
 
     def expanded(self, cube: Cube, upper: Function) -> Cube:
-        """``cube`` (implying ``upper``) with literals dropped, in variable order, while it
+        """``cube`` (implying ``upper``) with literals dropped, in text order, while it
         still implies ``upper``: a prime implicant of ``upper``."""
         kept = dict(cube)
         for n in list(cube):
@@ -230,10 +336,11 @@ class Engine:
         return None if c is None else self.expanded(c, u | ~care)
 
     def ordered(self, cube: Mapping[str, bool]) -> Cube:
-        return dict(sorted(cube.items(), key=lambda kv: self.level(kv[0])))
+        return dict(sorted(cube.items(), key=lambda kv: self.rank(kv[0])))
 
     # ---- covers
-    def _isop(self, lower: Function, upper: Function, memo: dict) -> tuple[list[Cube], Function]:
+    def _isop(self, lower: Function, upper: Function, memo: dict, limit: int | None = None,
+              firsts: dict[Function, str] | None = None) -> tuple[list[Cube], Function]:
         if lower == self.false:
             return [], self.false
         if upper == self.true:
@@ -241,25 +348,27 @@ class Engine:
         key = (lower, upper)
         if key in memo:
             return memo[key]
-        levels = [self.bdd.level_of_var(f.var) for f in (lower, upper) if f.var is not None]
-        inner = self.bdd.var_at_level(min(levels))
+        inner = self._first((lower, upper), firsts)
         x = self.bdd.var(inner)
         l0, l1 = self.bdd.let({inner: False}, lower), self.bdd.let({inner: True}, lower)
         u0, u1 = self.bdd.let({inner: False}, upper), self.bdd.let({inner: True}, upper)
-        c0, f0 = self._isop(l0 & ~u1, u0, memo)
-        c1, f1 = self._isop(l1 & ~u0, u1, memo)
-        cd, fd = self._isop((l0 & ~f0) | (l1 & ~f1), u0 & u1, memo)
+        c0, f0 = self._isop(l0 & ~u1, u0, memo, limit, firsts)
+        c1, f1 = self._isop(l1 & ~u0, u1, memo, limit, firsts)
+        cd, fd = self._isop((l0 & ~f0) | (l1 & ~f1), u0 & u1, memo, limit, firsts)
+        if limit is not None and len(c0) + len(c1) + len(cd) > limit:
+            raise CoverTooLarge(limit)
         name = self.name_of(inner)
         cover = [{name: False, **c} for c in c0] + [{name: True, **c} for c in c1] + cd
         result = (cover, (~x & f0) | (x & f1) | fd)
         memo[key] = result
         return result
 
-    def cover(self, lower: Function, upper: Function | None = None) -> list[Cube]:
+    def cover(self, lower: Function, upper: Function | None = None, limit: int | None = None) -> list[Cube]:
         """An irredundant cover of prime implicants of some function between ``lower`` and
-        ``upper`` (``upper`` defaults to ``lower``; the gap is the don't-care set)."""
+        ``upper`` (``upper`` defaults to ``lower``; the gap is the don't-care set).
+        :class:`CoverTooLarge` when the Minato–Morreale cover has more than ``limit`` cubes."""
         upper = lower if upper is None else upper
-        cubes, _ = self._isop(lower, upper, {})
+        cubes, _ = self._isop(lower, upper, {}, limit, {})
         primes: list[Cube] = []
         for c in (self.expanded(self.ordered(c), upper) for c in cubes):
             if c not in primes:
@@ -277,14 +386,15 @@ class Engine:
                 before |= functions[i]
         return kept
 
-    def text(self, lower: Function, upper: Function | None = None) -> str:
-        """``u`` (or some function between ``lower`` and ``upper``) in filter syntax."""
+    def text(self, lower: Function, upper: Function | None = None, limit: int | None = None) -> str:
+        """``u`` (or some function between ``lower`` and ``upper``) in filter syntax
+        (:class:`CoverTooLarge` past ``limit`` cubes, see :meth:`cover`)."""
         if lower == self.false:
             return "0"
-        cubes = self.cover(lower, upper)
+        cubes = self.cover(lower, upper, limit)
         if cubes == [{}]:
             return "1"
-        order = {n: i for i, n in enumerate(self.names)}
+        order = {n: self.rank(n) for n in self.names}
         return _factored([_literals(c, order) for c in cubes], top=True)
 
 

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 from typing import Any, Sequence
 
+from synth.filter.clusters import clusters
 from synth.filter.coherence import Check
 from synth.filter.cycle import Algorithm
 from synth.filter.from_rules import Classification, Skeleton
@@ -58,9 +59,10 @@ def check_json(file: str, c: Check) -> dict[str, Any]:
     return {"file": file, **c.coherence.as_dict(), "differences": list(c.differences)}
 
 
-def synthesis_text(s: Synthesis) -> str:
-    """The chained equations, then why the synthesis may have failed."""
-    lines = [f"equation {o} = {t}" for o, t in s.chained.items()]
+def synthesis_text(s: Synthesis, flat: bool = False) -> str:
+    """The chained equations (``flat``: the Y-only ones, in output order), then why the
+    synthesis may have failed."""
+    lines = [f"equation {o} = {t}" for o, t in (s.equations if flat else s.chained).items()]
     for o, cube in s.free.items():
         lines.append(f"not functional: {o} is free when {cube_text(cube)}")
     if s.inconsistent is not None:
@@ -77,6 +79,9 @@ def synthesis_json(file: str, s: Synthesis) -> dict[str, Any]:
         "consistent": s.consistent,
         "equations": dict(s.equations),
         "chained": {"order": list(s.chained), "equations": dict(s.chained)},
+        "flat_omitted": list(s.flat_omitted),
+        "variable_order": list(s.variable_order),
+        "clusters": [list(g) for g in clusters(s.functions.filter)],
         "warnings": s.warnings,
         "notes": list(s.notes),
         "criteria": [{"sense": a.criterion.sense.value, "expression": a.criterion.expr.text(),
