@@ -142,7 +142,10 @@ def cmd_st(args: argparse.Namespace) -> int:
     if args.xml:
         from synth.codegen.plcopen_export import st_project_xml
 
-        text = st_project_xml([block.pou], name=block.name, comment=f"safety logic filter from {args.filter}")
+        from synth.codegen.provenance import provenance_lines
+
+        text = st_project_xml([block.pou], name=block.name,
+                              comment="\n".join(provenance_lines(f"Safety logic filter {block.name}", [args.filter])))
     write_or_print(args.output, text)
     return 0
 
@@ -159,8 +162,10 @@ def _st_split(args: argparse.Namespace) -> int:
     if args.xml:
         from synth.codegen.plcopen_export import st_project_xml
 
+        from synth.codegen.provenance import provenance_lines
+
         text = st_project_xml([b.pou for b in blocks], name=blocks[0].name,
-                              comment=f"safety logic filter from {args.filter}")
+                              comment="\n".join(provenance_lines("Safety logic filter", [args.filter])))
     write_or_print(args.output, text)
     return 0
 
