@@ -33,7 +33,7 @@ def test_bundled_grafcets_exhaustively(path: Path):
     parses with blark and raises an InputError on any text blark rejects."""
     g = load_grafcet(path)
     program = grafcet_st.generate_program(g, version="test")
-    assert program.text.count("PROGRAM ") == 1 and program.text.rstrip().endswith("END_PROGRAM")
+    assert program.text.count("\nPROGRAM ") == 1 and program.text.rstrip().endswith("END_PROGRAM")
     report = differential_check(g, depth=DEPTH.get(path.name, 4), program=program)
     assert report.ok, report.text()
     assert report.sequences >= 1

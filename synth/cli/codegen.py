@@ -20,6 +20,7 @@ import sys
 TYPE_CHECKING = False  # typing.TYPE_CHECKING, without importing typing (fast --help)
 
 if TYPE_CHECKING:  # pragma: no cover - the library is imported by the commands only (fast --help)
+    from synth.codegen.targets import Target
     from synth.grafcet.language import Grafcet
 
 __all__ = ["register", "cmd_st", "cmd_sfc", "cmd_import"]
@@ -49,21 +50,53 @@ def _write(args: argparse.Namespace, data: str | bytes) -> None:
     write_or_print(args.output, data)
 
 
+def target_of(args: argparse.Namespace) -> "Target":
+    """``--target``, with ``--xml`` as the short form of ``--target plcopen``."""
+    from synth.codegen.targets import Target
+    from synth.errors import InputError
+
+    if args.xml and args.target not in (None, Target.PLCOPEN):
+        raise InputError(f"--xml is --target plcopen; it cannot go with --target {args.target}", None)
+    return Target(args.target or (Target.PLCOPEN if args.xml else Target.IEC))
+
+
+def write_target(args: argparse.Namespace, files: list[tuple[str, bytes]]) -> None:
+    """One file to ``-o`` (or standard output); several (TwinCAT: one per POU) into ``-o DIR``,
+    as is one into an existing folder or a path ending with ``/``."""
+    import os
+
+    from synth.output.files import write_files, write_or_print
+
+    folder = args.output is not None and (args.output.endswith(("/", os.sep)) or os.path.isdir(args.output))
+    if len(files) == 1 and not folder:
+        write_or_print(args.output, files[0][1])
+    else:
+        write_files(args.output, files)
+
+
 def cmd_st(args: argparse.Namespace) -> int:
     from synth.codegen.grafcet_st import generate_program
     from synth.codegen.program import filter_call
+    from synth.codegen.provenance import provenance_lines
+    from synth.codegen.targets import render
 
     grafcet, initial, sources = _load(args)
+    target = target_of(args)
     if args.check:
-        if args.filter or args.xml or args.output:
+        if args.filter or args.output:
             from synth.errors import InputError
 
-            raise InputError("--check proves the Grafcet's program and writes nothing: "
-                             "drop --filter, --xml and -o", None)
-        from synth.codegen.check import differential_check
+            raise InputError("--check proves the Grafcet's program and writes nothing: drop --filter and -o", None)
+        import dataclasses
 
-        report = differential_check(grafcet, initial, depth=args.depth,
-                                    program=generate_program(grafcet, name=args.name, sources=sources))
+        from synth.codegen.check import differential_check
+        from synth.codegen.targets import st_of
+
+        program = generate_program(grafcet, name=args.name, sources=sources)
+        header = provenance_lines(f"PROGRAM {program.program}", sources)
+        files = render(target, program.pous, text=program.text, name=program.program, header=header)
+        text = st_of(target, files, args.file)
+        report = differential_check(grafcet, initial, depth=args.depth, program=dataclasses.replace(program, text=text))
         if args.junit or args.sarif:
             from synth.output.ci import st_check_report, write_ci
 
@@ -83,18 +116,9 @@ def cmd_st(args: argparse.Namespace) -> int:
         from synth.codegen.program import configuration
 
         config = configuration(program.program, args.task)
-    if args.xml:
-        from synth.codegen.plcopen_export import st_project_xml
-
-        from synth.codegen.provenance import provenance_lines
-
-        _write(args, st_project_xml(program.pous, name=program.program, config=config,
-                                    comment="\n".join(provenance_lines(f"PROGRAM {program.program}", sources))))
-    else:
-        text = program.text
-        if config is not None:
-            text += "\n" + "\n".join(config.lines()) + "\n"
-        _write(args, text)
+    header = provenance_lines(f"PROGRAM {program.program}", sources)
+    write_target(args, render(target, program.pous, text=program.text, name=program.program, header=header,
+                              config=config))
     return 0
 
 
@@ -131,7 +155,10 @@ def register(sub: "argparse._SubParsersAction") -> None:
     p.add_argument("--filter", metavar="FILTER", help="a .filter file: its FUNCTION_BLOCK runs after the Grafcet")
     p.add_argument("--name", metavar="NAME", help="the PROGRAM's name (default: the file's stem)")
     p.add_argument("-o", "--output", metavar="FILE", help="write to FILE (default: standard output)")
-    p.add_argument("--xml", action="store_true", help="PLCopen TC6 XML instead of ST text")
+    p.add_argument("--xml", action="store_true", help="PLCopen TC6 XML instead of ST text (--target plcopen)")
+    p.add_argument("--target", choices=("iec", "plcopen", "codesys", "twincat"),
+                   help="iec: ST text (default); plcopen: TC6 XML; codesys: TC6 XML with CODESYS's project structure; "
+                        "twincat: one .TcPOU per POU (several: -o DIR)")
     p.add_argument("--task", metavar="PERIOD",
                    help="also write a CONFIGURATION running the PROGRAM every PERIOD (e.g. 10ms): builds as is in "
                         "Beremiz and OpenPLC")

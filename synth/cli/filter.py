@@ -47,7 +47,10 @@ def register_st(commands: "argparse._SubParsersAction") -> None:
     t.add_argument("filter", metavar="F.filter", help="the .filter file")
     _algorithm_mode(t)
     t.add_argument("-o", "--output", metavar="FB.st", help="write the block to this file (default: standard output)")
-    t.add_argument("--xml", action="store_true", help="write PLCopen TC6 XML instead of Structured Text")
+    t.add_argument("--xml", action="store_true", help="write PLCopen TC6 XML instead of Structured Text (--target plcopen)")
+    t.add_argument("--target", choices=("iec", "plcopen", "codesys", "twincat"),
+                   help="iec: ST text (default); plcopen: TC6 XML; codesys: TC6 XML with CODESYS's project structure; "
+                        "twincat: one .TcPOU per block (several: -o DIR)")
     t.add_argument("--name", metavar="NAME", help="the block is FB_NAME_Filter (default: the file's stem)")
     t.add_argument("--order", metavar="O1,O2,...", help="the order of the Sim criteria (algebraic)")
     t.add_argument("--split", action="store_true",
@@ -129,44 +132,28 @@ def cmd_solve(args: argparse.Namespace) -> int:
 
 
 def cmd_st(args: argparse.Namespace) -> int:
-    from synth.codegen.filter_st import filter_block
-    from synth.output.files import write_or_print
+    from synth.cli.codegen import target_of, write_target
+    from synth.codegen.filter_st import filter_block, split_blocks
+    from synth.codegen.provenance import provenance_lines
+    from synth.codegen.targets import Target, render
 
+    target = target_of(args)
+    f = _load(args.filter)
     if args.split:
-        return _st_split(args)
-
-    block = filter_block(_load(args.filter), args.algorithm, args.mode, args.name, _order(args.order))
-    for n in block.notes:
-        print(f"note: {n}", file=sys.stderr)
-    text: str | bytes = block.text
-    if args.xml:
-        from synth.codegen.plcopen_export import st_project_xml
-
-        from synth.codegen.provenance import provenance_lines
-
-        text = st_project_xml([block.pou], name=block.name,
-                              comment="\n".join(provenance_lines(f"Safety logic filter {block.name}", [args.filter])))
-    write_or_print(args.output, text)
-    return 0
-
-
-def _st_split(args: argparse.Namespace) -> int:
-    """``filter st --split``: one block per independent cluster of outputs, in one file."""
-    from synth.codegen.filter_st import split_blocks
-    from synth.output.files import write_or_print
-
-    blocks = split_blocks(_load(args.filter), args.algorithm, args.mode, args.name, _order(args.order))
+        blocks = split_blocks(f, args.algorithm, args.mode, args.name, _order(args.order))
+        what = "Safety logic filter"
+    else:
+        blocks = [filter_block(f, args.algorithm, args.mode, args.name, _order(args.order))]
+        what = f"Safety logic filter {blocks[0].name}"
     for n in (n for b in blocks for n in b.notes):
         print(f"note: {n}", file=sys.stderr)
-    text: str | bytes = "\n".join(b.text for b in blocks)
-    if args.xml:
-        from synth.codegen.plcopen_export import st_project_xml
-
-        from synth.codegen.provenance import provenance_lines
-
-        text = st_project_xml([b.pou for b in blocks], name=blocks[0].name,
-                              comment="\n".join(provenance_lines("Safety logic filter", [args.filter])))
-    write_or_print(args.output, text)
+    text = "\n".join(b.text for b in blocks)
+    files = render(target, [b.pou for b in blocks], text=text, name=blocks[0].name,
+                   header=provenance_lines(what, [args.filter]))
+    if target is Target.IEC and args.output is None:
+        sys.stdout.write(text)
+        return 0
+    write_target(args, files)
     return 0
 
 

@@ -54,6 +54,7 @@ from synth.codegen.plcopen_xml import (
 )
 from synth.codegen.program import Configuration, case_aliases, check_variable_name, first_location, program_name, renamed_note
 from synth.codegen.st import Pou, PouKind, st_expr, timer_literal
+from synth.codegen.twincat import object_id
 from synth.errors import InputError
 from synth.grafcet.language import (
     CONDITIONAL,
@@ -70,24 +71,40 @@ from synth.version import version as synth_version
 
 __all__ = ["st_project_xml", "sfc_project_xml"]
 
+CODESYS_DATA = "http://www.3s-software.com/plcopenxml/"
+"""The prefix of the ``addData`` names CODESYS V3.5 writes in its PLCopenXML exports."""
+
 _POU_TYPE = {PouKind.PROGRAM: "program", PouKind.FUNCTION_BLOCK: "functionBlock"}
 
 
 def st_project_xml(pous: Sequence[Pou], *, name: str = "synth", version: str | None = None, comment: str = "",
-                   config: Configuration | None = None) -> bytes:
+                   config: Configuration | None = None, codesys: bool = False) -> bytes:
     """PLCopen XML of generated POUs: their interfaces from their declarations, their ST bodies;
-    with ``config`` (``--task``), the configuration that runs the program (TC6 ``<task>``)."""
+    with ``config`` (``--task``), the configuration that runs the program (TC6 ``<task>``).
+    ``codesys``: with the ``addData`` CODESYS V3.5 writes and reads (each POU's ``ObjectId``, the
+    project's ``ProjectStructure`` listing them), so its PLCopenXML import places every object."""
     out = []
     for p in pous:
         body = element("body", None, element("ST", None, xhtml("\n".join(p.body).strip("\n") + "\n")))
-        out.append(element("pou", {"name": p.name, "pouType": _POU_TYPE[p.kind]}, interface(p.sections), body))
+        pou = element("pou", {"name": p.name, "pouType": _POU_TYPE[p.kind]}, interface(p.sections), body)
+        if codesys:
+            ident = element("ObjectId")
+            ident.text = object_id(p.name)
+            pou.append(element("addData", None, element("data", {"name": CODESYS_DATA + "objectid",
+                                                                 "handleUnknown": "discard"}, ident)))
+        out.append(pou)
+    extra = []
+    if codesys:
+        structure = element("ProjectStructure", None, *[element("Object", {"Name": p.name, "ObjectId": object_id(p.name)})
+                                                       for p in pous])
+        extra.append(element("data", {"name": CODESYS_DATA + "projectstructure", "handleUnknown": "discard"}, structure))
     configs = []
     if config is not None:
         task = element("task", {"name": config.task, "interval": config.interval, "priority": str(config.priority)},
                        element("pouInstance", {"name": config.instance, "typeName": config.program}))
         configs.append(element("configuration", {"name": config.name},
                                element("resource", {"name": config.resource}, task)))
-    return project(name, version or synth_version(), comment, out, configs)
+    return project(name, version or synth_version(), comment, out, configs, extra)
 
 
 class _Names:

@@ -83,7 +83,8 @@ def position(x: int, y: int, tag: str = "position"):
     return element(tag, {"x": str(x), "y": str(y)})
 
 
-def project(name: str, version: str, comment: str, pous: list, configurations: Sequence[Any] = ()) -> bytes:
+def project(name: str, version: str, comment: str, pous: list, configurations: Sequence[Any] = (),
+            data: Sequence[Any] = ()) -> bytes:
     from lxml import etree
 
     root = etree.Element(f"{{{NS}}}project", nsmap={None: NS, "xhtml": XHTML})
@@ -98,6 +99,8 @@ def project(name: str, version: str, comment: str, pous: list, configurations: S
     root.append(header)
     root.append(element("types", None, element("dataTypes"), element("pous", None, *pous)))
     root.append(element("instances", None, element("configurations", None, *configurations)))
+    if data:
+        root.append(element("addData", None, *data))
     return etree.tostring(root, xml_declaration=True, encoding="UTF-8", pretty_print=True)
 
 

@@ -27,6 +27,7 @@ from synth.logic.past import pre_name, st_past_name
 
 __all__ = [
     "st_expr",
+    "declaration_lines",
     "st_expression",
     "st_identifier_problem",
     "name_problem",
@@ -233,12 +234,17 @@ class Pou:
     body: tuple[str, ...]
 
 
-def pou_lines(pou: Pou, pad: str = "    ") -> list[str]:
-    """The ST lines of ``pou``, its declarations indented by ``pad`` (every section given is written)."""
+def declaration_lines(pou: Pou, pad: str = "    ") -> list[str]:
+    """The head of ``pou``: its kind and name, then every variable section (indented by ``pad``)."""
     lines = [f"{pou.kind} {pou.name}"]
     for section in pou.sections:
         lines += [str(section.kind), *(pad + d.text() for d in section.declarations), "END_VAR"]
-    return [*lines, *pou.body, f"END_{pou.kind}"]
+    return lines
+
+
+def pou_lines(pou: Pou, pad: str = "    ") -> list[str]:
+    """The ST lines of ``pou``, its declarations indented by ``pad`` (every section given is written)."""
+    return [*declaration_lines(pou, pad), *pou.body, f"END_{pou.kind}"]
 
 
 def indent(lines: Iterable[str], level: int = 1) -> list[str]:

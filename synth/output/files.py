@@ -6,7 +6,7 @@ import os
 import tempfile
 from pathlib import Path
 
-__all__ = ["write_atomic", "write_or_print"]
+__all__ = ["write_atomic", "write_or_print", "write_files"]
 
 
 def write_atomic(path: str | Path, data: str | bytes) -> Path:
@@ -47,3 +47,16 @@ def write_or_print(path: str | Path | None, data: str | bytes) -> None:
         sys.stdout.buffer.write(data)
     else:
         sys.stdout.write(data)
+
+
+def write_files(folder: str | Path | None, files: list[tuple[str, bytes]]) -> None:
+    """Several files (already rendered, so an error leaves none behind) into ``folder``, each
+    written atomically; ``folder`` is required (a located error on the command line otherwise)."""
+    from synth.errors import InputError
+
+    if not folder:
+        raise InputError(f"{len(files)} files to write ({', '.join(n for n, _ in files)}): give -o DIR", None)
+    if Path(folder).exists() and not Path(folder).is_dir():
+        raise InputError(f"{folder} is a file; {len(files)} files need a folder: give -o DIR", None)
+    for name, data in files:
+        write_atomic(Path(folder) / name, data)
