@@ -96,6 +96,10 @@ def cmd_check(args: argparse.Namespace) -> int:
         inv = invariants(f, args.plant)
         f = assumed(f, inv)
     c = check(f)
+    from synth.filter.reliefs import spelling_warnings
+
+    for w in spelling_warnings(f):
+        print(w.render(), file=sys.stderr)
     if args.junit or args.sarif:
         from synth.output.ci import filter_check_report, write_ci
 
