@@ -175,11 +175,36 @@ class PlantEncoding:
         return self.engine.conjunction(self.local_state(a, k, copy) for a, k in enumerate(local))
 
     def pick(self, u: Function) -> dict[str, bool] | None:
-        """The smallest state of ``u`` (a valuation of every current variable), ``None`` if
-        empty: variables in declaration order, false before true, whatever the BDD order
-        (so the states a report shows do not depend on it)."""
+        """One state of ``u`` (a valuation of every current variable), ``None`` if empty:
+        the first path to 1 in the BDD order, variables it leaves free false (every
+        completion of a path to 1 is in ``u``). Cheap, but which state depends on the
+        order: what a report shows comes from :meth:`smallest`."""
         if u == self.engine.false:
             return None
+        values = {v: False for v in self.variables}
+        outer = self.engine.name_of
+        f = u
+        true, false = self.engine.true, self.engine.false
+        while f != true:
+            lo, hi = f.low, f.high  # children of the regular node: complement them if f is
+            if f.negated:
+                lo, hi = ~lo, ~hi
+            name = outer(f.var)
+            if lo != false:
+                values[name] = False
+                f = lo
+            else:
+                values[name] = True
+                f = hi
+        return values
+
+    def smallest(self, u: Function) -> dict[str, bool] | None:
+        """The smallest state of ``u``, ``None`` if empty: variables in declaration order,
+        false before true, whatever the BDD order (:meth:`pick` when the two orders agree)."""
+        if u == self.engine.false:
+            return None
+        if self.order == tuple(range(len(self.order))):
+            return self.pick(u)
         values: dict[str, bool] = {}
         false = self.engine.false
         f = u
@@ -190,8 +215,8 @@ class PlantEncoding:
         return values
 
     def one(self, u: Function) -> tuple[int, ...]:
-        """The state :meth:`pick` chooses in ``u``, as local indices (``u`` not empty)."""
-        values = self.pick(u)
+        """The state :meth:`smallest` chooses in ``u``, as local indices (``u`` not empty)."""
+        values = self.smallest(u)
         if values is None:
             raise ValueError("no state to pick in an empty set")
         return self.local(values)
@@ -206,7 +231,7 @@ class PlantEncoding:
 
     def states(self, u: Function, limit: int) -> Iterator[tuple[int, ...]]:
         """Every state of ``u`` as local indices, at most ``limit``; in the order of
-        :meth:`pick` (variables in declaration order, false first), whatever the BDD order."""
+        :meth:`smallest` (variables in declaration order, false first), whatever the BDD order."""
         care = [self.engine.declare(v) for v in self.variables]
         found: list[tuple[bool, ...]] = []
         for n, inner in enumerate(self.bdd.pick_iter(u, care_vars=care)):
