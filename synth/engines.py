@@ -5,7 +5,7 @@
 ``auto`` estimates both engines' work before running anything:
 
 - ``validate``: symbolic when the model is large (the product of the element state
-  counts times the number of Grafcet steps above :data:`VALIDATE_THRESHOLD`, 10^6) *and*
+  counts times the number of Grafcet steps above :data:`VALIDATE_THRESHOLD`, 10^5) *and*
   the Grafcet moves many actuators at once (:func:`concurrency`, the widest AND
   divergence, at least :data:`CONCURRENCY_THRESHOLD`, 4). Both engines pay per stable
   situation; per situation the explicit engine lists every interleaving of the moving
@@ -52,7 +52,7 @@ if TYPE_CHECKING:  # pragma: no cover - the engines are imported once chosen
 __all__ = ["EngineChoice", "choose", "concurrency", "VALIDATE_THRESHOLD", "CONCURRENCY_THRESHOLD", "SUP_THRESHOLD",
            "validate", "SupRun", "supervisor"]
 
-VALIDATE_THRESHOLD = 10**6
+VALIDATE_THRESHOLD = 10**5
 """``validate --engine auto``: symbolic only when plant states × Grafcet steps exceed this."""
 
 CONCURRENCY_THRESHOLD = 4

@@ -103,7 +103,7 @@ def test_concurrency_is_the_widest_and_divergence(tmp_path):
 def test_auto_keeps_sequences_explicit_and_takes_wide_divergences_symbolic(tmp_path):
     assert choose(EngineChoice.AUTO, 10**9, width=3) == EngineChoice.EXPLICIT
     assert choose(EngineChoice.AUTO, 10**9, width=4) == EngineChoice.SYMBOLIC
-    assert choose(EngineChoice.AUTO, 10**6, width=8) == EngineChoice.EXPLICIT
+    assert choose(EngineChoice.AUTO, 10**5, width=8) == EngineChoice.EXPLICIT
     assert choose(EngineChoice.SYMBOLIC, 10, width=1) == EngineChoice.SYMBOLIC
     r, g, _ = write_branches(3, 2, tmp_path)  # 2·12^6 plant states × 16 steps, 3 branches: explicit
     assert engines.validate(g, r).engine_stats is None
