@@ -2,15 +2,19 @@
 ``synth validate`` and ``synth sup``, above both engines (:mod:`synth.validation`,
 :mod:`synth.symbolic`), which know nothing of each other.
 
-``auto`` estimates the explicit engine's work before running anything:
+``auto`` estimates both engines' work before running anything:
 
-- ``validate``: the product of the element state counts (the plant's size) times the
-  number of Grafcet steps (a stand-in for the situations); symbolic above
-  :data:`VALIDATE_THRESHOLD` (10^7). The explicit engine's cost follows the reachable
-  SYNC, which this bounds from above; at 10^7 the explicit engine still answers in well
-  under a second on sequential machines, and the symbolic engine costs a few tenths of a
-  second more at most (see docs/symbolic.md for the measurements behind the choice);
-  ``--report`` and ``--cor`` need every aggregated state, so ``auto`` keeps them explicit.
+- ``validate``: symbolic when the model is large (the product of the element state
+  counts times the number of Grafcet steps above :data:`VALIDATE_THRESHOLD`, 10^5) *and*
+  the Grafcet moves many actuators at once (:func:`concurrency`, the widest AND
+  divergence, at least :data:`CONCURRENCY_THRESHOLD`, 4). Both engines pay per stable
+  situation; per situation the explicit engine lists every interleaving of the moving
+  elements (about r^D SYNC states for D branches at once, r ≈ 3 for a cylinder), the
+  symbolic one builds BDDs whose size grows polynomially in D. Measured
+  (docs/performance.md, bench/symbolic.py): at D = 3 the explicit engine is as fast or
+  faster on every family (branches × sequence: 2.7× faster), from D = 4 on the symbolic
+  one wins (par, steep). ``--report`` and ``--cor`` need every aggregated state, so
+  ``auto`` keeps them explicit.
 - ``sup``: symbolic above :data:`SUP_THRESHOLD` (10^6) plant states, unless ``--export``
   or ``--why`` ask for the explicit listing.
 
@@ -21,6 +25,8 @@ Example
 -------
 >>> choose(EngineChoice.AUTO, 10**8)
 <EngineChoice.SYMBOLIC: 'symbolic'>
+>>> choose(EngineChoice.AUTO, 10**8, width=3)
+<EngineChoice.EXPLICIT: 'explicit'>
 >>> choose(EngineChoice.AUTO, 10**8, needs_listing=True)
 <EngineChoice.EXPLICIT: 'explicit'>
 """
@@ -35,6 +41,7 @@ from typing import TYPE_CHECKING, Any, Callable, Sequence
 from synth.errors import LimitExceeded, SynthError
 
 if TYPE_CHECKING:  # pragma: no cover - the engines are imported once chosen
+    from synth.grafcet.language import Grafcet
     from synth.plant.composition import Plant
     from synth.plant.rules import RuleSet
     from synth.sup.explain import Explanation
@@ -42,10 +49,14 @@ if TYPE_CHECKING:  # pragma: no cover - the engines are imported once chosen
     from synth.symbolic.supervisor import SymbolicSupervisor
     from synth.validation.result import Validation
 
-__all__ = ["EngineChoice", "choose", "VALIDATE_THRESHOLD", "SUP_THRESHOLD", "validate", "SupRun", "supervisor"]
+__all__ = ["EngineChoice", "choose", "concurrency", "VALIDATE_THRESHOLD", "CONCURRENCY_THRESHOLD", "SUP_THRESHOLD",
+           "validate", "SupRun", "supervisor"]
 
-VALIDATE_THRESHOLD = 10**7
-"""``validate --engine auto``: symbolic when plant states × Grafcet steps exceed this."""
+VALIDATE_THRESHOLD = 10**5
+"""``validate --engine auto``: symbolic only when plant states × Grafcet steps exceed this."""
+
+CONCURRENCY_THRESHOLD = 4
+"""``validate --engine auto``: symbolic only when the Grafcet starts this many branches at once."""
 
 SUP_THRESHOLD = 10**6
 """``sup --engine auto``: symbolic when the plant has more states than this."""
@@ -57,13 +68,28 @@ class EngineChoice(StrEnum):
     SYMBOLIC = "symbolic"
 
 
+def concurrency(g: Grafcet) -> int:
+    """The widest AND divergence of ``g``: the most steps one transition activates (1
+    for a sequence), the number of branches that can move actuators at once.
+
+    >>> from synth.grafcet.language_check import load_grafcet
+    >>> from synth.plant.composition import _plants
+    >>> concurrency(load_grafcet(_plants("../grafcets/tri.g7")))
+    1
+    """
+    return max((len(t.targets) for t in g.transitions), default=1)
+
+
 def choose(asked: EngineChoice | str, estimate: int, *, threshold: int = VALIDATE_THRESHOLD,
-           needs_listing: bool = False, listing_option: str = "--report/--cor") -> EngineChoice:
-    """The engine to run for an estimated size; ``needs_listing``: an option needs every
-    state explicitly (the symbolic engine cannot serve it)."""
+           width: int = CONCURRENCY_THRESHOLD, needs_listing: bool = False,
+           listing_option: str = "--report/--cor") -> EngineChoice:
+    """The engine to run for an estimated size and concurrency ``width`` (see module
+    docstring; ``sup`` passes no width); ``needs_listing``: an option needs every state
+    explicitly (the symbolic engine cannot serve it)."""
     asked = EngineChoice(asked)
     if asked == EngineChoice.AUTO:
-        return EngineChoice.EXPLICIT if needs_listing or estimate <= threshold else EngineChoice.SYMBOLIC
+        small = estimate <= threshold or width < CONCURRENCY_THRESHOLD
+        return EngineChoice.EXPLICIT if needs_listing or small else EngineChoice.SYMBOLIC
     if asked == EngineChoice.SYMBOLIC and needs_listing:
         raise SynthError(f"{listing_option} lists every state: use --engine explicit (or auto)")
     return asked
@@ -93,7 +119,8 @@ def validate(
     rs = load_rules(rules_path)
     p = plant(rs)
     g = load_grafcet(grafcet_path, inputs=p.inputs, outputs=p.outputs)
-    if asked != EngineChoice.EXPLICIT and choose(asked, p.size * max(1, len(g.steps))) == EngineChoice.SYMBOLIC:
+    estimate = p.size * max(1, len(g.steps))
+    if asked != EngineChoice.EXPLICIT and choose(asked, estimate, width=concurrency(g)) == EngineChoice.SYMBOLIC:
         from synth.symbolic.validate import validate_loaded as symbolic
 
         return symbolic(rs, p, g, expert=expert, homes=homes, max_nodes=max_nodes, progress=progress)

@@ -3,8 +3,10 @@
 A plant state is the valuation of every element variable (``A1``, ``a1_0``, …): the
 *current* copy carries a variable's own name, the *next* copy ``name'`` and an *auxiliary*
 copy ``name''`` (used to compose relations); the three copies of a variable are adjacent
-in the order, elements in declaration order, so relations that change one element stay
-small. Each element's reachable local codes form its *domain*; a state set is always a
+in the order, so relations that change one element stay small. Elements are ordered from
+the constraint graph (:func:`element_order`): the partners of each constraint (an
+interlock between two cylinders declared far apart) sit side by side, so a state set
+does not carry every constraint across one cut of the order. Each element's reachable local codes form its *domain*; a state set is always a
 subset of the product of the domains.
 
 Counts are exact Python integers (CUDD's own count is a double, wrong above 2^53).
@@ -26,10 +28,12 @@ from enum import Enum
 from typing import Iterator, Mapping, Sequence
 
 from synth.errors import LimitExceeded
-from synth.logic.bdd import Engine, Function
+from synth.logic.bdd import Engine, Function, interleaved_order
+from synth.logic.expr import names as expr_names
 from synth.plant.composition import Plant
+from synth.plant.rules import Constraint
 
-__all__ = ["Copy", "PlantEncoding", "NodeBudget", "live_nodes"]
+__all__ = ["Copy", "PlantEncoding", "NodeBudget", "live_nodes", "element_order"]
 
 
 class Copy(Enum):
@@ -77,14 +81,33 @@ class NodeBudget:
             )
 
 
-class PlantEncoding:
-    """BDD variables, domains and conversions for the states of one plant."""
+def element_order(p: Plant, constraints: Sequence[Constraint] = ()) -> tuple[int, ...]:
+    """The elements (indices in declaration order) in the BDD variable order: the elements
+    a constraint names are neighbours, visited breadth-first from the first declared
+    element of each connected part (:func:`~synth.logic.bdd.interleaved_order`). Elements
+    no constraint links keep their declaration order.
 
-    def __init__(self, p: Plant, budget: NodeBudget | None = None) -> None:
+    >>> from synth.plant.rules_check import load_rules
+    >>> from synth.plant.composition import plant, _plants
+    >>> rs = load_rules(_plants("tri.rules"))
+    >>> sorted(element_order(plant(rs), rs.constraints)) == list(range(len(rs.elements)))
+    True
+    """
+    label = [str(i) for i in range(len(p.elements))]
+    supports = [{label[p.owner[n.name]] for n in expr_names(c.forbidden) if n.name in p.owner} for c in constraints]
+    return tuple(int(a) for a in interleaved_order(label, supports, label, {}))
+
+
+class PlantEncoding:
+    """BDD variables, domains and conversions for the states of one plant; ``constraints``
+    choose the variable order (:func:`element_order`)."""
+
+    def __init__(self, p: Plant, budget: NodeBudget | None = None, constraints: Sequence[Constraint] = ()) -> None:
         self.plant = p
         self.budget = budget or NodeBudget()
         self.variables: tuple[str, ...] = tuple(v for e in p.elements for v in e.variables)
-        order = [v + c.value for v in self.variables for c in Copy]
+        self.order: tuple[int, ...] = element_order(p, constraints)
+        order = [v + c.value for a in self.order for v in p.elements[a].variables for c in Copy]
         self.engine = Engine(order)
         self.bdd = self.engine.bdd
         self.element_variables: tuple[tuple[str, ...], ...] = tuple(e.variables for e in p.elements)
@@ -152,9 +175,10 @@ class PlantEncoding:
         return self.engine.conjunction(self.local_state(a, k, copy) for a, k in enumerate(local))
 
     def pick(self, u: Function) -> dict[str, bool] | None:
-        """One state of ``u`` (a valuation of every current variable), ``None`` if empty.
-        Variables ``u`` leaves free on the path taken are false (every completion of a
-        path to 1 is in ``u``)."""
+        """One state of ``u`` (a valuation of every current variable), ``None`` if empty:
+        the first path to 1 in the BDD order, variables it leaves free false (every
+        completion of a path to 1 is in ``u``). Cheap, but which state depends on the
+        order: what a report shows comes from :meth:`smallest`."""
         if u == self.engine.false:
             return None
         values = {v: False for v in self.variables}
@@ -174,9 +198,25 @@ class PlantEncoding:
                 f = hi
         return values
 
+    def smallest(self, u: Function) -> dict[str, bool] | None:
+        """The smallest state of ``u``, ``None`` if empty: variables in declaration order,
+        false before true, whatever the BDD order (:meth:`pick` when the two orders agree)."""
+        if u == self.engine.false:
+            return None
+        if self.order == tuple(range(len(self.order))):
+            return self.pick(u)
+        values: dict[str, bool] = {}
+        false = self.engine.false
+        f = u
+        for v in self.variables:
+            low = self.bdd.let({self._inner[v]: False}, f)
+            values[v] = low == false
+            f = self.bdd.let({self._inner[v]: True}, f) if values[v] else low
+        return values
+
     def one(self, u: Function) -> tuple[int, ...]:
-        """The state :meth:`pick` chooses in ``u``, as local indices (``u`` not empty)."""
-        values = self.pick(u)
+        """The state :meth:`smallest` chooses in ``u``, as local indices (``u`` not empty)."""
+        values = self.smallest(u)
         if values is None:
             raise ValueError("no state to pick in an empty set")
         return self.local(values)
@@ -190,12 +230,16 @@ class PlantEncoding:
         return tuple(out)
 
     def states(self, u: Function, limit: int) -> Iterator[tuple[int, ...]]:
-        """Every state of ``u`` as local indices, in a deterministic order; at most ``limit``."""
+        """Every state of ``u`` as local indices, at most ``limit``; in the order of
+        :meth:`smallest` (variables in declaration order, false first), whatever the BDD order."""
         care = [self.engine.declare(v) for v in self.variables]
+        found: list[tuple[bool, ...]] = []
         for n, inner in enumerate(self.bdd.pick_iter(u, care_vars=care)):
             if n >= limit:
                 raise LimitExceeded(f"more than {limit} states to list from a BDD")
-            yield self.local({v: bool(inner[self.engine.declare(v)]) for v in self.variables})
+            found.append(tuple(bool(inner[c]) for c in care))
+        for values in sorted(found):
+            yield self.local(dict(zip(self.variables, values)))
 
     # ---- exact counting
     def count(self, u: Function, copies: Sequence[Copy] = (Copy.CURRENT,)) -> int:

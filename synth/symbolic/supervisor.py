@@ -45,7 +45,7 @@ class SymbolicSupervisor:
         self.plant = p
         self.constraints = tuple(constraints)
         self.compiled = CompiledConstraints(p, constraints)
-        self.enc = PlantEncoding(p, budget)
+        self.enc = PlantEncoding(p, budget, self.constraints)
         self.moves: tuple[Move, ...] = plant_moves(self.enc)
         self.states: Function = self.enc.engine.false
 

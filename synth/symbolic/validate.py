@@ -303,5 +303,9 @@ def _one_per_situation(ssync: SymbolicSync, ex: _Explicit) -> None:
             ex.node((s, ssync.enc.one(r.nodes)))
 
 
-def _stats(ssync: SymbolicSync) -> dict[str, int]:
-    return {"bdd_nodes": live_nodes(ssync.enc.engine), "situations": len(ssync.situations)}
+def _stats(ssync: SymbolicSync) -> dict[str, int | list[str]]:
+    """The engine's statistics: live BDD nodes, stable situations, and the elements in
+    the BDD variable order (:func:`~synth.symbolic.encoding.element_order`)."""
+    elements = ssync.plant.elements
+    return {"bdd_nodes": live_nodes(ssync.enc.engine), "situations": len(ssync.situations),
+            "variable_order": [elements[a].name for a in ssync.enc.order]}

@@ -54,7 +54,7 @@ class Validation:
     # set by the symbolic engine, whose ``sync`` holds only the nodes a report shows:
     counts: dict[str, int] | None = None  # the stats, counted on the whole SYNC
     reached_steps: frozenset[str] | None = None  # steps active in some reachable situation
-    engine_stats: dict[str, int] | None = None  # BDD nodes, situations
+    engine_stats: dict[str, int | list[str]] | None = None  # BDD nodes, situations, variable order
 
     @property
     def unreached_steps(self) -> list[str]:
