@@ -134,12 +134,19 @@ def cmd_sfc(args: argparse.Namespace) -> int:
 
 
 def cmd_import(args: argparse.Namespace) -> int:
-    from synth.codegen.plcopen_import import import_sfc
+    from synth.codegen.plcopen_import import import_sfc, list_pous
     from synth.grafcet.language_check import parse_grafcet
 
     with open(args.file, "rb") as fh:
         data = fh.read()
-    text = import_sfc(data, args.file)
+    if args.list:
+        for summary in list_pous(data, args.file):
+            print(summary.text())
+        return 0
+    notes: list[str] = []
+    text = import_sfc(data, args.file, pou=args.pou, notes=notes)
+    for n in notes:
+        print(f"{args.file}: note: {n}", file=sys.stderr)
     parse_grafcet(text, args.output or "<imported>")  # the result must be a valid .g7
     _write(args, text)
     return 0
@@ -177,6 +184,8 @@ def register(sub: "argparse._SubParsersAction") -> None:
     p.set_defaults(handler=cmd_sfc)
     p = sub.add_parser("import", help="a PLCopen XML SFC as a .g7 Grafcet",
                        description="Read the SFC of a PLCopen TC6 XML file into the .g7 language.")
-    p.add_argument("file", metavar="FILE.xml", help="PLCopen TC6 XML (v2.01)")
+    p.add_argument("file", metavar="FILE.xml", help="PLCopen TC6 XML (2.01, 2.00 as CODESYS writes it, or 1.0)")
     p.add_argument("-o", "--output", metavar="FILE", help="write to FILE (default: standard output)")
+    p.add_argument("--pou", metavar="NAME", help="import this SFC POU only (default: every SFC POU)")
+    p.add_argument("--list", action="store_true", help="list the POUs, their languages and what an import reads")
     p.set_defaults(handler=cmd_import)

@@ -30,18 +30,22 @@ _UNIT = {"ms": "ms", "s": "s", "m": "min", "h": "h"}
 
 
 class ExprReader:
-    def __init__(self, text: str, where, steps: dict[str, str]) -> None:
+    def __init__(self, text: str, where, steps: dict[str, str], what: str = "an ST condition") -> None:
         # comments become spaces, so that offsets still point into the original text
         text = re.sub(r"\(\*.*?\*\)|//[^\n]*", lambda m: re.sub(r"[^\n]", " ", m[0]), text, flags=re.S)
-        self.text, self.where, self.steps = text, where, steps
+        self.text, self.where, self.steps, self.what = text, where, steps, what
         self.tokens: list[tuple[str, str, int]] = []
+        data = re.search(r"(?<![:<>])(<>|>=|<=|<(?![=>])|>(?!=)|=)(?!\s*T#)", text)
+        if data is not None:
+            raise self.error(data.start(), f"a comparison of data in {what} ({' '.join(text.split())}): .g7 reads "
+                             "Boolean inputs and step flags; numeric values are not read yet", width=len(data[1]))
         pos = 0
         while pos < len(text):
             if not text[pos:].strip():
                 break
             m = _TOKEN.match(text, pos)
             if not m or m.end() == pos:
-                raise self.error(len(text) - len(text[pos:].lstrip()), "unexpected character in an ST condition")
+                raise self.error(len(text) - len(text[pos:].lstrip()), f"unexpected character in {self.what}")
             kind = m.lastgroup or ""
             self.tokens.append((kind, m[kind], m.start(kind)))
             pos = m.end()
@@ -85,7 +89,7 @@ class ExprReader:
             inner = self.expr()
             k, v, o = self.take()
             if v != ")":
-                raise self.error(o, "expected ')' in an ST condition", expected=("')'",))
+                raise self.error(o, f"expected ')' in {self.what}", expected=("')'",))
             return inner if re.fullmatch(r"[!\w↑↓/.]+", inner) else f"({inner})"
         if kind == "num" and value in ("0", "1"):
             return value
@@ -118,12 +122,12 @@ class ExprReader:
             if value.startswith("_RE_") or value.startswith("_FE_"):
                 return ("↑" if value.startswith("_RE_") else "↓") + value[4:]
             return value
-        raise self.error(offset, f"expected a variable, a step flag or '(' in an ST condition, not '{value or 'end'}'",
+        raise self.error(offset, f"expected a variable, a step flag or '(' in {self.what}, not '{value or 'end'}'",
                          width=max(1, len(value)))
 
     def whole(self) -> str:
         out = self.expr()
         kind, value, offset = self.peek()
         if kind != "end":
-            raise self.error(offset, f"unexpected '{value}' in an ST condition", width=len(value))
+            raise self.error(offset, f"unexpected '{value}' in {self.what}", width=len(value))
         return out

@@ -1,0 +1,109 @@
+"""PLCopen files as IDEs write them (issue 21): TC6 2.00 (CODESYS V3.5), 2.01 (Beremiz) and
+1.0 (``tc6.xsd``); conditions wired as FBD ``<inVariable>``/blocks or LD contacts, named
+transitions with FBD bodies; every SFC POU of a project; nothing dropped silently; what has
+no Boolean meaning is an error at its XML element. The fixtures are written here in each
+dialect's shape (the public files measured by ``bench/import_corpus.py`` stay out)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from synth.cli.main import main
+from synth.codegen.plcopen_import import import_sfc, list_pous
+from synth.errors import InputError
+from synth.grafcet.ass import stable_situation_automaton
+from synth.grafcet.language_check import load_grafcet, parse_grafcet
+from synth.grafcet.machine import GrafcetMachine
+from synth.output.summary import ass_json
+
+DATA = Path(__file__).resolve().parent / "data" / "plcopen"
+
+
+def _ass(g) -> dict:
+    return ass_json(stable_situation_automaton(GrafcetMachine(g), initial_inputs={n: False for n in g.inputs}))
+
+
+def test_a_codesys_export_imports_every_sfc_pou_with_fbd_conditions():
+    xml = (DATA / "codesys_v35.xml").read_bytes()
+    notes: list[str] = []
+    text = import_sfc(xml, "codesys_v35.xml", notes=notes)
+    assert text.split("\n", 1)[1] == """inputs xStart, xDown, xGripOk, xPart
+outputs LOWER, MOTOR
+
+grafcet Crane_G1 {
+  initial step Crane_Init
+  step Crane_Lower: LOWER
+  transition Crane_Init -> Crane_Lower when xStart & !xDown
+  transition Crane_Lower -> Crane_Init when (xDown) & !(xGripOk)
+}
+grafcet Belt_G1 {
+  initial step Belt_Idle
+  step Belt_Run: MOTOR
+  transition Belt_Idle -> Belt_Run when xPart
+  transition Belt_Run -> Belt_Idle when !(xPart)
+}
+"""
+    assert notes == ["POU PLC_PRG not imported: an ST body: .g7 holds SFC charts only"]
+    by_hand = load_grafcet(DATA / "codesys_v35.g7", inputs=("xStart", "xDown", "xGripOk", "xPart"),
+                           outputs=("LOWER", "MOTOR"))
+    imported = parse_grafcet(text, "imported.g7")
+    assert _ass(imported)["transitions"] == _ass(by_hand)["transitions"]
+    assert _ass(imported)["states"] == _ass(by_hand)["states"]
+
+
+def test_list_and_select_pous(capsys):
+    path = str(DATA / "codesys_v35.xml")
+    assert main(["import", "--list", path]) == 0
+    assert capsys.readouterr().out == ("Crane\tprogram\tSFC\timported\nBelt\tprogram\tSFC\timported\n"
+                                       "PLC_PRG\tprogram\tST\tnot imported: an ST body: .g7 holds SFC charts only\n")
+    assert main(["import", path, "--pou", "Belt"]) == 0
+    out, err = capsys.readouterr()
+    assert "grafcet G1 {\n  initial step Idle\n" in out and "Crane" not in out and err == ""
+    assert main(["import", path, "--pou", "Crne"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("--pou:1:1: error: no SFC POU named Crne in this file\n") and "did you mean Crane?" in err
+    assert main(["import", path]) == 0
+    assert capsys.readouterr().err == f"{path}: note: POU PLC_PRG not imported: an ST body: .g7 holds SFC charts only\n"
+
+
+def test_beremiz_ld_contacts_and_an_fbd_named_transition():
+    for name in ("beremiz_ld_fbd.xml", "beremiz_tc6_1_0.xml"):  # TC6 2.01, and the same chart in the 1.0 namespace
+        text = import_sfc((DATA / name).read_bytes(), name)
+        assert text.split("\n", 1)[1] == """inputs a, b, c
+outputs LAMP
+
+grafcet G1 {
+  initial step Idle
+  step On: LAMP
+  transition Idle -> On when (a) & !b
+  transition On -> Idle when !(c)
+}
+"""
+
+
+@pytest.mark.parametrize("old, new, first", [
+    ("<expression>xDown</expression>", "<expression>rPos &gt; 24290.0</expression>",
+     "x.xml:66:15: error: a comparison of data in an ST condition (rPos > 24290.0): .g7 reads Boolean inputs and "
+     "step flags; numeric values are not read yet"),
+    ('<block localId="9" typeName="AND">', '<block localId="9" typeName="TON">',
+     "x.xml:73:13: error: an FBD block TON in a transition condition: only AND, OR and NOT have a Boolean meaning "
+     "in .g7"),
+    ('<reference name="LOWER" />', "<inline><ST><xhtml xmlns=\"http://www.w3.org/1999/xhtml\">Cnt := Cnt + 1;</xhtml>"
+     "</ST></inline>", "x.xml:60:73: error: an assignment of data in an action body (Cnt := Cnt + 1;): .g7 actions "
+     "set Boolean outputs; internal integer variables are not read yet"),
+    ('<connection refLocalId="2" />', '<connection refLocalId="77" />',
+     "x.xml:46:17: error: connection to unknown localId 77"),
+])
+def test_what_has_no_boolean_meaning_is_located_in_the_xml(old, new, first):
+    text = (DATA / "codesys_v35.xml").read_text()
+    assert old in text
+    with pytest.raises(InputError) as info:
+        import_sfc(text.replace(old, new, 1).encode(), "x.xml")
+    assert info.value.render().splitlines()[0] == first
+
+
+def test_list_pous_of_a_file_without_sfc():
+    xml = (DATA / "codesys_v35.xml").read_text().replace("<SFC>", "<FBD>").replace("</SFC>", "</FBD>")
+    assert [p.imported for p in list_pous(xml.encode())] == [False, False, False]
