@@ -113,7 +113,7 @@ grafcet G1 {{
   transition GoDown: Init -> Down, Lamp when start & top & !guard
   transition AtBottom: Down, Lamp -> Wait when bottom
   transition Wait -> Up when 2s/XWait
-  transition Wait -> Up when guard
+  transition Wait -> Up when (guard) & !(2s/XWait)
   transition AtTop: Up -> Init when top
 }}
 """

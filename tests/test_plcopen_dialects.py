@@ -107,3 +107,26 @@ def test_what_has_no_boolean_meaning_is_located_in_the_xml(old, new, first):
 def test_list_pous_of_a_file_without_sfc():
     xml = (DATA / "codesys_v35.xml").read_text().replace("<SFC>", "<FBD>").replace("</SFC>", "</FBD>")
     assert [p.imported for p in list_pous(xml.encode())] == [False, False, False]
+
+
+def test_a_selection_divergence_keeps_its_sfc_priority_with_a_warning():
+    warnings: list[InputError] = []
+    root = Path(__file__).resolve().parent / "data" / "codegen"
+    text = import_sfc((root / "ide_sfc.xml").read_bytes(), "ide_sfc.xml", warnings=warnings)
+    assert "  transition Wait -> Up when 2s/XWait\n  transition Wait -> Up when (guard) & !(2s/XWait)\n" in text
+    assert [w.render().splitlines() for w in warnings] == [[
+        "ide_sfc.xml:154:13: warning: a selection divergence: IEC 61131-3 SFC fires the first true branch (left to "
+        "right), .g7 every true branch; the later branches' receptivities are made exclusive",
+        '  154 |             <selectionDivergence localId="16">',
+        "      |             ^~~~~~~~~~~~~~~~~~~~",
+        "  = note: Wait -> Up when (guard) & !(2s/XWait)"]]
+
+
+def test_a_level_self_loop_jump_is_imported_with_a_warning():
+    xml = (DATA / "beremiz_ld_fbd.xml").read_text().replace('targetName="Idle"', 'targetName="On"')
+    warnings: list[InputError] = []
+    text = import_sfc(xml.encode(), "loop.xml", warnings=warnings)
+    assert "  transition On -> On when !(c)\n" in text
+    assert [w.render().splitlines()[0] for w in warnings] == [
+        "loop.xml:106:13: warning: a jump from step On back to itself on a level condition (!(c)): IEC 61131-3 SFC "
+        "re-activates the step at every PLC scan while it holds, IEC 60848 (.g7) never stabilises there"]

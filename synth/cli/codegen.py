@@ -144,9 +144,12 @@ def cmd_import(args: argparse.Namespace) -> int:
             print(summary.text())
         return 0
     notes: list[str] = []
-    text = import_sfc(data, args.file, pou=args.pou, notes=notes)
+    warnings: list = []
+    text = import_sfc(data, args.file, pou=args.pou, notes=notes, warnings=warnings)
     for n in notes:
         print(f"{args.file}: note: {n}", file=sys.stderr)
+    for w in warnings:
+        print(w.render(), file=sys.stderr)
     parse_grafcet(text, args.output or "<imported>")  # the result must be a valid .g7
     _write(args, text)
     return 0

@@ -118,13 +118,14 @@ def list_pous(data: bytes | str, file: str = "<xml>") -> list[PouSummary]:
 
 
 def import_sfc(data: bytes | str, file: str = "<xml>", pou: str | None = None,
-               notes: list[str] | None = None) -> str:
+               notes: list[str] | None = None, warnings: list[InputError] | None = None) -> str:
     """The ``.g7`` text of the SFC POUs of a PLCopen XML project (``pou``: that one only).
 
     Layout (positions), comments, documentation and vendor ``addData`` are ignored;
     ``jumpStep`` is a link to its target step. Elements ``.g7`` cannot represent (macro-steps,
     LD objects, qualifiers other than N/S/R/P0/P1) are an :class:`~synth.errors.InputError`
-    at their line. ``notes`` receives what was left out (POUs that are not SFC).
+    at their line. ``notes`` receives what was left out (POUs that are not SFC), ``warnings``
+    where IEC 61131-3 SFC and IEC 60848 read the chart differently (located).
     """
     root, src, q = _project(data, file)
     all_pous = _pous(root, q)
@@ -147,6 +148,8 @@ def import_sfc(data: bytes | str, file: str = "<xml>", pou: str | None = None,
         notes += [f"POU {s.name} not imported: {s.note}" for s in list_pous(data, file) if not s.imported]
     several = len(sfc_pous) > 1
     charts = [read_chart(p, s, q, src, _read_action, f"{p.get('name')}_" if several else "") for p, s in sfc_pous]
+    if warnings is not None:
+        warnings += [w for c in charts for w in c.warnings]
     return _g7_text(charts, file, several)
 
 

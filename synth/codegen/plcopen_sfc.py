@@ -21,7 +21,7 @@ from typing import Any, Callable
 from synth.codegen.plcopen_fbd import FBD_ELEMENTS, fbd_condition, fbd_transition
 from synth.codegen.plcopen_xml import SYNTH_DATA
 from synth.codegen.st_condition import ExprReader, st_text
-from synth.errors import InputError, Location, close_names
+from synth.errors import InputError, Location, Severity, close_names
 
 __all__ = ["Chart", "read_chart", "Source"]
 
@@ -89,7 +89,15 @@ class Chart:
     outputs: list[str]
     steps: list[_ImportedStep]
     transitions: list[tuple[str, list[str], list[str], str, object]]
-    notes: list[str] = field(default_factory=list)
+    warnings: list[InputError] = field(default_factory=list)
+
+
+def _x(el: Any) -> int:
+    pos = next((c for c in el if isinstance(c.tag, str) and c.tag.endswith("position")), None)
+    try:
+        return int(float(pos.get("x", "0"))) if pos is not None else 0
+    except ValueError:
+        return 0
 
 
 def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
@@ -134,7 +142,7 @@ def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
     def kind(el) -> str:
         return etree.QName(el).localname
 
-    def producers(el) -> list[tuple[int, object]]:
+    def producers(el) -> list[tuple[int, Any]]:
         out = []
         for cp in el.iterfind(q("connectionPointIn")):
             if cp.find(q("expression")) is not None:
@@ -217,6 +225,8 @@ def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
 
     # transitions
     transitions: list[tuple[str, list[str], list[str], str, object]] = []
+    branches: dict[int, list[tuple[tuple[int, int], int]]] = {}  # selection divergence -> (order, transition)
+    warnings: list[InputError] = []
     for lid, el in elements.items():
         if kind(el) != "transition":
             continue
@@ -261,6 +271,31 @@ def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
         if negate:
             expr = f"!({expr})"
         transitions.append((label, sources, targets, expr, el))
+        div = [(ref, c) for ref, c in producers(el) if kind(elements[ref]) == "selectionDivergence"]
+        if len(div) == 1:
+            branch = div[0][1].get("formalParameter", "")
+            key = (int(branch) if branch.strip().isdigit() else 10 ** 6, _x(el))
+            branches.setdefault(div[0][0], []).append((key, len(transitions) - 1))
+        if sources and sources == targets and "↑" not in expr and "↓" not in expr:
+            warnings.append(InputError(
+                f"a jump from step {sources[0]} back to itself on a level condition ({expr}): IEC 61131-3 SFC "
+                "re-activates the step at every PLC scan while it holds, IEC 60848 (.g7) never stabilises there",
+                src.at(el), severity=Severity.WARNING, notes=("make the condition an edge, or add a step",)))
+    written_by_synth = any(st.grafcet for st in steps.values())  # its .g7 is the meaning: no rewriting
+    for d, members in branches.items():  # IEC 61131-3: the first true branch, left to right; .g7: every one
+        if len(members) < 2 or written_by_synth:
+            continue
+        ranked = [i for _, i in sorted(members)]
+        rewritten = []
+        for k, i in enumerate(ranked[1:], 1):
+            label, sources, targets, expr, el = transitions[i]
+            before = " & ".join(f"!({transitions[j][3]})" for j in ranked[:k])
+            transitions[i] = (label, sources, targets, f"({expr}) & {before}", el)
+            rewritten.append(f"{' -> '.join([', '.join(sources), ', '.join(targets)])} when {transitions[i][3]}")
+        warnings.append(InputError(
+            "a selection divergence: IEC 61131-3 SFC fires the first true branch (left to right), .g7 every true "
+            "branch; the later branches' receptivities are made exclusive", src.at(elements[d]),
+            severity=Severity.WARNING, notes=tuple(rewritten)))
 
     # actions
     for lid, el in elements.items():
@@ -295,4 +330,4 @@ def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
         if find(s.name) not in groups:
             groups[find(s.name)] = f"G{len(set(groups.values())) + 1}"
     order = sorted(steps.values(), key=lambda s: int(s.el.sourceline or 0))  # type: ignore[attr-defined]
-    return Chart(str(pou.get("name", "")), inputs, outputs, order, transitions)
+    return Chart(str(pou.get("name", "")), inputs, outputs, order, transitions, warnings)
