@@ -130,3 +130,32 @@ def test_a_level_self_loop_jump_is_imported_with_a_warning():
     assert [w.render().splitlines()[0] for w in warnings] == [
         "loop.xml:106:13: warning: a jump from step On back to itself on a level condition (!(c)): IEC 61131-3 SFC "
         "re-activates the step at every PLC scan while it holds, IEC 60848 (.g7) never stabilises there"]
+
+
+def _with_pou_action(body: str, qualifier: str = "N") -> bytes:
+    text = (DATA / "codesys_v35.xml").read_text()
+    text = text.replace('<variable name="LOWER"><type><BOOL /></type></variable>',
+                        '<variable name="LOWER"><type><BOOL /></type></variable>\n'
+                        '            <variable name="GRIP"><type><BOOL /></type></variable>', 1)
+    text = text.replace("        <body>\n          <SFC>",
+                        '        <actions>\n          <action name="Grip">\n            <body>\n              <ST><xhtml '
+                        f'xmlns="http://www.w3.org/1999/xhtml">{body}</xhtml></ST>\n            </body>\n'
+                        "          </action>\n        </actions>\n        <body>\n          <SFC>", 1)
+    text = text.replace('<reference name="LOWER" />\n              </action>',
+                        '<reference name="LOWER" />\n              </action>\n'
+                        f'              <action localId="0" qualifier="{qualifier}"><relPosition x="0" y="0" />'
+                        '<reference name="Grip" /></action>', 1)
+    return text.encode()
+
+
+def test_a_reference_to_a_pou_action_is_read_as_its_assignments():
+    text = import_sfc(_with_pou_action("GRIP := TRUE; (* close the gripper *)"), "x.xml", pou="Crane")
+    assert "  step Lower: LOWER, set GRIP\n" in text and "outputs LOWER, GRIP\n" in text
+    text = import_sfc(_with_pou_action("GRIP := FALSE;", "P0"), "x.xml", pou="Crane")
+    assert "  step Lower: LOWER, reset GRIP on deactivation\n" in text
+    with pytest.raises(InputError) as info:
+        import_sfc(_with_pou_action("GRIP := xDown;"), "x.xml", pou="Crane")
+    assert info.value.render().splitlines()[0] == (
+        "x.xml:34:63: error: a statement of action Grip that .g7 cannot hold (GRIP := xDown): a PLC keeps what an "
+        "action body assigns after its step is left, so only X := TRUE; and X := FALSE; are read (as set X / "
+        "reset X)")

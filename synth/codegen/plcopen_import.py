@@ -212,12 +212,48 @@ def _paired(actions: list[str]) -> list[str]:
                                        and a[len("reset "):-len(" on deactivation")] in conditional)]
 
 
-def _read_action(a, src: Source, steps: dict[str, str], q) -> str:
+def _read_action(a: Any, src: Source, steps: dict[str, str], q: Any, pou_actions: dict[str, Any]) -> list[str]:
+    """The ``.g7`` actions of one SFC action (an action block's line)."""
     qualifier = a.get("qualifier", "N")
-    ref, inline = a.find(q("reference")), a.find(q("inline"))
+    ref = a.find(q("reference"))
     if qualifier not in set(Qualifier):
         raise InputError(f"action qualifier {qualifier} cannot be represented in .g7", src.at(a),
                          expected=tuple(Qualifier))
+    if ref is not None and ref.get("name") in pou_actions:
+        return _pou_action(a, ref.get("name"), pou_actions[ref.get("name")], qualifier, src, q)
+    return [_one_action(a, src, steps, q, qualifier)]
+
+
+def _pou_action(a: Any, name: str, action: Any, qualifier: str, src: Source, q: Any) -> list[str]:
+    """A reference to a POU action: its ST body of ``X := TRUE;`` / ``X := FALSE;`` statements.
+    A PLC runs it while the action is active and does not undo it: stored actions (``set`` /
+    ``reset`` on activation, or on deactivation for ``P0``)."""
+    st = action.find(f"{q('body')}/{q('ST')}")
+    if st is None:
+        raise InputError(f"action {name} referenced here has no ST body: .g7 reads Boolean assignments only",
+                         src.at(a))
+    text = st_text(st)
+    where = lambda off, w, h=st, t=text: src.text_at(h, t, off, w)  # noqa: E731
+    if qualifier == Qualifier.R:
+        raise InputError(f"qualifier R on action {name}: a reset action has no body to run in .g7", src.at(a))
+    when = " on deactivation" if qualifier == Qualifier.P0 else ""
+    out = []
+    for m in re.finditer(r"[^;]+", re.sub(r"\(\*.*?\*\)", lambda c: " " * len(c[0]), text, flags=re.S)):
+        statement = m[0].strip()
+        if not statement:
+            continue
+        assign = re.fullmatch(r"(\w+)\s*:=\s*(TRUE|FALSE)", statement, re.I)
+        if assign is None:
+            raise InputError(f"a statement of action {name} that .g7 cannot hold ({statement}): a PLC keeps what "
+                             "an action body assigns after its step is left, so only X := TRUE; and X := FALSE; "
+                             "are read (as set X / reset X)", where(m.start() + len(m[0]) - len(m[0].lstrip()),
+                                                                    len(statement)))
+        out.append(f"{'set' if assign[2].upper() == 'TRUE' else 'reset'} {assign[1]}{when}")
+    return out
+
+
+def _one_action(a: Any, src: Source, steps: dict[str, str], q: Any, qualifier: str) -> str:
+    ref, inline = a.find(q("reference")), a.find(q("inline"))
     if ref is not None:
         name = ref.get("name", "")
         if qualifier == Qualifier.N:

@@ -101,11 +101,12 @@ def _x(el: Any) -> int:
 
 
 def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
-               read_action: Callable[..., str], prefix: str = "") -> Chart:
+               read_action: Callable[..., list[str]], prefix: str = "") -> Chart:
     """The chart of ``pou`` (its SFC body ``sfc``); step names get ``prefix`` (several POUs
     imported into one ``.g7``)."""
     from lxml import etree
 
+    pou_actions = {str(x.get("name")): x for x in pou.iterfind(f"{q('actions')}/{q('action')}")}
     inputs = [v.get("name") for v in pou.iterfind(f"{q('interface')}/{q('inputVars')}/{q('variable')}")]
     outputs = [v.get("name") for v in pou.iterfind(f"{q('interface')}/{q('outputVars')}/{q('variable')}")]
     named_conditions: dict[str, tuple[Any, str]] = {}
@@ -306,7 +307,7 @@ def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
             raise InputError("an action block must be connected to exactly one step", src.at(el))
         owner = steps[owners[0]]
         for a in el.iterfind(q("action")):
-            owner.actions.append(read_action(a, src, by_sfc_name, q))
+            owner.actions.extend(read_action(a, src, by_sfc_name, q, pou_actions))
 
     # partial grafcets: synth's addData, else the connected components
     parent: dict[str, str] = {s.name: s.name for s in steps.values()}
