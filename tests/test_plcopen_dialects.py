@@ -159,3 +159,22 @@ def test_a_reference_to_a_pou_action_is_read_as_its_assignments():
         "x.xml:34:63: error: a statement of action Grip that .g7 cannot hold (GRIP := xDown): a PLC keeps what an "
         "action body assigns after its step is left, so only X := TRUE; and X := FALSE; are read (as set X / "
         "reset X)")
+
+
+def test_names_a_transition_reads_are_checked_in_the_xml():
+    text = (DATA / "codesys_v35.xml").read_text().replace("<expression>xPart</expression>",
+                                                         "<expression>xLocal</expression>", 1)
+    with pytest.raises(InputError) as info:
+        import_sfc(text.encode(), "x.xml")
+    assert info.value.render().splitlines()[0] == (
+        "x.xml:124:13: error: a transition reads 'xLocal', which the POU Belt does not declare")
+    local = text.replace("</outputVars>\n        </interface>\n        <body>\n          <SFC>\n            <step "
+                         'localId="1" name="Idle"', "</outputVars>\n          <localVars>\n            <variable "
+                         'name="xLocal"><type><BOOL /></type></variable>\n          </localVars>\n        </interface>\n'
+                         '        <body>\n          <SFC>\n            <step localId="1" name="Idle"', 1)
+    warnings: list[InputError] = []
+    out = import_sfc(local.encode(), "x.xml", pou="Belt", warnings=warnings)
+    assert "inputs xPart, xLocal\n" in out
+    assert [w.message for w in warnings] == [
+        "'xLocal', declared in <localVars> of POU Belt, is read as an input: .g7 has no internal variables yet, so "
+        "nothing the chart does sets it"]

@@ -92,6 +92,34 @@ class Chart:
     warnings: list[InputError] = field(default_factory=list)
 
 
+_SECTIONS = ("inputVars", "outputVars", "inOutVars", "localVars", "tempVars", "externalVars")
+
+
+def _check_names(pou: Any, q: Callable[[str], str], src: Source, transitions: list, steps: set[str],
+                 inputs: list[str], outputs: list[str], warnings: list[InputError]) -> None:
+    """Every variable a receptivity reads is declared in the POU: an input, or a local (and the
+    like) read as an input with a warning; anything else is an error at the transition."""
+    declared: dict[str, Any] = {}
+    for section in _SECTIONS:
+        for v in pou.iterfind(f"{q('interface')}/{q(section)}/{q('variable')}"):
+            declared.setdefault(str(v.get("name")), (section, v))
+    for _, _, _, expr, el in transitions:
+        for name in dict.fromkeys(re.findall(r"(?<![\w/])[A-Za-z_]\w*", expr)):
+            if name.startswith("X") and name[1:] in steps or name in inputs:
+                continue
+            if name not in declared:
+                raise InputError(f"a transition reads '{name}', which the POU {pou.get('name')} does not declare",
+                                 src.at(el), suggestions=close_names(name, declared))
+            section, var = declared[name]
+            if name in outputs or section == "outputVars":
+                raise InputError(f"a transition reads the output '{name}': .g7 receptivities read inputs and step "
+                                 "flags", src.at(el))
+            inputs.append(name)
+            warnings.append(InputError(f"'{name}', declared in <{section}> of POU {pou.get('name')}, is read as an "
+                                       "input: .g7 has no internal variables yet, so nothing the chart does sets it",
+                                       src.at(var), severity=Severity.WARNING))
+
+
 def _x(el: Any) -> int:
     pos = next((c for c in el if isinstance(c.tag, str) and c.tag.endswith("position")), None)
     try:
@@ -282,6 +310,7 @@ def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
                 f"a jump from step {sources[0]} back to itself on a level condition ({expr}): IEC 61131-3 SFC "
                 "re-activates the step at every PLC scan while it holds, IEC 60848 (.g7) never stabilises there",
                 src.at(el), severity=Severity.WARNING, notes=("make the condition an edge, or add a step",)))
+    _check_names(pou, q, src, transitions, {st.name for st in steps.values()}, inputs, outputs, warnings)
     written_by_synth = any(st.grafcet for st in steps.values())  # its .g7 is the meaning: no rewriting
     for d, members in branches.items():  # IEC 61131-3: the first true branch, left to right; .g7: every one
         if len(members) < 2 or written_by_synth:
