@@ -83,15 +83,14 @@ class Product:
             raise LimitExceeded(f"{len(self.ynames)} inputs are read; verify codes an input vector in 40 bits")
         self.toggle: dict[str, np.ndarray] = {}
         self.uncontrollable: list[tuple[str, np.ndarray]] = []
+        moves: dict[str, np.ndarray] = {}  # uncontrollable event -> its successor array, in first-seen order
         for t, src, dst in p.transition_arrays():
-            if t.controllable:
-                arr = self.toggle.setdefault(t.event, np.full(size, -1, dtype=np.int64))
-            else:
-                found = [a for e, a in self.uncontrollable if e == t.event]
-                arr = found[0] if found else np.full(size, -1, dtype=np.int64)
-                if not found:
-                    self.uncontrollable.append((t.event, arr))
+            table = self.toggle if t.controllable else moves
+            arr = table.get(t.event)
+            if arr is None:  # one array per event (not one per local transition)
+                arr = table[t.event] = np.full(size, -1, dtype=np.int64)
             arr[src] = dst
+        self.uncontrollable.extend(moves.items())
         for z in self.orders:
             for edge in (Event.rise(z), Event.fall(z)):
                 self.toggle.setdefault(edge, np.full(size, -1, dtype=np.int64))

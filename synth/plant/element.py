@@ -94,23 +94,54 @@ class ElementAutomaton:
     def state_label(self, k: int) -> str:
         return "{" + ",".join(self.true_variables(k)) + "}"
 
-    def uncontrollable_closure(self) -> np.ndarray:
-        """``R[k, j]``: local state j is reachable from k by uncontrollable transitions (k included).
-        Computed once per automaton."""
-        return self._closure
+    @cached_property
+    def _uncontrollable(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """The uncontrollable moves as two sparse adjacency lists: (targets by source: indptr,
+        targets), (sources by target: indptr, sources), and the moves' sources and targets."""
+        u = ~self.controllable
+        src, dst = self.src[u].astype(np.int64), self.dst[u].astype(np.int64)
+        by_src, by_dst = np.argsort(src, kind="stable"), np.argsort(dst, kind="stable")
+        n = self.size
+        out_ptr = np.searchsorted(src[by_src], np.arange(n + 1))
+        in_ptr = np.searchsorted(dst[by_dst], np.arange(n + 1))
+        return out_ptr, dst[by_src], in_ptr, src[by_dst], src, dst
+
+    @staticmethod
+    def _closure(start: np.ndarray, ptr: np.ndarray, nbr: np.ndarray) -> np.ndarray:
+        """The states reached from ``start`` (a boolean mask) along the adjacency lists: one
+        pass per frontier, linear in the moves explored (no dense n x n matrix)."""
+        reach = start.astype(bool).copy()
+        frontier = np.nonzero(reach)[0]
+        while frontier.size:
+            lo, hi = ptr[frontier], ptr[frontier + 1]
+            counts = hi - lo
+            if not counts.sum():
+                break
+            idx = np.repeat(lo - np.concatenate(([0], np.cumsum(counts)[:-1])), counts) + np.arange(counts.sum())
+            found = np.unique(nbr[idx])
+            frontier = found[~reach[found]]
+            reach[frontier] = True
+        return reach
+
+    def can_reach(self, mask: np.ndarray) -> np.ndarray:
+        """The local states from which a state of ``mask`` is reachable by the element's own
+        uncontrollable moves (``mask`` included)."""
+        _, _, in_ptr, sources, _, _ = self._uncontrollable
+        return self._closure(np.asarray(mask, dtype=bool), in_ptr, sources)
+
+    def reachable_from(self, k: int) -> np.ndarray:
+        """The local states the element reaches from ``k`` by its own uncontrollable moves (``k`` included)."""
+        found = self._reached.get(k)
+        if found is None:
+            out_ptr, targets, _, _, _, _ = self._uncontrollable
+            start = np.zeros(self.size, dtype=bool)
+            start[k] = True
+            found = self._reached[k] = self._closure(start, out_ptr, targets)
+        return found
 
     @cached_property
-    def _closure(self) -> np.ndarray:
-        n = self.size
-        reach = np.eye(n, dtype=bool)
-        u = ~self.controllable
-        step = np.zeros((n, n), dtype=bool)
-        step[self.src[u], self.dst[u]] = True
-        while True:
-            nxt = reach | (reach.astype(np.uint8) @ step.astype(np.uint8) > 0)
-            if np.array_equal(nxt, reach):
-                return reach
-            reach = nxt
+    def _reached(self) -> dict[int, np.ndarray]:
+        return {}
 
     def is_true(self, k: int, name: str) -> bool:
         """Value of variable ``name`` in local state ``k``."""
@@ -127,7 +158,7 @@ class ElementAutomaton:
 
     def drift(self, k: int) -> tuple[Event, ...]:
         """Events the element can do from ``k`` on its own (uncontrollable moves only), sorted."""
-        reach = self._closure[k]
+        reach = self.reachable_from(k)
         return tuple(sorted({self.event(t) for t in range(self.src.size)
                              if not self.controllable[t] and reach[int(self.src[t])]}))
 

@@ -67,9 +67,9 @@ def _product(p: Plant, factors: Iterable[tuple[int, np.ndarray]]) -> np.ndarray:
     return grid
 
 
-def _closed(closures: Sequence[np.ndarray], factors: Iterable[tuple[int, np.ndarray]]) -> tuple[tuple[int, np.ndarray], ...]:
+def _closed(p: Plant, factors: Iterable[tuple[int, np.ndarray]]) -> tuple[tuple[int, np.ndarray], ...]:
     """Per-element factors of "can reach, by own uncontrollable moves, a satisfying state"."""
-    return tuple((a, (closures[a] @ v.astype(np.uint8)) > 0) for a, v in factors)
+    return tuple((a, p.elements[a].can_reach(v)) for a, v in factors)
 
 
 def _holds(factors: Sequence[tuple[int, np.ndarray]], digits: np.ndarray) -> np.ndarray:
@@ -94,9 +94,8 @@ class CompiledConstraints:
         self.plant = p
         self.constraints = tuple(constraints)
         self.terms = _terms(p, constraints)
-        closures = [e.uncontrollable_closure().astype(np.uint8) for e in p.elements]
         self.level_terms = [t for t in self.terms if t.event is None]
-        self.level_reach = [_closed(closures, t.factors) for t in self.level_terms]
+        self.level_reach = [_closed(p, t.factors) for t in self.level_terms]
         self.edge_terms: dict[str, list[_Term]] = {}
         for t in self.terms:
             if t.event is not None:
