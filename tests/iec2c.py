@@ -92,14 +92,16 @@ def compile_st(text: str, folder: Path) -> subprocess.CompletedProcess[str]:
 
 
 class CompiledProgram:
-    """The generated program compiled by ``iec2c`` and gcc, driven through the harness."""
+    """The generated program compiled by ``iec2c`` and gcc, driven through the harness;
+    ``pou``: the POU to run (default: the ``PROGRAM``; a ``FUNCTION_BLOCK`` runs the same way,
+    one call per cycle)."""
 
-    def __init__(self, program: StProgram, folder: Path) -> None:
+    def __init__(self, program: StProgram, folder: Path, pou: str | None = None) -> None:
         found = find_iec2c()
         assert found is not None, "iec2c is not installed"
         done = compile_st(program.text, folder)
         assert done.returncode == 0, done.stdout + done.stderr
-        main = next(p for p in program.pous if p.kind is PouKind.PROGRAM)
+        main = next(p for p in program.pous if (p.name == pou if pou else p.kind is PouKind.PROGRAM))
         inputs = [d.name for s in main.sections if s.kind is SectionKind.INPUT for d in s.declarations]
         watched = [d.name for s in main.sections for d in s.declarations if d.type == "BOOL"]
         self.input_index = {n.upper(): i for i, n in enumerate(inputs)}
@@ -134,6 +136,9 @@ class CompiledProgram:
 
     def value(self, name: str) -> bool:
         return self.last[self.watched_index[name.upper()]] == "1"
+
+    def __getitem__(self, name: str) -> bool:
+        return self.value(name)
 
     def advance(self, ms: int) -> None:
         self._send(f"a {int(ms)}")
