@@ -26,7 +26,6 @@ Example
 
 from __future__ import annotations
 
-from collections import deque
 from dataclasses import dataclass
 from functools import cached_property
 from typing import Iterable
@@ -168,91 +167,96 @@ class ElementAutomaton:
 
 
 def element_automaton(e: ElementSpec) -> ElementAutomaton:
-    """Build the automaton of element ``e`` (see module docstring)."""
+    """Build the automaton of element ``e`` (see module docstring): vectorised over every
+    code of the element's variables (at most 2^20), then a breadth-first search from the
+    initial state, one frontier at a time."""
     names = tuple(v.name for v in e.variables)
     n = len(names)
     if n > MAX_ELEMENT_VARIABLES:
         raise InputError(f"element {e.name} has {n} variables; at most {MAX_ELEMENT_VARIABLES} are supported", e.loc)
     index = {v: i for i, v in enumerate(names)}
+    every = np.arange(1 << n, dtype=np.int64)
+    bits = [((every >> i) & 1).astype(bool) for i in range(n)]
 
-    def value_of(code: int):
-        return lambda name: bool((code >> index[name]) & 1)
+    def val(name: str) -> np.ndarray:
+        return bits[index[name]]
 
-    def coherent(code: int) -> bool:
-        val = value_of(code)
-        for v in e.variables:
-            if v.held and val(v.name) != v.initial:
-                return False
-        return not any(evaluate(inc, val) for inc in e.incoherences)
+    def everywhere(x: object) -> np.ndarray:
+        return np.broadcast_to(np.asarray(x, dtype=bool), every.shape)
 
-    # per consequence event: list of (rule number, order index, post value, guard, extra conditions)
-    enablers: dict[tuple[int, bool], list] = {}
-    for k, r in enumerate(e.rules):
-        extra = []
-        for p in e.precedences:
-            if p.cause == r.cause and p.then == r.consequence:
-                extra.append(p.first)
-        key = (index[r.consequence.name], r.consequence.rising)
-        enablers.setdefault(key, []).append((k, index[r.cause.name], r.cause.rising, r.guard, tuple(extra)))
+    coherent = np.ones(every.size, dtype=bool)
+    for v in e.variables:
+        if v.held:
+            coherent &= bits[index[v.name]] == v.initial
+    for inc in e.incoherences:
+        coherent &= ~everywhere(evaluate(inc, val))
 
-    def uncontrollable_moves(code: int):
-        val = value_of(code)
-        for v in e.variables:
-            if v.kind == VarKind.ORDER:
+    # per variable: the codes where it may flip, and per rule the codes where that rule makes it flip
+    rule_masks: dict[int, np.ndarray] = {}
+    flips: list[tuple[int, bool, np.ndarray]] = []
+    for v in e.variables:
+        i = index[v.name]
+        if v.kind == VarKind.ORDER:
+            if not v.held:
+                flips.append((i, True, everywhere(True)))
+            continue
+        if v.kind is VarKind.FREE:
+            flips.append((i, False, everywhere(True)))
+            continue
+        enabled = np.zeros(every.size, dtype=bool)
+        for k, r in enumerate(e.rules):
+            if r.consequence.name != v.name:
                 continue
-            i = index[v.name]
-            bit = bool((code >> i) & 1)
-            rising = not bit
-            if v.kind is VarKind.FREE:
-                yield i, ()
-                continue
-            applying = []
-            for k, oi, post, guard, extra in enablers.get((i, rising), ()):
-                if bool((code >> oi) & 1) != post:
-                    continue
-                if guard is not None and not evaluate(guard, val):
-                    continue
-                if any(bool((code >> index[x.name]) & 1) != x.rising for x in extra):
-                    continue
-                applying.append(k)
-            if applying:
-                yield i, tuple(applying)
+            mask = (bits[i] != r.consequence.rising) & (bits[index[r.cause.name]] == r.cause.rising)
+            if r.guard is not None:
+                mask &= everywhere(evaluate(r.guard, val))
+            for p in e.precedences:
+                if p.cause == r.cause and p.then == r.consequence:
+                    mask &= bits[index[p.first.name]] == p.first.rising
+            rule_masks[k] = mask
+            enabled |= mask
+        flips.append((i, False, enabled))
 
     init = sum(1 << index[v.name] for v in e.variables if v.initial)
-    if not coherent(init):  # caught with a location by the rules checker; defensive here
+    if not coherent[init]:  # caught with a location by the rules checker; defensive here
         raise InputError(f"the initial state of element {e.name} is incoherent", e.loc)
-    order_bits = [index[v.name] for v in e.variables if v.kind == VarKind.ORDER and not v.held]
+    seen_mask = np.zeros(every.size, dtype=bool)
+    seen_mask[init] = True
+    frontier = np.array([init], dtype=np.int64)
+    while frontier.size:
+        found = []
+        for i, _, mask in flips:
+            src = frontier[mask[frontier]]
+            dst = src ^ (1 << i)
+            found.append(dst[coherent[dst]])
+        new = np.unique(np.concatenate(found)) if found else frontier[:0]
+        frontier = new[~seen_mask[new]]
+        seen_mask[frontier] = True
+    codes = np.nonzero(seen_mask)[0].astype(np.int64)  # the reachable codes, sorted: state k is codes[k]
+    parts = []
+    for i, ctrl, mask in flips:
+        src = codes[mask[codes]]
+        dst = src ^ (1 << i)
+        ok = coherent[dst]
+        parts.append((src[ok], dst[ok], np.full(int(ok.sum()), i, dtype=np.int64), np.full(int(ok.sum()), ctrl)))
+    src_pos = np.searchsorted(codes, np.concatenate([p[0] for p in parts]))
+    dst_pos = np.searchsorted(codes, np.concatenate([p[1] for p in parts]))
+    var = np.concatenate([p[2] for p in parts])
+    ctrl_arr = np.concatenate([p[3] for p in parts]).astype(bool)
+    order = np.lexsort((dst_pos, var, src_pos))  # by source, then variable, then target
+    applied = {k for k, mask in rule_masks.items()
+               if (mask[codes] & coherent[codes ^ (1 << index[e.rules[k].consequence.name])]).any()}
     held = {v.name: v.initial for v in e.variables if v.held}  # a rule caused by the other edge never applies, by design
-    seen = {init}
-    queue = deque([init])
-    edges: list[tuple[int, int, int, bool]] = []
-    applied: set[int] = set()
-    while queue:
-        code = queue.popleft()
-        moves = [(i, True, ()) for i in order_bits] + [(i, False, ks) for i, ks in uncontrollable_moves(code)]
-        for i, ctrl, ks in moves:
-            target = code ^ (1 << i)
-            if not coherent(target):
-                continue
-            applied.update(ks)
-            edges.append((code, target, i, ctrl))
-            if target not in seen:
-                seen.add(target)
-                queue.append(target)
-    codes = np.array(sorted(seen), dtype=np.int64)
-    pos = {int(c): k for k, c in enumerate(codes)}
-    edges.sort(key=lambda t: (pos[t[0]], t[2], pos[t[1]]))
-    arr = lambda f, dt: np.array([f(t) for t in edges], dtype=dt)  # noqa: E731
     return ElementAutomaton(
         name=e.name,
         variables=names,
         orders=frozenset(v.name for v in e.variables if v.kind == VarKind.ORDER),
         codes=codes,
-        initial=pos[init],
-        src=arr(lambda t: pos[t[0]], np.int64),
-        dst=arr(lambda t: pos[t[1]], np.int64),
-        var=arr(lambda t: t[2], np.int64),
-        controllable=arr(lambda t: t[3], bool),
+        initial=int(np.searchsorted(codes, init)),
+        src=src_pos[order].astype(np.int64),
+        dst=dst_pos[order].astype(np.int64),
+        var=var[order],
+        controllable=ctrl_arr[order],
         spec=e,
         warnings=tuple(
             InputError(
