@@ -15,7 +15,7 @@ from synth.codegen.program import StProgram
 from synth.filter.cycle import Algorithm, FilterCycle, Mode
 from synth.filter.language_check import load_filter
 from synth.filter.run import run
-from test_filter_deployed import CASES, ROOT, _rows, _runnable
+from test_filter_deployed import CASES, ROOT, _rows, _runnable, drive
 
 pytestmark = pytest.mark.skipif(find_iec2c() is None or shutil.which("gcc") is None,
                                 reason="MATIEC's iec2c (and gcc) are not on PATH")
@@ -31,13 +31,7 @@ def test_the_compiled_block_is_filter_run(name: str, algorithm: Algorithm, mode:
     cycle = FilterCycle(f, algorithm, mode)
     rows = _rows(cycle.reads, f"{name}{algorithm}{mode}")
     try:
-        for n, (row, result) in enumerate(zip(rows, run(cycle, rows))):
-            plc.cycle(dict(row.values))
-            assert tuple(plc[o] for o in f.outputs) == result.outputs, f"cycle {n + 1}"
-            if algorithm is Algorithm.LOOP:
-                assert plc["Fallback"] == result.fallback, f"cycle {n + 1}"
-            if mode is Mode.BLOCKING:
-                assert plc["Blocked"] == result.blocked, f"cycle {n + 1}"
+        drive(plc, f.outputs, algorithm, mode, rows, run(cycle, rows))
     finally:
         plc.close()
 

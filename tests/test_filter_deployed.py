@@ -34,6 +34,18 @@ def _rows(reads: tuple[str, ...], seed: str) -> list[Row]:
     return [Row(n + 2, tuple((x, rnd.random() < 0.5) for x in reads)) for n in range(CYCLES)]
 
 
+def drive(fb, outputs, algorithm: Algorithm, mode: Mode, rows: list[Row], results) -> None:
+    """Run the block ``fb`` (anything with ``cycle(values)`` and ``fb[name]``) on ``rows`` and
+    compare it with ``filter run``'s ``results``, cycle after cycle."""
+    for n, (row, result) in enumerate(zip(rows, results)):
+        fb.cycle(dict(row.values))
+        assert tuple(fb[o] for o in outputs) == result.outputs, f"cycle {n + 1}"
+        if algorithm is Algorithm.LOOP:
+            assert fb["Fallback"] == result.fallback, f"cycle {n + 1}"
+        if mode is Mode.BLOCKING:
+            assert fb["Blocked"] == result.blocked, f"cycle {n + 1}"
+
+
 @pytest.mark.parametrize(("name", "algorithm", "mode"), CASES, ids=[f"{n}-{a}-{m}" for n, a, m in CASES])
 def test_filter_run_is_the_emitted_block(name: str, algorithm: Algorithm, mode: Mode) -> None:
     if not _runnable(name, algorithm):
@@ -44,13 +56,7 @@ def test_filter_run_is_the_emitted_block(name: str, algorithm: Algorithm, mode: 
     cycle = FilterCycle(f, algorithm, mode)
     rows = _rows(cycle.reads, f"{name}{algorithm}{mode}")
     results = run(cycle, rows)
-    for n, (row, result) in enumerate(zip(rows, results)):
-        fb.cycle(dict(row.values))
-        assert tuple(fb[o] for o in f.outputs) == result.outputs, f"cycle {n + 1}"
-        if algorithm is Algorithm.LOOP:
-            assert fb["Fallback"] == result.fallback, f"cycle {n + 1}"
-        if mode is Mode.BLOCKING:
-            assert fb["Blocked"] == result.blocked, f"cycle {n + 1}"
+    drive(fb, f.outputs, algorithm, mode, rows, results)
     if algorithm is Algorithm.ALGEBRAIC and mode is Mode.SUPERVISOR and cycle.care != ((),):
         assert any(r.outside_care for r in results)  # the cycles left the care set
 
