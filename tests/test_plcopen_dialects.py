@@ -84,9 +84,6 @@ grafcet G1 {
 
 
 @pytest.mark.parametrize("old, new, first", [
-    ("<expression>xDown</expression>", "<expression>rPos &gt; 24290.0</expression>",
-     "x.xml:66:15: error: a comparison of data in an ST condition (rPos > 24290.0): .g7 reads Boolean inputs and "
-     "step flags; numeric values are not read yet"),
     ('<block localId="9" typeName="AND">', '<block localId="9" typeName="TON">',
      "x.xml:73:13: error: an FBD block TON in a transition condition: only AND, OR and NOT have a Boolean meaning "
      "in .g7"),
@@ -178,3 +175,17 @@ def test_names_a_transition_reads_are_checked_in_the_xml():
     assert [w.message for w in warnings] == [
         "'xLocal', declared in <localVars> of POU Belt, is read as an input: .g7 has no internal variables yet, so "
         "nothing the chart does sets it"]
+
+
+def test_a_comparison_becomes_a_declared_predicate():
+    text = (DATA / "codesys_v35.xml").read_text().replace("<expression>xDown</expression>",
+                                                         "<expression>rPos &gt; 24290.0</expression>", 1)
+    warnings: list[InputError] = []
+    out = import_sfc(text.encode(), "x.xml", pou="Crane", warnings=warnings)
+    assert "inputs xStart, xDown, xGripOk, rPos_gt_24290_0\n" in out
+    assert "  transition Lower -> Init when (rPos_gt_24290_0) & !(xGripOk)\n" in out
+    assert [w.render().splitlines()[0] for w in warnings] == [
+        "x.xml:66:15: warning: declared predicate rPos_gt_24290_0 stands for 'rPos > 24290.0': a Boolean input of "
+        "the imported Grafcet (.g7 reads no numeric values); bind it to a sensor of the plant, or leave it free"]
+    g = parse_grafcet(out, "crane.g7")
+    assert "rPos_gt_24290_0" in g.inputs

@@ -38,7 +38,7 @@ from typing import Any
 
 from synth.codegen.plcopen_sfc import Chart, Source, read_chart
 from synth.codegen.plcopen_xml import Qualifier
-from synth.codegen.st_condition import ExprReader, st_text
+from synth.codegen.st_condition import PREDICATES, ExprReader, st_text
 from synth.errors import InputError, Location
 from synth.version import version as synth_version
 
@@ -147,7 +147,13 @@ def import_sfc(data: bytes | str, file: str = "<xml>", pou: str | None = None,
     if notes is not None and pou is None:
         notes += [f"POU {s.name} not imported: {s.note}" for s in list_pous(data, file) if not s.imported]
     several = len(sfc_pous) > 1
-    charts = [read_chart(p, s, q, src, _read_action, f"{p.get('name')}_" if several else "") for p, s in sfc_pous]
+    charts = []
+    for p, s in sfc_pous:
+        token = PREDICATES.set({})  # comparisons become declared predicates while a chart is read
+        try:
+            charts.append(read_chart(p, s, q, src, _read_action, f"{p.get('name')}_" if several else ""))
+        finally:
+            PREDICATES.reset(token)
     if warnings is not None:
         warnings += [w for c in charts for w in c.warnings]
     return _g7_text(charts, file, several)

@@ -20,7 +20,7 @@ from typing import Any, Callable
 
 from synth.codegen.plcopen_fbd import FBD_ELEMENTS, fbd_condition, fbd_transition
 from synth.codegen.plcopen_xml import SYNTH_DATA
-from synth.codegen.st_condition import ExprReader, st_text
+from synth.codegen.st_condition import PREDICATES, ExprReader, st_text
 from synth.errors import InputError, Location, Severity, close_names
 
 __all__ = ["Chart", "read_chart", "Source"]
@@ -118,6 +118,17 @@ def _check_names(pou: Any, q: Callable[[str], str], src: Source, transitions: li
             warnings.append(InputError(f"'{name}', declared in <{section}> of POU {pou.get('name')}, is read as an "
                                        "input: .g7 has no internal variables yet, so nothing the chart does sets it",
                                        src.at(var), severity=Severity.WARNING))
+
+
+def _declare_predicates(inputs: list[str], warnings: list[InputError]) -> None:
+    """The comparisons read so far (:data:`~synth.codegen.st_condition.PREDICATES`) as inputs."""
+    for ident, (text, where) in (PREDICATES.get() or {}).items():
+        if ident not in inputs:
+            inputs.append(ident)
+            warnings.append(InputError(
+                f"declared predicate {ident} stands for '{text}': a Boolean input of the imported Grafcet (.g7 "
+                "reads no numeric values); bind it to a sensor of the plant, or leave it free", where,
+                severity=Severity.WARNING))
 
 
 def _x(el: Any) -> int:
@@ -310,6 +321,7 @@ def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
                 f"a jump from step {sources[0]} back to itself on a level condition ({expr}): IEC 61131-3 SFC "
                 "re-activates the step at every PLC scan while it holds, IEC 60848 (.g7) never stabilises there",
                 src.at(el), severity=Severity.WARNING, notes=("make the condition an edge, or add a step",)))
+    _declare_predicates(inputs, warnings)
     _check_names(pou, q, src, transitions, {st.name for st in steps.values()}, inputs, outputs, warnings)
     written_by_synth = any(st.grafcet for st in steps.values())  # its .g7 is the meaning: no rewriting
     for d, members in branches.items():  # IEC 61131-3: the first true branch, left to right; .g7: every one
@@ -360,4 +372,5 @@ def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
         if find(s.name) not in groups:
             groups[find(s.name)] = f"G{len(set(groups.values())) + 1}"
     order = sorted(steps.values(), key=lambda s: int(s.el.sourceline or 0))  # type: ignore[attr-defined]
+    _declare_predicates(inputs, warnings)  # those met in the actions' conditions
     return Chart(str(pou.get("name", "")), inputs, outputs, order, transitions, warnings)

@@ -10,11 +10,12 @@ and says where the rest is.
 
 from __future__ import annotations
 
+import contextvars
 import re
 
-from synth.errors import InputError, close_names
+from synth.errors import InputError, Location, close_names
 
-__all__ = ["st_text", "ExprReader"]
+__all__ = ["st_text", "ExprReader", "PREDICATES", "predicate_name"]
 
 
 def st_text(el) -> str:
@@ -24,9 +25,28 @@ def st_text(el) -> str:
 
 # A tiny reader for the ST expressions of conditions: NOT, AND/&, OR, parentheses, TRUE/FALSE,
 # names, S12.X, S12.T >= T#2s, _RE_x/_FE_x.
-_TOKEN = re.compile(r"\s*(?:(?P<dur>T#[0-9A-Za-z_.]+)|(?P<name>[A-Za-z_]\w*(?:\.[A-Za-z_]\w*)?)|(?P<num>\d+)"
+_TOKEN = re.compile(r"\s*(?:(?P<dur>T#[0-9A-Za-z_.]+)|(?P<name>[A-Za-z_]\w*(?:\.[A-Za-z_]\w*)?)"
+                    r"|(?P<num>\d+(?:\.\d+)?(?:[eE][+-]?\d+)?)"
                     r"|(?P<op>>=|<=|<>|:=|[()&>=<;+\-*/]))", re.I)
 _UNIT = {"ms": "ms", "s": "s", "m": "min", "h": "h"}
+_COMPARE = {">": "gt", ">=": "ge", "<": "lt", "<=": "le", "=": "eq", "<>": "ne"}
+_FLIP = {">": "<", ">=": "<=", "<": ">", "<=": ">=", "=": "=", "<>": "<>"}
+
+PREDICATES: contextvars.ContextVar[dict[str, tuple[str, Location]] | None] = contextvars.ContextVar(
+    "PREDICATES", default=None)
+"""While a chart is read (``synth import``): the comparisons met, each a *declared predicate*
+(a Boolean input named after it: ``rPos > 24290.0`` is ``rPos_gt_24290_0``) with the text it
+stands for and where it is; outside, a comparison is an error."""
+
+
+def predicate_name(name: str, op: str, operand: str) -> str:
+    """The input that stands for ``name op operand``.
+
+    >>> predicate_name("rPos", ">", "24290.0"), predicate_name("Cnt", "<>", "-3")
+    ('rPos_gt_24290_0', 'Cnt_ne_m3')
+    """
+    literal = operand.replace(".", "_").replace("-", "m").replace("+", "")
+    return re.sub(r"_+", "_", f"{name}_{_COMPARE[op]}_{literal}")
 
 
 class ExprReader:
@@ -36,7 +56,7 @@ class ExprReader:
         self.text, self.where, self.steps, self.what = text, where, steps, what
         self.tokens: list[tuple[str, str, int]] = []
         data = re.search(r"(?<![:<>])(<>|>=|<=|<(?![=>])|>(?!=)|=)(?!\s*T#)", text)
-        if data is not None:
+        if data is not None and PREDICATES.get() is None:
             raise self.error(data.start(), f"a comparison of data in {what} ({' '.join(text.split())}): .g7 reads "
                              "Boolean inputs and step flags; numeric values are not read yet", width=len(data[1]))
         pos = 0
@@ -91,6 +111,9 @@ class ExprReader:
             if v != ")":
                 raise self.error(o, f"expected ')' in {self.what}", expected=("')'",))
             return inner if re.fullmatch(r"[!\w↑↓/.]+", inner) else f"({inner})"
+        following = self.peek()[1]
+        if following in _COMPARE and PREDICATES.get() is not None and (kind == "num" or (kind == "name" and "." not in value)):
+            return self.predicate(kind, value, offset)
         if kind == "num" and value in ("0", "1"):
             return value
         if kind == "name":
@@ -124,6 +147,27 @@ class ExprReader:
             return value
         raise self.error(offset, f"expected a variable, a step flag or '(' in {self.what}, not '{value or 'end'}'",
                          width=max(1, len(value)))
+
+    def predicate(self, kind: str, value: str, offset: int) -> str:
+        """``a > 24290.0`` (or ``24290.0 < a``): a declared predicate, recorded in PREDICATES."""
+        _, op, _ = self.take()
+        k2, v2, o2 = self.take()
+        sign = ""
+        if v2 in ("-", "+"):
+            sign = "-" if v2 == "-" else ""
+            k2, v2, o2 = self.take()
+        if k2 not in ("num", "name") or (kind == "num" and k2 != "name"):
+            raise self.error(o2, f"expected a variable or a number after '{op}' in {self.what}")
+        if kind == "num":  # 24290.0 < a is a > 24290.0
+            name, op, operand = v2, _FLIP[op], value
+        else:
+            name, operand = value, sign + v2
+        ident = predicate_name(name, op, operand)
+        found = PREDICATES.get()
+        assert found is not None
+        end = o2 + len(v2)
+        found.setdefault(ident, (" ".join(self.text[offset:end].split()), self.where(offset, end - offset)))
+        return ident
 
     def whole(self) -> str:
         out = self.expr()
