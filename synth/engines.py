@@ -121,9 +121,16 @@ def validate(
     g = load_grafcet(grafcet_path, inputs=p.inputs, outputs=p.outputs)
     estimate = p.size * max(1, len(g.steps))
     if asked != EngineChoice.EXPLICIT and choose(asked, estimate, width=concurrency(g)) == EngineChoice.SYMBOLIC:
+        from synth.grafcet.situation import OutOfRange
         from synth.symbolic.validate import validate_loaded as symbolic
 
-        return symbolic(rs, p, g, expert=expert, homes=homes, max_nodes=max_nodes, progress=progress)
+        try:
+            return symbolic(rs, p, g, expert=expert, homes=homes, max_nodes=max_nodes, progress=progress)
+        except OutOfRange:  # the explicit engine says it with the shortest trace
+            from synth.validation.validate import validate_loaded as explicit
+
+            explicit(rs, p, g, expert=expert, homes=homes, max_states=max_states)
+            raise
     from synth.validation.validate import validate_loaded
 
     explored = None

@@ -146,7 +146,7 @@ def test_syntax_error_located_with_expected_tokens():
         "t.g7:3:26: error: syntax error: unexpected 'b'",
         "  3 |   transition 0 -> when a b",
         "    |                          ^",
-        "  = expected & (and), 'initial', 'step', 'transition', | (or), }",
+        "  = expected & (and), 'initial', 'step', 'transition', a comparison (>= <= = <> < >), | (or), }",
     ]
 
 

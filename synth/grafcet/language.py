@@ -27,7 +27,7 @@ import re
 from fractions import Fraction
 from dataclasses import dataclass, field
 from enum import StrEnum
-from typing import Collection, Iterator, Sequence
+from typing import Collection, Iterator, Mapping, Sequence
 
 from synth.errors import Location
 from synth.logic.expr import Expr, Var, names
@@ -48,6 +48,9 @@ __all__ = [
     "ON_DEACTIVATION",
     "ON_EVENT",
     "Action",
+    "ASSIGN",
+    "Internal",
+    "Sum",
     "Step",
     "Timer",
     "Transition",
@@ -65,6 +68,7 @@ class ActionKind(StrEnum):
     CONTINUOUS = "continuous"
     CONDITIONAL = "conditional"
     STORED = "stored"
+    ASSIGN = "assign"
 
 
 class StoredWhen(StrEnum):
@@ -76,6 +80,7 @@ class StoredWhen(StrEnum):
 
 
 CONTINUOUS, CONDITIONAL, STORED = ActionKind.CONTINUOUS, ActionKind.CONDITIONAL, ActionKind.STORED
+ASSIGN = ActionKind.ASSIGN
 ON_ACTIVATION, ON_DEACTIVATION, ON_EVENT = StoredWhen.ACTIVATION, StoredWhen.DEACTIVATION, StoredWhen.EVENT
 
 # a timer atom: duration, unit and step, e.g. ``2s/X101``
@@ -129,6 +134,56 @@ def timer_id(duration: str, step: str) -> str:
 
 
 @dataclass(frozen=True)
+class Internal:
+    """An internal variable: ``internal cnt : 0..3 = 0`` (bounded integer) or
+    ``internal busy : bool`` (Boolean, held as 0/1). Only assignments change it.
+
+    >>> Internal("cnt", 0, 3, 0).text(), Internal("busy", 0, 1, 0, boolean=True).text()
+    ('internal cnt : 0..3 = 0', 'internal busy : bool = 0')
+    """
+
+    name: str
+    low: int
+    high: int
+    initial: int
+    boolean: bool = False
+    loc: Location | None = field(default=None, compare=False)
+
+    def text(self) -> str:
+        kind = "bool" if self.boolean else f"{self.low}..{self.high}"
+        return f"internal {self.name} : {kind} = {self.initial}"
+
+
+@dataclass(frozen=True)
+class Sum:
+    """The right side of an assignment: signed terms, each a constant or an internal variable.
+
+    >>> e = Sum(((1, "cnt"), (1, 1)))
+    >>> e.text(), e.value({"cnt": 2}), Sum(((1, "cnt"), (-1, 1))).text(), Sum(((-1, 2),)).text()
+    ('cnt + 1', 3, 'cnt - 1', '-2')
+    """
+
+    terms: tuple[tuple[int, int | str], ...]
+    loc: Location | None = field(default=None, compare=False)
+
+    def text(self) -> str:
+        out = ""
+        for i, (sign, x) in enumerate(self.terms):
+            if i:
+                out += " + " if sign > 0 else " - "
+            elif sign < 0:
+                out += "-"
+            out += str(x)
+        return out
+
+    def names(self) -> tuple[str, ...]:
+        return tuple(x for _, x in self.terms if isinstance(x, str))
+
+    def value(self, values: Mapping[str, int]) -> int:
+        return sum(sign * (values[x] if isinstance(x, str) else x) for sign, x in self.terms)
+
+
+@dataclass(frozen=True)
 class Action:
     """An action attached to a step.
 
@@ -136,7 +191,9 @@ class Action:
     * conditional: ``AVANCER1 if v10`` (the same, when ``condition`` holds);
     * stored: ``set M on activation`` / ``reset M on deactivation`` / ``set M on ↑cp12``
       (``value`` is True for set; ``when`` is activation, deactivation or event;
-      ``condition`` is the event expression for ``on <event>``).
+      ``condition`` is the event expression for ``on <event>``);
+    * assignment: ``cnt := cnt + 1 on activation`` (``order`` is the internal variable,
+      ``assign`` the value, ``when``/``condition`` as for stored actions).
     """
 
     kind: ActionKind
@@ -145,8 +202,13 @@ class Action:
     value: bool = True
     when: StoredWhen | None = None
     loc: Location | None = field(default=None, compare=False)
+    assign: Sum | None = None
 
     def text(self) -> str:
+        if self.kind == ASSIGN:
+            assert self.assign is not None
+            moment = self.condition.text() if self.when == ON_EVENT and self.condition is not None else self.when
+            return f"{self.order} := {self.assign.text()} on {moment}"
         if self.kind == CONTINUOUS:
             return self.order
         if self.kind == CONDITIONAL:
@@ -235,6 +297,7 @@ class Grafcet:
     outputs: tuple[str, ...]
     timers: tuple[Timer, ...] = ()
     path: str = "<grafcet>"
+    internals: tuple[Internal, ...] = ()
 
     @property
     def steps(self) -> tuple[Step, ...]:

@@ -36,11 +36,14 @@ from typing import Sequence
 from synth.errors import close_names, location_in
 from synth.grafcet.language import (
     TIMER_RE,
+    ASSIGN,
     CONDITIONAL,
     ON_EVENT,
     STORED,
     Action,
     Grafcet,
+    Internal,
+    Sum,
     PartialGrafcet,
     Step,
     Timer,
@@ -50,8 +53,10 @@ from synth.grafcet.language import (
     step_of,
     step_variable,
 )
-from synth.logic.expr import Edge, Expr, Var, names
-from synth.grafcet.language_reader import GrafcetDecl, StepDecl, StepRef, TransitionDecl, VectorDecl, grafcet_items
+from synth.logic.expr import Compare, Edge, Expr, Var, names
+from synth.grafcet.language_reader import (
+    GrafcetDecl, InternalDecl, StepDecl, StepRef, TransitionDecl, VectorDecl, grafcet_items,
+)
 from synth.syntax import Checker, VectorKind, read_source
 
 __all__ = ["GrafcetChecker", "parse_grafcet", "load_grafcet"]
@@ -68,6 +73,7 @@ class GrafcetChecker(Checker):
         self.plant_outputs = tuple(plant_outputs) if plant_outputs is not None else None
         self.steps: dict[str, tuple[StepDecl, str]] = {}
         self.timers: dict[str, Timer] = {}
+        self.internals: dict[str, Internal] = {}
 
     # ---- declarations
     def declared(self, decls: list[VectorDecl], kind: VectorKind, plant: tuple[str, ...] | None) -> tuple[str, ...] | None:
@@ -91,11 +97,38 @@ class GrafcetChecker(Checker):
         return tuple(names_) if any(d.kind == kind for d in decls) else None
 
     # ---- the whole file
-    def check(self, items: list[VectorDecl | GrafcetDecl]) -> Grafcet:
+    def declare_internals(self, decls: list[InternalDecl], taken: dict[str, str]) -> None:
+        """``internal`` declarations: unique names, not an input, output or step variable,
+        a non-empty range holding the initial value."""
+        for d in decls:
+            if d.name in self.internals:
+                self.fail(f"internal variable '{d.name}' is declared twice", d.loc,
+                          notes=(f"first declared at {self.internals[d.name].loc}",))
+                continue
+            if d.name in taken:
+                self.fail(f"internal variable '{d.name}' has the name of {taken[d.name]}", d.loc,
+                          notes=("internal variables, inputs, outputs and step variables have distinct names",))
+                continue
+            if d.low > d.high:
+                self.fail(f"the range {d.low}..{d.high} of '{d.name}' is empty", d.range_loc,
+                          notes=("write LOW..HIGH with LOW <= HIGH, e.g. 0..3",))
+                continue
+            initial = d.low if d.initial is None else d.initial
+            if not d.low <= initial <= d.high:
+                self.fail(f"the initial value {initial} of '{d.name}' is outside "
+                          + ("0..1 (a Boolean)" if d.boolean else f"its range {d.low}..{d.high}"),
+                          d.initial_loc or d.loc)
+                continue
+            self.internals[d.name] = Internal(d.name, d.low, d.high, initial, d.boolean, d.loc)
+
+    def check(self, items: list[VectorDecl | InternalDecl | GrafcetDecl]) -> Grafcet:
         decls = [i for i in items if isinstance(i, VectorDecl)]
         grafs = [i for i in items if isinstance(i, GrafcetDecl)]
         inputs = self.declared(decls, VectorKind.INPUTS, self.plant_inputs)
         outputs = self.declared(decls, VectorKind.OUTPUTS, self.plant_outputs)
+        taken = {n: "an input" for n in inputs or ()} | {n: "an output" for n in outputs or ()}
+        taken |= {step_variable(s.name): f"the variable of step {s.name}" for g in grafs for s in g.steps}
+        self.declare_internals([i for i in items if isinstance(i, InternalDecl)], taken)
         if inputs is not None and outputs is not None:
             for d in decls:
                 if d.kind is VectorKind.INPUTS:
@@ -138,7 +171,8 @@ class GrafcetChecker(Checker):
         if inputs is None:
             inputs = self.infer_inputs(grafs, step_vars)
         if outputs is None:
-            outputs = tuple(dict.fromkeys(a.order for g in grafs for s in g.steps for a in s.actions))
+            outputs = tuple(dict.fromkeys(a.order for g in grafs for s in g.steps for a in s.actions
+                                          if a.order not in self.internals))
         # transitions and expressions
         built: list[PartialGrafcet] = []
         for g in grafs:
@@ -164,9 +198,8 @@ class GrafcetChecker(Checker):
                 )
             steps: list[Step] = []
             for s in g.steps:
-                for a in s.actions:
-                    self.check_action(a, outputs, inputs)
-                steps.append(Step(s.name, g.name, s.initial, s.actions, s.loc))
+                actions = tuple(self.check_action(a, outputs, inputs) for a in s.actions)
+                steps.append(Step(s.name, g.name, s.initial, actions, s.loc))
             if not any(s.initial for s in g.steps) and not any(not t.sources for t in g.transitions):
                 self.fail(
                     f"partial grafcet {g.name} has no initial step",
@@ -178,7 +211,7 @@ class GrafcetChecker(Checker):
         self.check_stored_outputs(grafs)
         self.raise_errors()
         timers = tuple(sorted(self.timers.values(), key=lambda x: (step_key(x.step), x.seconds, x.id)))
-        return Grafcet(tuple(built), tuple(inputs), tuple(outputs), timers, self.file)
+        return Grafcet(tuple(built), tuple(inputs), tuple(outputs), timers, self.file, tuple(self.internals.values()))
 
     def infer_inputs(self, grafs: list[GrafcetDecl], step_vars: set[str]) -> tuple[str, ...]:
         found: list[str] = []
@@ -188,7 +221,7 @@ class GrafcetChecker(Checker):
             exprs.extend(a.condition for s in g.steps for a in s.actions if a.condition is not None)
         for e in exprs:
             for n in names(e):
-                if n.name in step_vars or TIMER_RE.match(n.name):
+                if n.name in step_vars or TIMER_RE.match(n.name) or isinstance(n, Compare) or n.name in self.internals:
                     continue
                 if isinstance(n, Var) and re.fullmatch(r"X[0-9]+", n.name):
                     continue  # X of a missing step: reported by check_expr
@@ -216,6 +249,9 @@ class GrafcetChecker(Checker):
     def check_expr(self, e: Expr, inputs: Sequence[str], role: str, allow_edges: bool) -> None:
         known = set(inputs)
         for n in names(e):
+            if isinstance(n, Compare) or n.name in self.internals:
+                self.check_internal_read(n)
+                continue
             m = TIMER_RE.match(n.name)
             if m is not None:
                 step = m.group(3)
@@ -264,7 +300,60 @@ class GrafcetChecker(Checker):
                 notes=(("known inputs: " + ", ".join(inputs)) if inputs else "no input is declared",),
             )
 
-    def check_action(self, a: Action, outputs: Sequence[str], inputs: Sequence[str]) -> None:
+    def check_internal_read(self, n: Var | Edge) -> None:
+        """A comparison of integer internal variables, or a Boolean internal variable's level."""
+        if isinstance(n, Compare):
+            for x in n.operands():
+                v = self.internals.get(x)
+                if v is None:
+                    self.fail(f"unknown internal variable '{x}' in the comparison {n.text()}", n.loc,
+                              suggestions=close_names(x, self.internals),
+                              notes=("declare it: internal " + x + " : 0..3",))
+                elif v.boolean:
+                    self.fail(f"'{x}' is a Boolean: read it as a level ({x} or !{x}), not in a comparison", n.loc)
+        elif isinstance(n, Edge):
+            self.fail(f"edges of internal variables are not supported: {n.text()}", n.loc,
+                      notes=("edges are input events; read the level instead",))
+        elif not self.internals[n.name].boolean:
+            v = self.internals[n.name]
+            self.fail(f"'{n.name}' is an integer ({v.low}..{v.high}): compare it, e.g. {n.name} >= {min(v.high, v.low + 1)}",
+                      n.loc)
+
+    def check_assignment(self, a: Action) -> Action:
+        """``x := …``: ``x`` internal; an integer takes a sum of integer internals and constants,
+        a Boolean 0, 1 or another Boolean internal; ``set``/``reset`` of a Boolean internal is
+        ``x := 1``/``x := 0``."""
+        v = self.internals[a.order]
+        if a.kind == STORED:
+            return Action(ASSIGN, a.order, a.condition, True, a.when, a.loc, Sum(((1, 1 if a.value else 0),), a.loc))
+        if a.kind != ASSIGN:
+            self.fail(f"internal variable '{a.order}' is changed by assignments only",
+                      a.loc, notes=(f"write {a.order} := … on activation (or on deactivation, on ↑x)",))
+            return a
+        assert a.assign is not None
+        for x in a.assign.names():
+            w = self.internals.get(x)
+            if w is None:
+                self.fail(f"unknown internal variable '{x}' in the assignment to {a.order}", a.assign.loc,
+                          suggestions=close_names(x, self.internals),
+                          notes=("an assignment reads internal variables and integer constants",))
+            elif w.boolean != v.boolean:
+                self.fail(f"'{x}' is {'a Boolean' if w.boolean else 'an integer'} and '{a.order}' "
+                          f"{'a Boolean' if v.boolean else 'an integer'}", a.assign.loc)
+        terms = a.assign.terms
+        if v.boolean and not (len(terms) == 1 and terms[0][0] > 0 and terms[0][1] in (0, 1) or isinstance(terms[0][1], str)):
+            self.fail(f"'{a.order}' is a Boolean: assign 0, 1 or another Boolean internal variable", a.assign.loc)
+        return a
+
+    def check_action(self, a: Action, outputs: Sequence[str], inputs: Sequence[str]) -> Action:
+        if a.kind in (STORED, ASSIGN) and a.when == ON_EVENT:
+            self.check_event(a, inputs)
+        if a.order in self.internals:
+            return self.check_assignment(a)
+        if a.kind == ASSIGN:
+            self.fail(f"unknown internal variable '{a.order}'", a.loc, suggestions=close_names(a.order, self.internals),
+                      notes=(f"declare it before the grafcets: internal {a.order} : 0..3 = 0",))
+            return a
         if a.order not in outputs:
             source = "of the plant" if self.plant_outputs is not None else "declared"
             self.fail(
@@ -275,7 +364,10 @@ class GrafcetChecker(Checker):
             )
         if a.kind == CONDITIONAL and a.condition is not None:
             self.check_expr(a.condition, inputs, "condition of an action", allow_edges=False)
-        if a.kind == STORED and a.when == ON_EVENT and a.condition is not None:
+        return a
+
+    def check_event(self, a: Action, inputs: Sequence[str]) -> None:
+        if a.condition is not None:
             self.check_expr(a.condition, inputs, "event of a stored action", allow_edges=True)
             if not any(isinstance(n, Edge) for n in names(a.condition)):
                 self.fail(
@@ -285,7 +377,8 @@ class GrafcetChecker(Checker):
                 )
 
     def check_stored_outputs(self, grafs: list[GrafcetDecl]) -> None:
-        stored = {a.order for g in grafs for s in g.steps for a in s.actions if a.kind == STORED}
+        stored = {a.order for g in grafs for s in g.steps for a in s.actions
+                  if a.kind == STORED and a.order not in self.internals}
         for g in grafs:
             for s in g.steps:
                 for a in s.actions:

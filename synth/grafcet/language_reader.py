@@ -20,14 +20,16 @@ from synth.grafcet.language import (
     ON_DEACTIVATION,
     ON_EVENT,
     STORED,
+    ASSIGN,
     Action,
     StoredWhen,
+    Sum,
     timer_id,
 )
-from synth.logic.expr import Const, Expr, Var
+from synth.logic.expr import Compare, Const, Expr, Var
 from synth.syntax import ExprTransformer, Token, VectorKind, parse_tree
 
-__all__ = ["VectorDecl", "StepRef", "StepDecl", "TransitionDecl", "GrafcetDecl", "grafcet_items"]
+__all__ = ["VectorDecl", "InternalDecl", "StepRef", "StepDecl", "TransitionDecl", "GrafcetDecl", "grafcet_items"]
 
 
 @dataclass(frozen=True)
@@ -36,6 +38,23 @@ class VectorDecl:
 
     kind: VectorKind
     names: tuple[tuple[str, Location], ...]
+
+
+@dataclass(frozen=True)
+class InternalDecl:
+    """``internal NAME [: bool | : LOW..HIGH] [= INITIAL]`` as written (checked later)."""
+
+    name: str
+    boolean: bool
+    low: int
+    high: int
+    initial: int | None
+    loc: Location
+    range_loc: Location
+    initial_loc: Location | None
+
+
+_CMP_SPELLING = {"!=": "<>", "≠": "<>", "≥": ">=", "≤": "<="}
 
 
 @dataclass(frozen=True)
@@ -109,6 +128,43 @@ class _ToModel(ExprTransformer):
     def outputs_decl(self, items: list) -> VectorDecl:
         return VectorDecl(VectorKind.OUTPUTS, tuple((str(t), self._loc(t)) for t in items))
 
+    def bool_type(self, items: list) -> tuple[bool, int, int, Location]:
+        return (True, 0, 1, self._loc(items[0]))
+
+    def range_type(self, items: list) -> tuple[bool, int, int, Location]:
+        low, high = items
+        loc = self._loc(low, width=high.end_pos - low.start_pos if high.end_pos is not None and low.start_pos is not None else None)
+        return (False, int(low), int(high), loc)
+
+    def internal_decl(self, items: list) -> InternalDecl:
+        name, vtype, initial = items
+        boolean, low, high, rloc = vtype if vtype is not None else (True, 0, 1, self._loc(name))
+        return InternalDecl(str(name), boolean, low, high, int(initial) if initial is not None else None,
+                            self._loc(name), rloc, self._loc(initial) if initial is not None else None)
+
+    def compare(self, items: list) -> Compare:
+        left, op, right = items
+        value: int | str = str(right) if right.type == "NAME" else int(right)
+        return Compare.of(str(left), _CMP_SPELLING.get(str(op), str(op)), value, self._loc(left))
+
+    def operand(self, items: list) -> tuple[int | str, Location]:
+        (tok,) = items
+        return (str(tok) if tok.type == "NAME" else int(tok), self._loc(tok))
+
+    def sum(self, items: list) -> Sum:
+        first, *rest = items
+        terms: list[tuple[int, int | str]] = [(1, first[0])]
+        for sign, (x, _) in zip(rest[::2], rest[1::2]):
+            terms.append((1 if str(sign) == "+" else -1, x))
+        if isinstance(terms[0][1], int) and terms[0][1] < 0:
+            terms[0] = (-1, -terms[0][1])
+        return Sum(tuple(terms), first[1])
+
+    def assign_action(self, items: list) -> Action:
+        tok, value, when = items
+        moment, cond = when if when is not None else (ON_ACTIVATION, None)
+        return Action(ASSIGN, str(tok), cond, True, moment, self._loc(tok), value)
+
     # steps and actions
     def step_id(self, items: list) -> StepRef:
         (tok,) = items
@@ -176,6 +232,6 @@ class _ToModel(ExprTransformer):
         return items
 
 
-def grafcet_items(source: str, file: str) -> list[VectorDecl | GrafcetDecl]:
+def grafcet_items(source: str, file: str) -> list[VectorDecl | InternalDecl | GrafcetDecl]:
     """The top-level items of a ``.g7`` text, in file order."""
     return parse_tree("grafcet", source, file, _ToModel(file, source))

@@ -41,98 +41,30 @@ Example
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Callable, Mapping, Sequence
+from typing import Mapping
 
 from synth.errors import InputError
 from synth.logic.events import Event
-from synth.logic.expr import And, Const, Edge, Expr, Not, Var, names
+from synth.logic.expr import Var, names
 from synth.grafcet.language import (
+    ASSIGN,
     CONDITIONAL,
     CONTINUOUS,
     ON_ACTIVATION,
     ON_DEACTIVATION,
     ON_EVENT,
     STORED,
+    Action,
     Grafcet,
+    StoredWhen,
     Transition,
     receptivity_inputs,
-    step_key,
     step_of,
     step_variable,
 )
+from synth.grafcet.situation import CompiledFn, Situation, State, assign, compile_expr, sorted_steps
 
 __all__ = ["Situation", "GrafcetMachine"]
-
-
-def _sorted_steps(steps: Sequence[str] | set[str] | frozenset[str]) -> tuple[str, ...]:
-    return tuple(sorted(steps, key=step_key))
-
-
-@dataclass(frozen=True, order=True)
-class Situation:
-    """A situation of the Grafcet: active steps, stored outputs set, elapsed timers.
-
-    >>> Situation(("1", "101"), ("M",), ("2s/X101",)).text()
-    '{X1, X101} stored{M} elapsed{2s/X101}'
-    """
-
-    steps: tuple[str, ...]
-    stored: tuple[str, ...] = ()
-    elapsed: tuple[str, ...] = ()
-
-    def text(self) -> str:
-        out = "{" + ", ".join(self.step_variables) + "}"
-        if self.stored:
-            out += " stored{" + ", ".join(self.stored) + "}"
-        if self.elapsed:
-            out += " elapsed{" + ", ".join(self.elapsed) + "}"
-        return out
-
-    @property
-    def step_variables(self) -> tuple[str, ...]:
-        return tuple(step_variable(s) for s in self.steps)
-
-
-# --------------------------------------------------------------------------- compiled expressions
-
-_Fn = Callable[[Mapping[str, bool], frozenset[str], frozenset[str], "Event | None"], bool]
-
-
-def _code(e: Expr, steps: set[str], timers: set[str]) -> str:
-    if isinstance(e, Var):
-        if e.name in timers:
-            return f"({e.name!r} in T)"
-        step = step_of(e.name, steps)
-        if step is not None:
-            return f"({step!r} in A)"
-        return f"I[{e.name!r}]"
-    if isinstance(e, Const):
-        return "True" if e.value else "False"
-    if isinstance(e, Edge):
-        return f"(E == {str(e.event)!r})"
-    if isinstance(e, Not):
-        return f"(not {_code(e.arg, steps, timers)})"
-    op = " and " if isinstance(e, And) else " or "
-    return "(" + op.join(_code(a, steps, timers) for a in e.args) + ")"
-
-
-def _compile(e: Expr, steps: set[str], timers: set[str]) -> _Fn:
-    """``e`` as a fast function of (inputs I, active steps A, elapsed timers T, event E)."""
-    fn: _Fn = eval(f"lambda I, A, T, E: {_code(e, steps, timers)}", {"__builtins__": {}})  # noqa: S307 - names are repr-quoted
-    return fn
-
-
-@dataclass
-class _State:
-    """The machine's mutable state during one evolution: active steps, stored actions, elapsed timers."""
-
-    active: set[str]
-    stored: set[str]
-    elapsed: set[str]
-
-    def key(self) -> tuple[frozenset[str], frozenset[str], frozenset[str]]:
-        return (frozenset(self.active), frozenset(self.stored), frozenset(self.elapsed))
 
 
 class GrafcetMachine:
@@ -162,7 +94,10 @@ class GrafcetMachine:
             self._same_instant[t.id] = tuple(
                 u.id for u in grafcet.timers if u.step == t.step and u.seconds == t.seconds
             )
-        self._rec = [_compile(t.receptivity, steps, timers) for t in self.transitions]
+        self.internals = {v.name: v for v in grafcet.internals}
+        self._initial_data = tuple((v.name, v.initial) for v in grafcet.internals)
+        ints = set(self.internals)
+        self._rec = [compile_expr(t.receptivity, steps, timers, ints) for t in self.transitions]
         self._enabled_cache: dict[frozenset[str], tuple[int, ...]] = {}
         self._rec_inputs = [frozenset(receptivity_inputs(t, self.inputs)) for t in self.transitions]
         self._rec_steps = [
@@ -172,16 +107,16 @@ class GrafcetMachine:
         ]
         self._index = {t: i for i, t in enumerate(self.transitions)}
         self._steps = {s.name: s for s in grafcet.steps}
-        self._cond: dict[tuple[str, int], _Fn] = {}
+        self._cond: dict[tuple[str, int], CompiledFn] = {}
         for s in grafcet.steps:
             for i, a in enumerate(s.actions):
                 if a.condition is not None:
-                    self._cond[(s.name, i)] = _compile(a.condition, steps, timers)
+                    self._cond[(s.name, i)] = compile_expr(a.condition, steps, timers, ints)
         self._event_inputs: dict[str, frozenset[str]] = {}
         for s in grafcet.steps:
             used: set[str] = set()
             for a in s.actions:
-                if a.kind == STORED and a.when == ON_EVENT and a.condition is not None:
+                if a.kind in (STORED, ASSIGN) and a.when == ON_EVENT and a.condition is not None:
                     used.update(n.name for n in names(a.condition))
             self._event_inputs[s.name] = frozenset(used)
 
@@ -189,7 +124,7 @@ class GrafcetMachine:
     def initial(self, inputs: Mapping[str, bool]) -> Situation:
         """The initial situation: initial steps active (their ``on activation`` stored
         actions run), then, if ``settle_initial``, search for stability on ``inputs``."""
-        st = _State(set(self.grafcet.initial_steps), set(), set())
+        st = State(set(self.grafcet.initial_steps), set(), set(), dict(self._initial_data))
         self._stored_phase(st, st.active, ON_ACTIVATION)
         if self.settle_initial:
             self._settle(st, inputs, None, rounds=[])
@@ -266,11 +201,12 @@ class GrafcetMachine:
         out = set(sit.stored)
         active = frozenset(sit.steps)
         elapsed = frozenset(sit.elapsed)
+        data = sit.values
         for s in sit.steps:
             for i, a in enumerate(self._steps[s].actions):
                 if a.kind == CONTINUOUS:
                     out.add(a.order)
-                elif a.kind == CONDITIONAL and self._cond[(s, i)](inputs, active, elapsed, None):
+                elif a.kind == CONDITIONAL and self._cond[(s, i)](inputs, active, elapsed, None, data):
                     out.add(a.order)
         return frozenset(out)
 
@@ -281,10 +217,10 @@ class GrafcetMachine:
 
     def fireable(self, sit: Situation, inputs: Mapping[str, bool]) -> list[Transition]:
         """Enabled transitions whose receptivity holds on the levels ``inputs`` (no edge)."""
-        active, elapsed = frozenset(sit.steps), frozenset(sit.elapsed)
+        active, elapsed, data = frozenset(sit.steps), frozenset(sit.elapsed), sit.values
         return [
             t for i, t in enumerate(self.transitions)
-            if all(s in active for s in t.sources) and self._rec[i](inputs, active, elapsed, None)
+            if all(s in active for s in t.sources) and self._rec[i](inputs, active, elapsed, None, data)
         ]
 
     def _elapsed(self, sit: Situation, after_time: bool) -> frozenset[str]:
@@ -313,7 +249,7 @@ class GrafcetMachine:
             after = dict(inputs)
             after[x] = not inputs[x]
             event = Event.edge(x, after[x])
-            if self._rec[i](after, active, elapsed, event):
+            if self._rec[i](after, active, elapsed, event, sit.values):
                 out.append(event)
         return tuple(out)
 
@@ -341,7 +277,7 @@ class GrafcetMachine:
                 continue
             for y in names:
                 after = {**inputs, **before, y: not before[y]}
-                if self._rec[i](after, active, elapsed, Event.edge(y, after[y])):
+                if self._rec[i](after, active, elapsed, Event.edge(y, after[y]), sit.values):
                     best = (len(changes) + 1, changes, Event.edge(y, after[y]))
                     break
         return ((), None) if best is None else (best[1], best[2])
@@ -371,43 +307,40 @@ class GrafcetMachine:
             self._enabled_cache[active] = hit
         return hit
 
-    def _state(self, sit: Situation) -> _State:
-        return _State(set(sit.steps), set(sit.stored), set(sit.elapsed))
+    def _state(self, sit: Situation) -> State:
+        return State(set(sit.steps), set(sit.stored), set(sit.elapsed), dict(sit.data))
 
-    def _situation(self, st: _State) -> Situation:
-        return Situation(_sorted_steps(st.active), tuple(sorted(st.stored)), tuple(sorted(st.elapsed)))
+    def _situation(self, st: State) -> Situation:
+        return Situation(sorted_steps(st.active), tuple(sorted(st.stored)), tuple(sorted(st.elapsed)),
+                         tuple(st.data.items()))
 
-    def _stored_phase(self, st: _State, steps: set[str], when: str) -> None:
-        """Stored actions of ``steps`` for ``when``: sets first, then resets (reset wins)."""
-        sets: set[str] = set()
-        resets: set[str] = set()
-        for s in _sorted_steps(steps):
-            for a in self._steps[s].actions:
-                if a.kind == STORED and a.when == when:
-                    (sets if a.value else resets).add(a.order)
-        st.stored |= sets
-        st.stored -= resets
+    def _apply(self, st: State, stored: list[Action], assignments: list[Action]) -> None:
+        """Stored actions (sets first, then resets: reset wins) and assignments (simultaneous)."""
+        st.stored |= {a.order for a in stored if a.value}
+        st.stored -= {a.order for a in stored if not a.value}
+        if assignments:
+            assign(st.data, assignments, self.internals, self._situation(st).text())
 
-    def _event_actions(self, st: _State, inputs: Mapping[str, bool], event: Event) -> None:
-        sets: set[str] = set()
-        resets: set[str] = set()
-        active, elapsed = frozenset(st.active), frozenset(st.elapsed)
-        for s in _sorted_steps(st.active):
-            for i, a in enumerate(self._steps[s].actions):
-                if a.kind == STORED and a.when == ON_EVENT and self._cond[(s, i)](inputs, active, elapsed, event):
-                    (sets if a.value else resets).add(a.order)
-        st.stored |= sets
-        st.stored -= resets
+    def _stored_phase(self, st: State, steps: set[str], when: StoredWhen) -> None:
+        """Stored actions and assignments of ``steps`` for ``when``."""
+        acts = [a for s in sorted_steps(steps) for a in self._steps[s].actions if a.when == when]
+        self._apply(st, [a for a in acts if a.kind == STORED], [a for a in acts if a.kind == ASSIGN])
+
+    def _event_actions(self, st: State, inputs: Mapping[str, bool], event: Event) -> None:
+        active, elapsed, data = frozenset(st.active), frozenset(st.elapsed), st.data
+        acts = [a for s in sorted_steps(st.active) for i, a in enumerate(self._steps[s].actions)
+                if a.when == ON_EVENT and self._cond[(s, i)](inputs, active, elapsed, event, data)]
+        self._apply(st, [a for a in acts if a.kind == STORED], [a for a in acts if a.kind == ASSIGN])
 
     def _settle(
         self,
-        st: _State,
+        st: State,
         inputs: Mapping[str, bool],
         event: Event | None,
         rounds: list[tuple[Transition, ...]],
     ) -> None:
         """Search for stability, in place. Edges (``event``) hold in the first round only."""
-        seen: dict[tuple[frozenset[str], frozenset[str], frozenset[str]], int] = {}
+        seen: dict[tuple[frozenset[str], frozenset[str], frozenset[str], tuple[tuple[str, int], ...]], int] = {}
         history: list[tuple[Transition, ...]] = []
         first = True
         while True:
@@ -419,7 +352,8 @@ class GrafcetMachine:
             active, elapsed = frozenset(st.active), frozenset(st.elapsed)
             ev = event if first else None
             rec = self._rec
-            fire = tuple(self.transitions[i] for i in self._enabled(active) if rec[i](inputs, active, elapsed, ev))
+            data = st.data
+            fire = tuple(self.transitions[i] for i in self._enabled(active) if rec[i](inputs, active, elapsed, ev, data))
             first = False
             if not fire:
                 return
@@ -436,7 +370,7 @@ class GrafcetMachine:
             self._stored_phase(st, entered, ON_ACTIVATION)
 
     def _never_stable(self, cycle: list[tuple[Transition, ...]], inputs: Mapping[str, bool]) -> None:
-        steps = _sorted_steps({s for fire in cycle for t in fire for s in (*t.sources, *t.targets)})
+        steps = sorted_steps({s for fire in cycle for t in fire for s in (*t.sources, *t.targets)})
         trans = [t for fire in cycle for t in fire]
         first = trans[0]
         values = ", ".join(f"{n}={int(bool(inputs[n]))}" for n in self.read_inputs)

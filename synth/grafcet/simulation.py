@@ -17,8 +17,9 @@ from dataclasses import dataclass
 from typing import Iterator, Mapping, Sequence
 
 from synth.errors import InputError, Location, close_names
-from synth.grafcet.language import Grafcet
+from synth.grafcet.language import Grafcet, Transition
 from synth.grafcet.machine import GrafcetMachine, Situation
+from synth.grafcet.situation import OutOfRange, with_trace
 from synth.logic.events import FALL_MARKS, RISE_MARKS, Event, EventKind
 
 __all__ = ["SimulationStep", "comma_items", "parse_initial", "parse_events", "simulate", "inputs_text"]
@@ -115,29 +116,42 @@ def simulate(grafcet: Grafcet, inputs: Mapping[str, bool], events: Sequence[tupl
     def ordered(sit: Situation) -> tuple[str, ...]:
         return tuple(sorted(machine.orders(sit, inputs), key=grafcet.outputs.index))
 
-    sit = machine.initial(inputs)
+    try:
+        sit = machine.initial(inputs)
+    except OutOfRange as err:
+        raise with_trace(err, ()) from None
     rows = [SimulationStep("initial", sit, ordered(sit), ())]
     for event, loc in events:
-        if event.kind is EventKind.TIMER:
-            if machine.timer_event(event) not in machine.timers(sit):
-                step = next(t.step for t in grafcet.timers if t.id == event)
-                if event in sit.elapsed:
-                    why = "it has already elapsed"
-                elif step not in sit.steps:
-                    why = f"step {step} is not active"
-                else:
-                    why = f"a shorter timer of step {step} must elapse first ({', '.join(machine.timers(sit))})"
-                raise InputError(f"timer {event} cannot elapse now: {why}", loc, notes=(f"situation: {sit.text()}",))
-            sit, rounds = machine.fire_timer_with_trace(sit, event, inputs)
-        else:
-            if inputs[event.name] == event.rising:
-                raise InputError(
-                    f"{event} cannot happen: {event.name} is already {int(event.rising)}", loc,
-                    notes=("inputs at 1 now: " + inputs_text(inputs, grafcet.inputs),),
-                )
-            after = dict(inputs)
-            after[event.name] = event.rising
-            sit, rounds = machine.react_with_trace(sit, inputs, after)
-            inputs = after
+        try:
+            sit, rounds, inputs = _one_event(machine, grafcet, sit, inputs, event, loc)
+        except OutOfRange as err:
+            raise with_trace(err, [r.event for r in rows[1:]] + [str(event)]) from None
         rows.append(SimulationStep(str(event), sit, ordered(sit), tuple(tuple(t.name for t in r) for r in rounds)))
     return rows
+
+
+def _one_event(machine: GrafcetMachine, grafcet: Grafcet, sit: Situation, inputs: Mapping[str, bool],
+               event: Event, loc: Location) -> tuple[Situation, tuple[tuple[Transition, ...], ...], Mapping[str, bool]]:
+    """The situation after ``event``, the rounds fired, the inputs after it."""
+    if event.kind is EventKind.TIMER:
+        if machine.timer_event(event) not in machine.timers(sit):
+            step = next(t.step for t in grafcet.timers if t.id == event)
+            if event in sit.elapsed:
+                why = "it has already elapsed"
+            elif step not in sit.steps:
+                why = f"step {step} is not active"
+            else:
+                why = f"a shorter timer of step {step} must elapse first ({', '.join(machine.timers(sit))})"
+            raise InputError(f"timer {event} cannot elapse now: {why}", loc, notes=(f"situation: {sit.text()}",))
+        sit, rounds = machine.fire_timer_with_trace(sit, event, inputs)
+    else:
+        if inputs[event.name] == event.rising:
+            raise InputError(
+                f"{event} cannot happen: {event.name} is already {int(event.rising)}", loc,
+                notes=("inputs at 1 now: " + inputs_text(inputs, grafcet.inputs),),
+            )
+        after = dict(inputs)
+        after[event.name] = event.rising
+        sit, rounds = machine.react_with_trace(sit, inputs, after)
+        inputs = after
+    return sit, rounds, inputs

@@ -23,7 +23,7 @@ import operator
 from dataclasses import dataclass, field
 from functools import reduce
 from itertools import product
-from typing import Any, Callable, Iterator, Union
+from typing import Any, Callable, Iterator, Mapping, Union
 
 
 from synth.errors import Location
@@ -33,6 +33,8 @@ __all__ = [
     "Expr",
     "Var",
     "Const",
+    "Compare",
+    "CMP_OPS",
     "Not",
     "And",
     "Or",
@@ -73,6 +75,44 @@ class Var:
         return self.name
 
 
+CMP_OPS: dict[str, Callable[[int, int], bool]] = {
+    ">=": operator.ge, "<=": operator.le, "<>": operator.ne, "=": operator.eq, "<": operator.lt, ">": operator.gt,
+}
+"""The comparison operators of :class:`Compare`, by canonical spelling (IEC 61131-3's)."""
+
+
+@dataclass(frozen=True)
+class Compare(Var):
+    """``cnt >= 3``: a comparison of an integer variable with a constant or another one.
+
+    To every walker that does not know comparisons it is an atomic proposition named by its
+    text (``name``), like a step variable: a Boolean function of the state that holds it.
+
+    >>> c = Compare.of("cnt", ">=", 3)
+    >>> c.name, c.text(), c.holds({"cnt": 3}), c.holds({"cnt": 2})
+    ('cnt>=3', 'cnt >= 3', True, False)
+    """
+
+    left: str = ""
+    op: str = "="
+    right: int | str = 0
+
+    @staticmethod
+    def of(left: str, op: str, right: int | str, loc: Location | None = None) -> "Compare":
+        return Compare(f"{left}{op}{right}", loc, left, op, right)
+
+    def text(self) -> str:
+        return f"{self.left} {self.op} {self.right}"
+
+    def operands(self) -> tuple[str, ...]:
+        """The variable names compared (one or two)."""
+        return (self.left,) + ((self.right,) if isinstance(self.right, str) else ())
+
+    def holds(self, values: "Mapping[str, int]") -> bool:
+        right = values[self.right] if isinstance(self.right, str) else self.right
+        return CMP_OPS[self.op](values[self.left], right)
+
+
 @dataclass(frozen=True)
 class Const:
     """The constant ``1`` (True) or ``0`` (False)."""
@@ -109,7 +149,8 @@ class Not:
 
     def text(self) -> str:
         inner = self.arg.text()
-        return "!" + (inner if isinstance(self.arg, (Var, Const, Edge, Not)) else f"({inner})")
+        atomic = isinstance(self.arg, (Var, Const, Edge, Not)) and not isinstance(self.arg, Compare)
+        return "!" + (inner if atomic else f"({inner})")
 
 
 @dataclass(frozen=True)
@@ -227,6 +268,9 @@ def renamed(e: Expr, rename: Callable[[str], str]) -> Expr:
     >>> renamed(And((Var("A"), Edge(True, "b"))), str.upper).text()
     'A & ↑B'
     """
+    if isinstance(e, Compare):
+        right = rename(e.right) if isinstance(e.right, str) else e.right
+        return Compare.of(rename(e.left), e.op, right, e.loc)
     if isinstance(e, Var):
         return Var(rename(e.name), e.loc)
     if isinstance(e, Edge):

@@ -36,6 +36,7 @@ from typing import Callable, Sequence
 from synth.errors import LimitExceeded
 from synth.grafcet.language import Transition
 from synth.grafcet.machine import GrafcetMachine, Situation
+from synth.grafcet.situation import OutOfRange, with_trace
 from synth.logic.events import Event
 from synth.plant.composition import LocalTransition, Plant
 from synth.plant.rules import Constraint
@@ -231,11 +232,9 @@ def synchronous_product(
     queue: deque[int] = deque()
     if not oracle.kept(p.initial):
         return Sync(p, oracle, machine)
-    sit0 = machine.initial(inputs(p.initial))
-    initial = tuple(enter(sit0, p.initial))
-    last = time.monotonic()
-    while queue:
-        i = queue.popleft()
+    happening: list[Event] = []  # the event being explored, for an assignment out of range
+
+    def expand(i: int) -> None:
         node = nodes[i]
         cur = node.plant
         before = inputs(cur)
@@ -248,16 +247,47 @@ def synchronous_product(
             if not oracle.kept(n):  # cannot happen from a SUP state; kept for safety
                 continue
             after = inputs(n)
+            happening[:] = [t.event]
             sit, rounds = machine.react_with_trace(node.situation, before, after)
             note_conflicts(i, t.event, rounds)
             for j in enter(sit, n):
                 edges.append(Edge(i, t.event, j))
         for timer in machine.timers(node.situation):
+            happening[:] = [timer]
             sit, rounds = machine.fire_timer_with_trace(node.situation, timer, before)
             note_conflicts(i, timer, rounds)
             for j in enter(sit, cur):
                 edges.append(Edge(i, timer, j))
-        if progress is not None and time.monotonic() - last > 0.5:
-            progress(len(nodes), len(queue))
-            last = time.monotonic()
+
+    try:
+        sit0 = machine.initial(inputs(p.initial))
+    except OutOfRange as err:
+        raise with_trace(err, ()) from None
+    initial = tuple(enter(sit0, p.initial))
+    last = time.monotonic()
+    i = 0
+    try:
+        while queue:
+            i = queue.popleft()
+            expand(i)
+            if progress is not None and time.monotonic() - last > 0.5:
+                progress(len(nodes), len(queue))
+                last = time.monotonic()
+    except OutOfRange as err:
+        raise with_trace(err, [str(e) for e in path_events(edges, initial, i) + happening]) from None
     return Sync(p, oracle, machine, tuple(nodes), tuple(edges), initial, tuple(conflicts), len(sync_seen))
+
+
+def path_events(edges: Sequence[Edge], initial: Sequence[int], target: int) -> list[Event]:
+    """The events of a shortest path from an initial node to ``target``, on the edges of a
+    breadth-first exploration (the first edge into a node comes from a node found earlier)."""
+    first: dict[int, Edge] = {}
+    for e in edges:
+        if e.target not in first and e.target not in initial:
+            first[e.target] = e
+    out: list[Event] = []
+    while target not in initial and target in first:
+        e = first[target]
+        out.append(e.event)
+        target = e.source
+    return out[::-1]
