@@ -36,6 +36,7 @@ __all__ = [
     "InputError",
     "InputErrors",
     "ModelError",
+    "ModelFailure",
     "LimitExceeded",
     "close_names",
     "location_in",
@@ -112,6 +113,11 @@ class InputError(SynthError):
 
     def __str__(self) -> str:
         return self.render()
+
+
+class ModelFailure(InputError):
+    """A well-formed input whose model fails in a way located in it (an assignment that leaves
+    its variable's range): reported like an input error, with exit code 1, a failing model."""
 
 
 class InputErrors(SynthError):

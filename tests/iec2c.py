@@ -46,6 +46,8 @@ int main(void) {
     BOOL *inputs[] = {%(inputs)s};
     BOOL *watched[] = {%(watched)s};
     int n_watched = %(n_watched)d;
+    INT *numbers[] = {%(numbers)s};
+    int n_numbers = %(n_numbers)d;
     while (fgets(line, sizeof line, stdin)) {
         if (line[0] == 'c') {
             char *p = line + 1;
@@ -54,6 +56,7 @@ int main(void) {
             while (sscanf(p, "%%ld %%ld%%n", &i, &v, &used) == 2) { *inputs[i] = (BOOL)v; p += used; }
             %(type)s_body__(&inst);
             for (int k = 0; k < n_watched; k++) putchar(*watched[k] ? '1' : '0');
+            for (int k = 0; k < n_numbers; k++) printf(" %%d", (int)*numbers[k]);
             putchar('\n');
             fflush(stdout);
         } else if (line[0] == 'a') {
@@ -104,6 +107,9 @@ class CompiledProgram:
         main = next(p for p in program.pous if (p.name == pou if pou else p.kind is PouKind.PROGRAM))
         inputs = [d.name for s in main.sections if s.kind is SectionKind.INPUT for d in s.declarations]
         watched = [d.name for s in main.sections for d in s.declarations if d.type == "BOOL"]
+        numbers = [d.name for s in main.sections for d in s.declarations
+                   if d.type == "INT" and s.kind is not SectionKind.CONSTANT]
+        self.number_index = {n.upper(): i for i, n in enumerate(numbers)}
         self.input_index = {n.upper(): i for i, n in enumerate(inputs)}
         self.watched_index = {n.upper(): i for i, n in enumerate(watched)}
         c_type = main.name.upper()
@@ -112,6 +118,8 @@ class CompiledProgram:
             "inputs": ", ".join(f"&inst.{n.upper()}.value" for n in inputs) or "0",
             "watched": ", ".join(f"&inst.{n.upper()}.value" for n in watched),
             "n_watched": len(watched),
+            "numbers": ", ".join(f"&inst.{n.upper()}.value" for n in numbers) or "0",
+            "n_numbers": len(numbers),
         }, encoding="utf-8")
         cc = subprocess.run(["gcc", "-O1", "-w", "-I", str(found[1] / "C"), "-I", str(folder),
                              str(folder / "harness.c"), "-o", str(folder / "harness")],
@@ -135,7 +143,10 @@ class CompiledProgram:
         self.cycles += 1
 
     def value(self, name: str) -> bool:
-        return self.last[self.watched_index[name.upper()]] == "1"
+        return self.last.split(" ")[0][self.watched_index[name.upper()]] == "1"
+
+    def number(self, name: str) -> int:
+        return int(self.last.split(" ")[1 + self.number_index[name.upper()]])
 
     def __getitem__(self, name: str) -> bool:
         return self.value(name)

@@ -59,10 +59,13 @@ def main(argv: Sequence[str] | None = None) -> int:
         return EXIT_INPUT
     args = parser.parse_args(argv)
     handler: Callable[[argparse.Namespace], int] = args.handler
-    from synth.errors import InputError, InputErrors, LimitExceeded, ModelError, SynthError
+    from synth.errors import InputError, InputErrors, LimitExceeded, ModelError, ModelFailure, SynthError
 
     try:
         return handler(args)
+    except ModelFailure as err:  # located, but a verdict: the model fails
+        print(err.render(), file=sys.stderr)
+        return 1
     except (InputError, InputErrors) as err:
         print(err.render(), file=sys.stderr)
         return EXIT_INPUT

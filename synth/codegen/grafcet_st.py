@@ -38,7 +38,7 @@ Example
 
 from __future__ import annotations
 
-from typing import Sequence
+from typing import Callable, Sequence
 
 from synth.codegen.program import (
     FilterCall,
@@ -62,19 +62,24 @@ from synth.codegen.st import (
     st_expr,
     timer_literal,
 )
+from synth.codegen.st_internals import assignment_phase, compare_text, declarations as internal_declarations
 from synth.errors import InputError, Location
 from synth.version import version as synth_version
 from synth.grafcet.language import (
+    ASSIGN,
     CONDITIONAL,
     CONTINUOUS,
     ON_ACTIVATION,
     ON_DEACTIVATION,
     ON_EVENT,
     STORED,
+    Action,
     Grafcet,
     Step,
+    StoredWhen,
+    step_variable,
 )
-from synth.logic.expr import Edge, Expr, Var, names
+from synth.logic.expr import Compare, Edge, Expr, Var, names
 
 __all__ = ["DEFAULT_MAX_ROUNDS", "generate_program", "grafcet_program"]
 
@@ -105,7 +110,7 @@ class _Writer:
                              key=g.inputs.index)
         self.falling = sorted({n.name for x in self.g.expressions() for n in names(x) if isinstance(n, Edge) and not n.rising},
                               key=g.inputs.index)
-        self.event_actions = any(a.kind == STORED and a.when == ON_EVENT for s in self.steps for a in s.actions)
+        self.event_actions = any(a.kind in (STORED, ASSIGN) and a.when == ON_EVENT for s in self.steps for a in s.actions)
         # previous values: every input when an event action needs "some input changed"
         self.prev = list(g.inputs) if self.event_actions else [i for i in g.inputs if i in used_edges]
         self.stored = [o for o in g.outputs
@@ -117,8 +122,8 @@ class _Writer:
             self.extra_inputs = [n for n in filt.inputs if n not in g.inputs
                                  and not (n.startswith("R_") and n[2:] in g.outputs + filt.outputs)]
             self.outputs += [o for o in filt.outputs if o not in g.outputs]
-        self.needs_flags = bool(g.timers) or any(
-            a.kind == STORED and a.when in (ON_ACTIVATION, ON_DEACTIVATION) for s in self.steps for a in s.actions)
+        self.needs_flags = bool(g.timers) or any(a.kind in (STORED, ASSIGN) and a.when in (ON_ACTIVATION, ON_DEACTIVATION)
+                                                 for s in self.steps for a in s.actions)
         self.lines: list[str] = []
         self.alias: dict[str, str] = {}  # user name -> ST name, for case clashes only
 
@@ -130,6 +135,8 @@ class _Writer:
     def ref(self, e: Expr) -> str:
         if isinstance(e, Edge):
             return ("_RE_" if e.rising else "_FE_") + self.st(e.name)
+        if isinstance(e, Compare):
+            return compare_text(e, self.st)
         assert isinstance(e, Var)
         if e.name in self.timer_index:
             return f"_TE{self.timer_index[e.name]}"
@@ -143,10 +150,13 @@ class _Writer:
             user.setdefault(n, first_location(g, n))
         for s in self.steps:
             user.setdefault(s.variable, s.loc)
+        for v in g.internals:
+            user.setdefault(v.name, v.loc)
         internal = {"_Fire", "_Leave", "_Enter", "_Fired", "_Rounds", "Unstable", "_FirstCycle", "_InputEvent",
                     "_MAX_ROUNDS", self.name}
         internal |= {f"_Prev_{i}" for i in self.prev} | {f"_RE_{i}" for i in self.rising}
         internal |= {f"_FE_{i}" for i in self.falling} | {f"_Mem_{o}" for o in self.stored}
+        internal |= {f"_Next_{v.name}" for v in g.internals}
         internal |= {f"_Tmr{k}" for k in self.timer_index.values()} | {f"_TE{k}" for k in self.timer_index.values()}
         if self.filt is not None:
             internal |= {self.filt.fb_type} | {f"_Order_{o}" for o in g.outputs}
@@ -182,6 +192,7 @@ class _Writer:
         outputs.append(D("Unstable", comment="a transient evolution did not stabilise within _MAX_ROUNDS rounds; latched"))
         local = [D(self.st(s.variable), init="TRUE" if s.initial else None, comment=f"step {s.name} of {s.grafcet}")
                  for s in self.steps]
+        local += internal_declarations(g, self.st)
         for t in g.timers:
             k = self.timer_index[t.id]
             local += [D(f"_Tmr{k}", "TON", comment=t.id), D(f"_TE{k}", comment=f"{t.id} has elapsed")]
@@ -227,6 +238,19 @@ class _Writer:
                         (sets if a.value else resets).append(f"{flags}[{self.step_index[s.name]}]")
             self.stored_update(o, list(dict.fromkeys(sets)), list(dict.fromkeys(resets)), indent)
 
+    def assignments(self, condition: Callable[[Action, str], str | None], indent: int) -> None:
+        for line in assignment_phase(self.g, condition, self.st):
+            self.emit(line, indent)
+
+    def flagged(self, when: StoredWhen, flags: str) -> Callable[[Action, str], str | None]:
+        """The condition of an assignment ``on when`` in a round: its step is in ``flags``."""
+        return lambda a, s: f"{flags}[{self.step_index[s]}]" if a.when == when else None
+
+    def event_condition(self, a: Action, step: str) -> str | None:
+        if a.when != ON_EVENT or a.condition is None:
+            return None
+        return f"{self.st(step_variable(step))} AND {st_expr(a.condition, self.ref, 2)}"
+
     def body(self) -> None:
         g = self.g
         e = self.emit
@@ -240,6 +264,7 @@ class _Writer:
             if sets:
                 value = any(a.value for a in sets) and not any(not a.value for a in sets)
                 e(f"_Mem_{self.st(o)} := {'TRUE' if value else 'FALSE'};", 1)
+        self.assignments(lambda a, s: "TRUE" if a.when == ON_ACTIVATION and self.g.step(s).initial else None, 1)
         for i in self.prev:
             e(f"_Prev_{self.st(i)} := {self.st(i)}; (* no edge in the first cycle *)", 1)
         e("_FirstCycle := FALSE;", 1)
@@ -266,6 +291,7 @@ class _Writer:
                             cond = f"{self.st(s.variable)} AND {st_expr(a.condition, self.ref, 2)}"
                             (event_sets if a.value else event_resets).append(cond)
                 self.stored_update(o, event_sets, event_resets, 1)
+            self.assignments(self.event_condition, 1)
             e("END_IF;")
         e()
         e("(* 2. evolve to stability: rounds of simultaneous firing until no transition is fireable *)")
@@ -288,9 +314,9 @@ class _Writer:
         # _Leave/_Enter only for the steps whose timers or stored actions need them
         timed = {t.step for t in g.timers}
         on_leave = {s.name for s in self.steps if s.name in timed
-                    or any(a.kind == STORED and a.when == ON_DEACTIVATION for a in s.actions)}
+                    or any(a.kind in (STORED, ASSIGN) and a.when == ON_DEACTIVATION for a in s.actions)}
         on_enter = {s.name for s in self.steps
-                    if any(a.kind == STORED and a.when == ON_ACTIVATION for a in s.actions)}
+                    if any(a.kind in (STORED, ASSIGN) and a.when == ON_ACTIVATION for a in s.actions)}
         for s in self.steps:
             k = self.step_index[s.name]
             deact = [f"_Fire[{i}]" for i, t in enumerate(g.transitions, 1) if s.name in t.sources]
@@ -320,6 +346,10 @@ class _Writer:
             e("(* stored actions: on deactivation, then on activation; reset wins *)", 3)
             self.phase(ON_DEACTIVATION, "_Leave", 3)
             self.phase(ON_ACTIVATION, "_Enter", 3)
+        if g.internals:
+            e("(* assignments: on deactivation, then on activation; each phase reads the values before it *)", 3)
+            for when, flags in ((ON_DEACTIVATION, "_Leave"), (ON_ACTIVATION, "_Enter")):
+                self.assignments(self.flagged(when, flags), 3)
         e("END_IF;", 2)
         e("END_IF;", 1)
         if self.rising or self.falling:

@@ -56,7 +56,9 @@ from synth.codegen.program import Configuration, case_aliases, check_variable_na
 from synth.codegen.st import Pou, PouKind, st_expr, timer_literal
 from synth.codegen.twincat import object_id
 from synth.errors import InputError
+from synth.codegen.st_internals import compare_text, declarations as internal_declarations, sum_text
 from synth.grafcet.language import (
+    ASSIGN,
     CONDITIONAL,
     CONTINUOUS,
     ON_ACTIVATION,
@@ -66,7 +68,7 @@ from synth.grafcet.language import (
     Grafcet,
     Timer,
 )
-from synth.logic.expr import Edge, Expr, Var, names as expr_names
+from synth.logic.expr import Compare, Edge, Expr, Var, names as expr_names
 from synth.version import version as synth_version
 
 __all__ = ["st_project_xml", "sfc_project_xml"]
@@ -113,7 +115,8 @@ class _Names:
     def __init__(self, g: Grafcet) -> None:
         self.steps = {s.name for s in g.steps}
         self.timers = {t.id: t for t in g.timers}
-        self.alias = case_aliases([*g.inputs, *g.outputs], [sfc_step_name(s.name) for s in g.steps])
+        self.internals = {v.name: v for v in g.internals}
+        self.alias = case_aliases([*g.inputs, *g.outputs, *self.internals], [sfc_step_name(s.name) for s in g.steps])
 
     def __call__(self, n: str) -> str:
         return self.alias.get(n, n)
@@ -127,6 +130,8 @@ def _sfc_expr(e: Expr, names: _Names) -> str:
     def ref(x: Expr) -> str:
         if isinstance(x, Edge):
             return ("_RE_" if x.rising else "_FE_") + names(x.name)
+        if isinstance(x, Compare):
+            return compare_text(x, names)
         assert isinstance(x, Var)
         if x.name in timers:
             t = timers[x.name]
@@ -168,6 +173,8 @@ def sfc_project_xml(g: Grafcet, *, name: str | None = None, version: str | None 
     """The Grafcet ``g`` as one PLCopen SFC ``PROGRAM`` (see the module doc for the mapping)."""
     for n in (*g.inputs, *g.outputs):
         check_variable_name(n, first_location(g, n))
+    for v in g.internals:
+        check_variable_name(v.name, v.loc)
     for s in g.steps:
         check_variable_name(sfc_step_name(s.name), s.loc)
     for t in g.transitions:
@@ -274,6 +281,13 @@ def sfc_project_xml(g: Grafcet, *, name: str | None = None, version: str | None 
             vl.append(element("variable", {"name": names(n)}, element("type", None, element("BOOL"))))
         iface.append(vl)
     edges = sorted({(n.rising, n.name) for x in g.expressions() for n in expr_names(x) if isinstance(n, Edge)}, key=lambda e: (e[1], not e[0]))
+    if g.internals:
+        vl = element("localVars")
+        for d in internal_declarations(g, names)[:len(g.internals)]:
+            vl.append(element("variable", {"name": d.name}, element("type", None, element(d.type)),
+                              element("initialValue", None, element("simpleValue", {"value": str(d.init)})),
+                              element("documentation", None, xhtml(d.comment, cdata=False))))
+        iface.append(vl)
     if edges:
         vl = element("localVars")
         for rising, n in edges:
@@ -305,6 +319,11 @@ def _actions(a: Action, ids: _Ids, k: int, names: _Names) -> list[Any]:
         return element("inline", None, element("ST", None, xhtml(text)))
 
     value = "TRUE" if a.value else "FALSE"
+    if a.kind == ASSIGN:
+        assert a.assign is not None
+        value = sum_text(names.internals[a.order], a.assign, names)
+    if a.kind == ASSIGN and a.when == ON_ACTIVATION:
+        return [new(Qualifier.P1, st(f"{order} := {value};"))]
     if a.kind == CONTINUOUS:
         return [new(Qualifier.N, element("reference", {"name": order}))]
     if a.kind == CONDITIONAL:

@@ -19,7 +19,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Callable, Mapping, Sequence
 
-from synth.errors import InputError
+from synth.errors import ModelFailure
 from synth.grafcet.language import Action, Internal, step_key, step_of, step_variable
 from synth.logic.events import Event
 from synth.logic.expr import And, Compare, Const, Edge, Expr, Not, Var
@@ -114,8 +114,8 @@ def compile_expr(e: Expr, steps: set[str], timers: set[str], internals: set[str]
     return fn
 
 
-class OutOfRange(InputError):
-    """An assignment gives an internal variable a value outside its declared range."""
+class OutOfRange(ModelFailure):
+    """An assignment gives an internal variable a value outside its declared range (exit 1)."""
 
 
 def assign(data: dict[str, int], actions: Sequence[Action], internals: Mapping[str, Internal], where: str) -> None:
