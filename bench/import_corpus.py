@@ -3,7 +3,7 @@ example projects) import, what is refused and for which construct, and no traceb
 
     python3 bench/import_corpus.py DIR [--json FILE]
 
-For each file: ``imported`` (every SFC POU read, the ``.g7`` parsed back), ``no SFC`` (a
+For each file (a first-level folder of DIR is counted as one repository): ``imported`` (every SFC POU read, the ``.g7`` parsed back), ``no SFC`` (a
 project without an SFC POU: nothing to import), ``refused`` with the first error (a located
 message naming the construct), or ``TRACEBACK``. The files are third-party: fetch them
 locally (never into this repository) and give their folder.
@@ -47,6 +47,12 @@ def main() -> int:
     rows = [one(p) for p in sorted(args.folder.rglob("*.xml"))]
     for r in rows:
         print(f"{r['outcome']:<10} {r['file']}  {r['detail']}")
+    per_repo: dict[str, Counter] = {}
+    for path, r in zip(sorted(args.folder.rglob("*.xml")), rows):
+        repo = path.relative_to(args.folder).parts[0] if len(path.relative_to(args.folder).parts) > 1 else "."
+        per_repo.setdefault(repo, Counter())[r["outcome"]] += 1
+    for repo, c in sorted(per_repo.items()):
+        print(f"repository {repo}: " + ", ".join(f"{k} {c[k]}" for k in ("imported", "refused", "no SFC", "TRACEBACK")))
     counts = Counter(r["outcome"] for r in rows)
     print("total " + ", ".join(f"{k}: {counts[k]}" for k in ("imported", "refused", "no SFC", "TRACEBACK")))
     if args.json:

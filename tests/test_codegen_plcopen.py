@@ -131,8 +131,9 @@ def _edit(old: str, new: str) -> bytes:
     ('<jumpStep localId="24" targetName="Init" height="10" width="10">',
      '<macroStep localId="25" name="Sub"><position x="1" y="1"/></macroStep><jumpStep localId="24" targetName="Init">',
      "x.xml:195:13: error: unsupported SFC element <macroStep> (a macro-step): .g7 cannot represent it"),
-    ('<action localId="22" qualifier="N">', '<action localId="22" qualifier="L" duration="T#1s">',
-     "x.xml:187:15: error: action qualifier L cannot be represented in .g7"),
+    ('<action localId="22" qualifier="N">', '<action localId="22" qualifier="SD" duration="T#1s">',
+     "x.xml:187:15: error: action qualifier SD (stored and timed) cannot be represented in .g7: a .g7 timer belongs "
+     "to a step, not to a stored action"),
     ("<![CDATA[Wait.t >= T#2s]]>", "<![CDATA[Wiat.X AND top]]>",
      "x.xml:164:107: error: unknown step 'Wiat'"),
     ("<![CDATA[bottom]]>", "<![CDATA[bottom AND (top]]>",

@@ -154,8 +154,8 @@ def test_a_reference_to_a_pou_action_is_read_as_its_assignments():
         import_sfc(_with_pou_action("GRIP := xDown;"), "x.xml", pou="Crane")
     assert info.value.render().splitlines()[0] == (
         "x.xml:34:63: error: a statement of action Grip that .g7 cannot hold (GRIP := xDown): a PLC keeps what an "
-        "action body assigns after its step is left, so only X := TRUE; and X := FALSE; are read (as set X / "
-        "reset X)")
+        "action body assigns after its step is left, so only X := TRUE; and X := FALSE; (and, in an N action, IF "
+        "condition THEN X := TRUE; END_IF) are read")
 
 
 def test_names_a_transition_reads_are_checked_in_the_xml():
@@ -189,3 +189,57 @@ def test_a_comparison_becomes_a_declared_predicate():
         "the imported Grafcet (.g7 reads no numeric values); bind it to a sensor of the plant, or leave it free"]
     g = parse_grafcet(out, "crane.g7")
     assert "rPos_gt_24290_0" in g.inputs
+
+
+def test_a_twincat3_export_with_step_actions_in_vendor_data_equals_the_chart_by_hand():
+    """TwinCAT 3 (and CODESYS V3.5) keep a step's entry/active/exit actions in its addData: read as P1/N/P0
+    references to the POU's actions; D and L action blocks are step timers; an output read is its feedback."""
+    warnings: list[InputError] = []
+    text = import_sfc((DATA / "twincat3.xml").read_bytes(), "twincat3.xml", warnings=warnings)
+    by_hand = (DATA / "twincat3.g7").read_text()
+    assert text.split("\n", 1)[1] == by_hand.split("\n", 1)[1]
+    assert [w.render().splitlines()[0] for w in warnings] == [
+        "twincat3.xml:127:13: warning: a transition reads the output 'bLamp' of POU FB_Door: .g7 receptivities read "
+        "inputs, so it reads the input bLamp_fb (bind it to the output's value)",
+        "twincat3.xml:80:1: warning: IF (bOpenCmd = TRUE) AND NOT bIsOpen in action Idle_active (run while its step "
+        "is active) is read as the stored action on the rising edge ↑bOpenCmd & !bIsOpen | bOpenCmd & ↓bIsOpen: if "
+        "the condition already holds when the step becomes active, the PLC assigns at once and .g7 waits for the edge"]
+    imported, hand = parse_grafcet(text, "imported.g7"), load_grafcet(DATA / "twincat3.g7")
+    assert _ass(imported) == _ass(hand)
+
+
+@pytest.mark.parametrize("old, new, first", [
+    ('qualifier="D" duration="T#10s"', 'qualifier="SD" duration="T#10s"',
+     "x.xml:167:15: error: action qualifier SD (stored and timed) cannot be represented in .g7: a .g7 timer belongs "
+     "to a step, not to a stored action"),
+    ('<reference name="bAlarm" />', '<reference name="Motor.ACT_Stop" />',
+     "x.xml:167:15: error: action Motor.ACT_Stop belongs to the instance Motor of another block: .g7 holds this "
+     "chart's Boolean actions, not another block's code"),
+    (">Opening_active</attribute>", ">Opening_run</attribute>",
+     "x.xml:156:21: error: step action Opening_run is not an action of this POU"),
+    ("bMotorOpen := TRUE;</xhtml>", "Timer(IN := bIsOpen, PT := T#1s);</xhtml>",
+     "x.xml:90:61: error: a call of the block instance Timer in action Opening_active (Timer(IN := bIsOpen, PT := "
+     "T#1s)): .g7 runs no function blocks (its timers time a step's activity: 2s/X1)"),
+    ("bMotorOpen := TRUE;</xhtml>", "nCount := nCount + 1;</xhtml>",
+     "x.xml:90:61: error: an assignment of data in action Opening_active (nCount := nCount + 1): .g7 actions set "
+     "Boolean outputs; internal integer variables are not read yet"),
+    ("IF (bOpenCmd = TRUE) AND NOT bIsOpen THEN", "IF bOpenCmd OR bIsOpen THEN",
+     "x.xml:80:3: error: IF bOpenCmd OR bIsOpen in action Idle_active: only a condition that is a conjunction of "
+     "inputs (a AND NOT b) has a rising edge .g7 can write"),
+])
+def test_what_a_twincat3_step_action_cannot_be_is_located(old, new, first):
+    text = (DATA / "twincat3.xml").read_text()
+    assert old in text
+    with pytest.raises(InputError) as info:
+        import_sfc(text.replace(old, new, 1).encode(), "x.xml")
+    assert info.value.render().splitlines()[0] == first
+
+
+def test_qualifier_p_is_a_pulse_on_activation_and_true_false_literals_are_boolean():
+    text = (DATA / "codesys_v35.xml").read_text()
+    text = text.replace('<reference name="LOWER" />', '<inline><ST><xhtml xmlns="http://www.w3.org/1999/xhtml">'
+                        "LOWER := TRUE;</xhtml></ST></inline>", 1).replace('qualifier="N"', 'qualifier="P"', 1)
+    text = text.replace("<expression>xPart</expression>", "<expression>xPart = FALSE</expression>", 1)
+    out = import_sfc(text.encode(), "x.xml")
+    assert "  step Crane_Lower: set LOWER on activation\n" in out
+    assert "  transition Belt_Idle -> Belt_Run when !xPart\n" in out

@@ -36,7 +36,9 @@ import re
 from dataclasses import dataclass
 from typing import Any
 
+from synth.codegen.plcopen_actions import ACTION_WARNINGS, action_body
 from synth.codegen.plcopen_sfc import Chart, Source, read_chart
+from synth.codegen.plcopen_vendor import IecQualifier
 from synth.codegen.plcopen_xml import Qualifier
 from synth.codegen.st_condition import PREDICATES, ExprReader, st_text
 from synth.errors import InputError, Location
@@ -150,10 +152,14 @@ def import_sfc(data: bytes | str, file: str = "<xml>", pou: str | None = None,
     charts = []
     for p, s in sfc_pous:
         token = PREDICATES.set({})  # comparisons become declared predicates while a chart is read
+        action_warnings: list[InputError] = []
+        token2 = ACTION_WARNINGS.set(action_warnings)
         try:
             charts.append(read_chart(p, s, q, src, _read_action, f"{p.get('name')}_" if several else ""))
         finally:
             PREDICATES.reset(token)
+            ACTION_WARNINGS.reset(token2)
+        charts[-1].warnings.extend(action_warnings)
     if warnings is not None:
         warnings += [w for c in charts for w in c.warnings]
     return _g7_text(charts, file, several)
@@ -218,44 +224,62 @@ def _paired(actions: list[str]) -> list[str]:
                                        and a[len("reset "):-len(" on deactivation")] in conditional)]
 
 
-def _read_action(a: Any, src: Source, steps: dict[str, str], q: Any, pou_actions: dict[str, Any]) -> list[str]:
-    """The ``.g7`` actions of one SFC action (an action block's line)."""
-    qualifier = a.get("qualifier", "N")
-    ref = a.find(q("reference"))
-    if qualifier not in set(Qualifier):
-        raise InputError(f"action qualifier {qualifier} cannot be represented in .g7", src.at(a),
-                         expected=tuple(Qualifier))
-    if ref is not None and ref.get("name") in pou_actions:
-        return _pou_action(a, ref.get("name"), pou_actions[ref.get("name")], qualifier, src, q)
+_UNITS = {"ms": "ms", "s": "s", "m": "min", "h": "h"}
+
+
+def _read_action(a: Any, src: Source, steps: dict[str, str], q: Any, pou_actions: dict[str, Any], step: str,
+                 named: tuple[IecQualifier, str] | None = None) -> list[str]:
+    """The ``.g7`` actions of one SFC action (an action block's line) of step ``step``, or of a
+    vendor step action ``named`` (qualifier, action name) located at ``a``."""
+    if named is None:
+        raw = a.get("qualifier", "N")
+        if raw not in set(IecQualifier):
+            raise InputError(f"unknown action qualifier {raw}", src.at(a), expected=tuple(IecQualifier))
+        qualifier, ref = IecQualifier(raw), a.find(q("reference"))
+        name = ref.get("name") if ref is not None else None
+    else:
+        qualifier, name = named
+    if qualifier == IecQualifier.P:  # IEC 61131-3: a pulse when the step becomes active, as P1
+        qualifier = IecQualifier.P1
+    if qualifier in (IecQualifier.SD, IecQualifier.DS, IecQualifier.SL):
+        raise InputError(f"action qualifier {qualifier} (stored and timed) cannot be represented in .g7: a .g7 "
+                         "timer belongs to a step, not to a stored action", src.at(a),
+                         expected=tuple(k for k in IecQualifier if k not in ("SD", "DS", "SL")))
+    if name is not None and "." in name:
+        raise InputError(f"action {name} belongs to the instance {name.rsplit('.', 1)[0]} of another block: .g7 "
+                         "holds this chart's Boolean actions, not another block's code", src.at(a))
+    if name is not None and name in pou_actions:
+        if qualifier in (IecQualifier.D, IecQualifier.L):
+            raise InputError(f"qualifier {qualifier} on action {name}: a timed action's body of stored assignments "
+                             "has no .g7 form (a stored action's event cannot be a timer)", src.at(a))
+        return _pou_action(a, name, pou_actions[name], qualifier, src, q, steps)
+    if named is not None:
+        raise InputError(f"step action {name} is not an action of this POU", src.at(a),
+                         expected=tuple(pou_actions) or ("(the POU has no actions)",))
+    if qualifier in (IecQualifier.D, IecQualifier.L):
+        m = re.fullmatch(r"\s*T#(\d+(?:\.\d+)?)(ms|s|m|h)\s*", a.get("duration", ""), re.I)
+        if name is None or m is None:
+            raise InputError(f"a {qualifier} action needs a reference to an output and a duration such as T#2s",
+                             src.at(a))
+        timer = f"{m[1]}{_UNITS[m[2].lower()]}/X{step}"
+        return [f"{name} if {timer}" if qualifier == IecQualifier.D else f"{name} if !{timer}"]
     return [_one_action(a, src, steps, q, qualifier)]
 
 
-def _pou_action(a: Any, name: str, action: Any, qualifier: str, src: Source, q: Any) -> list[str]:
-    """A reference to a POU action: its ST body of ``X := TRUE;`` / ``X := FALSE;`` statements.
-    A PLC runs it while the action is active and does not undo it: stored actions (``set`` /
-    ``reset`` on activation, or on deactivation for ``P0``)."""
+def _pou_action(a: Any, name: str, action: Any, qualifier: IecQualifier, src: Source, q: Any,
+                steps: dict[str, str]) -> list[str]:
+    """A reference to a POU action: its ST body's Boolean assignments
+    (:func:`~synth.codegen.plcopen_actions.action_body`)."""
     st = action.find(f"{q('body')}/{q('ST')}")
     if st is None:
         raise InputError(f"action {name} referenced here has no ST body: .g7 reads Boolean assignments only",
                          src.at(a))
     text = st_text(st)
-    where = lambda off, w, h=st, t=text: src.text_at(h, t, off, w)  # noqa: E731
-    if qualifier == Qualifier.R:
-        raise InputError(f"qualifier R on action {name}: a reset action has no body to run in .g7", src.at(a))
-    when = " on deactivation" if qualifier == Qualifier.P0 else ""
-    out = []
-    for m in re.finditer(r"[^;]+", re.sub(r"\(\*.*?\*\)", lambda c: " " * len(c[0]), text, flags=re.S)):
-        statement = m[0].strip()
-        if not statement:
-            continue
-        assign = re.fullmatch(r"(\w+)\s*:=\s*(TRUE|FALSE)", statement, re.I)
-        if assign is None:
-            raise InputError(f"a statement of action {name} that .g7 cannot hold ({statement}): a PLC keeps what "
-                             "an action body assigns after its step is left, so only X := TRUE; and X := FALSE; "
-                             "are read (as set X / reset X)", where(m.start() + len(m[0]) - len(m[0].lstrip()),
-                                                                    len(statement)))
-        out.append(f"{'set' if assign[2].upper() == 'TRUE' else 'reset'} {assign[1]}{when}")
-    return out
+
+    def where(off: int, width: int) -> Location:
+        return src.text_at(st, text, off, width)
+
+    return action_body(name, text, qualifier, where, steps)
 
 
 def _one_action(a: Any, src: Source, steps: dict[str, str], q: Any, qualifier: str) -> str:

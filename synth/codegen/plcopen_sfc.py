@@ -18,6 +18,7 @@ import re
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
+from synth.codegen.plcopen_vendor import step_actions
 from synth.codegen.plcopen_fbd import FBD_ELEMENTS, fbd_condition, fbd_transition
 from synth.codegen.plcopen_xml import SYNTH_DATA
 from synth.codegen.st_condition import PREDICATES, ExprReader, st_text
@@ -103,7 +104,7 @@ def _check_names(pou: Any, q: Callable[[str], str], src: Source, transitions: li
     for section in _SECTIONS:
         for v in pou.iterfind(f"{q('interface')}/{q(section)}/{q('variable')}"):
             declared.setdefault(str(v.get("name")), (section, v))
-    for _, _, _, expr, el in transitions:
+    for i, (label, sources, targets, expr, el) in enumerate(transitions):
         for name in dict.fromkeys(re.findall(r"(?<![\w/])[A-Za-z_]\w*", expr)):
             if name.startswith("X") and name[1:] in steps or name in inputs:
                 continue
@@ -112,8 +113,19 @@ def _check_names(pou: Any, q: Callable[[str], str], src: Source, transitions: li
                                  src.at(el), suggestions=close_names(name, declared))
             section, var = declared[name]
             if name in outputs or section == "outputVars":
-                raise InputError(f"a transition reads the output '{name}': .g7 receptivities read inputs and step "
-                                 "flags", src.at(el))
+                feedback = f"{name}_fb"
+                if feedback in declared:
+                    raise InputError(f"a transition reads the output '{name}', and {feedback} (its feedback input) is "
+                                     "already declared", src.at(el))
+                expr = re.sub(rf"(?<![\w/]){name}\b", feedback, expr)
+                transitions[i] = (label, sources, targets, expr, el)
+                if feedback not in inputs:
+                    inputs.append(feedback)
+                    warnings.append(InputError(
+                        f"a transition reads the output '{name}' of POU {pou.get('name')}: .g7 receptivities read "
+                        f"inputs, so it reads the input {feedback} (bind it to the output's value)", src.at(el),
+                        severity=Severity.WARNING))
+                continue
             inputs.append(name)
             warnings.append(InputError(f"'{name}', declared in <{section}> of POU {pou.get('name')}, is read as an "
                                        "input: .g7 has no internal variables yet, so nothing the chart does sets it",
@@ -339,7 +351,10 @@ def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
             "branch; the later branches' receptivities are made exclusive", src.at(elements[d]),
             severity=Severity.WARNING, notes=tuple(rewritten)))
 
-    # actions
+    # actions: CODESYS/TwinCAT step actions (vendor addData), then the action blocks
+    for st in steps.values():
+        for which, name, attr in step_actions(st.el, q):
+            st.actions.extend(read_action(attr, src, by_sfc_name, q, pou_actions, st.name, (which.qualifier, name)))
     for lid, el in elements.items():
         if kind(el) != "actionBlock":
             continue
@@ -348,7 +363,7 @@ def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
             raise InputError("an action block must be connected to exactly one step", src.at(el))
         owner = steps[owners[0]]
         for a in el.iterfind(q("action")):
-            owner.actions.extend(read_action(a, src, by_sfc_name, q, pou_actions))
+            owner.actions.extend(read_action(a, src, by_sfc_name, q, pou_actions, owner.name))
 
     # partial grafcets: synth's addData, else the connected components
     parent: dict[str, str] = {s.name: s.name for s in steps.values()}

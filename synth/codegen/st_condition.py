@@ -55,7 +55,7 @@ class ExprReader:
         text = re.sub(r"\(\*.*?\*\)|//[^\n]*", lambda m: re.sub(r"[^\n]", " ", m[0]), text, flags=re.S)
         self.text, self.where, self.steps, self.what = text, where, steps, what
         self.tokens: list[tuple[str, str, int]] = []
-        data = re.search(r"(?<![:<>])(<>|>=|<=|<(?![=>])|>(?!=)|=)(?!\s*T#)", text)
+        data = re.search(r"(?<![:<>])(<>|>=|<=|<(?![=>])|>(?!=)|=)(?!\s*(?:T#|(?:TRUE|FALSE)\b))", text, re.I)
         if data is not None and PREDICATES.get() is None:
             raise self.error(data.start(), f"a comparison of data in {what} ({' '.join(text.split())}): .g7 reads "
                              "Boolean inputs and step flags; numeric values are not read yet", width=len(data[1]))
@@ -111,6 +111,17 @@ class ExprReader:
             if v != ")":
                 raise self.error(o, f"expected ')' in {self.what}", expected=("')'",))
             return inner if re.fullmatch(r"[!\w↑↓/.]+", inner) else f"({inner})"
+        following = self.peek()[1]
+        if following in ("=", "<>") and kind == "name" and self.i + 1 < len(self.tokens) and \
+                self.tokens[self.i + 1][1].upper() in ("TRUE", "FALSE"):  # a Boolean compared with a literal
+            self.take()
+            literal = self.take()[1].upper()
+            inner = self.boolean(kind, value, offset)
+            return inner if (literal == "TRUE") == (following == "=") else "!" + inner
+        return self.boolean(kind, value, offset)
+
+    def boolean(self, kind: str, value: str, offset: int) -> str:
+        """A name, a step flag, a timer, a constant or a comparison (the token just taken)."""
         following = self.peek()[1]
         if following in _COMPARE and PREDICATES.get() is not None and (kind == "num" or (kind == "name" and "." not in value)):
             return self.predicate(kind, value, offset)

@@ -1,0 +1,75 @@
+"""Vendor ``addData`` that carries SFC meaning (``synth import``): CODESYS V3.5 (and TwinCAT 3,
+built on it) keep a step's *step actions* (entry, active, exit) not in an ``<actionBlock>``
+but in the step's ``<addData><data name=".../plcopenxml/sfc/element">`` as attributes keyed
+by a GUID. Ignoring them would drop the step's actions silently; they are read as
+references to POU actions with the IEC 61131-3 qualifier that runs them the same way:
+entry ``P1``, active ``N``, exit ``P0``. Every other ``addData`` is layout or bookkeeping.
+
+Example
+-------
+>>> [k.name for k in StepAction]
+['ENTRY', 'ACTIVE', 'EXIT']
+>>> StepAction.EXIT.qualifier
+<IecQualifier.P0: 'P0'>
+"""
+
+from __future__ import annotations
+
+from enum import Enum, StrEnum
+from typing import Any, Callable
+
+__all__ = ["IecQualifier", "StepAction", "SFC_ELEMENT_DATA", "step_actions"]
+
+
+class IecQualifier(StrEnum):
+    """Every IEC 61131-3 action qualifier an imported action block may carry."""
+
+    N = "N"
+    S = "S"
+    R = "R"
+    P = "P"
+    P1 = "P1"
+    P0 = "P0"
+    D = "D"
+    L = "L"
+    SD = "SD"
+    DS = "DS"
+    SL = "SL"
+
+SFC_ELEMENT_DATA = "/plcopenxml/sfc/element"
+"""How the name of a CODESYS (``http://www.3s-software.com``) or TwinCAT SFC element's
+``<data>`` ends."""
+
+
+class StepAction(Enum):
+    """A CODESYS step action: its attribute GUID and the qualifier that runs it alike."""
+
+    ENTRY = ("a6b08bd8-b696-47e3-9cbf-7408b61c9ff8", IecQualifier.P1)
+    ACTIVE = ("700a583f-b4d4-43e4-8c14-629c7cd3bec8", IecQualifier.N)
+    EXIT = ("a2621e18-7de3-4ea6-ae6d-89e9e0b7befd", IecQualifier.P0)
+
+    @property
+    def guid(self) -> str:
+        return self.value[0]
+
+    @property
+    def qualifier(self) -> IecQualifier:
+        return self.value[1]
+
+
+def step_actions(step: Any, q: Callable[[str], str]) -> list[tuple[StepAction, str, Any]]:
+    """The step actions of a CODESYS/TwinCAT ``<step>``: (kind, action name, the
+    ``<attribute>`` element that names it), entry first, in :class:`StepAction` order."""
+    found: dict[StepAction, tuple[str, Any]] = {}
+    by_guid = {k.guid: k for k in StepAction}
+    for data in step.iterfind(f"{q('addData')}/{q('data')}"):
+        if not str(data.get("name", "")).endswith(SFC_ELEMENT_DATA):
+            continue
+        for attr in data.iter():
+            if not isinstance(attr.tag, str) or not attr.tag.endswith("attribute"):
+                continue
+            kind = by_guid.get(str(attr.get("guid", "")).lower())
+            name = (attr.text or "").strip()
+            if kind is not None and name:
+                found[kind] = (name, attr)
+    return [(k, *found[k]) for k in StepAction if k in found]
