@@ -16,7 +16,9 @@ STORED = ("M", "N")
 DURATIONS = ("500ms", "1s", "2s")
 
 
-def _atom(rng: random.Random, steps: list[str], src: list[str], edges: bool) -> str:
+def _atom(rng: random.Random, steps: list[str], src: list[str], edges: bool, data: bool = False) -> str:
+    if data and rng.random() < 0.3:
+        return rng.choice(("k >= 1", "k < 2", "k = 0", "k <> 2", "f", "!f"))
     r = rng.random()
     if edges and r < 0.25:
         return rng.choice("↑↓") + rng.choice(INPUTS)
@@ -30,8 +32,8 @@ def _atom(rng: random.Random, steps: list[str], src: list[str], edges: bool) -> 
     return rng.choice("01")
 
 
-def _expr(rng: random.Random, steps: list[str], src: list[str], edges: bool = True) -> str:
-    parts = [_atom(rng, steps, src, edges) for _ in range(rng.randint(1, 3))]
+def _expr(rng: random.Random, steps: list[str], src: list[str], edges: bool = True, data: bool = False) -> str:
+    parts = [_atom(rng, steps, src, edges, data) for _ in range(rng.randint(1, 3))]
     if len(parts) == 1:
         return parts[0]
     if len(parts) == 3 and rng.random() < 0.5:
@@ -39,27 +41,38 @@ def _expr(rng: random.Random, steps: list[str], src: list[str], edges: bool = Tr
     return rng.choice((" . ", " + ")).join(parts)
 
 
-def random_grafcet(seed: int) -> str:
-    """The ``.g7`` text of a random Grafcet (deterministic in ``seed``).
+ASSIGNMENTS = ("k := k + 1", "k := k - 1 on deactivation", "k := 0", "k := k + 1 on ↑a", "f := 1",
+               "f := 0 on deactivation", "set f on ↓b", "reset f")
+
+
+def random_grafcet(seed: int, data: bool = False) -> str:
+    """The ``.g7`` text of a random Grafcet (deterministic in ``seed``); with ``data``, the
+    internal variables ``k : 0..2`` and ``f : bool``, assignments and comparisons.
 
     >>> random_grafcet(1) == random_grafcet(1), "grafcet G1" in random_grafcet(1)
     (True, True)
+    >>> "internal k : 0..2" in random_grafcet(1, data=True)
+    True
     """
     rng = random.Random(seed)
     sizes = [rng.randint(2, 3)] + ([2] if rng.random() < 0.35 else [])
     names = [[f"{10 * (g + 1) + i}" for i in range(n)] for g, n in enumerate(sizes)]
     every = [s for group in names for s in group]
     lines = [f"inputs {', '.join(INPUTS)}", f"outputs {', '.join(ASSIGNED + STORED)}"]
+    if data:
+        lines += ["internal k : 0..2 = 0", "internal f : bool"]
     for g, steps in enumerate(names):
         lines.append(f"grafcet G{g + 1} {{")
         for i, s in enumerate(steps):
             actions = []
             for _ in range(rng.choice((0, 1, 1))):
                 kind = rng.random()
-                if kind < 0.4:
+                if data and kind < 0.4:
+                    actions.append(rng.choice(ASSIGNMENTS))
+                elif kind < 0.4:
                     actions.append(rng.choice(ASSIGNED))
                 elif kind < 0.6:
-                    actions.append(f"{rng.choice(ASSIGNED)} if {_expr(rng, every, [s], edges=False)}")
+                    actions.append(f"{rng.choice(ASSIGNED)} if {_expr(rng, every, [s], edges=False, data=data)}")
                 elif kind < 0.8:
                     verb = rng.choice(("set", "reset"))
                     when = rng.choice(("", " on activation", " on deactivation"))
@@ -87,7 +100,7 @@ def random_grafcet(seed: int) -> str:
             if src == dst or (tuple(src), tuple(dst)) in seen:
                 continue
             seen.add((tuple(src), tuple(dst)))
-            rec = _expr(rng, every, src)
+            rec = _expr(rng, every, src, data=data)
             if not src:
                 rec = f"{rng.choice('↑↓')}{rng.choice(INPUTS)}"
             lines.append(f"  transition {', '.join(src)} -> {', '.join(dst)} when {rec}")
@@ -95,13 +108,13 @@ def random_grafcet(seed: int) -> str:
     return "\n".join(lines) + "\n"
 
 
-def check_seed(seed: int, depth: int = 3) -> tuple[int, int, int, str]:
+def check_seed(seed: int, depth: int = 3, data: bool = False) -> tuple[int, int, int, str]:
     """The differential check of ``random_grafcet(seed)`` (compact ST): (seed, sequences,
     cycles, mismatch text or ""). A top-level function, so a process pool can run it."""
     from synth.codegen.check import differential_check
     from synth.codegen.grafcet_st import generate_program
     from synth.grafcet.language_check import parse_grafcet
 
-    g = parse_grafcet(random_grafcet(seed), f"random{seed}.g7")
+    g = parse_grafcet(random_grafcet(seed, data), f"random{seed}.g7")
     report = differential_check(g, depth=depth, program=generate_program(g, version="test", comments=False))
     return seed, report.sequences, report.cycles, "" if report.ok else report.text()

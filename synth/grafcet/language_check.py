@@ -109,17 +109,18 @@ class GrafcetChecker(Checker):
                 self.fail(f"internal variable '{d.name}' has the name of {taken[d.name]}", d.loc,
                           notes=("internal variables, inputs, outputs and step variables have distinct names",))
                 continue
-            if d.low > d.high:
-                self.fail(f"the range {d.low}..{d.high} of '{d.name}' is empty", d.range_loc,
+            low, high = d.low, d.high
+            if low > high:
+                self.fail(f"the range {low}..{high} of '{d.name}' is empty", d.range_loc,
                           notes=("write LOW..HIGH with LOW <= HIGH, e.g. 0..3",))
-                continue
-            initial = d.low if d.initial is None else d.initial
-            if not d.low <= initial <= d.high:
+                high = low  # still declared: its uses are checked
+            initial = low if d.initial is None else d.initial
+            if not low <= initial <= high:
                 self.fail(f"the initial value {initial} of '{d.name}' is outside "
-                          + ("0..1 (a Boolean)" if d.boolean else f"its range {d.low}..{d.high}"),
+                          + ("0..1 (a Boolean)" if d.boolean else f"its range {low}..{high}"),
                           d.initial_loc or d.loc)
-                continue
-            self.internals[d.name] = Internal(d.name, d.low, d.high, initial, d.boolean, d.loc)
+                initial = low
+            self.internals[d.name] = Internal(d.name, low, high, initial, d.boolean, d.loc)
 
     def check(self, items: list[VectorDecl | InternalDecl | GrafcetDecl]) -> Grafcet:
         decls = [i for i in items if isinstance(i, VectorDecl)]
