@@ -203,7 +203,7 @@ def element_automaton(e: ElementSpec) -> ElementAutomaton:
 
     def own(mask: np.ndarray) -> np.ndarray:
         """A mask over own codes: some value of the read variables satisfies ``mask``."""
-        return mask.reshape(1 << r, 1 << n).any(axis=0)
+        return np.asarray(mask.reshape(1 << r, 1 << n).any(axis=0), dtype=bool)
 
     coherent = np.ones(1 << n, dtype=bool)  # incoherences and held orders speak of own variables only
     for v in e.variables:
