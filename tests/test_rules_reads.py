@@ -81,6 +81,11 @@ def test_chain_reachable_states_and_successors():
     target[p.parse_state("go,s")] = True
     before = p.preimage(target, controllable=False)
     assert sorted(p.label(p.local(int(c))) for c in np.nonzero(before.ravel())[0]) == ["{go}", "{s}"]
+    # global copies: go's 8 moves on the grid, ↑s where go (2), ↑t where s (2); 9 among reachable states
+    copies = {str(t.event): (src.tolist(), dst.tolist()) for t, src, dst in p.transition_arrays()}
+    assert copies == {"↑go": ([0, 1, 2, 3], [4, 5, 6, 7]), "↓go": ([4, 5, 6, 7], [0, 1, 2, 3]),
+                      "↑s": ([4, 5], [6, 7]), "↑t": ([2, 6], [3, 7])}
+    assert sum(src.size for _, src, _ in p.transition_arrays(p.reachable)) == 9
 
 
 def test_model_with_reads_renamed():

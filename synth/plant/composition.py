@@ -323,13 +323,16 @@ class Plant:
 
     def transition_arrays(self, keep: np.ndarray | None = None) -> Iterator[tuple[LocalTransition, np.ndarray, np.ndarray]]:
         """For each local transition, flat source and target codes of its global copies
-        (restricted to sources and targets in ``keep`` when given)."""
+        (restricted to sources and targets in ``keep`` when given, and to the sources where
+        its guard holds)."""
         flat = np.arange(self.size, dtype=np.int64).reshape(self.shape)
         for t in self.transitions:
             s, d = self.slices(t)
             src, dst = flat[s], flat[d]
-            if keep is not None:
-                m = keep[s] & keep[d]
+            if keep is not None or t.guard is not None:
+                m = np.broadcast_to(self.guard_grid(t), src.shape)
+                if keep is not None:
+                    m = m & keep[s] & keep[d]
                 src, dst = src[m], dst[m]
             yield t, src.ravel(), dst.ravel()
 
