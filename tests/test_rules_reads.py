@@ -86,6 +86,9 @@ def test_chain_reachable_states_and_successors():
     assert copies == {"↑go": ([0, 1, 2, 3], [4, 5, 6, 7]), "↓go": ([4, 5, 6, 7], [0, 1, 2, 3]),
                       "↑s": ([4, 5], [6, 7]), "↑t": ([2, 6], [3, 7])}
     assert sum(src.size for _, src, _ in p.transition_arrays(p.reachable)) == 9
+    from synth.filter.invariants import _reachable  # the filter's own exploration agrees
+
+    assert (_reachable(p) == p.reachable.ravel()).all()
 
 
 def test_model_with_reads_renamed():
