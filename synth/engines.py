@@ -17,6 +17,8 @@
   ``auto`` keeps them explicit.
 - ``sup``: symbolic above :data:`SUP_THRESHOLD` (10^6) plant states, unless ``--export``
   or ``--why`` ask for the explicit listing.
+- a plant whose elements read each other's variables (``reads``) is always explicit:
+  the symbolic engine refuses it.
 
 The engines themselves are imported only once chosen: a passing box-sorting
 validation never imports the BDD library.
@@ -120,6 +122,8 @@ def validate(
     p = plant(rs)
     g = load_grafcet(grafcet_path, inputs=p.inputs, outputs=p.outputs)
     estimate = p.size * max(1, len(g.steps))
+    if p.reads and asked == EngineChoice.AUTO:  # elements read each other: explicit engine only
+        asked = EngineChoice.EXPLICIT
     if asked != EngineChoice.EXPLICIT and choose(asked, estimate, width=concurrency(g)) == EngineChoice.SYMBOLIC:
         from synth.grafcet.situation import OutOfRange
         from synth.symbolic.validate import validate_loaded as symbolic
@@ -219,6 +223,8 @@ def supervisor(
     if loaded is not None:
         loaded(p)
     chosen = choose(engine, p.size, threshold=SUP_THRESHOLD, needs_listing=needs_listing, listing_option="--export/--why")
+    if p.reads and EngineChoice(engine) == EngineChoice.AUTO:  # elements read each other: explicit engine only
+        chosen = EngineChoice.EXPLICIT
     if chosen == EngineChoice.SYMBOLIC:
         from synth.symbolic.encoding import NodeBudget
         from synth.symbolic.supervisor import symbolic_supervisor

@@ -84,11 +84,11 @@ def _reachable(p: Plant) -> np.ndarray:
     boolean array, by whole-grid images per local transition until nothing is added."""
     grid = np.zeros(p.shape, dtype=bool)
     grid.flat[p.initial_index] = True
-    slices = [p.slices(t) for t in p.transitions]
+    slices = [(*p.slices(t), p.guard_grid(t)) for t in p.transitions]  # guards: elements that read others
     while True:
         before = int(np.count_nonzero(grid))
-        for s, d in slices:
-            grid[d] |= grid[s]
+        for s, d, g in slices:
+            grid[d] |= grid[s] & g
         if int(np.count_nonzero(grid)) == before:
             return grid.ravel()
 

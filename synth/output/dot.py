@@ -264,11 +264,14 @@ def ass_dot(ass: "ASS", title: str = "ASS") -> str:
 def plant_dot(p: "Plant") -> str:
     """The whole plant automaton (small plants only: one node per state)."""
     nodes = []
+    keep = p.reachable.ravel() if p.reads else None  # elements reading each other: reachable states only
     for code in range(p.size):
+        if keep is not None and not keep[code]:
+            continue
         local = p.local(code)
         nodes.append((str(code), p.label(local), {"peripheries": "2"} if local == p.initial else {}))
     edges = []
-    for t, src, dst in p.transition_arrays():
+    for t, src, dst in p.transition_arrays(p.reachable if p.reads else None):
         style = CONTROLLABLE_STYLE if t.controllable else UNCONTROLLABLE_STYLE
         for s, d in zip(src.tolist(), dst.tolist()):
             edges.append((str(s), str(d), t.event, style))

@@ -79,9 +79,10 @@ def _grid_generator(p: Plant, name: str, keep: np.ndarray, allowed) -> str:
 
 
 def plant_generator(p: Plant, name: str = "plant") -> str:
-    """The whole plant (every grid state is reachable)."""
-    keep = np.ones(p.shape, dtype=bool)
-    return _grid_generator(p, name, keep, lambda t: np.ones(keep[p.slices(t)[0]].shape, dtype=bool))
+    """The whole plant: its reachable states (every grid state unless elements read each
+    other) and the transitions enabled there."""
+    keep = p.reachable
+    return _grid_generator(p, name, keep, lambda t: keep[p.slices(t)[0]] & p.guard_grid(t))
 
 
 def supervisor_generator(sup: "Supervisor", name: str = "sup") -> str:

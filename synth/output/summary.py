@@ -98,7 +98,7 @@ def element_text(data: Mapping[str, Any]) -> str:
 
 def _sizes(p: "Plant") -> dict[str, int]:
     return {
-        "states": p.size,
+        "states": p.state_count,  # the grid's size unless elements read each other
         "transitions": p.count_transitions(),
         "controllable": p.count_transitions(True),
         "uncontrollable": p.count_transitions(False),

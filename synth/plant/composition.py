@@ -12,6 +12,13 @@ Every local state of every element is reachable (element automata keep only
 reachable states) and elements move independently, so every grid position is a
 reachable plant state: ``|Q| = Π|Q_i|`` and ``|δ| = Σ_i |δ_i| Π_{j≠i} |Q_j|``.
 
+An element that ``reads`` other elements' variables is the exception: its local
+transition ``t`` carries ``guard``, a truth table over the codes of the variables it
+reads, and its global copies are those whose source satisfies it (``enabled``). Such a
+plant (``reads`` true) is explored from its initial state: ``reachable`` is the grid of
+its reachable states, ``state_count`` their number, and ``count_transitions`` counts the
+enabled transitions leaving them. Still one variable changes per event.
+
 Example
 -------
 >>> from synth.plant.rules_check import load_rules
@@ -31,12 +38,15 @@ from typing import Callable, Iterator, Mapping
 
 import numpy as np
 
-from synth.errors import SynthError, close_names
+from synth.errors import LimitExceeded, SynthError, close_names
 from synth.logic.events import Event
 from synth.plant.element import ElementAutomaton, element_automaton
 from synth.plant.rules import RuleSet
 
-__all__ = ["Plant", "plant", "asynchronous_composition", "LocalTransition"]
+__all__ = ["Plant", "plant", "asynchronous_composition", "LocalTransition", "READS_GRID_LIMIT"]
+
+READS_GRID_LIMIT = 50_000_000
+"""A plant whose elements read each other is explored on its grid: at most this many states."""
 
 
 def _plants(name: str) -> str:
@@ -52,6 +62,7 @@ class LocalTransition:
     dst: int
     event: Event
     controllable: bool
+    guard: tuple[bool, ...] | None = None  # over the codes of the element's reads; None: always enabled
 
 
 class _LocalValues(dict[int, dict[str, bool]]):
@@ -117,8 +128,68 @@ class Plant:
         out = []
         for i, e in enumerate(self.elements):
             for t in range(e.src.size):
-                out.append(LocalTransition(i, int(e.src[t]), int(e.dst[t]), e.event(t), bool(e.controllable[t])))
+                out.append(LocalTransition(i, int(e.src[t]), int(e.dst[t]), e.event(t), bool(e.controllable[t]), e.guard(t)))
         return tuple(out)
+
+    # ------------------------------------------------------------------ reads
+    @cached_property
+    def reads(self) -> bool:
+        """Some element reads another's variables: moves depend on the global state."""
+        return any(e.guards is not None and not bool(e.guards.all()) for e in self.elements)
+
+    def enabled(self, t: LocalTransition, local: tuple[int, ...]) -> bool:
+        """Whether ``t`` may occur in the state ``local`` (its source assumed there)."""
+        if t.guard is None:
+            return True
+        val = self.valuation(local)
+        return t.guard[sum(1 << j for j, r in enumerate(self.elements[t.axis].reads) if val[r])]
+
+    def enabled_digits(self, t: LocalTransition, digits: np.ndarray) -> np.ndarray:
+        """Whether ``t``'s guard holds at each state whose local indices (ndim × n) are given."""
+        if t.guard is None:
+            return np.ones(digits.shape[1], dtype=bool)
+        code = np.zeros(digits.shape[1], dtype=np.int64)
+        for j, r in enumerate(self.elements[t.axis].reads):
+            a = self.owner[r]
+            code |= self.elements[a].value(r)[digits[a]].astype(np.int64) << j
+        return np.asarray(t.guard, dtype=bool)[code]
+
+    def guard_grid(self, t: LocalTransition) -> np.ndarray:
+        """``t``'s guard as an array broadcastable to the grid of its sources ``[..., src, ...]``."""
+        if t.guard is None:
+            return np.ones((1,) * (self.ndim - 1), dtype=bool)
+        code = np.zeros((1,) * self.ndim, dtype=np.int64)
+        for j, r in enumerate(self.elements[t.axis].reads):
+            code = code | (self.values(r).astype(np.int64) << j)
+        return np.asarray(t.guard, dtype=bool)[code][(slice(None),) * t.axis + (0,)]
+
+    @cached_property
+    def reachable(self) -> np.ndarray:
+        """The grid of the states reachable from the initial state (every state without reads)."""
+        if not self.reads:
+            return np.ones(self.shape, dtype=bool)
+        if self.size > READS_GRID_LIMIT:
+            raise LimitExceeded(
+                f"the plant has {self.size} states and elements that read each other's variables; "
+                f"its reachable states are computed on its grid, at most {READS_GRID_LIMIT} states"
+            )
+        reach = np.zeros(self.shape, dtype=bool)
+        reach[self.initial] = True
+        grow = True
+        while grow:
+            grow = False
+            for t in self.transitions:
+                s, d = self.slices(t)
+                new = reach[s] & self.guard_grid(t) & ~reach[d]
+                if new.any():
+                    reach[d] |= new
+                    grow = True
+        return reach
+
+    @property
+    def state_count(self) -> int:
+        """The number of reachable plant states (``size`` without reads)."""
+        return int(np.count_nonzero(self.reachable)) if self.reads else self.size
 
     @cached_property
     def events(self) -> dict[Event, bool]:
@@ -126,6 +197,10 @@ class Plant:
         return dict(sorted({t.event: t.controllable for t in self.transitions}.items()))
 
     def count_transitions(self, controllable: bool | None = None) -> int:
+        """Transitions leaving reachable states (of the given kind)."""
+        if self.reads:
+            return sum(int(np.count_nonzero(self.reachable[self.slices(t)[0]] & self.guard_grid(t)))
+                       for t in self.transitions if controllable is None or t.controllable == controllable)
         total = 0
         for i, e in enumerate(self.elements):
             others = self.size // e.size
@@ -226,7 +301,7 @@ class Plant:
     def successors(self, local: tuple[int, ...]) -> Iterator[tuple[LocalTransition, tuple[int, ...]]]:
         """Outgoing transitions of one state, in a stable order."""
         for t in self.transitions:
-            if local[t.axis] == t.src:
+            if local[t.axis] == t.src and self.enabled(t, local):
                 nxt = list(local)
                 nxt[t.axis] = t.dst
                 yield t, tuple(nxt)
@@ -243,18 +318,21 @@ class Plant:
             if controllable is not None and t.controllable != controllable:
                 continue
             s, d = self.slices(t)
-            out[s] |= mask[d]
+            out[s] |= mask[d] & self.guard_grid(t)
         return out
 
     def transition_arrays(self, keep: np.ndarray | None = None) -> Iterator[tuple[LocalTransition, np.ndarray, np.ndarray]]:
         """For each local transition, flat source and target codes of its global copies
-        (restricted to sources and targets in ``keep`` when given)."""
+        (restricted to sources and targets in ``keep`` when given, and to the sources where
+        its guard holds)."""
         flat = np.arange(self.size, dtype=np.int64).reshape(self.shape)
         for t in self.transitions:
             s, d = self.slices(t)
             src, dst = flat[s], flat[d]
-            if keep is not None:
-                m = keep[s] & keep[d]
+            if keep is not None or t.guard is not None:
+                m = np.broadcast_to(self.guard_grid(t), src.shape)
+                if keep is not None:
+                    m = m & keep[s] & keep[d]
                 src, dst = src[m], dst[m]
             yield t, src.ravel(), dst.ravel()
 

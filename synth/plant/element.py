@@ -13,6 +13,12 @@ Construction (thesis lines 2470-2520), state-based reading of the rules:
 
 Only the states reachable from the initial state are kept.
 
+An element that ``reads`` other elements' variables has them as extra bits while its
+masks are computed; its own automaton over-approximates them (a move exists when some
+value of the read variables allows it), and ``guards[t]`` keeps, per code of the read
+variables (bit j = ``reads[j]``), whether transition ``t`` is enabled: the product
+evaluates it with the other elements' actual values.
+
 Example
 -------
 >>> from synth.plant.rules_check import parse_rules
@@ -62,6 +68,8 @@ class ElementAutomaton:
     controllable: np.ndarray
     spec: ElementSpec
     warnings: tuple[InputError, ...] = ()
+    reads: tuple[str, ...] = ()
+    guards: np.ndarray | None = None  # (transitions × 2^len(reads)) booleans, None without reads
 
     @property
     def size(self) -> int:
@@ -82,6 +90,13 @@ class ElementAutomaton:
         i = int(self.var[t])
         rising = bool((self.codes[self.dst[t]] >> i) & 1)
         return Event.edge(self.variables[i], rising)
+
+    def guard(self, t: int) -> tuple[bool, ...] | None:
+        """Transition ``t``'s condition on the variables it reads, as a truth table over
+        their codes (bit j = ``reads[j]``); None when it does not depend on them."""
+        if self.guards is None or bool(self.guards[t].all()):
+            return None
+        return tuple(bool(x) for x in self.guards[t])
 
     def events(self) -> list[Event]:
         return [self.event(t) for t in range(self.src.size)]
@@ -168,15 +183,17 @@ class ElementAutomaton:
 
 def element_automaton(e: ElementSpec) -> ElementAutomaton:
     """Build the automaton of element ``e`` (see module docstring): vectorised over every
-    code of the element's variables (at most 2^20), then a breadth-first search from the
-    initial state, one frontier at a time."""
+    code of the element's variables and of the variables it reads (at most 2^20 in all),
+    then a breadth-first search from the initial state, one frontier at a time."""
     names = tuple(v.name for v in e.variables)
-    n = len(names)
-    if n > MAX_ELEMENT_VARIABLES:
-        raise InputError(f"element {e.name} has {n} variables; at most {MAX_ELEMENT_VARIABLES} are supported", e.loc)
-    index = {v: i for i, v in enumerate(names)}
-    every = np.arange(1 << n, dtype=np.int64)
-    bits = [((every >> i) & 1).astype(bool) for i in range(n)]
+    reads = e.read_names
+    n, r = len(names), len(reads)
+    if n + r > MAX_ELEMENT_VARIABLES:
+        what = f"{n} variables" + (f" and reads {r}" if r else "")
+        raise InputError(f"element {e.name} has {what}; at most {MAX_ELEMENT_VARIABLES} are supported", e.loc)
+    index = {v: i for i, v in enumerate(names + reads)}
+    every = np.arange(1 << (n + r), dtype=np.int64)  # bit i < n: own variable i; bit n + j: reads[j]
+    bits = [((every >> i) & 1).astype(bool) for i in range(n + r)]
 
     def val(name: str) -> np.ndarray:
         return bits[index[name]]
@@ -184,12 +201,16 @@ def element_automaton(e: ElementSpec) -> ElementAutomaton:
     def everywhere(x: object) -> np.ndarray:
         return np.broadcast_to(np.asarray(x, dtype=bool), every.shape)
 
-    coherent = np.ones(every.size, dtype=bool)
+    def own(mask: np.ndarray) -> np.ndarray:
+        """A mask over own codes: some value of the read variables satisfies ``mask``."""
+        return np.asarray(mask.reshape(1 << r, 1 << n).any(axis=0), dtype=bool)
+
+    coherent = np.ones(1 << n, dtype=bool)  # incoherences and held orders speak of own variables only
     for v in e.variables:
         if v.held:
-            coherent &= bits[index[v.name]] == v.initial
+            coherent &= bits[index[v.name]][: 1 << n] == v.initial
     for inc in e.incoherences:
-        coherent &= ~everywhere(evaluate(inc, val))
+        coherent &= ~everywhere(evaluate(inc, val))[: 1 << n]
 
     # per variable: the codes where it may flip, and per rule the codes where that rule makes it flip
     rule_masks: dict[int, np.ndarray] = {}
@@ -204,28 +225,29 @@ def element_automaton(e: ElementSpec) -> ElementAutomaton:
             flips.append((i, False, everywhere(True)))
             continue
         enabled = np.zeros(every.size, dtype=bool)
-        for k, r in enumerate(e.rules):
-            if r.consequence.name != v.name:
+        for k, rule in enumerate(e.rules):
+            if rule.consequence.name != v.name:
                 continue
-            mask = (bits[i] != r.consequence.rising) & (bits[index[r.cause.name]] == r.cause.rising)
-            if r.guard is not None:
-                mask &= everywhere(evaluate(r.guard, val))
+            mask = (bits[i] != rule.consequence.rising) & (bits[index[rule.cause.name]] == rule.cause.rising)
+            if rule.guard is not None:
+                mask &= everywhere(evaluate(rule.guard, val))
             for p in e.precedences:
-                if p.cause == r.cause and p.then == r.consequence:
+                if p.cause == rule.cause and p.then == rule.consequence:
                     mask &= bits[index[p.first.name]] == p.first.rising
-            rule_masks[k] = mask
+            rule_masks[k] = own(mask)
             enabled |= mask
         flips.append((i, False, enabled))
+    local_flips = [(i, ctrl, own(mask)) for i, ctrl, mask in flips]
 
     init = sum(1 << index[v.name] for v in e.variables if v.initial)
     if not coherent[init]:  # caught with a location by the rules checker; defensive here
         raise InputError(f"the initial state of element {e.name} is incoherent", e.loc)
-    seen_mask = np.zeros(every.size, dtype=bool)
+    seen_mask = np.zeros(1 << n, dtype=bool)
     seen_mask[init] = True
     frontier = np.array([init], dtype=np.int64)
     while frontier.size:
         found = []
-        for i, _, mask in flips:
+        for i, _, mask in local_flips:
             src = frontier[mask[frontier]]
             dst = src ^ (1 << i)
             found.append(dst[coherent[dst]])
@@ -234,16 +256,20 @@ def element_automaton(e: ElementSpec) -> ElementAutomaton:
         seen_mask[frontier] = True
     codes = np.nonzero(seen_mask)[0].astype(np.int64)  # the reachable codes, sorted: state k is codes[k]
     parts = []
-    for i, ctrl, mask in flips:
+    tables = []
+    for (i, ctrl, mask), (_, _, full) in zip(local_flips, flips):
         src = codes[mask[codes]]
         dst = src ^ (1 << i)
         ok = coherent[dst]
         parts.append((src[ok], dst[ok], np.full(int(ok.sum()), i, dtype=np.int64), np.full(int(ok.sum()), ctrl)))
+        if r:
+            tables.append(np.broadcast_to(full, every.shape).reshape(1 << r, 1 << n)[:, src[ok]].T)
     src_pos = np.searchsorted(codes, np.concatenate([p[0] for p in parts]))
     dst_pos = np.searchsorted(codes, np.concatenate([p[1] for p in parts]))
     var = np.concatenate([p[2] for p in parts])
     ctrl_arr = np.concatenate([p[3] for p in parts]).astype(bool)
     order = np.lexsort((dst_pos, var, src_pos))  # by source, then variable, then target
+    guards = np.concatenate(tables)[order] if r else None
     applied = {k for k, mask in rule_masks.items()
                if (mask[codes] & coherent[codes ^ (1 << index[e.rules[k].consequence.name])]).any()}
     held = {v.name: v.initial for v in e.variables if v.held}  # a rule caused by the other edge never applies, by design
@@ -260,13 +286,15 @@ def element_automaton(e: ElementSpec) -> ElementAutomaton:
         spec=e,
         warnings=tuple(
             InputError(
-                f"rule {r.text()} of element {e.name} never applies in any reachable state",
-                r.loc,
+                f"rule {rule.text()} of element {e.name} never applies in any reachable state",
+                rule.loc,
                 notes=("its guard, a precedence or the incoherences rule it out everywhere: the element will never "
-                       f"produce {r.consequence.text()} this way",),
+                       f"produce {rule.consequence.text()} this way",),
                 severity=Severity.WARNING,
             )
-            for k, r in enumerate(e.rules)
-            if k not in applied and not (held.get(r.cause.name) is not None and held[r.cause.name] != r.cause.rising)
+            for k, rule in enumerate(e.rules)
+            if k not in applied and not (held.get(rule.cause.name) is not None and held[rule.cause.name] != rule.cause.rising)
         ),
+        reads=reads,
+        guards=guards,
     )

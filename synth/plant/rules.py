@@ -25,6 +25,7 @@ from synth.logic.expr import Edge, Expr, Not
 __all__ = [
     "VarKind",
     "VarDecl",
+    "Read",
     "Rule",
     "Precedence",
     "ElementSpec",
@@ -55,6 +56,15 @@ class VarDecl:
     @property
     def is_input(self) -> bool:
         return self.kind != VarKind.ORDER
+
+
+@dataclass(frozen=True)
+class Read:
+    """``reads NAME``: a variable of another element that this element's rules may read
+    (in guards, and as the cause of a rule); it keeps its one owner."""
+
+    name: str
+    loc: Location | None = field(default=None, compare=False)
 
 
 @dataclass(frozen=True)
@@ -95,6 +105,7 @@ class ElementSpec:
     precedences: tuple[Precedence, ...] = ()
     loc: Location | None = field(default=None, compare=False)
     model: str | None = None
+    reads: tuple[Read, ...] = ()
 
     @property
     def orders(self) -> tuple[VarDecl, ...]:
@@ -106,6 +117,11 @@ class ElementSpec:
 
     def variable(self, name: str) -> VarDecl | None:
         return next((v for v in self.variables if v.name == name), None)
+
+    @property
+    def read_names(self) -> tuple[str, ...]:
+        """The other elements' variables it reads, as declared."""
+        return tuple(r.name for r in self.reads)
 
 
 @dataclass(frozen=True)

@@ -39,7 +39,7 @@ from typing import Mapping
 from synth.errors import InputError, Location, close_names, location_in
 from synth.logic.expr import Edge, Expr, NegatedEdge, NormalFormTooLarge, Var, disjunctive_normal_form, evaluate, names, renamed
 from synth.plant.library import library_file
-from synth.plant.rules import Constraint, ElementSpec, Precedence, Rule, RuleSet, VarDecl, VarKind
+from synth.plant.rules import Constraint, ElementSpec, Precedence, Read, Rule, RuleSet, VarDecl, VarKind
 from synth.plant.rules_reader import Hold, Inline, Instance, Item, Model, Use, Vector, rules_items
 from synth.syntax import Checker, VectorKind, read_source
 
@@ -79,7 +79,8 @@ class RulesChecker(Checker):
                 else:
                     self.models[it.name] = it
             elif isinstance(it, Inline):
-                self.add_element(ElementSpec(it.name, it.body.decls, it.body.incoherences, it.body.rules, it.body.precedences, it.loc))
+                self.add_element(ElementSpec(it.name, it.body.decls, it.body.incoherences, it.body.rules, it.body.precedences, it.loc,
+                                             reads=it.body.reads))
             elif isinstance(it, Instance):
                 self.instantiate(it)
             elif isinstance(it, Hold):
@@ -123,7 +124,7 @@ class RulesChecker(Checker):
                 notes=("models are defined with `model NAME { ... }`, here or in a file named by `use`",),
             )
             return
-        declared = {d.name for d in model.body.decls}
+        declared = {d.name for d in model.body.decls} | {r.name for r in model.body.reads}
         mapping: dict[str, str] = {}
         for old, new, old_loc, new_loc in inst.renaming:
             self.renamed.setdefault(new, (inst.name, old, new_loc))
@@ -275,37 +276,67 @@ class RulesChecker(Checker):
             blamed[u] = new
         self.errors.extend(e for n, e in self.unknown_uses if n not in blamed)
 
+    def check_reads(self, e: ElementSpec, owner: Mapping[str, tuple[ElementSpec, VarDecl]]) -> set[str]:
+        """The valid ``reads`` of ``e``: each a variable of another element, declared once."""
+        valid: set[str] = set()
+        foreign = [n for n, (el, _) in owner.items() if el.name != e.name]
+        for r in e.reads:
+            if r.name in valid:
+                self.fail(f"element {e.name} reads '{r.name}' twice", r.loc)
+            elif r.name not in owner:
+                self.fail(
+                    f"element {e.name} reads unknown variable '{r.name}'",
+                    r.loc,
+                    suggestions=close_names(r.name, foreign),
+                    notes=("`reads` names variables of other elements",),
+                )
+            elif owner[r.name][0].name == e.name:
+                self.fail(f"element {e.name} reads '{r.name}', but it is its own variable: no `reads` needed", r.loc)
+            else:
+                valid.add(r.name)
+        return valid
+
     def check_element(self, e: ElementSpec, owner: Mapping[str, tuple[ElementSpec, VarDecl]]) -> None:
         own = {v.name: v for v in e.variables}
+        reads = self.check_reads(e, owner)
+        readable = set(own) | reads
 
         def unknown(n: Var | Edge, role: str) -> None:
             if n.name in owner and owner[n.name][0].name != e.name:
                 other = owner[n.name][0].name
+                where = "its own variables" if role == "incoherence" else "its own variables and those it `reads`"
+                pool = own if role == "incoherence" else readable
+                notes = [f"an element's {role}s may only use {where}: {', '.join(sorted(pool))}"]
+                if role != "incoherence":
+                    notes.append(f"to read {other}'s variable, declare `reads {n.name}` in element {e.name}")
                 self.fail(
                     f"{role} of element {e.name} uses '{n.name}', which belongs to element {other}",
                     n.loc,
-                    suggestions=close_names(n.name, own),
-                    notes=(f"an element's {role}s may only use its own variables: {', '.join(sorted(own))}",),
+                    suggestions=close_names(n.name, pool),
+                    notes=tuple(notes),
                 )
             else:
-                self.fail(f"unknown variable '{n.name}' in element {e.name}", n.loc, suggestions=close_names(n.name, own))
+                self.fail(f"unknown variable '{n.name}' in element {e.name}", n.loc, suggestions=close_names(n.name, readable))
 
-        def levels_only(x: Expr, role: str) -> None:
+        def levels_only(x: Expr, role: str, allowed: set[str] | dict[str, VarDecl]) -> None:
             for n in names(x):
                 if isinstance(n, Edge):
                     self.fail(f"an edge is not allowed in a {role}; write a level", n.loc)
-                elif n.name not in own:
+                elif n.name not in allowed:
                     unknown(n, role)
 
         for inc in e.incoherences:
-            levels_only(inc, "incoherence")
+            levels_only(inc, "incoherence", own)
         for r in e.rules:
             c, q = r.cause, r.consequence
-            if c.name not in own:
+            if c.name in reads:
+                pass  # the edge of a variable it reads: the rule applies while that variable has its post-edge value
+            elif c.name not in own:
                 unknown(c, "rule")
             elif own[c.name].kind != VarKind.ORDER:
                 self.fail(
-                    f"the cause of a rule must be an edge of one of {e.name}'s orders; '{c.name}' is an input",
+                    f"the cause of a rule must be an edge of one of {e.name}'s orders (or of a variable it reads); "
+                    f"'{c.name}' is an input",
                     c.loc,
                     suggestions=close_names(c.name, [v.name for v in e.orders]),
                 )
@@ -335,9 +366,11 @@ class RulesChecker(Checker):
                     suggestions=close_names(q.name, [v.name for v in e.inputs]),
                 )
             if r.guard is not None:
-                levels_only(r.guard, "guard")
+                levels_only(r.guard, "guard", readable)
         for p in e.precedences:
             for role, x in (("cause", p.cause), ("first", p.first), ("then", p.then)):
+                if role == "cause" and x.name in reads:
+                    continue
                 if x.name not in own:
                     unknown(x, "precedence")
                 elif (own[x.name].kind == VarKind.ORDER) != (role == "cause"):
@@ -376,6 +409,7 @@ def _rename(name: str, model: Model, mapping: Mapping[str, str], loc: Location) 
         tuple(Precedence(re_(p.cause), re_(p.first), re_(p.then), p.loc) for p in b.precedences),
         loc,
         model.name,
+        tuple(Read(r(x.name), x.loc) for x in b.reads),
     )
 
 

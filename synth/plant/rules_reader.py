@@ -15,7 +15,7 @@ from typing import Iterable
 
 from synth.errors import Location
 from synth.logic.expr import Expr
-from synth.plant.rules import Constraint, Precedence, Rule, VarDecl, VarKind
+from synth.plant.rules import Constraint, Precedence, Read, Rule, VarDecl, VarKind
 from synth.syntax import ExprTransformer, Token, VectorKind, parse_tree
 
 __all__ = ["Body", "Model", "Instance", "Inline", "Use", "Hold", "Vector", "Item", "rules_items"]
@@ -29,6 +29,7 @@ class Body:
     incoherences: tuple[Expr, ...]
     rules: tuple[Rule, ...]
     precedences: tuple[Precedence, ...]
+    reads: tuple[Read, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -109,6 +110,9 @@ class _ToModel(ExprTransformer):
     def hold(self, items: list) -> Hold:
         return Hold(self._decls(items, VarKind.ORDER, held=True))
 
+    def reads(self, items: list) -> list[Read]:
+        return [Read(str(n), self._loc(n)) for n in items]
+
     def incoherent(self, items: list) -> Expr:
         return items[0]
 
@@ -128,8 +132,11 @@ class _ToModel(ExprTransformer):
         inc: list[Expr] = []
         rules: list[Rule] = []
         precs: list[Precedence] = []
+        reads: list[Read] = []
         for it in items:
-            if isinstance(it, tuple):
+            if isinstance(it, list):
+                reads.extend(it)
+            elif isinstance(it, tuple):
                 decls.extend(it)
             elif isinstance(it, Rule):
                 rules.append(it)
@@ -137,7 +144,7 @@ class _ToModel(ExprTransformer):
                 precs.append(it)
             else:
                 inc.append(it)
-        return Body(tuple(decls), tuple(inc), tuple(rules), tuple(precs))
+        return Body(tuple(decls), tuple(inc), tuple(rules), tuple(precs), tuple(reads))
 
     def model(self, items: list) -> Model:
         name, *rest = items

@@ -72,6 +72,16 @@ def _closed(p: Plant, factors: Iterable[tuple[int, np.ndarray]]) -> tuple[tuple[
     return tuple((a, p.elements[a].can_reach(v)) for a, v in factors)
 
 
+def _backward(p: Plant, grid: np.ndarray) -> np.ndarray:
+    """The states from which uncontrollable moves (guards evaluated) reach ``grid``."""
+    reach = grid.copy()
+    while True:
+        more = p.preimage(reach, controllable=False) & ~reach
+        if not more.any():
+            return reach
+        reach |= more
+
+
 def _holds(factors: Sequence[tuple[int, np.ndarray]], digits: np.ndarray) -> np.ndarray:
     """Whether a product term holds at each of the states whose digits (ndim × n) are given."""
     out = np.ones(digits.shape[1], dtype=bool)
@@ -96,6 +106,11 @@ class CompiledConstraints:
         self.terms = _terms(p, constraints)
         self.level_terms = [t for t in self.terms if t.event is None]
         self.level_reach = [_closed(p, t.factors) for t in self.level_terms]
+        # elements that read each other: "can reach" is no product of per-element closures
+        # (a move depends on other elements' values); one exact grid per term instead
+        self.reach_grids: list[np.ndarray] | None = (
+            [_backward(p, _product(p, t.factors)) for t in self.level_terms] if p.reads else None
+        )
         self.edge_terms: dict[str, list[_Term]] = {}
         for t in self.terms:
             if t.event is not None:
@@ -114,6 +129,8 @@ class CompiledConstraints:
 
     def kept(self, local: tuple[int, ...]) -> bool:
         """No constraint violation is reachable from ``local`` by uncontrollable events."""
+        if self.reach_grids is not None:
+            return not any(g[local] for g in self.reach_grids)
         return not any(all(vec[local[a]] for a, vec in factors) for factors in self.level_reach)
 
     def violated(self, local: tuple[int, ...]) -> list[str]:
@@ -122,6 +139,8 @@ class CompiledConstraints:
 
     def threatened(self, local: tuple[int, ...]) -> list[str]:
         """Ids of the constraints whose violation is reachable by uncontrollable events."""
+        if self.reach_grids is not None:
+            return list(dict.fromkeys(t.constraint for t, g in zip(self.level_terms, self.reach_grids) if g[local]))
         return self._ids(zip(self.level_terms, self.level_reach), local)
 
     def forbidding(self, event: str, local: tuple[int, ...]) -> list[str]:

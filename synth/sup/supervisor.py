@@ -70,6 +70,11 @@ class Supervisor(CompiledConstraints):
     def kept_digits(self, digits: np.ndarray) -> np.ndarray:
         """Not removed: no violation reachable by uncontrollable events."""
         bad = np.zeros(digits.shape[1], dtype=bool)
+        if self.reach_grids is not None:  # elements read each other: exact grids
+            codes = (digits * self.strides[:, None]).sum(axis=0)
+            for g in self.reach_grids:
+                bad |= g.ravel()[codes]
+            return ~bad
         for factors in self.level_reach:
             bad |= _holds(factors, digits)
         return ~bad
@@ -104,15 +109,20 @@ class Supervisor(CompiledConstraints):
                 rest[(k, a)] = r
         for t in self.plant.transitions:
             sel = digits[t.axis] == t.src
+            if t.guard is not None:
+                sel &= self.plant.enabled_digits(t, digits)
             if not sel.any():
                 continue
             src = codes[sel]
             dst = src + (t.dst - t.src) * self.strides[t.axis]
-            hits = [
-                (self.level_terms[k].constraint, rest[(k, t.axis)][sel])
-                for k, a, vec in self._on_axis[t.axis]
-                if vec[t.dst]
-            ]
+            if self.reach_grids is not None:  # the target threatened, read on the exact grids
+                hits = [(term.constraint, g.ravel()[dst]) for term, g in zip(self.level_terms, self.reach_grids)]
+            else:
+                hits = [
+                    (self.level_terms[k].constraint, rest[(k, t.axis)][sel])
+                    for k, a, vec in self._on_axis[t.axis]
+                    if vec[t.dst]
+                ]
             if t.controllable:
                 for term in self.edge_terms.get(t.event, ()):
                     hits.append((term.constraint, _holds(term.factors, digits[:, sel])))
@@ -192,6 +202,8 @@ class Supervisor(CompiledConstraints):
 
     @cached_property
     def removed(self) -> np.ndarray:
+        if self.reach_grids is not None:
+            return np.logical_or.reduce(self.reach_grids) if self.reach_grids else np.zeros(self.plant.shape, dtype=bool)
         return self._grid(self.level_reach)
 
     @cached_property
@@ -221,12 +233,13 @@ class Supervisor(CompiledConstraints):
             return out
         legal = ~self.illegal
         weak = self.removed & legal & ~self.defended
+        inside = self.plant.reachable if self.plant.reads else True  # elements reading each other: reachable states only
         out.update(
             {
-                "illegal": int(np.count_nonzero(self.illegal)),
-                "defended": int(np.count_nonzero(self.defended)),
-                "weakly_defended": int(np.count_nonzero(weak)),
-                "unreachable_removed": int(np.count_nonzero(~self.removed)) - self.size,
+                "illegal": int(np.count_nonzero(self.illegal & inside)),
+                "defended": int(np.count_nonzero(self.defended & inside)),
+                "weakly_defended": int(np.count_nonzero(weak & inside)),
+                "unreachable_removed": int(np.count_nonzero(~self.removed & inside)) - self.size,
             }
         )
         return out

@@ -239,7 +239,7 @@ def synchronous_product(
         cur = node.plant
         before = inputs(cur)
         for t in uncontrollable:
-            if t.src != cur[t.axis]:
+            if t.src != cur[t.axis] or not p.enabled(t, cur):
                 continue
             nxt = list(cur)
             nxt[t.axis] = t.dst
