@@ -15,6 +15,7 @@ TYPE_CHECKING = False  # typing.TYPE_CHECKING, without importing typing (fast --
 
 if TYPE_CHECKING:
     from synth.filter.language import Filter
+    from synth.filter.verification import Verification
 
 __all__ = ["register", "register_run", "register_verify", "register_from_rules"]
 
@@ -230,6 +231,11 @@ def register_verify(commands: "argparse._SubParsersAction") -> None:
                    help="a state outside SUP (uncontrollable events alone lead to a violation) makes the loop unsafe")
     v.add_argument("--max-states", type=int, default=1_000_000, metavar="N",
                    help="stop the exploration after N states (default 1000000)")
+    v.add_argument("--events-per-cycle", type=int, default=1, metavar="K",
+                   help="the plant makes 0..K events between two PLC scans (default 1)")
+    v.add_argument("--progress", metavar="GOAL",
+                   help="GOAL (a condition on the plant's variables, or ↑x / ↓x) stays reachable from every state "
+                        "and no fair cycle avoids it")
     v.add_argument("--json", action="store_true", help="print JSON instead of text")
     ci_options(v)
     v.set_defaults(handler=cmd_verify)
@@ -244,19 +250,55 @@ def cmd_verify(args: argparse.Namespace) -> int:
     f = _load(args.filter)
     v = verify(f, args.plant, args.grafcet, any_control=args.any_control, algorithm=Algorithm(args.algorithm),
                mode=Mode(args.mode), atomic=args.atomic_outputs, strict=args.strict, require_sup=args.require_sup,
-               max_states=args.max_states)
+               max_states=args.max_states, events_per_cycle=args.events_per_cycle, progress=args.progress)
     if args.junit or args.sarif:
         from synth.output.ci import filter_verify_report, write_ci
 
         write_ci([filter_verify_report(f, v)], args.junit, args.sarif)
     if args.json:
-        print_json(verification_json(v))
+        out = verification_json(v)
+        out["events_per_cycle"] = v.events_per_cycle
+        if args.progress is not None:
+            out["progress"] = _progress_json(v)
+        print_json(out)
     else:
-        sys.stdout.write(verification_text(v))
-    if not (v.safe and v.coherent):
+        text = verification_text(v)
+        if v.events_per_cycle != 1:
+            head, _, rest = text.partition("\n")
+            text = f"{head}\nup to {v.events_per_cycle} plant events between two scans\n{rest}"
+        sys.stdout.write(text + (_progress_text(v, args.progress) if args.progress is not None else ""))
+    if not (v.safe and v.coherent) or (v.progress is not None and not v.progress.holds):
         return 1
     if not v.complete:
         print(f"stopped: the exploration reached --max-states {args.max_states} before covering every "
-              "reachable state; nothing wrong was found in the explored part", file=sys.stderr)
+              "reachable state; nothing wrong was found in the explored part"
+              + (" (progress needs every state: not checked)" if args.progress is not None else ""), file=sys.stderr)
         return 2
     return 0
+
+
+def _progress_text(v: "Verification", goal: str) -> str:
+    """The lines of ``--progress GOAL``, after the verification's text."""
+    from synth.filter.verification import ProgressFailure
+    from synth.output.filter_text import trace_text
+
+    p = v.progress
+    if p is None:
+        return f"progress {goal}: not checked (the exploration stopped at the state limit)\n"
+    if p.holds:
+        return f"progress {goal}: holds: GOAL stays reachable from every state and no fair cycle avoids it\n"
+    if p.failure is ProgressFailure.UNREACHABLE:
+        head = f"progress {goal}: fails: GOAL cannot be reached from {p.unreachable} states"
+    else:
+        head = f"progress {goal}: fails: {p.avoiding} states lie on fair cycles that avoid GOAL"
+    return f"{head}\n\nshortest trace (progress):\n{trace_text(p.trace)}"
+
+
+def _progress_json(v: "Verification") -> dict | None:
+    p = v.progress
+    if p is None:
+        return None
+    return {"goal": p.goal, "holds": p.holds, "failure": None if p.failure is None else str(p.failure),
+            "unreachable": p.unreachable, "avoiding": p.avoiding,
+            "trace": [{"event": r.event, "state": r.state, "situation": r.situation, "requests": list(r.requests),
+                       "orders": list(r.orders), "note": r.note, "plc_ran": r.ran} for r in p.trace]}

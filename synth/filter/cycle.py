@@ -4,6 +4,8 @@ generator reproduces.
 
 Semantics (docs/filter.md, "One PLC cycle"):
 
+- *observers* declared ``observer P := EXPR`` are computed first, from the inputs, the
+  requests and the memory (any other observer is read like an input);
 - *memory*: the previous cycle's value ``x^-1`` of every input, observer and output
   of the filter (and of a request, when the file reads ``R_o^-1``), all FALSE
   initially, stored at the end of the cycle (the inputs read, the outputs produced);
@@ -185,15 +187,19 @@ class FilterCycle:
                 if not c.has_priority:
                     raise InputError(f"{c.id} is a combined constraint without priority: the loop needs "
                                      "`keep L` or `force o=v, ...` to relieve it", c.loc)
+        # observers declared ``observer P := EXPR``: computed at the start of every cycle
+        self.defined: tuple[tuple[str, Cover], ...] = tuple(
+            (d.name, _cover(e.cover(e.expr(d.definition)))) for d in flt.observers if d.definition is not None)
         covers = [*self.constraint.values(), *self.fs0.values(), *self.fs1.values(),
-                  *(c for _, c in self.equations), self.care]
+                  *(c for _, c in self.equations), self.care, *(c for _, c in self.defined)]
         used = sorted({n for cover in covers for cube in cover for n, _ in cube if is_pre(n)})
         base = [*flt.inputs, *flt.observer_names, *self.outputs]
         base += [b for b in (base_name(n) for n in used) if b not in base]
         self.remembered: tuple[str, ...] = tuple(base)
         self.used: tuple[str, ...] = tuple(b for b in self.remembered if pre_name(b) in used)
-        self.reads: tuple[str, ...] = (*flt.inputs, *flt.observer_names, *self.requests) + (
-            (ACK,) if self.mode is Mode.BLOCKING else ())
+        computed = {n for n, _ in self.defined}
+        self.reads: tuple[str, ...] = (*flt.inputs, *(n for n in flt.observer_names if n not in computed),
+                                       *self.requests) + ((ACK,) if self.mode is Mode.BLOCKING else ())
 
     # ------------------------------------------------------------------ public API
     def initial(self) -> Memory:
@@ -236,6 +242,8 @@ class FilterCycle:
                     break
             return out
 
+        for n, cover in self.defined:  # from the inputs, the requests and the memory
+            values[n] = ev(cover, values)
         requests = tuple(values[r] for r in self.requests)
         with_requests = dict(values)
         with_requests.update(zip(self.outputs, requests))

@@ -23,7 +23,8 @@ from typing import Any
 import numpy as np
 
 from synth.filter.cycle import ACK, Memory, Mode
-from synth.filter.outcomes import Outcome, OutcomeArrays, lane_bits, unpack
+from synth.errors import LimitExceeded
+from synth.filter.outcomes import Outcome, OutcomeArrays, lane_bits, react, situation_text, trace_row, unpack
 from synth.filter.product import Product
 from synth.filter.verification import Finding, FindingKind, TraceRow
 from synth.logic.events import Event
@@ -47,8 +48,8 @@ class Explorer:
     vector at once; the writes are then applied to whole arrays of (state, outcome) pairs.
     """
 
-    def __init__(self, pr: Product, max_states: int) -> None:
-        self.pr, self.max_states = pr, max_states
+    def __init__(self, pr: Product, max_states: int, events_per_cycle: int = 1, edges: bool = False) -> None:
+        self.pr, self.max_states, self.k, self.track = pr, max_states, events_per_cycle, edges
         self.size = pr.size
         self.aux_of: dict[tuple, int] = {}
         self.aux_list: list[tuple] = []
@@ -58,7 +59,17 @@ class Explorer:
         self.flat: list[int] = []  # the outcomes of every class, class after class
         self.n_out: list[int] = []
         self.arrays = OutcomeArrays(len(pr.orders))
-        self.events: list[str] = ["-"] + [e for e, _ in pr.uncontrollable]
+        # the events of a cycle: its label ("-", "↑a", "↑a, ↓b", a timer) and sequence, interned
+        self.events: list[str] = []
+        self.seqs: list[tuple[str, ...]] = []
+        self.seq_of: dict[tuple[str, ...], int] = {}
+        for seq in [(), *((e,) for e, _ in pr.uncontrollable)]:  # ids in the plant's event order
+            self.intern_seq(seq)
+        # the events the plant (and the Grafcet's timers) may not postpone forever: one bit each
+        self.fair: dict[str, int] = {e: i for i, (e, _) in enumerate(pr.uncontrollable)}
+        self.order: list[int] = []  # the nodes in the order they were found (breadth-first)
+        # (source, target, fairness bits of the events taken, events id, outcome): with --progress
+        self.edge_parts: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
         self.parent: dict[int, tuple[int, str, int]] = {}  # node -> (parent node, event, outcome)
         self.seen_keys: set[int] = set()
         self.seen_arrays: dict[int, np.ndarray] = {}
@@ -87,6 +98,21 @@ class Explorer:
             self.aux_list.append(a)
         return k
 
+    def intern_seq(self, seq: tuple[str, ...]) -> int:
+        k = self.seq_of.get(seq)
+        if k is None:
+            k = self.seq_of[seq] = len(self.seqs)
+            self.seqs.append(seq)
+            self.events.append(", ".join(seq) if seq else "-")
+        return k
+
+    def bit(self, event: str) -> int:
+        """The fairness bit of a plant event or timer (at most 64 of them, for --progress)."""
+        b = self.fair.setdefault(event, len(self.fair))
+        if b >= 64 and self.track:
+            raise LimitExceeded("--progress tracks at most 64 plant events and Grafcet timers in this closed loop")
+        return 1 << b if b < 64 else 0
+
     def seen_array(self, aux: int) -> np.ndarray:
         arr = self.seen_arrays.get(aux)
         if arr is None:
@@ -96,6 +122,7 @@ class Explorer:
     def admit_one(self, key: int) -> None:
         code = key % self.size
         self.seen_keys.add(key)
+        self.order.append(key)
         self.seen_array(key // self.size)[code] = True
         if self.pr.outside_sup[code]:
             self.outside_sup.add(code)
@@ -172,33 +199,48 @@ class Explorer:
         return k
 
     # ------------------------------------------------------------------ one level
-    def events_from(self, frontier: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Step 1 of a cycle for every node: (state after the plant's event, node, event id),
-        the event being none, an uncontrollable event of the plant, or a Grafcet timer."""
+    def events_from(self, frontier: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Step 1 of a cycle for every node: (state after the plant's events, node, events id,
+        fairness bits of the events taken). The events are none, up to ``events_per_cycle``
+        uncontrollable events of the plant in sequence (one entry per state reached, with the
+        union of the events of every sequence reaching it, the shortest shown), or a Grafcet
+        timer. A plant event into a violating state is a transient finding."""
         pr, size = self.pr, self.size
-        codes_all, auxes_all = frontier % size, frontier // size
-        post_l, node_l, event_l = [], [], []
-
-        def add(post: np.ndarray, nodes: np.ndarray, ei: int) -> None:
-            post_l.append(post)
-            node_l.append(nodes)
-            event_l.append(np.full(post.size, ei, dtype=np.int64))
-
-        for aux in np.unique(auxes_all).tolist():
-            sel = auxes_all == aux
-            codes, nodes = codes_all[sel], frontier[sel]
-            add(codes, nodes, 0)
-            for ei, (_, nxt) in enumerate(pr.uncontrollable, 1):
-                dst = nxt[codes]
+        codes0 = frontier % size
+        fi = np.arange(frontier.size, dtype=np.int64)
+        post, seq, mask = codes0, np.zeros(frontier.size, dtype=np.int64), np.zeros(frontier.size, dtype=np.uint64)
+        parts = [(fi, post, seq, mask)]
+        for _ in range(self.k):
+            found = []
+            for ev, nxt in pr.uncontrollable:
+                dst = nxt[post]
                 ok = dst >= 0
-                if ok.any():
-                    add(dst[ok], nodes[ok], ei)
-            if pr.machine is not None:
+                if not ok.any():
+                    continue
+                uniq, inv = np.unique(seq[ok], return_inverse=True)
+                ids = np.array([self.intern_seq(self.seqs[u] + (ev,)) for u in uniq.tolist()], dtype=np.int64)
+                found.append((fi[ok], dst[ok], ids[inv.ravel()], mask[ok] | np.uint64(self.bit(ev))))
+            if not found:
+                break
+            fi, post, seq, mask = _merge([np.concatenate(c) for c in zip(*found)], size, frontier,
+                                          pr.machine is not None)
+            bad = pr.illegal[post] & ~pr.illegal[codes0[fi]]
+            self.record(FindingKind.TRANSIENT, bad, post, frontier[fi], seq, None, post,
+                        lambda i: pr.violated(int(post[i])))
+            parts.append((fi, post, seq, mask))
+        fi, post, seq, mask = _merge([np.concatenate(c) for c in zip(*parts)], size, frontier, pr.machine is not None)
+        if pr.machine is not None:
+            timed = [(fi, post, seq, mask)]
+            auxes = frontier // size
+            for aux in np.unique(auxes).tolist():
+                where = np.nonzero(auxes == aux)[0]
                 for tev in pr.machine.timers(self.aux_list[aux][2]):
-                    if tev not in self.events:
-                        self.events.append(tev)
-                    add(codes, nodes, self.events.index(tev))
-        return np.concatenate(post_l), np.concatenate(node_l), np.concatenate(event_l)
+                    timed.append((where, codes0[where], np.full(where.size, self.intern_seq((tev,)), dtype=np.int64),
+                                  np.full(where.size, self.bit(tev), dtype=np.uint64)))
+            fi, post, seq, mask = (np.concatenate(c) for c in zip(*timed))
+            by_aux = np.argsort(auxes[fi], kind="stable")  # a node's timers after its plant events
+            fi, post, seq, mask = fi[by_aux], post[by_aux], seq[by_aux], mask[by_aux]
+        return post, frontier[fi], seq, mask
 
     def classify(self, post: np.ndarray, node: np.ndarray, event: np.ndarray) -> np.ndarray:
         """Steps 2-3: the class of each (state after the event, node, event)."""
@@ -206,6 +248,8 @@ class Explorer:
         ybits = np.zeros(post.size, dtype=np.int64)
         for i, n in enumerate(pr.ynames):
             ybits |= pr.val[n][post].astype(np.int64) << i
+        if pr.machine is None:  # the events matter only to a Grafcet
+            event = np.zeros_like(event)
         combo = ((node // self.size) * len(self.events) + event) * (1 << width) + ybits
         uniq, inverse = np.unique(combo, return_inverse=True)
         class_ids = np.empty(uniq.size, dtype=np.int64)
@@ -214,7 +258,7 @@ class Explorer:
             ei, aux = rest % len(self.events), rest // len(self.events)
             sit = self.aux_list[aux][2]
             if pr.machine is not None:
-                sit = _react(pr, sit, self.events[ei], yb)
+                sit = react(pr, sit, self.seqs[ei], yb)
             class_ids[u] = self.outcomes_for(yb, aux, sit)
         return class_ids[inverse]
 
@@ -257,17 +301,18 @@ class Explorer:
     def level(self, frontier: np.ndarray) -> np.ndarray:
         """Every cycle from the nodes of ``frontier``; returns the new nodes."""
         pr, size = self.pr, self.size
-        post, node, event = self.events_from(frontier)
-        # a plant event into a violating state, before the PLC writes (a violation the
-        # node already had is reported for the node)
-        bad = (event > 0) & pr.illegal[post] & ~pr.illegal[node % size]
-        self.record(FindingKind.TRANSIENT, bad, post, node, event, None, post, lambda i: pr.violated(int(post[i])))
+        post, node, event, taken = self.events_from(frontier)
         cls = self.classify(post, node, event)
         n_out = np.array(self.n_out, dtype=np.int64)
         self.cycles += int(n_out[cls].sum())
         # one expansion per distinct (state, class); the first occurrence is the parent
-        _, keep = np.unique(post * len(self.n_out) + cls, return_index=True)
-        keep.sort()
+        _, keep, rep = np.unique(post * len(self.n_out) + cls, return_index=True, return_inverse=True)
+        by_position = np.argsort(keep)
+        keep = keep[by_position]
+        position = np.empty_like(by_position)
+        position[by_position] = np.arange(by_position.size)
+        rep = position[rep.ravel()]  # the kept entry that stands for each (state, class)
+        sources, taken_all, events_all = node, taken, event
         post, node, event, cls = post[keep], node[keep], event[keep], cls[keep]
         # one entry per (state, outcome of its class)
         reps = n_out[cls]
@@ -297,7 +342,23 @@ class Explorer:
             dist = (requests[oid] != targets).sum(axis=1)
             self.corrected += int((dist > 0).sum())
             self.max_distance = max(self.max_distance, int(dist.max()))
+        if self.track:
+            self.edges((sources, taken_all, events_all), rep, entry[ok], aux_after[oid][ok] * size + final[ok],
+                       oid[ok], keep.size)
         return self.admit(aux_after[oid][ok] * size + final[ok], node[ok], event[ok], oid[ok])
+
+    def edges(self, entries: tuple[np.ndarray, np.ndarray, np.ndarray], rep: np.ndarray, succ_rep: np.ndarray,
+              succ_key: np.ndarray, succ_oid: np.ndarray, reps: int) -> None:
+        """Every edge of the product (for --progress): each (node, events) entry gets the
+        successors (and outcomes) of the entry that stands for its (state, class)."""
+        sources, taken, events = entries
+        counts = np.bincount(succ_rep, minlength=reps)
+        starts = np.cumsum(counts) - counts
+        by_rep = np.argsort(succ_rep, kind="stable")
+        n = counts[rep]
+        pick = np.repeat(starts[rep], n) + np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)
+        self.edge_parts.append((np.repeat(sources, n), succ_key[by_rep][pick], np.repeat(taken, n),
+                                np.repeat(events, n), succ_oid[by_rep][pick]))
 
     def admit(self, keys: np.ndarray, node: np.ndarray, event: np.ndarray, oid: np.ndarray) -> np.ndarray:
         """The nodes of ``keys`` not seen before (their first occurrence is the parent)."""
@@ -329,10 +390,10 @@ class Explorer:
         rows = []
         while key in self.parent:
             pk, ev, g = self.parent[key]
-            rows.append(_row(self.pr, self.outcomes[g], ev, key % self.size, self.aux_list[key // self.size][2]))
+            rows.append(trace_row(self.pr, self.outcomes[g], ev, key % self.size, self.aux_list[key // self.size][2]))
             key = pk
         rows.append(TraceRow("initial", self.pr.label(key % self.size),
-                             _sit_text(self.aux_list[key // self.size][2]), (), ()))
+                             situation_text(self.aux_list[key // self.size][2]), (), ()))
         return rows[::-1]
 
     def findings(self) -> dict[FindingKind, Finding]:
@@ -349,7 +410,7 @@ class Explorer:
                                      False))
             else:
                 oc = self.outcomes[g]
-                rows.append(_row(self.pr, oc, ev, code, self.aux_list[oc.aux][2], _NOTES[kind]))
+                rows.append(trace_row(self.pr, oc, ev, code, self.aux_list[oc.aux][2], _NOTES[kind]))
             out[kind] = Finding(kind, ids, tuple(rows), len(self.counts[kind]))
         if self.first_outside_sup is not None:
             key = self.first_outside_sup
@@ -361,31 +422,17 @@ class Explorer:
         return {k: out[k] for k in FindingKind if k in out}
 
 
-def _react(pr: Product, sit: Any, event: str, ybits: int) -> Any:
-    """The Grafcet's stable situation after ``event`` (a plant event, a timer, or none)."""
-    assert pr.machine is not None
-    values = {n: bool((ybits >> i) & 1) for i, n in enumerate(pr.ynames)}
-    inputs = {n: values[n] for n in pr.grafcet_inputs}
-    if event == "-":
-        return sit
-    ev = Event(event)
-    if ev.kind.value == "timer":
-        return pr.machine.fire_timer(sit, ev, inputs)
-    if ev.name not in inputs:
-        return sit
-    return pr.machine.react_event(sit, ev, inputs)[0]
-
-
-def _sit_text(sit: Any) -> str:
-    return "" if sit is None else sit.text()
-
-
-def _row(pr: Product, oc: Outcome, event: str, code: int, sit: Any, note: str = "") -> TraceRow:
-    req = tuple(o for o, v in zip(pr.orders, oc.requests) if v)
-    out = tuple(o for o, v in zip(pr.orders, oc.targets) if v)
-    extra = []
-    if oc.violated:
-        extra.append("requests violate " + ", ".join(oc.violated))
-    if note:
-        extra.append(note)
-    return TraceRow(event, pr.label(code), _sit_text(sit), req, out, "; ".join(extra))
+def _merge(arrays: list[np.ndarray], size: int, frontier: np.ndarray, by_events: bool) -> list[np.ndarray]:
+    """(node index, state, events id, bits) with one row per (node index, state) -- and
+    events, ``by_events`` (a Grafcet reacts to the events) --: the first row's events, the
+    union of the rows' bits; in the search's order (by the node's aux, the events, the node)."""
+    fi, post, seq, mask = arrays
+    order = np.lexsort((np.arange(fi.size), seq if by_events else np.zeros_like(seq), post, fi))
+    same = (fi[order][1:] == fi[order][:-1]) & (post[order][1:] == post[order][:-1])
+    if by_events:
+        same &= seq[order][1:] == seq[order][:-1]
+    starts = np.flatnonzero(np.concatenate(([True], ~same)))
+    first = order[starts]
+    fi, post, seq, mask = fi[first], post[first], seq[first], np.bitwise_or.reduceat(mask[order], starts)
+    again = np.lexsort((fi, seq, frontier[fi] // size))
+    return [fi[again], post[again], seq[again], mask[again]]

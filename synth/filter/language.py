@@ -68,12 +68,15 @@ class Sense(StrEnum):
 
 @dataclass(frozen=True)
 class Declared:
-    """A declared name; ``grafcet`` is the file of an observer computed from a Grafcet."""
+    """A declared name; ``grafcet`` is the file of an observer computed from a Grafcet;
+    ``definition`` the expression of an observer declared ``observer P := EXPR`` (over
+    inputs, requests and past values, evaluated at the start of every cycle)."""
 
     name: str
     kind: VarKind
     loc: Location | None = field(default=None, compare=False)
     grafcet: str | None = None
+    definition: Expr | None = None
 
 
 @dataclass(frozen=True)

@@ -72,7 +72,8 @@ class _FilterChecker(Checker):
         self.engine: "Engine | None" = None
 
     # ---- declarations
-    def declare(self, name: str, kind: VarKind, loc: Location | None, grafcet: str | None = None) -> None:
+    def declare(self, name: str, kind: VarKind, loc: Location | None, grafcet: str | None = None,
+                definition: Expr | None = None) -> None:
         if name in self.declared:
             first = self.declared[name]
             if first.kind is kind and loc is None:  # a plant's vector repeated in the filter
@@ -80,7 +81,7 @@ class _FilterChecker(Checker):
             where = f" at {first.loc}" if first.loc else " by the plant"
             self.fail(f"'{name}' is declared twice", loc, notes=(f"first declared as {first.kind.value}{where}",))
             return
-        self.declared[name] = Declared(name, kind, loc, grafcet)
+        self.declared[name] = Declared(name, kind, loc, grafcet, definition)
 
     def use(self, u: Use) -> None:
         from synth.plant.rules_check import load_rules
@@ -202,6 +203,20 @@ class _FilterChecker(Checker):
             return None
         return forced
 
+    def observer_definition(self, d: Declared) -> None:
+        """``observer P := EXPR``: inputs and requests at t, anything at t-1 (no output or
+        observer at t: the observer is computed before the outputs, from the cycle's reads)."""
+        if d.definition is None or not self.known(d.definition, f"the definition of observer {d.name}"):
+            return
+        observers = self.of_kind(VarKind.OBSERVER)
+        for v in names(d.definition):
+            if v.name in self.of_kind(VarKind.OUTPUT) or v.name in observers:
+                what = "output" if v.name not in observers else "observer"
+                self.fail(f"observer {d.name} cannot read the {what} '{v.name}' at t", v.loc,
+                          notes=(f"an observer is computed from the inputs, the requests and past values: "
+                                 f"write {v.name}^-1",))
+                return
+
     def assumption(self, a: Assumption) -> Assumption | None:
         if not self.known(a.expr, "an assumption"):
             return None
@@ -244,7 +259,7 @@ class _FilterChecker(Checker):
                 for n, loc in it.names:
                     self.declare(n, it.kind, loc)
             elif isinstance(it, Declared):
-                self.declare(it.name, it.kind, it.loc, it.grafcet)
+                self.declare(it.name, it.kind, it.loc, it.grafcet, it.definition)
         outputs = self.of_kind(VarKind.OUTPUT)
         for o in outputs:
             r = request_name(o)
@@ -255,6 +270,8 @@ class _FilterChecker(Checker):
         if not outputs:
             self.fail("no outputs declared", location_in(self.file, self.source, 1, 1),
                       notes=("declare them with `outputs A0, A1, ...` or `use` a plant",))
+        for d in self.of_kind(VarKind.OBSERVER):
+            self.observer_definition(self.declared[d])
         ids: dict[str, Safety] = {}
         simmed: set[str] = set()
         eqs: dict[str, Equation] = {}

@@ -73,6 +73,10 @@ class _ToFilter(ExprTransformer):
     def observer(self, items: list) -> tuple[Declared, ...]:
         return tuple(items)
 
+    def defined(self, items: list) -> Declared:
+        name, e = items
+        return Declared(str(name), VarKind.OBSERVER, self._loc(name), None, e)
+
     def assume(self, items: list) -> Assumption:
         (e,) = items
         return Assumption(e, _first_loc(e))

@@ -1,7 +1,7 @@
 """The outcomes of one PLC cycle in ``synth filter verify``'s exploration: an outcome
 (the orders written, the memory after the cycle, the flags), the arrays over every
-outcome found so far, and the lane masks of :meth:`~synth.filter.cycle.FilterCycle.lanes`
-as numpy arrays.
+outcome found so far, the lane masks of :meth:`~synth.filter.cycle.FilterCycle.lanes`
+as numpy arrays, the Grafcet's reaction to a cycle's events and a trace row.
 
 Example
 -------
@@ -17,11 +17,18 @@ Example
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Sequence
+from typing import Any, Sequence
 
 import numpy as np
 
-__all__ = ["Outcome", "OutcomeArrays", "unpack", "lane_bits"]
+from synth.filter.verification import TraceRow
+from synth.logic.events import Event, EventKind
+
+TYPE_CHECKING = False
+if TYPE_CHECKING:
+    from synth.filter.product import Product
+
+__all__ = ["Outcome", "OutcomeArrays", "unpack", "lane_bits", "react", "situation_text", "trace_row"]
 
 
 @dataclass(frozen=True)
@@ -70,3 +77,40 @@ class OutcomeArrays:
             self.outside = np.concatenate((self.outside, np.array([o.outside_care for o in new], dtype=bool)))
             self.aux = np.concatenate((self.aux, np.array([o.aux for o in new], dtype=np.int64)))
         return self.targets, self.fallback, self.outside, self.aux, self.requests
+
+
+def react(pr: "Product", sit: Any, events: tuple[str, ...], ybits: int) -> Any:
+    """The Grafcet's stable situation after a cycle's ``events``: a timer, or plant events
+    (none, one, or up to ``--events-per-cycle``); the Grafcet reacts to each event on one
+    of its inputs in turn, with the inputs as they were just after it."""
+    assert pr.machine is not None
+    values = {n: bool((ybits >> i) & 1) for i, n in enumerate(pr.ynames)}
+    inputs = {n: values[n] for n in pr.grafcet_inputs}
+    if len(events) == 1 and Event(events[0]).kind is EventKind.TIMER:
+        return pr.machine.fire_timer(sit, events[0], inputs)
+    after: list[dict[str, bool]] = []
+    for e in reversed(events):  # the inputs after each event, from the last one back
+        after.append(dict(inputs))
+        ev = Event(e)
+        if ev.name in inputs:
+            inputs[ev.name] = not ev.rising
+    for e, seen in zip(events, reversed(after)):
+        if Event(e).name in seen:
+            sit = pr.machine.react_event(sit, Event(e), seen)[0]
+    return sit
+
+
+def situation_text(sit: Any) -> str:
+    return "" if sit is None else sit.text()
+
+
+def trace_row(pr: "Product", oc: Outcome, event: str, code: int, sit: Any, note: str = "") -> TraceRow:
+    """One cycle of a trace: its events, the plant state after the write, the requests and orders."""
+    req = tuple(o for o, v in zip(pr.orders, oc.requests) if v)
+    out = tuple(o for o, v in zip(pr.orders, oc.targets) if v)
+    extra = []
+    if oc.violated:
+        extra.append("requests violate " + ", ".join(oc.violated))
+    if note:
+        extra.append(note)
+    return TraceRow(event, pr.label(code), situation_text(sit), req, out, "; ".join(extra))

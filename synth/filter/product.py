@@ -69,9 +69,9 @@ class Product:
         self.steps: tuple[str, ...] = () if self.grafcet is None else tuple(s.name for s in self.grafcet.steps)
         observable = {f"X{s}" for s in self.steps}
         for d in f.observers:
-            if d.name not in observable:
-                raise InputError(f"observer {d.name} has no value in verify: only step variables of the "
-                                 "--grafcet Grafcet can be observed", d.loc)
+            if d.name not in observable and d.definition is None:
+                raise InputError(f"observer {d.name} has no value in verify: define it (`observer {d.name} := "
+                                 "EXPR`) or make it a step variable of the --grafcet Grafcet", d.loc)
         size, shape = p.size, p.shape
         self.size = size
         self.val = {v: np.broadcast_to(p.values(v), shape).ravel().copy() for v in p.variables}

@@ -17,7 +17,8 @@ from enum import StrEnum
 
 from synth.filter.cycle import Algorithm, Mode
 
-__all__ = ["ANY_CONTROL", "FindingKind", "UNSAFE", "INCOHERENT", "TraceRow", "Finding", "Verification"]
+__all__ = ["ANY_CONTROL", "FindingKind", "UNSAFE", "INCOHERENT", "TraceRow", "Finding", "ProgressFailure",
+           "Progress", "Verification"]
 
 ANY_CONTROL = "any control"
 """The request source of ``--any-control`` (otherwise the source is the Grafcet's file)."""
@@ -67,6 +68,30 @@ class Finding:
     count: int
 
 
+class ProgressFailure(StrEnum):
+    """How ``--progress GOAL`` fails."""
+
+    UNREACHABLE = "unreachable"  # a reachable state from which no path reaches GOAL
+    AVOIDED = "avoided"  # a fair cycle of the closed loop that never meets GOAL
+
+
+@dataclass(frozen=True)
+class Progress:
+    """The outcome of ``--progress GOAL``: the states from which GOAL cannot be reached,
+    the states on a fair cycle avoiding it, and the shortest trace of the first failure
+    (to the first such state; for a cycle, then once around it)."""
+
+    goal: str
+    unreachable: int
+    avoiding: int
+    failure: ProgressFailure | None = None
+    trace: tuple[TraceRow, ...] = ()
+
+    @property
+    def holds(self) -> bool:
+        return self.failure is None
+
+
 @dataclass(frozen=True)
 class Verification:
     """The outcome of :func:`~synth.filter.closed_loop.verify`."""
@@ -87,6 +112,8 @@ class Verification:
     findings: dict[FindingKind, Finding] = field(default_factory=dict)
     corrected: int = 0  # cycles where O != R (with a Grafcet: the transparency)
     max_distance: int = 0
+    events_per_cycle: int = 1  # the plant makes 0..K events between two scans
+    progress: Progress | None = None  # with --progress (None: not asked, or the exploration stopped)
 
     @property
     def safe(self) -> bool:
