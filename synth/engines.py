@@ -108,11 +108,13 @@ def validate(
     max_states: int | None = None,
     max_nodes: int | None = None,
     progress: Callable[[str], None] | None = None,
+    semantics: str = "grafcet",
 ) -> Validation:
     """``synth validate``: load, choose the engine, run it. ``needs_listing``: ``--report``
     or ``--cor`` will list every aggregated state (explicit engine only; with ``--engine
     symbolic`` an error before any input is read); ``max_states`` bounds the explicit
-    engine, ``max_nodes`` the symbolic one; ``progress`` receives progress lines."""
+    engine, ``max_nodes`` the symbolic one; ``progress`` receives progress lines;
+    ``semantics`` ``sfc`` (one evolution per PLC scan) runs on the explicit engine."""
     from synth.grafcet.language_check import load_grafcet
     from synth.plant.composition import plant
     from synth.plant.rules_check import load_rules
@@ -120,9 +122,9 @@ def validate(
     asked = choose(engine, 0, needs_listing=True) if needs_listing else EngineChoice(engine)
     rs = load_rules(rules_path)
     p = plant(rs)
-    g = load_grafcet(grafcet_path, inputs=p.inputs, outputs=p.outputs)
+    g = load_grafcet(grafcet_path, inputs=p.inputs, outputs=p.outputs, semantics=semantics)
     estimate = p.size * max(1, len(g.steps))
-    if p.reads and asked == EngineChoice.AUTO:  # elements read each other: explicit engine only
+    if (p.reads or semantics != "grafcet") and asked == EngineChoice.AUTO:  # explicit engine only
         asked = EngineChoice.EXPLICIT
     if asked != EngineChoice.EXPLICIT and choose(asked, estimate, width=concurrency(g)) == EngineChoice.SYMBOLIC:
         from synth.grafcet.situation import OutOfRange

@@ -108,13 +108,13 @@ def random_grafcet(seed: int, data: bool = False) -> str:
     return "\n".join(lines) + "\n"
 
 
-def check_seed(seed: int, depth: int = 3, data: bool = False) -> tuple[int, int, int, str]:
+def check_seed(seed: int, depth: int = 3, data: bool = False, semantics: str = "grafcet") -> tuple[int, int, int, str]:
     """The differential check of ``random_grafcet(seed)`` (compact ST): (seed, sequences,
     cycles, mismatch text or ""). A top-level function, so a process pool can run it."""
     from synth.codegen.check import differential_check
     from synth.codegen.grafcet_st import generate_program
     from synth.grafcet.language_check import parse_grafcet
 
-    g = parse_grafcet(random_grafcet(seed, data), f"random{seed}.g7")
+    g = parse_grafcet(random_grafcet(seed, data), f"random{seed}.g7", semantics=semantics)
     report = differential_check(g, depth=depth, program=generate_program(g, version="test", comments=False))
     return seed, report.sequences, report.cycles, "" if report.ok else report.text()

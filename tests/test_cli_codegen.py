@@ -126,7 +126,8 @@ def test_import_error_exit_2_with_caret_and_no_output_file(capsys, tmp_path):
     out = tmp_path / "out.g7"
     code, stdout, err = run(capsys, "import", bad, "-o", out)
     assert (code, stdout) == (2, "")
-    assert err.splitlines()[0] == f"{bad}:76:15: error: action qualifier SD cannot be represented in .g7"
+    assert err.splitlines()[0] == (f"{bad}:76:15: error: action qualifier SD (stored and timed) cannot be represented "
+                                   "in .g7: a .g7 timer belongs to a step, not to a stored action")
     assert err.splitlines()[2].endswith("^~~~~~~")
     assert not out.exists()
 

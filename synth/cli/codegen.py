@@ -36,11 +36,12 @@ def _load(args: argparse.Namespace) -> tuple["Grafcet", dict[str, bool], list[st
         from synth.plant.rules_check import load_rules
 
         rs = load_rules(args.plant)
-        grafcet = load_grafcet(args.file, inputs=rs.inputs, outputs=rs.outputs)
+        grafcet = load_grafcet(args.file, inputs=rs.inputs, outputs=rs.outputs,
+                               semantics=getattr(args, "semantics", "grafcet"))
         initial = {v.name: v.initial for v in rs.variables if v.is_input}
         sources.append(args.plant)
     else:
-        grafcet = load_grafcet(args.file)
+        grafcet = load_grafcet(args.file, semantics=getattr(args, "semantics", "grafcet"))
     return grafcet, {n: initial.get(n, False) for n in grafcet.inputs}, sources
 
 
@@ -163,6 +164,9 @@ def register(sub: "argparse._SubParsersAction") -> None:
     p.add_argument("file", metavar="FILE.g7", help="the Grafcet")
     p.add_argument("--plant", metavar="RULES", help="plant .rules file: its inputs/outputs (and initial inputs)")
     p.add_argument("--filter", metavar="FILTER", help="a .filter file: its FUNCTION_BLOCK runs after the Grafcet")
+    p.add_argument("--semantics", choices=("grafcet", "sfc"), default="grafcet",
+                   help="grafcet: evolve to stability in every PLC cycle (IEC 60848; default); sfc: one evolution "
+                        "per cycle (IEC 61131-3 SFC), as the PLC runs an imported SFC")
     p.add_argument("--name", metavar="NAME", help="the PROGRAM's name (default: the file's stem)")
     p.add_argument("-o", "--output", metavar="FILE", help="write to FILE (default: standard output)")
     p.add_argument("--xml", action="store_true", help="PLCopen TC6 XML instead of ST text (--target plcopen)")

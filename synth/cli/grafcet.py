@@ -40,11 +40,11 @@ def _load(args: argparse.Namespace) -> tuple[Grafcet, dict[str, bool], Callable[
         from synth.plant.rules_check import load_rules
 
         rs = load_rules(args.plant)
-        grafcet = load_grafcet(args.file, inputs=rs.inputs, outputs=rs.outputs)
+        grafcet = load_grafcet(args.file, inputs=rs.inputs, outputs=rs.outputs, semantics=args.semantics)
         initial = {v.name: v.initial for v in rs.variables if v.is_input}
         admissible = plant(rs).admissible_inputs()
     else:
-        grafcet = load_grafcet(args.file)
+        grafcet = load_grafcet(args.file, semantics=args.semantics)
     initial = {n: initial.get(n, False) for n in grafcet.inputs}
     if args.initial:
         from synth.grafcet.simulation import parse_initial
@@ -91,10 +91,15 @@ def cmd_run(args: argparse.Namespace) -> int:
     return 0
 
 
+SEMANTICS_HELP = ("how the Grafcet evolves: grafcet (IEC 60848, search for stability; default) or sfc "
+                  "(IEC 61131-3 SFC, one evolution per PLC scan: the meaning of an imported PLC program)")
+
+
 def _common(p: argparse.ArgumentParser) -> None:
     p.add_argument("file", metavar="FILE.g7", help="the Grafcet")
     p.add_argument("--plant", metavar="RULES", help="plant .rules file: its inputs/outputs and initial input values")
     p.add_argument("--initial", metavar="X=1,...", help="initial input values (default: the plant's, else all 0)")
+    p.add_argument("--semantics", choices=("grafcet", "sfc"), default="grafcet", help=SEMANTICS_HELP)
 
 
 def register(sub: "argparse._SubParsersAction") -> None:

@@ -29,6 +29,7 @@ def register(sub: "argparse._SubParsersAction") -> None:
     v.add_argument("--json", action="store_true", help="print the result as JSON (docs/validate-json.md)")
     v.add_argument("--cor", metavar="FILE", help="write the reduced controller as JSON to FILE and DOT beside it")
     v.add_argument("--max-states", metavar="N", type=int, help="stop after N aggregated states (explicit engine)")
+    v.add_argument("--semantics", choices=("grafcet", "sfc"), default="grafcet", help=SEMANTICS_HELP)
     v.add_argument("--engine", choices=("auto", "explicit", "symbolic"), default="auto",
                    help="explicit exploration, BDDs (for many actuators moving at once), or chosen by "
                         "estimated size (default; docs/symbolic.md)")
@@ -37,6 +38,10 @@ def register(sub: "argparse._SubParsersAction") -> None:
     v.add_argument("--junit", metavar="FILE", help="also write the findings as JUnit XML (one test case per finding)")
     v.add_argument("--sarif", metavar="FILE", help="also write the findings as SARIF 2.1.0 (one result per finding)")
     v.set_defaults(handler=cmd_validate)
+
+
+SEMANTICS_HELP = ("how the Grafcet evolves: grafcet (IEC 60848, search for stability; default) or sfc "
+                  "(IEC 61131-3 SFC, one evolution per PLC scan: the meaning of an imported PLC program)")
 
 
 def cmd_validate(args: argparse.Namespace) -> int:
@@ -65,6 +70,7 @@ def cmd_validate(args: argparse.Namespace) -> int:
         max_states=args.max_states,
         max_nodes=args.max_nodes,
         progress=show,
+        semantics=args.semantics,
     )
     clear_progress(show)
     if result.engine_stats is not None and not args.quiet:

@@ -40,7 +40,7 @@ from synth.errors import InputError, SynthError
 from synth.grafcet.language import Grafcet
 from synth.grafcet.machine import GrafcetMachine, Situation
 from synth.grafcet.situation import OutOfRange
-from synth.logic.events import Event
+from synth.logic.events import Event, EventKind
 
 __all__ = ["Aspect", "Mismatch", "DifferentialReport", "ProgramRunner", "InterpretedProgram", "differential_check",
            "require_blark"]
@@ -235,8 +235,11 @@ class _Checker:
 
     # ------------------------------------------------------------------ exploration
     def events(self, side: _Side) -> list[tuple[Event, int]]:
-        """Input events (every input), then the next timer to elapse with its delay."""
+        """Input events (every input), then the next timer to elapse with its delay, then (IEC
+        61131-3 SFC) a scan without input change when one would evolve the situation."""
         out = [(Event.edge(n, not side.inputs[n]), 0) for n in self.g.inputs]
+        if self.machine.scans(side.sit, side.inputs):
+            out.append((Event.scan(), 0))
         running = [t for t in self.machine.timers(side.sit)]
         if running:
             elapsed = set(side.sit.elapsed)
@@ -259,6 +262,9 @@ class _Checker:
                 after[event.name] = event.rising
                 sit, rounds = self.machine.react_with_trace(side.sit, side.inputs, after)
                 inputs, now = after, side.now
+            elif event.kind is EventKind.SCAN:
+                sit, rounds = self.machine.scan(side.sit, side.inputs)
+                inputs, now = side.inputs, side.now
             else:
                 inputs = side.inputs
                 now = side.now + delay

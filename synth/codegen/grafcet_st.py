@@ -75,6 +75,7 @@ from synth.grafcet.language import (
     STORED,
     Action,
     Grafcet,
+    Semantics,
     Step,
     StoredWhen,
     step_variable,
@@ -179,7 +180,9 @@ class _Writer:
             self.emit(line)
         if self.alias:
             self.emit(f"(* {renamed_note(self.alias)} *)")
-        self.emit("(* One PLC cycle: read inputs, evolve to stability (IEC 60848), "
+        evolve = ("one evolution (IEC 61131-3 SFC)" if self.g.semantics is Semantics.SFC
+                  else "evolve to stability (IEC 60848)")
+        self.emit(f"(* One PLC cycle: read inputs, {evolve}, "
                   + ("run the filter, " if self.filt else "") + "write outputs. *)")
         if self.filt is not None:
             self.emit()
@@ -358,6 +361,8 @@ class _Writer:
             e(f"_RE_{self.st(i)} := FALSE;", 1)
         for i in self.falling:
             e(f"_FE_{self.st(i)} := FALSE;", 1)
+        if self.g.semantics is Semantics.SFC:
+            e("_Fired := FALSE; (* IEC 61131-3 SFC: one evolution per PLC cycle *)", 1)
         e("END_WHILE;")
         e()
         orders = "_Order_" if self.filt is not None else ""

@@ -160,6 +160,8 @@ def stable_situation_automaton(
             reader = InputRecorder(partial(valuation, v))
             if event.kind is EventKind.TIMER:
                 result = machine.fire_timer_with_trace(sits[k], event, reader)[0]
+            elif event.kind is EventKind.SCAN:
+                result = machine.scan(sits[k], reader)[0]
             else:
                 result = machine.react_event(sits[k], event, reader)[0]
             target = known(result)
@@ -199,7 +201,7 @@ def stable_situation_automaton(
                     if target != k:
                         m = moves.setdefault((k, label), {})
                         m[target] = m.get(target, 0) | cubes.flip(vecs, i)
-        for t in timers[k]:
+        for t in timers[k] + ((Event.scan(),) if machine.sfc else ()):
             for target, vecs in classify(k, t, todo).items():
                 add(target, vecs)
                 if target != k:

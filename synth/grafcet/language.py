@@ -41,6 +41,7 @@ __all__ = [
     "step_of",
     "ActionKind",
     "StoredWhen",
+    "Semantics",
     "CONTINUOUS",
     "CONDITIONAL",
     "STORED",
@@ -77,6 +78,14 @@ class StoredWhen(StrEnum):
     ACTIVATION = "activation"
     DEACTIVATION = "deactivation"
     EVENT = "event"
+
+
+class Semantics(StrEnum):
+    """How the Grafcet evolves (docs/grafcet.md, "Semantics"): IEC 60848 with search for
+    stability (``grafcet``, the default), or IEC 61131-3 SFC, one evolution per PLC scan (``sfc``)."""
+
+    GRAFCET = "grafcet"
+    SFC = "sfc"
 
 
 CONTINUOUS, CONDITIONAL, STORED = ActionKind.CONTINUOUS, ActionKind.CONDITIONAL, ActionKind.STORED
@@ -298,6 +307,7 @@ class Grafcet:
     timers: tuple[Timer, ...] = ()
     path: str = "<grafcet>"
     internals: tuple[Internal, ...] = ()
+    semantics: Semantics = Semantics.GRAFCET
 
     @property
     def steps(self) -> tuple[Step, ...]:

@@ -30,6 +30,7 @@ unknown step 9
 from __future__ import annotations
 
 import re
+from dataclasses import replace
 from pathlib import Path
 from typing import Sequence
 
@@ -45,6 +46,7 @@ from synth.grafcet.language import (
     Internal,
     Sum,
     PartialGrafcet,
+    Semantics,
     Step,
     Timer,
     Transition,
@@ -397,9 +399,12 @@ def parse_grafcet(
     *,
     inputs: Sequence[str] | None = None,
     outputs: Sequence[str] | None = None,
+    semantics: Semantics | str = Semantics.GRAFCET,
 ) -> Grafcet:
-    """Parse and check ``.g7`` text; ``inputs``/``outputs`` are the plant's, if known."""
-    return GrafcetChecker(file, source, inputs, outputs).check(grafcet_items(source, file))
+    """Parse and check ``.g7`` text; ``inputs``/``outputs`` are the plant's, if known;
+    ``semantics``: how it evolves (IEC 60848, or IEC 61131-3 SFC)."""
+    g = GrafcetChecker(file, source, inputs, outputs).check(grafcet_items(source, file))
+    return g if Semantics(semantics) is Semantics.GRAFCET else replace(g, semantics=Semantics(semantics))
 
 
 def load_grafcet(
@@ -407,6 +412,7 @@ def load_grafcet(
     *,
     inputs: Sequence[str] | None = None,
     outputs: Sequence[str] | None = None,
+    semantics: Semantics | str = Semantics.GRAFCET,
 ) -> Grafcet:
     """Read, parse and check a ``.g7`` file (see :func:`parse_grafcet`)."""
-    return parse_grafcet(read_source(path), str(path), inputs=inputs, outputs=outputs)
+    return parse_grafcet(read_source(path), str(path), inputs=inputs, outputs=outputs, semantics=semantics)

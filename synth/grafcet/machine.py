@@ -56,6 +56,7 @@ from synth.grafcet.language import (
     STORED,
     Action,
     Grafcet,
+    Semantics,
     StoredWhen,
     Transition,
     receptivity_inputs,
@@ -81,6 +82,7 @@ class GrafcetMachine:
         self.outputs: tuple[str, ...] = grafcet.outputs
         self.read_inputs: tuple[str, ...] = grafcet.read_inputs
         self.settle_initial = settle_initial
+        self.sfc = grafcet.semantics is Semantics.SFC  # one evolution (round) per PLC scan
         self.transitions: tuple[Transition, ...] = grafcet.transitions
         steps = {s.name for s in grafcet.steps}
         timers = {t.id for t in grafcet.timers}
@@ -155,6 +157,15 @@ class GrafcetMachine:
         rounds: list[tuple[Transition, ...]] = []
         self._settle(st, after, event, rounds)
         return self._situation(st), tuple(rounds)
+
+    def scan(self, sit: Situation, inputs: Mapping[str, bool]) -> tuple[Situation, tuple[tuple[Transition, ...], ...]]:
+        """``--semantics sfc``: the situation after one PLC scan in which no input changed
+        (one round of the transitions fireable on the levels ``inputs``), with the round fired."""
+        return self.react_event(sit, None, inputs)
+
+    def scans(self, sit: Situation, inputs: Mapping[str, bool]) -> bool:
+        """``--semantics sfc``: whether a scan without input change evolves ``sit``."""
+        return self.sfc and bool(self.fireable(sit, inputs))
 
     def timers(self, sit: Situation) -> tuple[Event, ...]:
         """Timer events that can occur now (sorted): the step is active, the timer has not
@@ -359,15 +370,21 @@ class GrafcetMachine:
                 return
             history.append(fire)
             rounds.append(fire)
-            deact = {s for t in fire for s in t.sources}
-            act = {s for t in fire for s in t.targets}
-            left = deact - act
-            entered = act - st.active
-            st.active = (st.active - deact) | act
-            for s in left:
-                st.elapsed -= set(self._timers_of_step.get(s, ()))
-            self._stored_phase(st, left, ON_DEACTIVATION)
-            self._stored_phase(st, entered, ON_ACTIVATION)
+            self._fire(st, fire)
+            if self.sfc:  # IEC 61131-3 SFC: this round is the scan's one evolution
+                return
+
+    def _fire(self, st: State, fire: tuple[Transition, ...]) -> None:
+        """Rules 3 and 5: fire ``fire`` at once, with the stored actions and assignments."""
+        deact = {s for t in fire for s in t.sources}
+        act = {s for t in fire for s in t.targets}
+        left = deact - act
+        entered = act - st.active
+        st.active = (st.active - deact) | act
+        for s in left:
+            st.elapsed -= set(self._timers_of_step.get(s, ()))
+        self._stored_phase(st, left, ON_DEACTIVATION)
+        self._stored_phase(st, entered, ON_ACTIVATION)
 
     def _never_stable(self, cycle: list[tuple[Transition, ...]], inputs: Mapping[str, bool]) -> None:
         steps = sorted_steps({s for fire in cycle for t in fire for s in (*t.sources, *t.targets)})

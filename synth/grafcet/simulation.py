@@ -107,6 +107,10 @@ def inputs_text(values: Mapping[str, bool], names: Sequence[str]) -> str:
     return ", ".join(ones) if ones else "-"
 
 
+MAX_SCANS = 100
+"""``--semantics sfc``: at most this many scans without input change are shown after an event."""
+
+
 def simulate(grafcet: Grafcet, inputs: Mapping[str, bool], events: Sequence[tuple[Event, Location]]) -> list[SimulationStep]:
     """Run ``events`` from the initial situation; an event that cannot happen now (an
     input already at that level, a timer not running) is an :class:`InputError` at its
@@ -121,12 +125,27 @@ def simulate(grafcet: Grafcet, inputs: Mapping[str, bool], events: Sequence[tupl
     except OutOfRange as err:
         raise with_trace(err, ()) from None
     rows = [SimulationStep("initial", sit, ordered(sit), ())]
+
+    def scans() -> None:
+        """``--semantics sfc``: the PLC scans until no transition is fireable (or the
+        situation repeats, as a level self-loop jump does every scan)."""
+        nonlocal sit
+        seen = {sit}
+        while machine.scans(sit, inputs) and len(seen) <= MAX_SCANS:
+            sit, rounds = machine.scan(sit, inputs)
+            rows.append(SimulationStep(str(Event.scan()), sit, ordered(sit), tuple(tuple(t.name for t in r) for r in rounds)))
+            if sit in seen:
+                return
+            seen.add(sit)
+
     for event, loc in events:
+        scans()
         try:
             sit, rounds, inputs = _one_event(machine, grafcet, sit, inputs, event, loc)
         except OutOfRange as err:
             raise with_trace(err, [r.event for r in rows[1:]] + [str(event)]) from None
         rows.append(SimulationStep(str(event), sit, ordered(sit), tuple(tuple(t.name for t in r) for r in rounds)))
+    scans()
     return rows
 
 

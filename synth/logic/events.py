@@ -23,12 +23,14 @@ __all__ = ["EventKind", "Event", "parse_event", "event_text", "RISE_MARKS", "FAL
 
 RISE_MARKS = ("↑", "^")  # printed mark first, ASCII spelling second
 FALL_MARKS = ("↓", "_")
+SCAN_TEXT = "scan"
 
 
 class EventKind(StrEnum):
     RISE = "rise"  # a variable goes 0 → 1
     FALL = "fall"  # a variable goes 1 → 0
     TIMER = "timer"  # ``t/Xi`` becomes true
+    SCAN = "scan"  # a PLC cycle with no input change (IEC 61131-3 SFC: one evolution per scan)
 
 
 class Event(str):
@@ -57,6 +59,11 @@ class Event(str):
     def timer(cls, timer_id: str) -> Event:
         return cls(timer_id)
 
+    @classmethod
+    def scan(cls) -> Event:
+        """A PLC scan in which no input changed (``--semantics sfc``)."""
+        return cls(SCAN_TEXT)
+
     @property
     def kind(self) -> EventKind:
         head = self[:1]
@@ -64,11 +71,13 @@ class Event(str):
             return EventKind.RISE
         if head == FALL_MARKS[0]:
             return EventKind.FALL
+        if self == SCAN_TEXT:
+            return EventKind.SCAN
         return EventKind.TIMER
 
     @property
     def is_edge(self) -> bool:
-        return self.kind is not EventKind.TIMER
+        return self.kind in (EventKind.RISE, EventKind.FALL)
 
     @property
     def rising(self) -> bool:
@@ -92,6 +101,8 @@ def parse_event(text: str) -> Event:
     ('↑dcy', '↓v10', 'timer')
     """
     t = text.strip()
+    if t == SCAN_TEXT:
+        return Event.scan()
     if t[:1] in RISE_MARKS:
         return Event.rise(t[1:].strip())
     if t[:1] in FALL_MARKS:

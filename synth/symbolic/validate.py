@@ -22,7 +22,8 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Callable, Iterator, Sequence
 
-from synth.grafcet.language import Grafcet
+from synth.errors import SynthError
+from synth.grafcet.language import Grafcet, Semantics
 from synth.grafcet.machine import GrafcetMachine
 from synth.logic.bdd import Function
 from synth.logic.expr import evaluate
@@ -158,6 +159,8 @@ def validate_loaded(
     progress: Callable[[str], None] | None = None,
 ) -> Validation:
     """:func:`validate_symbolic` on a rule set, its plant and a Grafcet already loaded."""
+    if g.semantics is not Semantics.GRAFCET:
+        raise SynthError(f"--semantics {g.semantics} runs on the explicit engine: use --engine explicit (or auto)")
     with _cyclic_gc_paused():
         return _validate_loaded(rs, p, g, expert=expert, homes=homes, max_nodes=max_nodes, progress=progress)
 

@@ -258,6 +258,12 @@ def synchronous_product(
             note_conflicts(i, timer, rounds)
             for j in enter(sit, cur):
                 edges.append(Edge(i, timer, j))
+        if machine.scans(node.situation, before):  # --semantics sfc: the PLC scans again
+            happening[:] = [Event.scan()]
+            sit, rounds = machine.scan(node.situation, before)
+            note_conflicts(i, happening[0], rounds)
+            for j in enter(sit, cur):
+                edges.append(Edge(i, happening[0], j))
 
     try:
         sit0 = machine.initial(inputs(p.initial))
