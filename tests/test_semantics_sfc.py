@@ -50,6 +50,11 @@ def test_run_shows_every_scan_and_a_level_self_loop_is_legal(cli, chain):
     assert code == 2 and "the Grafcet never stabilises: transient cycle through steps 1" in err
 
 
+def test_the_ass_lists_the_situations_after_each_scan(cli, chain):
+    code, out, _ = cli("ass", chain, "--semantics", "sfc")
+    assert code == 0 and out.splitlines()[0] == f"ASS of {chain}: 6 situations after a PLC scan (--semantics sfc), 15 transitions"
+
+
 def test_the_ass_has_a_scan_event_where_the_plc_evolves_without_input_change():
     g = parse_grafcet(CHAIN, "chain.g7", semantics="sfc")
     ass = stable_situation_automaton(GrafcetMachine(g))

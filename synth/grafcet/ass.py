@@ -56,6 +56,7 @@ class ASS:
     initial: int = 0
     inputs: tuple[str, ...] = ()
     initial_inputs: tuple[tuple[str, bool], ...] = field(default=())
+    per_scan: bool = False  # --semantics sfc: the situations after each PLC scan, not stable ones
 
     def state_of(self, sit: Situation) -> ASSState:
         for s in self.states:
@@ -230,4 +231,4 @@ def stable_situation_automaton(
             on = by_target[target] & domain
             trans.append(ASSTransition(k, label, condition_text(cubes, on, domain & ~on, read, free), target))
     trans.sort(key=lambda t: (t.source, rank.get(t.event, len(rank)), t.event, t.target))
-    return ASS(tuple(states), tuple(trans), 0, read, tuple((n, base[n]) for n in read))
+    return ASS(tuple(states), tuple(trans), 0, read, tuple((n, base[n]) for n in read), machine.sfc)

@@ -165,7 +165,8 @@ def sup_text(data: Mapping[str, Any], labels: Mapping[str, str], empty_why: str 
 def ass_text(ass: "ASS", title: str = "") -> str:
     """The ASS as a readable listing."""
     lines = []
-    head = f"ASS{' of ' + title if title else ''}: {len(ass.states)} stable situations, {len(ass.transitions)} transitions"
+    kind = "situations after a PLC scan (--semantics sfc)" if ass.per_scan else "stable situations"
+    head = f"ASS{' of ' + title if title else ''}: {len(ass.states)} {kind}, {len(ass.transitions)} transitions"
     lines.append(head)
     lines.append("inputs explored: " + (", ".join(ass.inputs) if ass.inputs else "none"))
     if any(s.conditional for s in ass.states):
