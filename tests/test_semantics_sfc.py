@@ -3,6 +3,7 @@ in run, ass, validate and st; its generated ST equal to synth run, interpreted a
 
 from __future__ import annotations
 
+import json
 import sys
 from pathlib import Path
 
@@ -70,7 +71,11 @@ def test_validate_the_box_sorting_as_the_plc_runs_it(cli):
     code, out, _ = cli("validate", g7, "--plant", rules, "--semantics", "sfc")
     assert code == 1
     assert out.splitlines()[0] == ("FAIL: 2 blocking situation(s), 4 situation(s) with prohibited orders  [designer mode; "
-                                   "SYNC 372 states, aggregated 221 states / 657 transitions]")
+                                   "IEC 61131-3 SFC semantics; SYNC 372 states, aggregated 221 states / 657 transitions]")
+    data = json.loads(cli("validate", g7, "--plant", rules, "--semantics", "sfc", "--json")[1])
+    assert data["semantics"] == "sfc" and "semantics" not in json.loads(cli("validate", g7, "--plant", rules, "--json")[1])
+    jsonschema = pytest.importorskip("jsonschema")
+    jsonschema.validate(data, json.loads((ROOT / "synth/output/schemas/validate.json").read_text()))
     assert " scan " in out.splitlines()[6]  # the trace holds a PLC scan without input change
     assert cli("validate", g7, "--plant", rules, "--semantics", "sfc", "--engine", "explicit")[1] == out
     code, _, err = cli("validate", g7, "--plant", rules, "--semantics", "sfc", "--engine", "symbolic")

@@ -80,9 +80,11 @@ def validation_json(v: Validation) -> dict[str, Any]:
         d["diagnosis"] = v.diagnoses[b].as_dict()
         blocking.append(d)
     prohibited = [d for i in a.prohibited for d in prohibited_json(v, i)]
+    semantics = {"semantics": str(v.grafcet.semantics)} if v.grafcet.semantics == "sfc" else {}
     return {
         "verdict": "pass" if v.passed else "fail",
         "mode": "expert" if v.expert else "designer",
+        **semantics,
         "grafcet": v.grafcet.path,
         "plant": v.rules.path,
         "sup_empty": v.sup_empty,
@@ -113,7 +115,9 @@ def validation_text(v: Validation) -> str:
     head = "PASS" if v.passed else "FAIL"
     lines = [
         f"{head}: {len(a.blocking)} blocking situation(s), {len(a.prohibited)} situation(s) with prohibited orders"
-        f"  [{'expert' if v.expert else 'designer'} mode; SYNC {st['sync_states']} states, "
+        f"  [{'expert' if v.expert else 'designer'} mode; "
+        + ("IEC 61131-3 SFC semantics; " if v.grafcet.semantics == "sfc" else "")
+        + f"SYNC {st['sync_states']} states, "
         f"aggregated {st['aggregated_states']} states / {st['aggregated_transitions']} transitions]"
     ]
     if v.sup_empty:
