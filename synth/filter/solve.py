@@ -26,10 +26,10 @@ Example (004 eqs. 4-13)
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Callable, Sequence
+from typing import Sequence
 
 from synth.errors import InputError, LimitExceeded
-from synth.logic.bdd import CoverTooLarge, Cube, Function, cube_text
+from synth.logic.bdd import CoverTooLarge, Cube, Engine, Function, cube_text
 from synth.filter.language import Criterion, Filter, Sense, SimCriterion, request_name
 from synth.logic.past import pre_name
 from synth.filter.model import FilterFunctions, equation_functions, functions
@@ -197,18 +197,14 @@ def synthesis(f: Filter | FilterFunctions, order: Sequence[str] | None = None, *
     e, outs = m.engine, m.outputs
     steps = [(c, e.expr(c.expr)) for c in (criteria(m.filter, order) if applied is None else applied)]
 
-    def narrowed(admissible: Function, c: Criterion, u: Function) -> Function:
-        if c.sense is Sense.MAX:
-            best = e.exists(outs, admissible & u)
-        else:
-            best = e.forall(outs, ~admissible | u)
-        return admissible & u.equiv(best)
-
-    states = [m.assumed & ~m.forbidden]
-    for c, u in steps:
-        states.append(narrowed(states[-1], c, u))
+    inner = [e.declare(o) for o in outs]
+    goods = [u if c.sense is Sense.MAX else ~u for c, u in steps]  # Min(c) is Max(!c)
+    states, bests = [m.assumed & ~m.forbidden], []
+    for g in goods:  # Max(g): S := S ∧ (g ↔ ∃O.(S∧g)), the ∃ in one and-abstract pass
+        bests.append(e.and_exists(states[-1], g, inner))
+        states.append(states[-1] & g.equiv(bests[-1]))
     admissible = states[-1]
-    verdicts = [Applied(c, states[i + 1] != states[i], _effect(i, steps, states, narrowed, e.false))
+    verdicts = [Applied(c, states[i + 1] != states[i], _effect(i, goods, states, bests, e, inner))
                 for i, (c, _) in enumerate(steps)]
     care = e.exists(outs, admissible)
     result = Synthesis(m, admissible, care, verdicts)
@@ -242,23 +238,29 @@ def synthesis(f: Filter | FilterFunctions, order: Sequence[str] | None = None, *
     return result
 
 
-def _effect(i: int, steps: Sequence[tuple[Criterion, Function]], states: Sequence[Function],
-            narrowed: Callable[[Function, Criterion, Function], Function], false: Function) -> bool:
-    """Whether the final filter differs without criterion ``i`` (which narrows it where it
-    stands): the later criteria are re-applied from ``states[i]``, reusing the chain — it
-    has no effect as soon as the re-narrowed set rejoins the chain (the rest is the chain's
-    own computation), and has one as soon as it lost part of the final set (narrowing only
-    removes), so most criteria are decided within a few steps instead of all the later ones."""
+def _effect(i: int, goods: Sequence[Function], states: Sequence[Function], bests: Sequence[Function],
+            e: Engine, inner: Sequence[str]) -> bool:
+    """Whether the final filter differs without criterion ``i`` (each criterion read as
+    ``Max(g)``, ``Min(c)`` as ``Max(!c)``; ``bests[j]`` is ``∃O.(S_j ∧ g_j)``).
+
+    Narrowing acts on each Y alone. Where ``i`` narrows, it splits ``S_i(Y)`` into the kept
+    part (the chain goes on with it) and the dropped part ``Z``; without ``i`` the later
+    criteria narrow their union, and they keep the chain's part alone (no effect there) as
+    soon as a criterion finds a solution in the chain's part and none in ``Z``, while the
+    filter differs as soon as one finds a solution in ``Z`` and none in the chain's part,
+    or when ``Z`` survives to the end. So ``Z`` is narrowed alongside the chain, each Y
+    dropped once decided: most criteria are decided within a step or two, on a ``Z``
+    much smaller than the chain's sets."""
     if states[i + 1] == states[i]:
         return False
-    final = states[-1]
-    without = states[i]
-    for j in range(i + 1, len(steps)):
-        without = narrowed(without, *steps[j])
-        if without == states[j + 1]:
-            return False
-        if (final & ~without) != false:
+    dropped = states[i] & ~states[i + 1]
+    for j in range(i + 1, len(goods)):
+        own = e.and_exists(dropped, goods[j], inner)
+        if (own & ~bests[j]) != e.false:
             return True
+        dropped &= ~(bests[j] & ~own) & goods[j].equiv(own)
+        if dropped == e.false:
+            return False
     return True
 
 
