@@ -88,8 +88,8 @@ grafcet G1 {
      "x.xml:73:13: error: an FBD block TON in a transition condition: only AND, OR and NOT have a Boolean meaning "
      "in .g7"),
     ('<reference name="LOWER" />', "<inline><ST><xhtml xmlns=\"http://www.w3.org/1999/xhtml\">Cnt := Cnt + 1;</xhtml>"
-     "</ST></inline>", "x.xml:60:73: error: an assignment of data in an action body (Cnt := Cnt + 1;): .g7 actions "
-     "set Boolean outputs; internal integer variables are not read yet"),
+     "</ST></inline>", "x.xml:60:73: error: an assignment of data in an action body (Cnt := Cnt + 1;): Cnt is not a "
+     "local variable of an integer type (.g7 internal variables are the chart's own)"),
     ('<connection refLocalId="2" />', '<connection refLocalId="77" />',
      "x.xml:46:17: error: connection to unknown localId 77"),
 ])
@@ -221,8 +221,8 @@ def test_a_twincat3_export_with_step_actions_in_vendor_data_equals_the_chart_by_
      "x.xml:90:61: error: a call of the block instance Timer in action Opening_active (Timer(IN := bIsOpen, PT := "
      "T#1s)): .g7 runs no function blocks (its timers time a step's activity: 2s/X1)"),
     ("bMotorOpen := TRUE;</xhtml>", "nCount := nCount + 1;</xhtml>",
-     "x.xml:90:61: error: an assignment of data in action Opening_active (nCount := nCount + 1): .g7 actions set "
-     "Boolean outputs; internal integer variables are not read yet"),
+     "x.xml:90:61: error: an assignment of data in action Opening_active (nCount := nCount + 1): nCount is not a "
+     "local variable of an integer type (.g7 internal variables are the chart's own)"),
     ("IF (bOpenCmd = TRUE) AND NOT bIsOpen THEN", "IF bOpenCmd OR bIsOpen THEN",
      "x.xml:80:3: error: IF bOpenCmd OR bIsOpen in action Idle_active: only a condition that is a conjunction of "
      "inputs (a AND NOT b) has a rising edge .g7 can write"),

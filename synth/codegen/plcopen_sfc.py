@@ -18,6 +18,7 @@ import re
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
+from synth.codegen.plcopen_data import DATA
 from synth.codegen.plcopen_vendor import step_actions
 from synth.codegen.plcopen_fbd import FBD_ELEMENTS, fbd_condition, fbd_transition
 from synth.codegen.plcopen_xml import SYNTH_DATA
@@ -91,6 +92,7 @@ class Chart:
     steps: list[_ImportedStep]
     transitions: list[tuple[str, list[str], list[str], str, object]]
     warnings: list[InputError] = field(default_factory=list)
+    internals: list[str] = field(default_factory=list)  # internal declarations (.g7 text)
 
 
 _SECTIONS = ("inputVars", "outputVars", "inOutVars", "localVars", "tempVars", "externalVars")
@@ -104,9 +106,15 @@ def _check_names(pou: Any, q: Callable[[str], str], src: Source, transitions: li
     for section in _SECTIONS:
         for v in pou.iterfind(f"{q('interface')}/{q(section)}/{q('variable')}"):
             declared.setdefault(str(v.get("name")), (section, v))
+    scope = DATA.get()
     for i, (label, sources, targets, expr, el) in enumerate(transitions):
         for name in dict.fromkeys(re.findall(r"(?<![\w/])[A-Za-z_]\w*", expr)):
             if name.startswith("X") and name[1:] in steps or name in inputs:
+                continue
+            if scope is not None and name.upper() in scope.used:
+                continue
+            if scope is not None and name in scope.globals_in.values():
+                inputs.append(name)
                 continue
             if name not in declared:
                 raise InputError(f"a transition reads '{name}', which the POU {pou.get('name')} does not declare",
