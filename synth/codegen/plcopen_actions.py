@@ -63,6 +63,8 @@ def _order(name: str, where: Location) -> str:
                              "chart's variables, not another block's", where)
         return scope.global_name(name, True, where)
     v = scope.find(name)
+    if v is None and name.upper() in scope.inputs:
+        return scope.input_written(name, where)
     return v.name if v is not None else scope.spelling.get(name.upper(), name)
 
 
@@ -101,9 +103,6 @@ def action_body(name: str, text: str, qualifier: IecQualifier, where: Callable[[
     ``qualifier``; ``where(offset, width)`` locates a character of ``text``."""
     if qualifier == IecQualifier.R:
         raise InputError(f"qualifier R on action {name}: a reset action has no body to run in .g7", where(0, 1))
-    scope = DATA.get()
-    if scope is not None and name in scope.timer_actions:
-        return []
     when = " on deactivation" if qualifier == IecQualifier.P0 else ""
     clean = re.sub(r"\(\*.*?\*\)|//[^\n]*", lambda c: re.sub(r"[^\n]", " ", c[0]), text, flags=re.S)
     out: list[str] = []
@@ -156,6 +155,10 @@ def _level_if(name: str, m: re.Match[str], where: Callable[[int, int], Location]
     body = m["body"]
     while body[pos:].strip():
         pos += len(body[pos:]) - len(body[pos:].lstrip())
+        end = body.find(";", pos)
+        if _timer_statement(" ".join(body[pos:end if end >= 0 else len(body)].split()), body_at + pos, where):
+            pos = end + 1 if end >= 0 else len(body)
+            continue
         a = _ASSIGN.match(body, pos)
         d = None if a else _DATA.match(body, pos)
         found = _data(d, body_at, where) if d else None
@@ -171,6 +174,8 @@ def _level_if(name: str, m: re.Match[str], where: Callable[[int, int], Location]
                              "X := TRUE;, X := FALSE; and assignments of internal variables are read",
                              where(body_at + pos, 1))
         pos = (a or d).end()  # type: ignore[union-attr]
+    if not actions:  # only a TON made a step timer
+        return []
     cond = ExprReader(m["cond"], lambda o, w: where(start + o, w), steps, "an action's IF").whole()
     edge = rising(cond[1:-1] if cond.startswith("(") and cond.endswith(")") else cond)
     if not edge or any(f"X{s}" in re.findall(r"\w+", edge) for s in steps.values()):

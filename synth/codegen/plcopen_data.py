@@ -56,6 +56,7 @@ class DataVar:
     initial: int
     documented: bool  # synth's own export: its range is the .g7 one
     el: Any
+    output: bool = False  # an integer output: .g7 outputs are Boolean
 
     @property
     def boolean(self) -> bool:
@@ -75,9 +76,11 @@ class DataScope:
     used: dict[str, DataVar] = field(default_factory=dict)
     timers: dict[str, str] = field(default_factory=dict)  # upper-case alias -> .g7 timer (50ms/XS)
     timer_blocks: set[str] = field(default_factory=set)  # upper-case TON instances made step timers
-    timer_actions: set[str] = field(default_factory=set)  # POU actions read as step timers
+    ton_charts: list[tuple[str, str, str, str, str, Any, str]] = field(default_factory=list)  # TONs as grafcets
     spelling: dict[str, str] = field(default_factory=dict)  # upper-case name -> declared name
     global_lists: set[str] = field(default_factory=set)  # upper-case names of the project's global lists
+    inputs: set[str] = field(default_factory=set)  # upper-case names of the POU's inputVars
+    inputs_out: dict[str, str] = field(default_factory=dict)  # an input the chart assigns -> its output
     globals_out: dict[str, str] = field(default_factory=dict)  # dotted name -> .g7 output name
     globals_in: dict[str, str] = field(default_factory=dict)  # dotted name -> .g7 input name
     warnings: list[InputError] = field(default_factory=list)
@@ -89,7 +92,7 @@ class DataScope:
             if not v.documented:
                 kind = "bool" if v.boolean else f"{v.low}..{v.high}"
                 self.warnings.append(InputError(
-                    f"local variable {v.name} ({v.iec}) of POU {self.pou}, assigned by its actions, is the internal "
+                    f"{'output' if v.output else 'local variable'} {v.name} ({v.iec}) of POU {self.pou}, assigned by its actions, is the internal "
                     f"variable {v.name} : {kind} = {v.initial}" + ("" if v.boolean else
                                                                     ": give it the range it really has"),
                     self.at(v.el), severity=Severity.WARNING))
@@ -105,6 +108,17 @@ class DataScope:
                 f"the global {dotted} is {'assigned' if output else 'read'} here: .g7 names have no dot, so it is "
                 f"the {'output' if output else 'input'} {flat}", where, severity=Severity.WARNING))
         return flat
+
+    def input_written(self, name: str, where: Location) -> str:
+        """An input the chart assigns: the output ``NAME_out``, with a warning once."""
+        declared = self.spelling.get(name.upper(), name)
+        if declared not in self.inputs_out:
+            self.inputs_out[declared] = f"{declared}_out"
+            self.warnings.append(InputError(
+                f"the chart assigns its input {declared}: .g7 inputs are read only, so it assigns the output "
+                f"{declared}_out (bind it to what writes {declared}; transitions still read the input)", where,
+                severity=Severity.WARNING))
+        return self.inputs_out[declared]
 
     def declarations(self) -> list[str]:
         return [v.text() for v in self.used.values()]
@@ -132,12 +146,14 @@ def data_scope(pou: Any, q: Callable[[str], str], at: Callable[[Any], Location],
     scope.global_lists = {str(g.get("name", "")).upper() for g in pou.getroottree().iter(q("globalVars"))
                           if g.get("name")}
     written = set().union(*(assigned_names(b) for b in bodies)) if bodies else set()
-    for var in pou.iterfind(f"{q('interface')}/{q('localVars')}/{q('variable')}"):
+    scope.inputs = {str(v.get("name", "")).upper() for v in pou.iterfind(f"{q('interface')}/{q('inputVars')}/{q('variable')}")}
+    outputs = list(pou.iterfind(f"{q('interface')}/{q('outputVars')}/{q('variable')}"))
+    for var in [*pou.iterfind(f"{q('interface')}/{q('localVars')}/{q('variable')}"), *outputs]:
         typ = var.find(q("type"))
         kinds = [c for c in (typ if typ is not None else []) if isinstance(c.tag, str)]
         iec = kinds[0].tag.rsplit("}", 1)[-1] if len(kinds) == 1 else ""
         name = str(var.get("name", ""))
-        if iec not in IEC_RANGES or name.upper() in exclude:
+        if iec not in IEC_RANGES or name.upper() in exclude or (var in outputs and iec == "BOOL"):
             continue
         doc = " ".join("".join(d.itertext()).split()) if (d := var.find(q("documentation"))) is not None else ""
         m = re.fullmatch(r"internal (-?\d+)\.\.(-?\d+)|internal (Boolean)", doc)
@@ -154,7 +170,8 @@ def data_scope(pou: Any, q: Callable[[str], str], at: Callable[[Any], Location],
                 raise InputError(f"the initial value '{init.get('value')}' of {name} is not a {iec} in {low}..{high}",
                                  at(init))
             initial = found
-        scope.vars[name.upper()] = DataVar(name, iec, low, high, max(low, min(high, initial)), m is not None, var)
+        scope.vars[name.upper()] = DataVar(name, iec, low, high, max(low, min(high, initial)), m is not None, var,
+                                           var in outputs)
     return scope
 
 

@@ -167,7 +167,9 @@ def import_sfc(data: bytes | str, file: str = "<xml>", pou: str | None = None,
             DATA.reset(token3)
         charts[-1].warnings.extend(action_warnings + scope.warnings)
         charts[-1].internals = scope.declarations()
-        charts[-1].outputs.extend(n for n in scope.globals_out.values() if n not in charts[-1].outputs)
+        charts[-1].outputs[:] = [o for o in charts[-1].outputs if o.upper() not in scope.used]
+        charts[-1].outputs.extend(n for n in [*scope.globals_out.values(), *scope.inputs_out.values()]
+                                  if n not in charts[-1].outputs)
     if warnings is not None:
         warnings += [w for c in charts for w in c.warnings]
     return _g7_text(charts, file, several)

@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 from typing import Any, Callable
 
 from synth.codegen.plcopen_data import DATA
+from synth.codegen.plcopen_timers import ton_chart
 from synth.codegen.plcopen_vendor import step_actions
 from synth.codegen.plcopen_fbd import FBD_ELEMENTS, fbd_condition, fbd_transition
 from synth.codegen.plcopen_xml import SYNTH_DATA
@@ -341,8 +342,13 @@ def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
                 f"a jump from step {sources[0]} back to itself on a level condition ({expr}): IEC 61131-3 SFC "
                 "re-activates the step at every PLC scan while it holds, IEC 60848 (.g7) never stabilises there",
                 src.at(el), severity=Severity.WARNING, notes=("make the condition an edge, or add a step",)))
+    helpers: list[_ImportedStep] = []
+    scope = DATA.get()
+    for gname, hsteps, htrans in ton_chart(scope, by_sfc_name, src.text_at) if scope is not None else []:
+        helpers += [_ImportedStep(n, initial, [], gname, pou) for n, initial in hsteps]
+        transitions += [("", a, b, expr, pou) for a, b, expr in htrans]
     _declare_predicates(inputs, warnings)
-    _check_names(pou, q, src, transitions, {st.name for st in steps.values()}, inputs, outputs, warnings)
+    _check_names(pou, q, src, transitions, {st.name for st in [*steps.values(), *helpers]}, inputs, outputs, warnings)
     written_by_synth = any(st.grafcet for st in steps.values())  # its .g7 is the meaning: no rewriting
     for d, members in branches.items():  # IEC 61131-3: the first true branch, left to right; .g7: every one
         if len(members) < 2 or written_by_synth:
@@ -374,7 +380,7 @@ def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
             owner.actions.extend(read_action(a, src, by_sfc_name, q, pou_actions, owner.name))
 
     # partial grafcets: synth's addData, else the connected components
-    parent: dict[str, str] = {s.name: s.name for s in steps.values()}
+    parent: dict[str, str] = {s.name: s.name for s in [*steps.values(), *helpers]}
 
     def find(x: str) -> str:
         while parent[x] != x:
@@ -396,4 +402,4 @@ def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
             groups[find(s.name)] = f"G{len(set(groups.values())) + 1}"
     order = sorted(steps.values(), key=lambda s: int(s.el.sourceline or 0))  # type: ignore[attr-defined]
     _declare_predicates(inputs, warnings)  # those met in the actions' conditions
-    return Chart(str(pou.get("name", "")), inputs, outputs, order, transitions, warnings)
+    return Chart(str(pou.get("name", "")), inputs, outputs, order + helpers, transitions, warnings)

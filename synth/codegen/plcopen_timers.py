@@ -26,7 +26,7 @@ from synth.codegen.plcopen_vendor import IecQualifier, StepAction, step_actions
 from synth.codegen.st_condition import st_text
 from synth.errors import InputError, Location, Severity
 
-__all__ = ["duration", "prepare_scope"]
+__all__ = ["duration", "prepare_scope", "ton_chart"]
 
 _MS = {"ms": 1, "s": 1000, "m": 60_000, "h": 3_600_000, "d": 86_400_000}
 
@@ -57,22 +57,24 @@ def _locals(pou: Any, q: Callable[[str], str]) -> dict[str, tuple[str, Any]]:
     return out
 
 
-def _timer_idiom(text: str, local: dict[str, tuple[str, Any]], q: Callable[[str], str]) -> tuple[str, str, str] | None:
-    """(T, V, duration) when ``text`` is ``T(IN:=TRUE, PT:=D); V := T.Q;``."""
+def _timer_idiom(text: str, local: dict[str, tuple[str, Any]],
+                 q: Callable[[str], str]) -> tuple[str, str, str, str] | None:
+    """(T, V, duration, IN) when ``text`` calls the TON ``T(IN:=x, PT:=D)`` (x not FALSE)
+    and assigns ``V := T.Q``."""
     statements = [" ".join(s.split()) for s in strip_comments(text).split(";") if s.strip()]
-    if len(statements) != 2:
-        return None
-    call = re.fullmatch(r"(\w+) ?\( ?IN ?:= ?TRUE ?, ?PT ?:= ?([\w#.]+) ?\)", statements[0], re.I)
-    alias = re.fullmatch(r"(\w+) ?:= ?(\w+)\.Q", statements[1], re.I)
-    if call is None or alias is None or alias[2].upper() != call[1].upper():
-        return None
-    if local.get(call[1].upper(), ("",))[0] != "TON":
-        return None
-    pt = duration(call[2])
-    if pt is None and local.get(call[2].upper(), ("",))[0] == "TIME":
-        init = local[call[2].upper()][1].find(f"{q('initialValue')}/{q('simpleValue')}")
-        pt = duration(str(init.get("value", ""))) if init is not None else None
-    return (call[1], alias[1], pt) if pt is not None else None
+    for i, statement in enumerate(statements):
+        call = re.fullmatch(r"(\w+) ?\( ?IN ?:= ?(.+?) ?, ?PT ?:= ?([\w#.]+) ?\)", statement, re.I)
+        if call is None or call[2].upper() == "FALSE" or local.get(call[1].upper(), ("",))[0] != "TON":
+            continue
+        alias = [m for s in statements[i + 1:] if (m := re.fullmatch(r"(\w+) ?:= ?(\w+)\.Q", s, re.I))
+                 and m[2].upper() == call[1].upper()]
+        pt = duration(call[3])
+        if pt is None and local.get(call[3].upper(), ("",))[0] == "TIME":
+            init = local[call[3].upper()][1].find(f"{q('initialValue')}/{q('simpleValue')}")
+            pt = duration(str(init.get("value", ""))) if init is not None else None
+        if len(alias) == 1 and pt is not None:
+            return call[1], alias[0][1], pt, call[2]
+    return None
 
 
 def prepare_scope(pou: Any, sfc: Any, q: Callable[[str], str], at: Callable[[Any], Location], prefix: str,
@@ -84,7 +86,7 @@ def prepare_scope(pou: Any, sfc: Any, q: Callable[[str], str], at: Callable[[Any
     inline = [st for st in sfc.iter(q("ST")) if st.getparent() is not None and st.getparent().tag == q("inline")
               and st.getparent().getparent() is not None and st.getparent().getparent().tag == q("action")]
     local = _locals(pou, q)
-    found: dict[str, list[tuple[str, str, str, Any, str]]] = {}  # V -> (T, timer, action, located element, text)
+    found: dict[str, list[tuple[str, str, str, Any, str, str, str]]] = {}  # V -> (T, step, duration, action, text, IN, V)
     for step in sfc.iterfind(q("step")):
         sname = str(step.get("name", ""))
         g7 = prefix + (sname[1:] if re.fullmatch(r"S\d+", sname) else sname)
@@ -99,23 +101,45 @@ def prepare_scope(pou: Any, sfc: Any, q: Callable[[str], str], at: Callable[[Any
         for name, el in runs:
             idiom = _timer_idiom(bodies.get(name, ""), local, q)
             if idiom is not None:
-                t, v, pt = idiom
-                found.setdefault(v.upper(), []).append((t, f"{pt}/X{g7}", name, actions[name], bodies[name]))
+                t, v, pt, cond = idiom
+                found.setdefault(v.upper(), []).append((t, g7, pt, actions[name], bodies[name], cond, v))
     scope = DataScope(str(pou.get("name", "")), at)
     for v, uses in found.items():
-        if len({u[1] for u in uses}) != 1:
+        if len({(u[0].upper(), u[1]) for u in uses}) != 1:
             continue  # one alias timing two steps: not a step timer
-        t, timer, name, el, text = uses[0]
-        scope.timers[v] = timer
-        scope.timer_blocks.add(t.upper())
-        scope.timer_actions.update(u[2] for u in uses)
+        t, step, pt, el, text, cond, alias = uses[0]
         st = el.find(f"{q('body')}/{q('ST')}")
+        where = where_text(st, text, text.upper().find(t.upper()), len(t))
+        if cond.upper() == "TRUE":
+            scope.timers[v] = f"{pt}/X{step}"
+            what = f"the step timer {pt}/X{step}"
+        else:  # the TON as a partial grafcet: its step on is active while step and IN hold
+            on = f"{prefix}{t}_on"
+            scope.timers[v] = f"{pt}/X{on}"
+            scope.ton_charts.append((f"{t}_TON", f"{prefix}{t}_off", on, step, cond, st, text))
+            what = (f"{pt}/X{on}, the timer of step {on} of the partial grafcet {t}_TON, active while step "
+                    f"{step} is and {cond} holds")
+        scope.timer_blocks.add(t.upper())
         scope.warnings.append(InputError(
-            f"the TON {t} called with IN:=TRUE in action {name} times the activity of its step: {v} is read as the "
-            f"step timer {timer} (a TON keeps Q until it is called with IN FALSE; a .g7 step timer restarts at each "
-            "activation of the step)", where_text(st, text, len(text) - len(text.lstrip()), len(t)),
-            severity=Severity.WARNING))
+            f"the TON {t} called with IN:={cond} in action {el.get('name')} of step {step}: {alias} is read as {what} (a "
+            "TON keeps Q until it is called with IN FALSE; a .g7 timer restarts at each activation of its step)",
+            where, severity=Severity.WARNING))
     full = data_scope(pou, q, at, list(bodies.values()) + [st_text(st) for st in inline], set(scope.timers))
-    full.timers, full.timer_blocks, full.timer_actions = scope.timers, scope.timer_blocks, scope.timer_actions
+    full.timers, full.timer_blocks, full.ton_charts = scope.timers, scope.timer_blocks, scope.ton_charts
     full.warnings = scope.warnings + full.warnings
     return full
+
+
+def ton_chart(scope: DataScope, steps: dict[str, str], at: Callable[[Any, str, int, int], Location]
+              ) -> list[tuple[str, list[tuple[str, bool]], list[tuple[list[str], list[str], str]]]]:
+    """The partial grafcets of the TONs called with ``IN:=c`` (not TRUE): (name, steps
+    (name, initial), transitions (sources, targets, receptivity))."""
+    from synth.codegen.st_condition import ExprReader
+
+    out = []
+    for name, off, on, step, cond, st, text in scope.ton_charts:
+        start = text.upper().find("IN")
+        c = ExprReader(cond, lambda o, w, h=st, t=text, s=start: at(h, t, s + o, w), steps, "a TON's IN").whole()
+        both = f"X{step} & " + (c if re.fullmatch(r"[!\w]+", c) else f"({c})")
+        out.append((name, [(off, True), (on, False)], [([off], [on], both), ([on], [off], f"!({both})")]))
+    return out

@@ -138,6 +138,7 @@ class ExprReader:
                     raise self.error(offset, f"{value} is an integer ({v.low}..{v.high}): compare it, e.g. "
                                      f"{value} >= 1", width=len(value))
                 return scope.find(value).name  # type: ignore[union-attr]
+            value = scope.spelling.get(value.upper(), value)  # ST names ignore case
         if kind == "name" and scope is not None and "." in value and value.split(".")[0] not in self.steps \
                 and value.split(".")[0].upper() in scope.global_lists:
             return scope.global_name(value, False, self.where(offset, len(value)))
