@@ -139,6 +139,7 @@ def action_body(name: str, text: str, qualifier: IecQualifier, where: Callable[[
             raise InputError(f"a statement of action {name} that .g7 cannot hold ({statement}): a PLC keeps what an "
                              "action body assigns after its step is left, so only X := TRUE; and X := FALSE; (and, "
                              "in an N action, IF condition THEN X := TRUE; END_IF) are read", where(pos, 1))
+        assert m is not None
         pos = m.end()
         pos += len(clean[pos:]) - len(clean[pos:].lstrip())
     return out

@@ -91,10 +91,11 @@ class DataScope:
             self.used[v.name.upper()] = v
             if not v.documented:
                 kind = "bool" if v.boolean else f"{v.low}..{v.high}"
+                what = "output" if v.output else "local variable"
                 self.warnings.append(InputError(
-                    f"{'output' if v.output else 'local variable'} {v.name} ({v.iec}) of POU {self.pou}, assigned by its actions, is the internal "
-                    f"variable {v.name} : {kind} = {v.initial}" + ("" if v.boolean else
-                                                                    ": give it the range it really has"),
+                    f"{what} {v.name} ({v.iec}) of POU {self.pou}, assigned by its actions, is the internal variable "
+                    f"{v.name} : {kind} = {v.initial}" + ("" if v.boolean else ": give it the range it really has")
+                    + (" (.g7 outputs are Boolean: it is not an output of the .g7)" if v.output else ""),
                     self.at(v.el), severity=Severity.WARNING))
         return v
 
@@ -167,7 +168,7 @@ def data_scope(pou: Any, q: Callable[[str], str], at: Callable[[Any], Location],
         if init is not None:
             found = _value(str(init.get("value", "")), iec == "BOOL")
             if found is None or not low <= found <= high:
-                raise InputError(f"the initial value '{init.get('value')}' of {name} is not a {iec} in {low}..{high}",
+                raise InputError(f"the initial value '{init.get('value')}' of {name} is not a value of its type {iec} ({low}..{high})",
                                  at(init))
             initial = found
         scope.vars[name.upper()] = DataVar(name, iec, low, high, max(low, min(high, initial)), m is not None, var,

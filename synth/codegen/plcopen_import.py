@@ -170,9 +170,35 @@ def import_sfc(data: bytes | str, file: str = "<xml>", pou: str | None = None,
         charts[-1].outputs[:] = [o for o in charts[-1].outputs if o.upper() not in scope.used]
         charts[-1].outputs.extend(n for n in [*scope.globals_out.values(), *scope.inputs_out.values()]
                                   if n not in charts[-1].outputs)
+    _feedback(charts, src)
     if warnings is not None:
         warnings += [w for c in charts for w in c.warnings]
     return _g7_text(charts, file, several)
+
+
+def _feedback(charts: list[Chart], src: Source) -> None:
+    """A name some chart assigns (an output) and some chart reads (a global such as
+    ``GVL_xBusy``): the reads are of the input ``NAME_fb``, with a warning."""
+    from synth.errors import Severity
+
+    outputs = {n for c in charts for n in c.outputs}
+    for c in charts:
+        for name in [n for n in c.inputs if n in outputs]:
+            fb = f"{name}_fb"
+            pattern = re.compile(rf"(?<![\w/]){name}\b")
+            c.inputs[c.inputs.index(name)] = fb
+            first = None
+            for i, (label, sources, targets, expr, el) in enumerate(c.transitions):
+                if pattern.search(expr):
+                    first = first if first is not None else el
+                    c.transitions[i] = (label, sources, targets, pattern.sub(fb, expr), el)
+            for st in c.steps:
+                st.actions = [(m[1] + pattern.sub(fb, m[2])) if (m := re.fullmatch(r"(.*? (?:if|on) )(.*)", a)) else a
+                              for a in st.actions]
+            c.warnings.append(InputError(
+                f"{name} is assigned by the imported chart and read by a transition: .g7 receptivities read inputs, "
+                f"so it reads the input {fb} (bind it to the output's value)",
+                src.at(first) if first is not None else None, severity=Severity.WARNING))
 
 
 def _g7_text(charts: list[Chart], file: str, several: bool) -> str:

@@ -137,7 +137,7 @@ def _check_names(pou: Any, q: Callable[[str], str], src: Source, transitions: li
                 continue
             inputs.append(name)
             warnings.append(InputError(f"'{name}', declared in <{section}> of POU {pou.get('name')}, is read as an "
-                                       "input: .g7 has no internal variables yet, so nothing the chart does sets it",
+                                       "input: nothing the chart does assigns it",
                                        src.at(var), severity=Severity.WARNING))
 
 

@@ -132,10 +132,10 @@ class ExprReader:
         if kind == "name" and scope is not None and "." not in value:
             if value.upper() in scope.timers:
                 return scope.timers[value.upper()]
-            v = scope.vars.get(value.upper())
-            if v is not None:
-                if not v.boolean:
-                    raise self.error(offset, f"{value} is an integer ({v.low}..{v.high}): compare it, e.g. "
+            known = scope.vars.get(value.upper())
+            if known is not None:
+                if not known.boolean:
+                    raise self.error(offset, f"{value} is an integer ({known.low}..{known.high}): compare it, e.g. "
                                      f"{value} >= 1", width=len(value))
                 return scope.find(value).name  # type: ignore[union-attr]
             value = scope.spelling.get(value.upper(), value)  # ST names ignore case
