@@ -88,8 +88,8 @@ grafcet G1 {
      "x.xml:73:13: error: an FBD block TON in a transition condition: only AND, OR and NOT have a Boolean meaning "
      "in .g7"),
     ('<reference name="LOWER" />', "<inline><ST><xhtml xmlns=\"http://www.w3.org/1999/xhtml\">Cnt := Cnt + 1;</xhtml>"
-     "</ST></inline>", "x.xml:60:73: error: an assignment of data in an action body (Cnt := Cnt + 1;): .g7 actions "
-     "set Boolean outputs; internal integer variables are not read yet"),
+     "</ST></inline>", "x.xml:60:73: error: an assignment of data in an action body (Cnt := Cnt + 1;): Cnt is not a "
+     "local variable of an integer type (.g7 internal variables are the chart's own)"),
     ('<connection refLocalId="2" />', '<connection refLocalId="77" />',
      "x.xml:46:17: error: connection to unknown localId 77"),
 ])
@@ -173,8 +173,7 @@ def test_names_a_transition_reads_are_checked_in_the_xml():
     out = import_sfc(local.encode(), "x.xml", pou="Belt", warnings=warnings)
     assert "inputs xPart, xLocal\n" in out
     assert [w.message for w in warnings] == [
-        "'xLocal', declared in <localVars> of POU Belt, is read as an input: .g7 has no internal variables yet, so "
-        "nothing the chart does sets it"]
+        "'xLocal', declared in <localVars> of POU Belt, is read as an input: nothing the chart does assigns it"]
 
 
 def test_a_comparison_becomes_a_declared_predicate():
@@ -221,8 +220,8 @@ def test_a_twincat3_export_with_step_actions_in_vendor_data_equals_the_chart_by_
      "x.xml:90:61: error: a call of the block instance Timer in action Opening_active (Timer(IN := bIsOpen, PT := "
      "T#1s)): .g7 runs no function blocks (its timers time a step's activity: 2s/X1)"),
     ("bMotorOpen := TRUE;</xhtml>", "nCount := nCount + 1;</xhtml>",
-     "x.xml:90:61: error: an assignment of data in action Opening_active (nCount := nCount + 1): .g7 actions set "
-     "Boolean outputs; internal integer variables are not read yet"),
+     "x.xml:90:61: error: an assignment of data in action Opening_active (nCount := nCount + 1): nCount is not a "
+     "local variable of an integer type (.g7 internal variables are the chart's own)"),
     ("IF (bOpenCmd = TRUE) AND NOT bIsOpen THEN", "IF bOpenCmd OR bIsOpen THEN",
      "x.xml:80:3: error: IF bOpenCmd OR bIsOpen in action Idle_active: only a condition that is a conjunction of "
      "inputs (a AND NOT b) has a rising edge .g7 can write"),
@@ -243,3 +242,148 @@ def test_qualifier_p_is_a_pulse_on_activation_and_true_false_literals_are_boolea
     out = import_sfc(text.encode(), "x.xml")
     assert "  step Crane_Lower: set LOWER on activation\n" in out
     assert "  transition Belt_Idle -> Belt_Run when !xPart\n" in out
+
+
+def test_an_integer_local_assigned_in_p1_p0_bodies_is_an_internal_variable():
+    """Beremiz (TC6 2.01): Cnt := Cnt + 1 under P1, Cnt := 0 under P0, 3 <= Cnt in a condition."""
+    warnings: list[InputError] = []
+    text = import_sfc((DATA / "beremiz_counter.xml").read_bytes(), "beremiz_counter.xml", warnings=warnings)
+    assert text.split("\n", 1)[1] == """inputs go
+outputs FULL
+internal Cnt : -32768..32767 = 0
+
+grafcet G1 {
+  initial step Start
+  step Count: Cnt := Cnt + 1
+  step Full: FULL, Cnt := 0 on deactivation
+  transition Start -> Count when go
+  transition Count -> Full when !go & Cnt >= 3
+  transition Full -> Start when go
+  transition Count -> Start when !go & Cnt < 3
+}
+"""
+    assert [w.render().splitlines()[0] for w in warnings] == [
+        "beremiz_counter.xml:23:13: warning: local variable Cnt (INT) of POU CounterSFC, assigned by its actions, is "
+        "the internal variable Cnt : -32768..32767 = 0: give it the range it really has"]
+    g = parse_grafcet(text, "counter.g7")
+    assert [(v.name, v.low, v.high, v.initial) for v in g.internals] == [("Cnt", -32768, 32767, 0)]
+    assert len(_ass(g)["states"]) == 7  # Start/Count with Cnt 0..3, then Full
+
+
+@pytest.mark.parametrize("old, new, first", [
+    ('<action localId="0" qualifier="P1">', '<action localId="0">',
+     "x.xml:66:39: error: Cnt := Cnt + 1; in an N action, run at every PLC scan while its step is active: .g7 assigns "
+     "once, on activation, on deactivation or on an event (use P1 or P0, or IF condition THEN ... END_IF)"),
+    ("Cnt := 0;", "Cnt := Cnt * 2;",
+     "x.xml:109:50: error: the assignment to Cnt is not a sum of integers and internal variables ('Cnt * 2'): .g7 "
+     "assigns sums such as Cnt + 1"),
+    ("Cnt := 0;", "Cnt := FULL + 1;",
+     "x.xml:109:46: error: 'FULL' in the assignment to Cnt: .g7 adds integer internal variables and integer constants"),
+    ("<![CDATA[go]]>", "<![CDATA[Cnt]]>", "x.xml:42:39: error: Cnt is an integer (-32768..32767): compare it, e.g. Cnt >= 1"),
+    ('<variable name="Cnt"><type><INT/></type></variable>',
+     '<variable name="Cnt"><type><INT/></type><initialValue><simpleValue value="40000"/></initialValue></variable>',
+     "x.xml:23:67: error: the initial value '40000' of Cnt is not a value of its type INT (-32768..32767)"),
+])
+def test_what_an_internal_variable_cannot_be_is_located(old, new, first):
+    text = (DATA / "beremiz_counter.xml").read_text()
+    assert old in text
+    with pytest.raises(InputError) as info:
+        import_sfc(text.replace(old, new, 1).encode(), "x.xml")
+    assert info.value.render().splitlines()[0] == first
+
+
+def test_sfc_round_trip_of_internal_variables():
+    """synth sfc writes INT locals documented 'internal 0..3' and P1/P0 bodies; import reads them back."""
+    from synth.codegen.plcopen_export import sfc_project_xml
+
+    g = load_grafcet(Path(__file__).resolve().parent.parent / "grafcets/tri_counting.g7")
+    warnings: list[InputError] = []
+    text = import_sfc(sfc_project_xml(g, version="test"), "x.xml", warnings=warnings)
+    assert "\ninternal boxes : 0..3 = 0\n" in text
+    assert "  step 2: boxes := 0 on deactivation\n" in text and text.count(": boxes := boxes + 1\n") == 2
+    assert "  transition 1 -> 0 when !dcy & X100 & boxes < 3\n  transition 1 -> 2 when X100 & boxes >= 3\n" in text
+    assert not [w for w in warnings if "boxes" in w.message]
+    back = parse_grafcet(text, "x.g7")
+    assert back.internals == g.internals
+
+
+def test_codesys_step_timers_globals_and_data_of_step_actions():
+    """CODESYS V3.5: TON T(IN:=TRUE, PT:=D); V := T.Q is the step timer, with IN:=c a two-step partial
+    grafcet; GVL.x a flattened name (its reads the _fb input); an INT output and locals internal; an input the
+    chart assigns its _out output."""
+    warnings: list[InputError] = []
+    text = import_sfc((DATA / "codesys_data.xml").read_bytes(), "codesys_data.xml", warnings=warnings)
+    assert text.split("\n", 1)[1] == """inputs xPart, xGo, xStart, GVL_xBusy_fb
+outputs Belt, GVL_xBusy, xStart_out
+internal xSeen : bool = 0
+internal nBoxes : 0..255 = 1
+internal Pressure : -32768..32767 = 0
+
+grafcet G1 {
+  initial step Init
+  step Count: nBoxes := nBoxes + 1, set GVL_xBusy, set Belt, set xSeen on ↑xPart, Pressure := 6000 on deactivation, \
+reset xStart_out on deactivation
+  step Settle
+  step Check
+  step Done: nBoxes := 0, reset GVL_xBusy
+  transition Init -> Count when xStart & !GVL_xBusy_fb
+  transition Count -> Settle when !xPart
+  transition Settle -> Check when 50ms/XSettle & xSeen
+  transition Check -> Done when 2s/XHold_on & nBoxes >= 3
+  transition Done -> Init when nBoxes = 0
+}
+grafcet Hold_TON {
+  initial step Hold_off
+  step Hold_on
+  transition Hold_off -> Hold_on when XCheck & xPart
+  transition Hold_on -> Hold_off when !(XCheck & xPart)
+}
+"""
+    assert [w.render().splitlines()[0] for w in warnings] == [
+        "codesys_data.xml:109:1: warning: IF xPart in action Count_active (run while its step is active) is read as "
+        "the stored action on the rising edge ↑xPart: if the condition already holds when the step becomes active, "
+        "the PLC assigns at once and .g7 waits for the edge",
+        "codesys_data.xml:128:61: warning: the TON Delay called with IN:=TRUE in action Settle_active of step Settle: "
+        "Delay_Q is read as the step timer 50ms/XSettle (a TON keeps Q until it is called with IN FALSE; a .g7 timer "
+        "restarts at each activation of its step)",
+        "codesys_data.xml:137:61: warning: the TON Hold called with IN:=xPart in action Check_active of step Check: "
+        "Hold_Q is read as 2s/XHold_on, the timer of step Hold_on of the partial grafcet Hold_TON, active while step "
+        "Check is and xPart holds (a TON keeps Q until it is called with IN FALSE; a .g7 timer restarts at each "
+        "activation of its step)",
+        "codesys_data.xml:171:42: warning: the global GVL.xBusy is read here: .g7 names have no dot, so it is the "
+        "input GVL_xBusy",
+        "codesys_data.xml:60:13: warning: local variable xSeen (BOOL) of POU Sorter, assigned by its actions, is the "
+        "internal variable xSeen : bool = 0",
+        "codesys_data.xml:52:13: warning: local variable nBoxes (USINT) of POU Sorter, assigned by its actions, is the "
+        "internal variable nBoxes : 0..255 = 1: give it the range it really has",
+        "codesys_data.xml:100:1: warning: the global GVL.xBusy is assigned here: .g7 names have no dot, so it is the "
+        "output GVL_xBusy",
+        "codesys_data.xml:45:13: warning: output Pressure (INT) of POU Sorter, assigned by its actions, is the "
+        "internal variable Pressure : -32768..32767 = 0: give it the range it really has (.g7 outputs are Boolean: "
+        "it is not an output of the .g7)",
+        "codesys_data.xml:120:1: warning: the chart assigns its input xStart: .g7 inputs are read only, so it assigns "
+        "the output xStart_out (bind it to what writes xStart; transitions still read the input)",
+        "codesys_data.xml:173:13: warning: GVL_xBusy is assigned by the imported chart and read by a transition: .g7 "
+        "receptivities read inputs, so it reads the input GVL_xBusy_fb (bind it to the output's value)"]
+    g = parse_grafcet(text, "sorter.g7")
+    assert [t.id for t in g.timers] == ["2s/XHold_on", "50ms/XSettle"]
+
+
+@pytest.mark.parametrize("old, new, first", [
+    ("Belt := TRUE;", "nBoxes := nBoxes + 1;",
+     "x.xml:108:61: error: nBoxes := nBoxes + 1 in action Count_active, run at every PLC scan while its step is "
+     "active: .g7 assigns once, on activation, on deactivation or on an event (use P1 or P0, or IF condition THEN "
+     "... END_IF)"),
+    ("GVL.xBusy := TRUE;", "Motor.xBusy := TRUE;",
+     "x.xml:100:1: error: Motor.xBusy is a member of the block instance Motor: .g7 holds this chart's variables, not "
+     "another block's"),
+    ("Delay(IN:=TRUE, PT:=Delay_PT);", "Delay(IN:=TRUE, PT:=Delay_Q);",
+     "x.xml:128:61: error: a call of the block instance Delay in action Settle_active (Delay(IN:=TRUE, PT:=Delay_Q)): "
+     ".g7 runs no function blocks (its timers time a step's activity: 2s/X1)"),
+])
+def test_what_a_codesys_data_body_cannot_be_is_located(old, new, first):
+    text = (DATA / "codesys_data.xml").read_text()
+    assert old in text
+    with pytest.raises(InputError) as info:
+        import_sfc(text.replace(old, new, 1).encode(), "x.xml")
+    assert info.value.render().splitlines()[0] == first

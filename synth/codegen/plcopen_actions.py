@@ -22,6 +22,7 @@ import contextvars
 import re
 from typing import Any, Callable
 
+from synth.codegen.plcopen_data import DATA, sum_text
 from synth.codegen.plcopen_vendor import IecQualifier
 from synth.codegen.st_condition import ExprReader
 from synth.errors import InputError, Location, Severity
@@ -32,7 +33,8 @@ ACTION_WARNINGS: contextvars.ContextVar[list[InputError] | None] = contextvars.C
     "ACTION_WARNINGS", default=None)
 """While a chart is read: the warnings of its action bodies (a level ``IF`` read as an edge)."""
 
-_ASSIGN = re.compile(r"(\w+)\s*:=\s*(TRUE|FALSE)\s*;", re.I)
+_ASSIGN = re.compile(r"([\w.]+)\s*:=\s*(TRUE|FALSE)\s*;", re.I)
+_DATA = re.compile(r"(\w+)\s*:=\s*([^;]*?)\s*;", re.I)
 _IF = re.compile(r"IF\b(?P<cond>.*?)\bTHEN\b(?P<body>.*?)\bEND_IF\b\s*;?", re.I | re.S)
 
 
@@ -49,6 +51,52 @@ def rising(expr: str) -> str:
     return " | ".join(terms)
 
 
+def _order(name: str, where: Location) -> str:
+    """The ``.g7`` name of an assigned variable: its declared spelling (ST ignores case), a
+    dotted global flattened (``GVL.X``: ``GVL_X``, with a warning)."""
+    scope = DATA.get()
+    if scope is None:
+        return name
+    if "." in name:
+        if name.split(".")[0].upper() not in scope.global_lists:
+            raise InputError(f"{name} is a member of the block instance {name.rsplit('.', 1)[0]}: .g7 holds this "
+                             "chart's variables, not another block's", where)
+        return scope.global_name(name, True, where)
+    v = scope.find(name)
+    if v is None and name.upper() in scope.inputs:
+        return scope.input_written(name, where)
+    return v.name if v is not None else scope.spelling.get(name.upper(), name)
+
+
+def _data(m: re.Match[str], base: int, where: Callable[[int, int], Location]) -> tuple[str, bool] | None:
+    """``V := sum;`` (``m``, in a text at ``base``) with ``V`` an internal variable: ``V := sum`` and
+    whether the sum reads a variable; None when ``V`` is not one."""
+    scope = DATA.get()
+    v = scope.find(m[1]) if scope is not None else None
+    if scope is None or v is None:
+        return None
+    value = sum_text(scope, v, m[2], lambda o, w: where(base + m.start(2) + o, w))
+    return f"{v.name} := {value}", bool(re.search(r"[A-Za-z]", value))
+
+
+def _timer_statement(statement: str, pos: int, where: Callable[[int, int], Location]) -> bool:
+    """A call of a TON made a step timer, or an assignment of its alias: nothing in ``.g7``."""
+    scope = DATA.get()
+    if scope is None:
+        return False
+    call = re.fullmatch(r"(\w+)\s*\(.*\)", statement, re.S)
+    if call and call[1].upper() in scope.timer_blocks:
+        return True
+    alias = re.fullmatch(r"(\w+)\s*:=\s*(.*)", statement, re.S)
+    if alias and alias[1].upper() in scope.timers:
+        if not re.fullmatch(r"\w+\.Q", alias[2].strip(), re.I):
+            scope.warnings.append(InputError(
+                f"{statement} is left out: {alias[1]} stands for the step timer {scope.timers[alias[1].upper()]}",
+                where(pos, len(alias[1])), severity=Severity.WARNING))
+        return True
+    return False
+
+
 def action_body(name: str, text: str, qualifier: IecQualifier, where: Callable[[int, int], Location],
                 steps: dict[str, str]) -> list[str]:
     """The ``.g7`` stored actions of the ST ``text`` of POU action ``name`` run with
@@ -60,17 +108,24 @@ def action_body(name: str, text: str, qualifier: IecQualifier, where: Callable[[
     out: list[str] = []
     pos = len(clean) - len(clean.lstrip())
     while pos < len(clean):
+        end = clean.find(";", pos)
+        statement = " ".join(clean[pos:end if end >= 0 else len(clean)].split())
         m = _ASSIGN.match(clean, pos) or re.compile(r";").match(clean, pos)  # ';' alone: an empty statement
         if m and m[0] == ";":
             pass
+        elif _timer_statement(statement, pos, where):
+            m = re.compile(r"[^;]*;?").match(clean, pos)
         elif m:
-            out.append(f"{'set' if m[2].upper() == 'TRUE' else 'reset'} {m[1]}{when}")
-        elif (m := _IF.match(clean, pos)) and qualifier == IecQualifier.N and \
-                re.fullmatch(r"(\s*\w+\s*:=\s*(TRUE|FALSE)\s*;)+\s*", m["body"], re.I):
+            out.append(f"{'set' if m[2].upper() == 'TRUE' else 'reset'} {_order(m[1], where(pos, len(m[1])))}{when}")
+        elif (m := _DATA.match(clean, pos)) and (found := _data(m, 0, where)) is not None:
+            if found[1] and qualifier == IecQualifier.N:
+                raise InputError(f"{statement} in action {name}, run at every PLC scan while its step is active: "
+                                 ".g7 assigns once, on activation, on deactivation or on an event (use P1 or P0, or "
+                                 "IF condition THEN ... END_IF)", where(pos, len(m[1])))
+            out.append(found[0] + when)
+        elif (m := _IF.match(clean, pos)) and qualifier == IecQualifier.N:
             out += _level_if(name, m, where, steps)
         else:
-            end = clean.find(";", pos)
-            statement = " ".join(clean[pos:end if end >= 0 else len(clean)].split())
             call = re.fullmatch(r"([\w.]+)\s*\(.*\)", statement, re.S)
             if call:
                 raise InputError(f"a call of the block instance {call[1]} in action {name} ({statement}): .g7 runs no "
@@ -78,11 +133,13 @@ def action_body(name: str, text: str, qualifier: IecQualifier, where: Callable[[
             data = re.fullmatch(r"([\w.]+)\s*:=\s*(.*)", statement, re.S)
             if data and not re.fullmatch(r"TRUE|FALSE", data[2], re.I) and \
                     re.search(r"^[-+]?\d|[+\-*/]|\bMOD\b", data[2], re.I):
-                raise InputError(f"an assignment of data in action {name} ({statement}): .g7 actions set Boolean "
-                                 "outputs; internal integer variables are not read yet", where(pos, len(data[1])))
+                raise InputError(f"an assignment of data in action {name} ({statement}): {data[1]} is not a local "
+                                 "variable of an integer type (.g7 internal variables are the chart's own)",
+                                 where(pos, len(data[1])))
             raise InputError(f"a statement of action {name} that .g7 cannot hold ({statement}): a PLC keeps what an "
                              "action body assigns after its step is left, so only X := TRUE; and X := FALSE; (and, "
                              "in an N action, IF condition THEN X := TRUE; END_IF) are read", where(pos, 1))
+        assert m is not None
         pos = m.end()
         pos += len(clean[pos:]) - len(clean[pos:].lstrip())
     return out
@@ -90,8 +147,36 @@ def action_body(name: str, text: str, qualifier: IecQualifier, where: Callable[[
 
 def _level_if(name: str, m: re.Match[str], where: Callable[[int, int], Location],
               steps: dict[str, str]) -> list[str]:
-    """``IF c THEN X := TRUE; END_IF`` run while the step is active: ``set X on ↑c``."""
+    """``IF c THEN X := TRUE; END_IF`` run while the step is active: ``set X on ↑c`` (an
+    assignment of an internal variable likewise: ``V := V + 1 on ↑c``)."""
     start = m.start("cond")
+    body_at = m.start("body")
+    actions: list[str] = []
+    pos = 0
+    body = m["body"]
+    while body[pos:].strip():
+        pos += len(body[pos:]) - len(body[pos:].lstrip())
+        end = body.find(";", pos)
+        if _timer_statement(" ".join(body[pos:end if end >= 0 else len(body)].split()), body_at + pos, where):
+            pos = end + 1 if end >= 0 else len(body)
+            continue
+        a = _ASSIGN.match(body, pos)
+        d = None if a else _DATA.match(body, pos)
+        found = _data(d, body_at, where) if d else None
+        if a:
+            actions.append(f"{'set' if a[2].upper() == 'TRUE' else 'reset'} "
+                           f"{_order(a[1], where(body_at + pos, len(a[1])))}")
+        elif found is not None:
+            actions.append(found[0])
+        else:
+            end = body.find(";", pos)
+            statement = " ".join(body[pos:end if end >= 0 else len(body)].split())
+            raise InputError(f"a statement of action {name} that .g7 cannot hold in IF ... THEN ({statement}): only "
+                             "X := TRUE;, X := FALSE; and assignments of internal variables are read",
+                             where(body_at + pos, 1))
+        pos = (a or d).end()  # type: ignore[union-attr]
+    if not actions:  # only a TON made a step timer
+        return []
     cond = ExprReader(m["cond"], lambda o, w: where(start + o, w), steps, "an action's IF").whole()
     edge = rising(cond[1:-1] if cond.startswith("(") and cond.endswith(")") else cond)
     if not edge or any(f"X{s}" in re.findall(r"\w+", edge) for s in steps.values()):
@@ -103,5 +188,4 @@ def _level_if(name: str, m: re.Match[str], where: Callable[[int, int], Location]
             f"IF {' '.join(m['cond'].split())} in action {name} (run while its step is active) is read as the stored "
             f"action on the rising edge {edge}: if the condition already holds when the step becomes active, the PLC "
             "assigns at once and .g7 waits for the edge", where(m.start(), 2), severity=Severity.WARNING))
-    return [f"{'set' if a[2].upper() == 'TRUE' else 'reset'} {a[1]} on {edge}"
-            for a in _ASSIGN.finditer(m["body"])]
+    return [f"{a} on {edge}" for a in actions]

@@ -37,7 +37,9 @@ from dataclasses import dataclass
 from typing import Any
 
 from synth.codegen.plcopen_actions import ACTION_WARNINGS, action_body
+from synth.codegen.plcopen_data import DATA, sum_text
 from synth.codegen.plcopen_sfc import Chart, Source, read_chart
+from synth.codegen.plcopen_timers import prepare_scope
 from synth.codegen.plcopen_vendor import IecQualifier
 from synth.codegen.plcopen_xml import Qualifier
 from synth.codegen.st_condition import PREDICATES, ExprReader, st_text
@@ -154,15 +156,49 @@ def import_sfc(data: bytes | str, file: str = "<xml>", pou: str | None = None,
         token = PREDICATES.set({})  # comparisons become declared predicates while a chart is read
         action_warnings: list[InputError] = []
         token2 = ACTION_WARNINGS.set(action_warnings)
+        prefix = f"{p.get('name')}_" if several else ""
+        scope = prepare_scope(p, s, q, src.at, prefix, src.text_at)
+        token3 = DATA.set(scope)
         try:
-            charts.append(read_chart(p, s, q, src, _read_action, f"{p.get('name')}_" if several else ""))
+            charts.append(read_chart(p, s, q, src, _read_action, prefix))
         finally:
             PREDICATES.reset(token)
             ACTION_WARNINGS.reset(token2)
-        charts[-1].warnings.extend(action_warnings)
+            DATA.reset(token3)
+        charts[-1].warnings.extend(action_warnings + scope.warnings)
+        charts[-1].internals = scope.declarations()
+        charts[-1].outputs[:] = [o for o in charts[-1].outputs if o.upper() not in scope.used]
+        charts[-1].outputs.extend(n for n in [*scope.globals_out.values(), *scope.inputs_out.values()]
+                                  if n not in charts[-1].outputs)
+    _feedback(charts, src)
     if warnings is not None:
         warnings += [w for c in charts for w in c.warnings]
     return _g7_text(charts, file, several)
+
+
+def _feedback(charts: list[Chart], src: Source) -> None:
+    """A name some chart assigns (an output) and some chart reads (a global such as
+    ``GVL_xBusy``): the reads are of the input ``NAME_fb``, with a warning."""
+    from synth.errors import Severity
+
+    outputs = {n for c in charts for n in c.outputs}
+    for c in charts:
+        for name in [n for n in c.inputs if n in outputs]:
+            fb = f"{name}_fb"
+            pattern = re.compile(rf"(?<![\w/]){name}\b")
+            c.inputs[c.inputs.index(name)] = fb
+            first = None
+            for i, (label, sources, targets, expr, el) in enumerate(c.transitions):
+                if pattern.search(expr):
+                    first = first if first is not None else el
+                    c.transitions[i] = (label, sources, targets, pattern.sub(fb, expr), el)
+            for st in c.steps:
+                st.actions = [(m[1] + pattern.sub(fb, m[2])) if (m := re.fullmatch(r"(.*? (?:if|on) )(.*)", a)) else a
+                              for a in st.actions]
+            c.warnings.append(InputError(
+                f"{name} is assigned by the imported chart and read by a transition: .g7 receptivities read inputs, "
+                f"so it reads the input {fb} (bind it to the output's value)",
+                src.at(first) if first is not None else None, severity=Severity.WARNING))
 
 
 def _g7_text(charts: list[Chart], file: str, several: bool) -> str:
@@ -176,6 +212,9 @@ def _g7_text(charts: list[Chart], file: str, several: bool) -> str:
         lines.insert(1, "inputs " + ", ".join(inputs))
     if outputs:
         lines.insert(1 + bool(inputs), "outputs " + ", ".join(outputs))
+    internals = list(dict.fromkeys(d for c in charts for d in c.internals))
+    if internals:
+        lines[-1:-1] = internals
     count = 0
     for chart in charts:
         if several:
@@ -299,26 +338,48 @@ def _one_action(a: Any, src: Source, steps: dict[str, str], q: Any, qualifier: s
     body = st_text(st).strip()
     where = lambda off, w, h=st, t=st_text(st): src.text_at(h, t, off, w)  # noqa: E731
     m = re.fullmatch(r"(\w+)\s*:=\s*(TRUE|FALSE)\s*;?", body, re.I)
+    scope = DATA.get()
+    data = re.fullmatch(r"(\w+)\s*:=\s*([^;]*?)\s*;?", body, re.S)
+    target = scope.find(data[1]) if scope is not None and data is not None else None
+    if qualifier in (Qualifier.P0, Qualifier.P1) and target is not None and data is not None and scope is not None:
+        raw = st_text(st)
+        value = sum_text(scope, target, data[2], lambda o, w: where(raw.find(data[2]) + o, w))
+        return f"{target.name} := {value}" + (" on deactivation" if qualifier == Qualifier.P0 else "")
     if qualifier in (Qualifier.P0, Qualifier.P1):
         if not m:
-            raise InputError(f"a {qualifier} action body must be 'NAME := TRUE;' or 'NAME := FALSE;'", where(0, 1))
+            raise InputError(f"a {qualifier} action body must be 'NAME := TRUE;' or 'NAME := FALSE;' (or assign an "
+                             "integer local variable)", where(0, 1))
         verb = "set" if m[2].upper() == "TRUE" else "reset"
         return f"{verb} {m[1]} on {'deactivation' if qualifier == Qualifier.P0 else 'activation'}"
     if qualifier == Qualifier.N:
-        ev = re.fullmatch(r"IF\s+(.*?)\s+THEN\s+(\w+)\s*:=\s*(TRUE|FALSE)\s*;\s*END_IF\s*;?", body, re.I | re.S)
+        ev = re.fullmatch(r"IF\s+(.*?)\s+THEN\s+(\w+)\s*:=\s*(.*?)\s*;\s*END_IF\s*;?", body, re.I | re.S)
         if ev:
             raw = st_text(st)
             off = raw.find(ev[1])
             cond = ExprReader(ev[1], lambda o, w: where(off + o, w), steps, "an action body").whole()
-            verb = "set" if ev[3].upper() == "TRUE" else "reset"
-            return f"{verb} {ev[2]} on {cond}"
+            v = scope.find(ev[2]) if scope is not None else None
+            if v is not None and scope is not None:
+                value = sum_text(scope, v, ev[3], lambda o, w: where(raw.find(ev[3], off) + o, w))
+                return f"{v.name} := {value} on {cond}"
+            if ev[3].upper() in ("TRUE", "FALSE"):
+                verb = "set" if ev[3].upper() == "TRUE" else "reset"
+                return f"{verb} {ev[2]} on {cond}"
         cm = re.fullmatch(r"(\w+)\s*:=\s*(.*?)\s*;?", body, re.S)
+        if cm and target is not None and scope is not None:
+            raw = st_text(st)
+            value = sum_text(scope, target, cm[2], lambda o, w: where(raw.find(cm[2]) + o, w))
+            if re.search(r"[A-Za-z]", value):
+                raise InputError(f"{body.strip()} in an N action, run at every PLC scan while its step is active: .g7 "
+                                 "assigns once, on activation, on deactivation or on an event (use P1 or P0, or IF "
+                                 "condition THEN ... END_IF)", where(0, len(cm[1])))
+            return f"{target.name} := {value}"
         if cm:
             raw = st_text(st)
             off = raw.find(cm[2])
             if re.search(r"[+\-*/]|\b(MOD|ADD|SUB|MUL|DIV)\b", cm[2], re.I):
-                raise InputError(f"an assignment of data in an action body ({body.strip()}): .g7 actions set Boolean "
-                                 "outputs; internal integer variables are not read yet", where(0, len(body.strip())))
+                raise InputError(f"an assignment of data in an action body ({body.strip()}): {cm[1]} is not a local "
+                                 "variable of an integer type (.g7 internal variables are the chart's own)",
+                                 where(0, len(body.strip())))
             cond = ExprReader(cm[2], lambda o, w: where(off + o, w), steps, "an action body").whole()
             return f"{cm[1]} if {cond}"
     raise InputError(f"a {qualifier} action body that .g7 cannot represent (expected 'NAME := condition;')",

@@ -18,6 +18,8 @@ import re
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
+from synth.codegen.plcopen_data import DATA
+from synth.codegen.plcopen_timers import ton_chart
 from synth.codegen.plcopen_vendor import step_actions
 from synth.codegen.plcopen_fbd import FBD_ELEMENTS, fbd_condition, fbd_transition
 from synth.codegen.plcopen_xml import SYNTH_DATA
@@ -91,6 +93,7 @@ class Chart:
     steps: list[_ImportedStep]
     transitions: list[tuple[str, list[str], list[str], str, object]]
     warnings: list[InputError] = field(default_factory=list)
+    internals: list[str] = field(default_factory=list)  # internal declarations (.g7 text)
 
 
 _SECTIONS = ("inputVars", "outputVars", "inOutVars", "localVars", "tempVars", "externalVars")
@@ -104,9 +107,15 @@ def _check_names(pou: Any, q: Callable[[str], str], src: Source, transitions: li
     for section in _SECTIONS:
         for v in pou.iterfind(f"{q('interface')}/{q(section)}/{q('variable')}"):
             declared.setdefault(str(v.get("name")), (section, v))
+    scope = DATA.get()
     for i, (label, sources, targets, expr, el) in enumerate(transitions):
         for name in dict.fromkeys(re.findall(r"(?<![\w/])[A-Za-z_]\w*", expr)):
             if name.startswith("X") and name[1:] in steps or name in inputs:
+                continue
+            if scope is not None and name.upper() in scope.used:
+                continue
+            if scope is not None and name in scope.globals_in.values():
+                inputs.append(name)
                 continue
             if name not in declared:
                 raise InputError(f"a transition reads '{name}', which the POU {pou.get('name')} does not declare",
@@ -128,7 +137,7 @@ def _check_names(pou: Any, q: Callable[[str], str], src: Source, transitions: li
                 continue
             inputs.append(name)
             warnings.append(InputError(f"'{name}', declared in <{section}> of POU {pou.get('name')}, is read as an "
-                                       "input: .g7 has no internal variables yet, so nothing the chart does sets it",
+                                       "input: nothing the chart does assigns it",
                                        src.at(var), severity=Severity.WARNING))
 
 
@@ -333,8 +342,13 @@ def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
                 f"a jump from step {sources[0]} back to itself on a level condition ({expr}): IEC 61131-3 SFC "
                 "re-activates the step at every PLC scan while it holds, IEC 60848 (.g7) never stabilises there",
                 src.at(el), severity=Severity.WARNING, notes=("make the condition an edge, or add a step",)))
+    helpers: list[_ImportedStep] = []
+    scope = DATA.get()
+    for gname, hsteps, htrans in ton_chart(scope, by_sfc_name, src.text_at) if scope is not None else []:
+        helpers += [_ImportedStep(n, initial, [], gname, pou) for n, initial in hsteps]
+        transitions += [("", a, b, expr, pou) for a, b, expr in htrans]
     _declare_predicates(inputs, warnings)
-    _check_names(pou, q, src, transitions, {st.name for st in steps.values()}, inputs, outputs, warnings)
+    _check_names(pou, q, src, transitions, {st.name for st in [*steps.values(), *helpers]}, inputs, outputs, warnings)
     written_by_synth = any(st.grafcet for st in steps.values())  # its .g7 is the meaning: no rewriting
     for d, members in branches.items():  # IEC 61131-3: the first true branch, left to right; .g7: every one
         if len(members) < 2 or written_by_synth:
@@ -366,7 +380,7 @@ def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
             owner.actions.extend(read_action(a, src, by_sfc_name, q, pou_actions, owner.name))
 
     # partial grafcets: synth's addData, else the connected components
-    parent: dict[str, str] = {s.name: s.name for s in steps.values()}
+    parent: dict[str, str] = {s.name: s.name for s in [*steps.values(), *helpers]}
 
     def find(x: str) -> str:
         while parent[x] != x:
@@ -388,4 +402,4 @@ def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
             groups[find(s.name)] = f"G{len(set(groups.values())) + 1}"
     order = sorted(steps.values(), key=lambda s: int(s.el.sourceline or 0))  # type: ignore[attr-defined]
     _declare_predicates(inputs, warnings)  # those met in the actions' conditions
-    return Chart(str(pou.get("name", "")), inputs, outputs, order, transitions, warnings)
+    return Chart(str(pou.get("name", "")), inputs, outputs, order + helpers, transitions, warnings)

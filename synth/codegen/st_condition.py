@@ -13,6 +13,7 @@ from __future__ import annotations
 import contextvars
 import re
 
+from synth.codegen.plcopen_data import DATA
 from synth.errors import InputError, Location, close_names
 
 __all__ = ["st_text", "ExprReader", "PREDICATES", "predicate_name"]
@@ -123,6 +124,24 @@ class ExprReader:
     def boolean(self, kind: str, value: str, offset: int) -> str:
         """A name, a step flag, a timer, a constant or a comparison (the token just taken)."""
         following = self.peek()[1]
+        scope = DATA.get()
+        if following in _COMPARE and scope is not None:
+            compared = self.compare(kind, value)
+            if compared is not None:
+                return compared
+        if kind == "name" and scope is not None and "." not in value:
+            if value.upper() in scope.timers:
+                return scope.timers[value.upper()]
+            known = scope.vars.get(value.upper())
+            if known is not None:
+                if not known.boolean:
+                    raise self.error(offset, f"{value} is an integer ({known.low}..{known.high}): compare it, e.g. "
+                                     f"{value} >= 1", width=len(value))
+                return scope.find(value).name  # type: ignore[union-attr]
+            value = scope.spelling.get(value.upper(), value)  # ST names ignore case
+        if kind == "name" and scope is not None and "." in value and value.split(".")[0] not in self.steps \
+                and value.split(".")[0].upper() in scope.global_lists:
+            return scope.global_name(value, False, self.where(offset, len(value)))
         if following in _COMPARE and PREDICATES.get() is not None and (kind == "num" or (kind == "name" and "." not in value)):
             return self.predicate(kind, value, offset)
         if kind == "num" and value in ("0", "1"):
@@ -158,6 +177,34 @@ class ExprReader:
             return value
         raise self.error(offset, f"expected a variable, a step flag or '(' in {self.what}, not '{value or 'end'}'",
                          width=max(1, len(value)))
+
+    def compare(self, kind: str, value: str) -> str | None:
+        """``Cnt >= 5`` (or ``5 <= Cnt``) of integer internal variables
+        (:data:`~synth.codegen.plcopen_data.DATA`): its ``.g7`` text; None when it is not one."""
+        scope = DATA.get()
+        assert scope is not None
+        j, sign = self.i + 1, ""
+        if j < len(self.tokens) and self.tokens[j][1] in ("-", "+"):
+            sign, j = self.tokens[j][1].replace("+", ""), j + 1
+        if j >= len(self.tokens):
+            return None
+        op = self.tokens[self.i][1]
+        k2, v2, _ = self.tokens[j]
+        left = scope.vars.get(value.upper()) if kind == "name" else None
+        right = scope.vars.get(v2.upper()) if k2 == "name" else None
+        if left is not None and not left.boolean and k2 == "num" and v2.isdigit():
+            text = f"{left.name} {op} {sign}{int(v2)}"
+        elif left is not None and not left.boolean and right is not None and not right.boolean and not sign:
+            text = f"{left.name} {op} {right.name}"
+        elif kind == "num" and value.isdigit() and right is not None and not right.boolean and not sign:
+            text = f"{right.name} {_FLIP[op]} {int(value)}"
+        else:
+            return None
+        for v in (left, right):
+            if v is not None:
+                scope.find(v.name)
+        self.i = j + 1
+        return text
 
     def predicate(self, kind: str, value: str, offset: int) -> str:
         """``a > 24290.0`` (or ``24290.0 < a``): a declared predicate, recorded in PREDICATES."""

@@ -1,0 +1,212 @@
+"""The data of an imported SFC POU that ``.g7`` can hold (``synth import``): integer and
+Boolean local variables the chart's actions assign become ``.g7`` *internal variables*;
+global names written with a dot (``GVL.IsSFCResetting``) become Boolean variables
+``GVL_IsSFCResetting``; TON instances that only time a step's activity are step timers
+(:mod:`synth.codegen.plcopen_timers`).
+
+A local ``INT``/``SINT``/``DINT``/``UINT``/``USINT``/``BOOL`` that an action body assigns is
+``internal NAME : <the IEC type's range> = <initialValue or 0>`` with a located warning (the
+type's range is rarely the one the program needs); one ``synth sfc`` wrote (documentation
+``internal 0..3`` or ``internal Boolean``) gets its range back without a warning. While a
+chart is read, :data:`DATA` holds its :class:`DataScope`; the ST readers ask it.
+
+Example
+-------
+>>> IEC_RANGES["USINT"], DataVar("cnt", "INT", 0, 3, 0, True, None).text()
+((0, 255), 'internal cnt : 0..3 = 0')
+"""
+
+from __future__ import annotations
+
+import contextvars
+import re
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+from synth.errors import InputError, Location, Severity
+
+__all__ = ["IEC_RANGES", "DataVar", "DataScope", "DATA", "data_scope", "assigned_names", "strip_comments",
+           "sum_text"]
+
+IEC_RANGES: dict[str, tuple[int, int]] = {
+    "BOOL": (0, 1), "SINT": (-128, 127), "USINT": (0, 255), "INT": (-32768, 32767), "UINT": (0, 65535),
+    "DINT": (-2 ** 31, 2 ** 31 - 1)}
+"""The IEC 61131-3 types read as internal variables, with their ranges."""
+
+
+def strip_comments(text: str) -> str:
+    """``text`` with its ST comments as spaces (offsets unchanged)."""
+    return re.sub(r"\(\*.*?\*\)|//[^\n]*", lambda c: re.sub(r"[^\n]", " ", c[0]), text, flags=re.S)
+
+
+def assigned_names(text: str) -> set[str]:
+    """The names an ST body assigns (upper case), block call arguments left out."""
+    clean = re.sub(r"[\w.]+\s*\([^()]*\)", " ", strip_comments(text))
+    return {m[1].upper() for m in re.finditer(r"(?<![\w.])(\w+)\s*:=", clean)}
+
+
+@dataclass
+class DataVar:
+    """A local variable read as an internal variable."""
+
+    name: str
+    iec: str
+    low: int
+    high: int
+    initial: int
+    documented: bool  # synth's own export: its range is the .g7 one
+    el: Any
+    output: bool = False  # an integer output: .g7 outputs are Boolean
+
+    @property
+    def boolean(self) -> bool:
+        return self.iec == "BOOL"
+
+    def text(self) -> str:
+        return f"internal {self.name} : {'bool' if self.boolean else f'{self.low}..{self.high}'} = {self.initial}"
+
+
+@dataclass
+class DataScope:
+    """What the readers of one chart know of its data (see the module doc)."""
+
+    pou: str
+    at: Callable[[Any], Location]
+    vars: dict[str, DataVar] = field(default_factory=dict)  # upper-case name -> variable
+    used: dict[str, DataVar] = field(default_factory=dict)
+    timers: dict[str, str] = field(default_factory=dict)  # upper-case alias -> .g7 timer (50ms/XS)
+    timer_blocks: set[str] = field(default_factory=set)  # upper-case TON instances made step timers
+    ton_charts: list[tuple[str, str, str, str, str, Any, str]] = field(default_factory=list)  # TONs as grafcets
+    spelling: dict[str, str] = field(default_factory=dict)  # upper-case name -> declared name
+    global_lists: set[str] = field(default_factory=set)  # upper-case names of the project's global lists
+    inputs: set[str] = field(default_factory=set)  # upper-case names of the POU's inputVars
+    inputs_out: dict[str, str] = field(default_factory=dict)  # an input the chart assigns -> its output
+    globals_out: dict[str, str] = field(default_factory=dict)  # dotted name -> .g7 output name
+    globals_in: dict[str, str] = field(default_factory=dict)  # dotted name -> .g7 input name
+    warnings: list[InputError] = field(default_factory=list)
+
+    def find(self, name: str) -> DataVar | None:
+        v = self.vars.get(name.upper())
+        if v is not None and v.name.upper() not in self.used:
+            self.used[v.name.upper()] = v
+            if not v.documented:
+                kind = "bool" if v.boolean else f"{v.low}..{v.high}"
+                what = "output" if v.output else "local variable"
+                self.warnings.append(InputError(
+                    f"{what} {v.name} ({v.iec}) of POU {self.pou}, assigned by its actions, is the internal variable "
+                    f"{v.name} : {kind} = {v.initial}" + ("" if v.boolean else ": give it the range it really has")
+                    + (" (.g7 outputs are Boolean: it is not an output of the .g7)" if v.output else ""),
+                    self.at(v.el), severity=Severity.WARNING))
+        return v
+
+    def global_name(self, dotted: str, output: bool, where: Location) -> str:
+        """``GVL.X`` as the Boolean ``GVL_X`` (an output when assigned), with a warning once."""
+        flat = dotted.replace(".", "_")
+        table = self.globals_out if output else self.globals_in
+        if dotted not in table:
+            table[dotted] = flat
+            self.warnings.append(InputError(
+                f"the global {dotted} is {'assigned' if output else 'read'} here: .g7 names have no dot, so it is "
+                f"the {'output' if output else 'input'} {flat}", where, severity=Severity.WARNING))
+        return flat
+
+    def input_written(self, name: str, where: Location) -> str:
+        """An input the chart assigns: the output ``NAME_out``, with a warning once."""
+        declared = self.spelling.get(name.upper(), name)
+        if declared not in self.inputs_out:
+            self.inputs_out[declared] = f"{declared}_out"
+            self.warnings.append(InputError(
+                f"the chart assigns its input {declared}: .g7 inputs are read only, so it assigns the output "
+                f"{declared}_out (bind it to what writes {declared}; transitions still read the input)", where,
+                severity=Severity.WARNING))
+        return self.inputs_out[declared]
+
+    def declarations(self) -> list[str]:
+        return [v.text() for v in self.used.values()]
+
+
+DATA: contextvars.ContextVar[DataScope | None] = contextvars.ContextVar("DATA", default=None)
+"""While a chart is read (``synth import``): its :class:`DataScope`."""
+
+
+def _value(text: str, boolean: bool) -> int | None:
+    t = re.sub(r"^\w+#", "", text.strip()).replace("_", "")
+    if boolean:
+        return {"TRUE": 1, "FALSE": 0, "1": 1, "0": 0}.get(t.upper())
+    return int(t) if re.fullmatch(r"[-+]?\d+", t) else None
+
+
+def data_scope(pou: Any, q: Callable[[str], str], at: Callable[[Any], Location], bodies: list[str],
+               exclude: set[str]) -> DataScope:
+    """The scope of ``pou``: its local variables of :data:`IEC_RANGES` types that synth wrote
+    as internal or that an action body (``bodies``) assigns; ``exclude`` (upper case): names
+    read otherwise (timer aliases)."""
+    scope = DataScope(str(pou.get("name", "")), at)
+    for v in pou.iterfind(f"{q('interface')}/*/{q('variable')}"):
+        scope.spelling.setdefault(str(v.get("name", "")).upper(), str(v.get("name", "")))
+    scope.global_lists = {str(g.get("name", "")).upper() for g in pou.getroottree().iter(q("globalVars"))
+                          if g.get("name")}
+    written = set().union(*(assigned_names(b) for b in bodies)) if bodies else set()
+    scope.inputs = {str(v.get("name", "")).upper() for v in pou.iterfind(f"{q('interface')}/{q('inputVars')}/{q('variable')}")}
+    outputs = list(pou.iterfind(f"{q('interface')}/{q('outputVars')}/{q('variable')}"))
+    for var in [*pou.iterfind(f"{q('interface')}/{q('localVars')}/{q('variable')}"), *outputs]:
+        typ = var.find(q("type"))
+        kinds = [c for c in (typ if typ is not None else []) if isinstance(c.tag, str)]
+        iec = kinds[0].tag.rsplit("}", 1)[-1] if len(kinds) == 1 else ""
+        name = str(var.get("name", ""))
+        if iec not in IEC_RANGES or name.upper() in exclude or (var in outputs and iec == "BOOL"):
+            continue
+        doc = " ".join("".join(d.itertext()).split()) if (d := var.find(q("documentation"))) is not None else ""
+        m = re.fullmatch(r"internal (-?\d+)\.\.(-?\d+)|internal (Boolean)", doc)
+        if m is None and name.upper() not in written:
+            continue
+        low, high = IEC_RANGES[iec]
+        if m is not None and m[1] is not None:
+            low, high = int(m[1]), int(m[2])
+        init = var.find(f"{q('initialValue')}/{q('simpleValue')}")
+        initial = 0
+        if init is not None:
+            found = _value(str(init.get("value", "")), iec == "BOOL")
+            if found is None or not low <= found <= high:
+                raise InputError(f"the initial value '{init.get('value')}' of {name} is not a value of its type {iec} ({low}..{high})",
+                                 at(init))
+            initial = found
+        scope.vars[name.upper()] = DataVar(name, iec, low, high, max(low, min(high, initial)), m is not None, var,
+                                           var in outputs)
+    return scope
+
+
+def sum_text(scope: DataScope, target: DataVar, rhs: str, where: Callable[[int, int], Location]) -> str:
+    """The ``.g7`` right side of ``target := rhs`` (``rhs``: ST text): a sum of integer
+    literals and integer internal variables, or for a Boolean ``TRUE``/``FALSE``/another one."""
+    text = rhs.strip()
+    lead = len(rhs) - len(rhs.lstrip())
+    if target.boolean:
+        if text.upper() in ("TRUE", "FALSE"):
+            return "1" if text.upper() == "TRUE" else "0"
+        other = scope.find(text) if re.fullmatch(r"\w+", text) else None
+        if other is None or not other.boolean:
+            raise InputError(f"{target.name} is a Boolean internal variable: assign TRUE, FALSE or another Boolean "
+                             f"internal variable, not '{text}'", where(lead, max(1, len(text))))
+        return other.name
+    out = ""
+    pos = 0
+    for i, m in enumerate(re.finditer(r"\s*([-+]?)\s*(\w+#)?(\w+)\s*", text)):
+        if m.start() != pos or (i and not m[1]):
+            break
+        pos = m.end()
+        term = m[3]
+        if re.fullmatch(r"\d+", term.replace("_", "")):
+            term = term.replace("_", "")
+        else:
+            v = scope.find(term)
+            if v is None or v.boolean or m[2]:
+                raise InputError(f"'{term}' in the assignment to {target.name}: .g7 adds integer internal variables "
+                                 "and integer constants", where(lead + m.start(3), len(term)))
+            term = v.name
+        sign = m[1] or "+"
+        out += (f" {sign} " if out else ("-" if sign == "-" else "")) + term
+    if pos != len(text) or not out:
+        raise InputError(f"the assignment to {target.name} is not a sum of integers and internal variables "
+                         f"('{text}'): .g7 assigns sums such as {target.name} + 1", where(lead + pos, 1))
+    return out
