@@ -129,6 +129,20 @@ def test_a_level_self_loop_jump_is_imported_with_a_warning():
         "re-activates the step at every PLC scan while it holds, IEC 60848 (.g7) never stabilises there"]
 
 
+def test_a_chart_inside_an_action_of_a_function_block_is_named_not_dropped(cli, tmp_path):
+    fb = ('<pou name="Cyl" pouType="functionBlock"><interface/><actions><action name="ACT_Extend"><body><SFC>'
+          '<step localId="1" name="Init" initialStep="true"><position x="0" y="0"/></step></SFC></body></action>'
+          '</actions><body><ST><xhtml:p>ACT_Extend();</xhtml:p></ST></body></pou>\n    </pous>')
+    xml = (DATA / "beremiz_ld_fbd.xml").read_text().replace("</pous>", fb, 1)
+    (tmp_path / "fb.xml").write_text(xml)
+    code, out, _ = cli("import", "--list", tmp_path / "fb.xml")
+    assert code == 0 and out.splitlines()[-1].split("\t") == [
+        "Cyl", "functionBlock", "ST", "not imported: an ST body: .g7 holds SFC charts only; SFC in its action ACT_Extend: "
+        "not imported (.g7 reads the SFC body of a POU, not a chart inside an action of a function block)"]
+    code, _, err = cli("import", tmp_path / "fb.xml", "-o", tmp_path / "fb.g7")
+    assert code == 0 and "SFC in its action ACT_Extend: not imported" in err
+
+
 def _with_pou_action(body: str, qualifier: str = "N") -> bytes:
     text = (DATA / "codesys_v35.xml").read_text()
     text = text.replace('<variable name="LOWER"><type><BOOL /></type></variable>',

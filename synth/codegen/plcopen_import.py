@@ -117,6 +117,12 @@ def list_pous(data: bytes | str, file: str = "<xml>") -> list[PouSummary]:
         note = "" if lang == "SFC" else f"an {lang} body: .g7 holds SFC charts only"
         if pou.find(q("actions")) is not None and lang == "SFC":
             note = "POU actions are read where an action block references them"
+        charts = [str(a.get("name", "")) for a in pou.findall(f"{q('actions')}/{q('action')}")
+                  if a.find(f"{q('body')}/{q('SFC')}") is not None]
+        if charts:
+            note += ("; " if note else "") + (f"SFC in its action{'s' if len(charts) > 1 else ''} {', '.join(charts)}: "
+                                              "not imported (.g7 reads the SFC body of a POU, not a chart inside "
+                                              "an action of a function block)")
         out.append(PouSummary(str(pou.get("name", "")), str(pou.get("pouType", "")), lang, lang == "SFC", note))
     return out
 
@@ -149,7 +155,8 @@ def import_sfc(data: bytes | str, file: str = "<xml>", pou: str | None = None,
         raise InputError("no POU with an SFC body in this file", src.at(root),
                          notes=(("POUs: " + ", ".join(names)) if names else "the file has no POU",))
     if notes is not None and pou is None:
-        notes += [f"POU {s.name} not imported: {s.note}" for s in list_pous(data, file) if not s.imported]
+        notes += [f"POU {s.name} not imported: {s.note}" if not s.imported else f"POU {s.name}: {s.note}"
+                  for s in list_pous(data, file) if not s.imported or "SFC in its action" in s.note]
     several = len(sfc_pous) > 1
     charts = []
     for p, s in sfc_pous:

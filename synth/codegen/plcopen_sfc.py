@@ -341,7 +341,9 @@ def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
             warnings.append(InputError(
                 f"a jump from step {sources[0]} back to itself on a level condition ({expr}): IEC 61131-3 SFC "
                 "re-activates the step at every PLC scan while it holds, IEC 60848 (.g7) never stabilises there",
-                src.at(el), severity=Severity.WARNING, notes=("make the condition an edge, or add a step",)))
+                src.at(el), severity=Severity.WARNING,
+                notes=("validate it as the PLC runs it with --semantics sfc (validate, run, st), or make the "
+                       "condition an edge, or add a step",)))
     helpers: list[_ImportedStep] = []
     scope = DATA.get()
     for gname, hsteps, htrans in ton_chart(scope, by_sfc_name, src.text_at) if scope is not None else []:
