@@ -116,3 +116,15 @@ def test_the_compiled_program_in_sfc_semantics_equals_synth_run(tmp_path):
         report, cycles = compiled_check(g, tmp_path / name, {v.name: v.initial for v in rs.variables if v.is_input})
         assert report.ok, report.text()
         assert cycles > 1000
+
+
+def test_import_names_the_steps_a_plc_keeps_for_a_scan(cli, tmp_path):
+    xml = ROOT / "tests/data/plcopen/codesys_data.xml"
+    code, _, err = cli("import", xml, "-o", tmp_path / "x.g7")
+    assert code == 0
+    assert err.splitlines()[-1] == (
+        f"{xml}: note: steps Check, Hold_on stay active for a PLC scan (IEC 61131-3 SFC, their actions run) where "
+        "IEC 60848 passes through them in one evolution: validate with --semantics sfc for the meaning the program "
+        "has on the PLC")
+    code, _, err = cli("import", ROOT / "tests/data/plcopen/twincat3.xml", "-o", tmp_path / "y.g7")
+    assert code == 0 and "PLC scan" not in err

@@ -151,7 +151,14 @@ def cmd_import(args: argparse.Namespace) -> int:
         print(f"{args.file}: note: {n}", file=sys.stderr)
     for w in warnings:
         print(w.render(), file=sys.stderr)
-    parse_grafcet(text, args.output or "<imported>")  # the result must be a valid .g7
+    g = parse_grafcet(text, args.output or "<imported>")  # the result must be a valid .g7
+    from synth.grafcet.semantics import scan_only_steps
+
+    steps = scan_only_steps(g)
+    if steps:
+        print(f"{args.file}: note: step{'s' if len(steps) > 1 else ''} {', '.join(steps)} stay active for a PLC scan "
+              "(IEC 61131-3 SFC, their actions run) where IEC 60848 passes through them in one evolution: validate "
+              "with --semantics sfc for the meaning the program has on the PLC", file=sys.stderr)
     _write(args, text)
     return 0
 

@@ -1,0 +1,39 @@
+"""Where IEC 60848 (search for stability) and IEC 61131-3 SFC (one evolution per scan) read one
+Grafcet differently: the steps a PLC keeps active for a scan that IEC 60848 only passes through.
+
+``synth import`` says so after reading a PLC program, so that it is validated with the meaning
+it has on the PLC (``--semantics sfc``).
+
+Example
+-------
+>>> from synth.grafcet.language_check import parse_grafcet
+>>> g = parse_grafcet("grafcet G { initial step 1 step 2: A step 3: B "
+...                   "transition 1 -> 2 when ↑go transition 2 -> 3 when 1 transition 3 -> 1 when !go }")
+>>> scan_only_steps(g)
+('2',)
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+from synth.errors import InputError, LimitExceeded
+from synth.grafcet.ass import stable_situation_automaton
+from synth.grafcet.language import Grafcet, Semantics, step_key
+from synth.grafcet.machine import GrafcetMachine
+
+__all__ = ["scan_only_steps"]
+
+
+def scan_only_steps(g: Grafcet, max_states: int = 20_000) -> tuple[str, ...] | None:
+    """The steps active in some situation of the SFC reading and in no stable situation of the
+    IEC 60848 one (inputs free); None when either cannot be explored (a limit, or a Grafcet
+    that never stabilises in IEC 60848)."""
+    try:
+        stable = stable_situation_automaton(GrafcetMachine(replace(g, semantics=Semantics.GRAFCET)),
+                                            max_states=max_states)
+        scans = stable_situation_automaton(GrafcetMachine(replace(g, semantics=Semantics.SFC)), max_states=max_states)
+    except (LimitExceeded, InputError):
+        return None
+    seen = {s for st in stable.states for s in st.situation.steps}
+    return tuple(sorted({s for st in scans.states for s in st.situation.steps} - seen, key=step_key))
