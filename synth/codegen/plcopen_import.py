@@ -376,9 +376,7 @@ def _one_action(a: Any, src: Source, steps: dict[str, str], q: Any, qualifier: s
             raw = st_text(st)
             value = sum_text(scope, target, cm[2], lambda o, w: where(raw.find(cm[2]) + o, w))
             if re.search(r"[A-Za-z]", value):
-                raise InputError(f"{body.strip()} in an N action, run at every PLC scan while its step is active: .g7 "
-                                 "assigns once, on activation, on deactivation or on an event (use P1 or P0, or IF "
-                                 "condition THEN ... END_IF)", where(0, len(cm[1])))
+                scope.every_scan(body.strip(), "an N action", where(0, len(cm[1])))
             return f"{target.name} := {value}"
         if cm:
             raw = st_text(st)

@@ -132,6 +132,8 @@ class ExprReader:
         if kind == "name" and scope is not None and "." not in value:
             if value.upper() in scope.timers:
                 return scope.timers[value.upper()]
+            if value.upper() in scope.step_timers:
+                return self.step_timer(value, offset)
             known = scope.vars.get(value.upper())
             if known is not None:
                 if not known.boolean:
@@ -178,6 +180,19 @@ class ExprReader:
         raise self.error(offset, f"expected a variable, a step flag or '(' in {self.what}, not '{value or 'end'}'",
                          width=max(1, len(value)))
 
+    def step_timer(self, value: str, offset: int) -> str:
+        """A TON alias set in several steps (``interconnect := T.Q`` after each): the timer of
+        the step the transition being read leaves."""
+        scope = DATA.get()
+        assert scope is not None
+        timers = scope.step_timers[value.upper()]
+        found = [timers[s] for s in scope.sources if s in timers]
+        if len(found) != 1:
+            raise self.error(offset, f"{value} stands for a TON's Q in steps {', '.join(timers)}: read here "
+                             f"{'outside a transition' if not scope.sources else 'by a transition leaving ' + ', '.join(scope.sources)}"
+                             ", it has no one step timer", width=len(value))
+        return found[0]
+
     def compare(self, kind: str, value: str) -> str | None:
         """``Cnt >= 5`` (or ``5 <= Cnt``) of integer internal variables
         (:data:`~synth.codegen.plcopen_data.DATA`): its ``.g7`` text; None when it is not one."""
@@ -192,6 +207,9 @@ class ExprReader:
         k2, v2, _ = self.tokens[j]
         left = scope.vars.get(value.upper()) if kind == "name" else None
         right = scope.vars.get(v2.upper()) if k2 == "name" else None
+        if k2 == "name" and right is None and v2.upper() in scope.constants:  # VAR CONSTANT: its value
+            number = scope.constants[v2.upper()] * (-1 if sign == "-" else 1)
+            k2, v2, sign = "num", str(abs(number)), "-" if number < 0 else ""
         if left is not None and not left.boolean and k2 == "num" and v2.isdigit():
             text = f"{left.name} {op} {sign}{int(v2)}"
         elif left is not None and not left.boolean and right is not None and not right.boolean and not sign:
