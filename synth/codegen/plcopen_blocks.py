@@ -13,8 +13,8 @@ Boolean or step-timer meaning in ``.g7``:
 
 Example
 -------
->>> sel("g", "a", "b")
-'!(g) & (a) | (g) & (b)'
+>>> sel("g", "(a)", "b | c")
+'!g & a | g & (b | c)'
 """
 
 from __future__ import annotations
@@ -35,12 +35,13 @@ FBD_FUNCTION_BLOCKS = ("SEL", "R_TRIG", "F_TRIG", "TON")
 
 def sel(g: str, in0: str, in1: str) -> str:
     """``SEL(G, IN0, IN1)`` of Booleans (``.g7`` texts)."""
-    return f"!({g}) & ({in0}) | ({g}) & ({in1})"
+    g, in0, in1 = (x if re.fullmatch(r"[!\w↑↓/.]+", x := _bare(y)) else f"({x})" for y in (g, in0, in1))
+    return f"!{g} & {in0} | {g} & {in1}" if not g.startswith("!") else f"!({g}) & {in0} | {g} & {in1}"
 
 
 def _bare(text: str) -> str:
     """``text`` without the parentheses around a name or a negated name."""
-    while re.fullmatch(r"\(!?\(?[\w/.]+\)?\)", text):
+    while re.fullmatch(r"\(!?\(?[↑↓\w/.]+\)?\)", text):
         text = text[1:-1]
     return text
 

@@ -25,7 +25,7 @@ from typing import Any, Callable
 
 from synth.errors import InputError, Location, Severity
 
-__all__ = ["IEC_RANGES", "DataVar", "DataScope", "DATA", "data_scope", "assigned_names", "strip_comments",
+__all__ = ["duration", "IEC_RANGES", "DataVar", "DataScope", "DATA", "data_scope", "assigned_names", "strip_comments",
            "sum_text"]
 
 IEC_RANGES: dict[str, tuple[int, int]] = {
@@ -92,6 +92,7 @@ class DataScope:
     constant_durations: dict[str, str] = field(default_factory=dict)  # upper-case name -> .g7 duration
     one_scan: dict[str, str] = field(default_factory=dict)  # step left at once -> its receptivities
     current_step: str = ""  # the step whose actions are being read
+    action_refs: list[str] = field(default_factory=list)  # names an action block references (outputs)
 
     def every_scan(self, statement: str, action: str, where: Location) -> None:
         """``statement`` (data read) runs at every PLC scan while its step is active: an error,
@@ -129,6 +130,17 @@ class DataScope:
             self.warnings.append(InputError(
                 f"the global {dotted} is {'assigned' if output else 'read'} here: .g7 names have no dot, so it is "
                 f"the {'output' if output else 'input'} {flat}", where, severity=Severity.WARNING))
+        return flat
+
+    def member_read(self, dotted: str, where: Location) -> str:
+        """``Inst.X``, a member of a variable of the POU (a block instance), read: the input ``Inst_X``."""
+        flat = dotted.replace(".", "_")
+        if dotted not in self.globals_in:
+            self.globals_in[dotted] = flat
+            self.warnings.append(InputError(
+                f"{dotted}, a member of {dotted.split('.')[0]} (a variable of POU {self.pou}), is read here: .g7 names "
+                f"have no dot, so it is the input {flat} (bind it to the member's value)", where,
+                severity=Severity.WARNING))
         return flat
 
     def input_written(self, name: str, where: Location) -> str:
@@ -198,11 +210,25 @@ def data_scope(pou: Any, q: Callable[[str], str], at: Callable[[Any], Location],
     return scope
 
 
+_MS = {"ms": 1, "s": 1000, "m": 60_000, "h": 3_600_000, "d": 86_400_000}
+
+
+def duration(text: str) -> str | None:
+    """A TIME literal as a ``.g7`` duration, or None when ``text`` is not one."""
+    m = re.fullmatch(r"\s*(?:T|TIME)#((?:\d+(?:\.\d+)?(?:ms|s|m|h|d)_?)+)\s*", text, re.I)
+    if m is None:
+        return None
+    parts = re.findall(r"(\d+(?:\.\d+)?)(ms|s|m|h|d)", m[1].lower())
+    if len(parts) == 1 and parts[0][1] != "d":
+        number, unit = parts[0]
+        return f"{number}{'min' if unit == 'm' else unit}"
+    total = sum(float(n) * _MS[u] for n, u in parts)
+    return f"{int(total)}ms" if total == int(total) else None
+
+
 def _constants(scope: DataScope, pou: Any, q: Callable[[str], str]) -> None:
     """The constants in reach of ``pou`` (its ``VAR CONSTANT`` and the project's constant global
     variables, ``constant="true"``) with an integer or TIME initial value."""
-    from synth.codegen.plcopen_timers import duration
-
     sections = [g for g in pou.getroottree().iter(q("globalVars")) if g.get("constant") in ("true", "1")]
     sections += [s for s in pou.iterfind(f"{q('interface')}/{q('localVars')}") if s.get("constant") in ("true", "1")]
     for section in sections:

@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 from typing import Any, Callable
 
 from synth.codegen.plcopen_data import DATA
+from synth.codegen.plcopen_ids import number_ids
 from synth.codegen.plcopen_scan import one_scan_steps
 from synth.codegen.plcopen_timers import ton_chart
 from synth.codegen.plcopen_vendor import step_actions
@@ -168,7 +169,8 @@ def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
     from lxml import etree
 
     pou_actions = {str(x.get("name")): x for x in pou.iterfind(f"{q('actions')}/{q('action')}")}
-    inputs = [v.get("name") for v in pou.iterfind(f"{q('interface')}/{q('inputVars')}/{q('variable')}")]
+    inputs = [v.get("name") for v in pou.iterfind(f"{q('interface')}/{q('inputVars')}/{q('variable')}")
+              if v.find(f"{q('type')}/{q('derived')}") is None]  # a block instance is no Boolean input
     outputs = [v.get("name") for v in pou.iterfind(f"{q('interface')}/{q('outputVars')}/{q('variable')}")]
     named_conditions: dict[str, tuple[Any, str]] = {}
     named_fbd: dict[str, tuple[Any, Any]] = {}
@@ -183,6 +185,7 @@ def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
         else:
             raise InputError("a named transition whose body is neither ST nor FBD", src.at(t))
 
+    number_ids(sfc, q, src.at)
     elements: dict[int, Any] = {}  # localId -> lxml element
     for el in sfc:
         if not isinstance(el.tag, str):

@@ -21,28 +21,12 @@ from __future__ import annotations
 import re
 from typing import Any, Callable
 
-from synth.codegen.plcopen_data import DataScope, data_scope, strip_comments
+from synth.codegen.plcopen_data import DataScope, data_scope, duration, strip_comments
 from synth.codegen.plcopen_vendor import IecQualifier, StepAction, step_actions
 from synth.codegen.st_condition import st_text
 from synth.errors import InputError, Location, Severity
 
 __all__ = ["duration", "prepare_scope", "ton_chart"]
-
-_MS = {"ms": 1, "s": 1000, "m": 60_000, "h": 3_600_000, "d": 86_400_000}
-
-
-def duration(text: str) -> str | None:
-    """A TIME literal as a ``.g7`` duration, or None when ``text`` is not one."""
-    m = re.fullmatch(r"\s*(?:T|TIME)#((?:\d+(?:\.\d+)?(?:ms|s|m|h|d)_?)+)\s*", text, re.I)
-    if m is None:
-        return None
-    parts = re.findall(r"(\d+(?:\.\d+)?)(ms|s|m|h|d)", m[1].lower())
-    if len(parts) == 1 and parts[0][1] != "d":
-        number, unit = parts[0]
-        return f"{number}{'min' if unit == 'm' else unit}"
-    total = sum(float(n) * _MS[u] for n, u in parts)
-    return f"{int(total)}ms" if total == int(total) else None
-
 
 def _locals(pou: Any, q: Callable[[str], str]) -> dict[str, tuple[str, Any]]:
     """Local variables (upper-case name -> (type name, element))."""
@@ -115,7 +99,7 @@ def prepare_scope(pou: Any, sfc: Any, q: Callable[[str], str], at: Callable[[Any
     inline = [st for st in sfc.iter(q("ST")) if st.getparent() is not None and st.getparent().tag == q("inline")
               and st.getparent().getparent() is not None and st.getparent().getparent().tag == q("action")]
     local = _locals(pou, q)
-    found: dict[str, list[tuple[str, str, str, Any, str, str, str]]] = {}  # V -> (T, step, duration, action, text, IN, V)
+    found: dict[str, list[tuple[str, str, str, Any, str, str, str, bool]]] = {}  # V -> (T, step, PT, action, text, IN, V, IF)
     for step in sfc.iterfind(q("step")):
         sname = str(step.get("name", ""))
         g7 = prefix + (sname[1:] if re.fullmatch(r"S\d+", sname) else sname)
