@@ -35,7 +35,7 @@ def always(expr: str, ranges: dict[str, tuple[int, int]]) -> bool:
         return False
     if any(t not in _PY and not re.fullmatch(r"-?\d+|[A-Za-z_]\w*", t) for t in tokens):
         return False
-    code = "".join(_PY.get(t, f" {t} ") for t in tokens)
+    code = "".join(_PY.get(t, f" {t} ") for t in tokens).strip()
     try:
         compiled = compile(code, "<receptivity>", "eval")
     except SyntaxError:
