@@ -84,9 +84,11 @@ grafcet G1 {
 
 
 @pytest.mark.parametrize("old, new, first", [
+    ('<block localId="9" typeName="AND">', '<block localId="9" typeName="CTU">',
+     "x.xml:73:13: error: an FBD block CTU in a transition condition: only AND, OR, NOT, SEL, R_TRIG, F_TRIG and TON "
+     "have a Boolean or step-timer meaning in .g7"),
     ('<block localId="9" typeName="AND">', '<block localId="9" typeName="TON">',
-     "x.xml:73:13: error: an FBD block TON in a transition condition: only AND, OR and NOT have a Boolean meaning "
-     "in .g7"),
+     "x.xml:73:13: error: an FBD TON block without its input IN"),
     ('<reference name="LOWER" />', "<inline><ST><xhtml xmlns=\"http://www.w3.org/1999/xhtml\">Cnt := Cnt + 1;</xhtml>"
      "</ST></inline>", "x.xml:60:73: error: an assignment of data in an action body (Cnt := Cnt + 1;): Cnt is not a "
      "local variable of an integer type (.g7 internal variables are the chart's own)"),
@@ -401,3 +403,144 @@ def test_what_a_codesys_data_body_cannot_be_is_located(old, new, first):
     with pytest.raises(InputError) as info:
         import_sfc(text.replace(old, new, 1).encode(), "x.xml")
     assert info.value.render().splitlines()[0] == first
+
+
+def test_sel_r_trig_and_ton_blocks_wired_in_fbd_transitions():
+    """Beremiz FBD: SEL(auto, R_TRIG(step_btn).Q, go); TON(IN:=PRESSING, PT:=T#1500ms).Q with PRESSING only
+    the continuous action of step Press: the step timer of Press."""
+    warnings: list[InputError] = []
+    text = import_sfc((DATA / "beremiz_fbd_blocks.xml").read_bytes(), "b.xml", warnings=warnings)
+    assert text.split("\n", 1)[1] == """inputs auto, go, step_btn
+outputs PRESS, PRESSING
+
+grafcet G1 {
+  initial step Wait
+  step Press: PRESS, PRESSING
+  transition Wait -> Press when !auto & ↑step_btn | auto & go
+  transition Press -> Wait when 1500ms/XPress
+}
+"""
+    assert [w.render().splitlines()[0] for w in warnings] == [
+        "b.xml:84:13: warning: R_TRIG R_TRIG0 is read as ↑step_btn: the PLC's instance remembers CLK from its last "
+        "call (made while the transition is evaluated, i.e. while its step is active), so a change of CLK while the "
+        "step was inactive is seen at its activation by the PLC, never by .g7",
+        "b.xml:124:13: warning: the TON TON0 wired with IN:=PRESSING (only the continuous action of step Press: "
+        "XPress) to the condition of a transition leaving step Press: TON0.Q is read as the step timer 1500ms/XPress "
+        "(a TON keeps Q until it is called with IN FALSE; a .g7 timer restarts at each activation of its step)"]
+    xml = (DATA / "beremiz_fbd_blocks.xml").read_text().replace("<expression>PRESSING</expression>",
+                                                                 "<expression>go</expression>")
+    text = import_sfc(xml.encode(), "b.xml")
+    assert "  transition Press -> Wait when 1500ms/XTON0_on\n" in text
+    assert "  transition TON0_off -> TON0_on when XPress & go\n  transition TON0_on -> TON0_off when !(XPress & go)\n" in text
+    with pytest.raises(InputError) as info:
+        import_sfc(xml.replace("<expression>T#1500ms</expression>", "<expression>Delay</expression>").encode(), "b.xml")
+    assert info.value.render().splitlines()[0] == (
+        "b.xml:119:13: error: the PT of TON TON0 is 'Delay': a step timer needs a constant duration such as T#2s")
+
+
+def _crane(expression: str, *, by: str = "xDown") -> str:
+    return (DATA / "codesys_v35.xml").read_text().replace(f"<expression>{by}</expression>",
+                                                          f"<expression>{expression}</expression>", 1)
+
+
+def test_xor_step_times_members_and_two_names_in_a_row_in_st_conditions():
+    warnings: list[InputError] = []
+    out = import_sfc(_crane("xDown XOR xGripOk").encode(), "x.xml", pou="Crane")
+    assert "  transition Lower -> Init when (xDown & !xGripOk | !xDown & xGripOk) & !(xGripOk)\n" in out
+    out = import_sfc(_crane("xDown XOR xGripOk AND xStart OR NOT xStart").encode(), "x.xml", pou="Crane")
+    assert "when (xDown & !(xGripOk & xStart) | !xDown & (xGripOk & xStart) | !xStart) & !(xGripOk)\n" in out
+    out = import_sfc(_crane("Lower.t &gt; T#2s").replace("<expression>xGripOk</expression>",
+                                                         "<expression>T#5s &gt; Lower.T</expression>").encode(),
+                     "x.xml", pou="Crane", warnings=warnings)
+    assert "  transition Lower -> Init when (2s/XLower) & !(!5s/XLower)\n" in out
+    assert [w.render().splitlines()[0] for w in warnings] == [
+        "x.xml:66:15: warning: Lower.t > T#2s is read as 2s/XLower: > and >= differ only at the instant the step has "
+        "been active exactly that long, the same at this abstraction (a step timer elapses once)",
+        "x.xml:71:15: warning: T#5s > Lower.T is read as !5s/XLower: < and <= differ only at the instant the step "
+        "has been active exactly that long, the same at this abstraction (a step timer elapses once)"]
+    with pytest.raises(InputError) as info:
+        import_sfc(_crane("Lower.t = T#2s").encode(), "x.xml", pou="Crane")
+    assert info.value.render().splitlines()[0] == (
+        "x.xml:66:35: error: a step time Lower.t is compared with '=': only < <= > >= with a duration have a "
+        "step-timer meaning (D/XS, or its negation)")
+    member = _crane("Motor.xReady", by="xStart AND NOT xDown").replace(
+        '<variable name="xStart"><type><BOOL /></type></variable>',
+        '<variable name="xStart"><type><BOOL /></type></variable>\n'
+        '            <variable name="Motor"><type><derived name="FB_Motor" /></type></variable>', 1)
+    warnings.clear()
+    out = import_sfc(member.encode(), "x.xml", pou="Crane", warnings=warnings)
+    assert "inputs xStart, xDown, xGripOk, Motor_xReady\n" in out and "  transition Init -> Lower when Motor_xReady\n" in out
+    assert warnings[0].render().splitlines()[0] == (
+        "x.xml:40:27: warning: Motor.xReady, a member of Motor (a variable of POU Crane), is read here: .g7 names "
+        "have no dot, so it is the input Motor_xReady (bind it to the member's value)")
+    with pytest.raises(InputError) as info:
+        import_sfc(_crane("Power ON").encode(), "x.xml", pou="Crane")
+    assert info.value.render().splitlines()[0] == (
+        "x.xml:66:33: error: unexpected 'ON' in an ST condition: 'Power ON' is two names in a row, not an ST "
+        "expression (an operator is missing)")
+
+
+def test_non_numeric_local_ids_are_renumbered_when_unique():
+    xml = (DATA / "beremiz_ld_fbd.xml").read_text().replace('localId="1" ', 'localId="idle" ').replace(
+        '<connection refLocalId="1">', '<connection refLocalId="idle">')
+    assert 'localId="idle"' in xml and 'refLocalId="idle"' in xml
+    assert import_sfc(xml.encode(), "x.xml") == import_sfc((DATA / "beremiz_ld_fbd.xml").read_bytes(), "x.xml")
+    with pytest.raises(InputError) as info:
+        import_sfc(xml.replace('localId="4" ', 'localId="idle" ').encode(), "x.xml")
+    assert info.value.render().splitlines()[0] == "x.xml:95:13: error: <step> with localId 'idle', which another element has"
+
+
+def _counter(*pairs: tuple[str, str]) -> bytes:
+    text = (DATA / "beremiz_counter.xml").read_text()
+    for old, new in pairs:
+        assert old in text
+        text = text.replace(old, new, 1)
+    return text.encode()
+
+
+def test_constants_multi_statement_p1_bodies_and_a_step_left_at_the_first_scan():
+    consts = ('          <localVars>\n', '          <localVars constant="true">\n            <variable name="Limit"><type>'
+              '<INT/></type><initialValue><simpleValue value="3"/></initialValue></variable>\n          </localVars>\n'
+              '          <localVars>\n')
+    out = import_sfc(_counter(consts, ("3 <= Cnt", "Limit <= Cnt"), ("Cnt < 3", "Cnt < Limit"),
+                              ("Cnt := 0;", "Cnt := Limit - 1; FULL := FALSE;")), "x.xml")
+    assert "  step Full: FULL, Cnt := 3 - 1 on deactivation, reset FULL on deactivation\n" in out
+    assert "  transition Count -> Full when !go & Cnt >= 3\n" in out and "  transition Count -> Start when !go & Cnt < 3\n" in out
+    with pytest.raises(InputError) as info:
+        import_sfc(_counter(("Cnt := 0;", "Cnt := Limit - 1;")), "x.xml")
+    assert info.value.render().splitlines()[0] == (
+        "x.xml:109:46: error: 'Limit' in the assignment to Cnt: .g7 adds integer internal variables and integer constants")
+    warnings: list[InputError] = []
+    out = import_sfc(_counter(('<action localId="0" qualifier="P1">', '<action localId="0">'),
+                              ("NOT go AND 3 <= Cnt", "3 <= Cnt"),
+                              ("NOT go AND Cnt < 3", "Cnt < 3")), "x.xml", warnings=warnings)
+    assert "  step Count: Cnt := Cnt + 1\n" in out
+    assert [w.render().splitlines()[0] for w in warnings if "first scan" in w.message] == [(
+        "x.xml:66:39: warning: Cnt := Cnt + 1; in an N action runs at every PLC scan while step Count is active; the "
+        "step is left at the first scan (its transitions' receptivities Cnt >= 3 | Cnt < 3 always hold), so it runs "
+        "once: read as an assignment on activation")]
+
+
+def test_a_ton_in_if_then_and_one_alias_timing_two_steps():
+    text = (DATA / "codesys_data.xml").read_text()
+    for old, new in [("Delay(IN:=TRUE, PT:=Delay_PT);\nDelay_Q := Delay.Q;", "Hold(IN:=TRUE, PT:=T#1S);\nHold_Q := Hold.Q;"),
+                     ("Hold(IN:=xPart, PT:=T#2S);\nHold_Q := Hold.Q;",
+                      "IF xPart = TRUE THEN\n  Hold(IN:=xPart, PT:=T#2S);\n  Hold_Q := Hold.Q;\nEND_IF"),
+                     ("<expression>Delay_Q", "<expression>Hold_Q")]:
+        assert old in text
+        text = text.replace(old, new, 1)
+    warnings: list[InputError] = []
+    out = import_sfc(text.encode(), "x.xml", warnings=warnings)
+    assert "  transition Settle -> Check when 1s/XSettle & xSeen\n  transition Check -> Done when 2s/XHold_Check_on & " \
+           "nBoxes >= 3\n" in out
+    assert "grafcet Hold_Check_TON {\n  initial step Hold_Check_off\n  step Hold_Check_on\n  transition Hold_Check_off -> " \
+           "Hold_Check_on when XCheck & xPart\n" in out
+    assert [w.render().splitlines()[0] for w in warnings][1:3] == [
+        "x.xml:128:61: warning: the TON Hold called with IN:=TRUE in action Settle_active of step Settle: Hold_Q is read "
+        "as the step timer 1s/XSettle in the transitions leaving step Settle (a TON keeps Q until it is called with IN "
+        "FALSE; a .g7 timer restarts at each activation of its step)",
+        "x.xml:138:3: warning: the TON Hold called with IN:=xPart in action Check_active of step Check: Hold_Q is read "
+        "as 2s/XHold_Check_on, the timer of step Hold_Check_on of the partial grafcet Hold_Check_TON, active while step "
+        "Check is and xPart holds in the transitions leaving step Check (a TON keeps Q until it is called with IN FALSE; "
+        "a .g7 timer restarts at each activation of its step; the PLC calls it only while the IF condition holds, so it "
+        "does not restart when the condition falls)"]

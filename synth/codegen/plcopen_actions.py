@@ -88,10 +88,11 @@ def _timer_statement(statement: str, pos: int, where: Callable[[int, int], Locat
     if call and call[1].upper() in scope.timer_blocks:
         return True
     alias = re.fullmatch(r"(\w+)\s*:=\s*(.*)", statement, re.S)
-    if alias and alias[1].upper() in scope.timers:
+    if alias and (alias[1].upper() in scope.timers or alias[1].upper() in scope.step_timers):
         if not re.fullmatch(r"\w+\.Q", alias[2].strip(), re.I):
+            timer = scope.timers.get(alias[1].upper()) or ", ".join(scope.step_timers[alias[1].upper()].values())
             scope.warnings.append(InputError(
-                f"{statement} is left out: {alias[1]} stands for the step timer {scope.timers[alias[1].upper()]}",
+                f"{statement} is left out: {alias[1]} stands for the step timer {timer}",
                 where(pos, len(alias[1])), severity=Severity.WARNING))
         return True
     return False
@@ -118,10 +119,8 @@ def action_body(name: str, text: str, qualifier: IecQualifier, where: Callable[[
         elif m:
             out.append(f"{'set' if m[2].upper() == 'TRUE' else 'reset'} {_order(m[1], where(pos, len(m[1])))}{when}")
         elif (m := _DATA.match(clean, pos)) and (found := _data(m, 0, where)) is not None:
-            if found[1] and qualifier == IecQualifier.N:
-                raise InputError(f"{statement} in action {name}, run at every PLC scan while its step is active: "
-                                 ".g7 assigns once, on activation, on deactivation or on an event (use P1 or P0, or "
-                                 "IF condition THEN ... END_IF)", where(pos, len(m[1])))
+            if found[1] and qualifier == IecQualifier.N and (scope := DATA.get()) is not None:
+                scope.every_scan(statement, f"action {name}", where(pos, len(m[1])))
             out.append(found[0] + when)
         elif (m := _IF.match(clean, pos)) and qualifier == IecQualifier.N:
             out += _level_if(name, m, where, steps)

@@ -25,7 +25,7 @@ from typing import Any, Callable
 
 from synth.errors import InputError, Location, Severity
 
-__all__ = ["IEC_RANGES", "DataVar", "DataScope", "DATA", "data_scope", "assigned_names", "strip_comments",
+__all__ = ["duration", "IEC_RANGES", "DataVar", "DataScope", "DATA", "data_scope", "assigned_names", "strip_comments",
            "sum_text"]
 
 IEC_RANGES: dict[str, tuple[int, int]] = {
@@ -84,6 +84,28 @@ class DataScope:
     globals_out: dict[str, str] = field(default_factory=dict)  # dotted name -> .g7 output name
     globals_in: dict[str, str] = field(default_factory=dict)  # dotted name -> .g7 input name
     warnings: list[InputError] = field(default_factory=list)
+    step_timers: dict[str, dict[str, str]] = field(default_factory=dict)  # alias -> step -> timer (several steps)
+    sources: tuple[str, ...] = ()  # the source steps of the transition being read
+    prefix: str = ""  # of the step names (several POUs in one .g7)
+    helper_charts: list[tuple[str, str, str, str]] = field(default_factory=list)  # (grafcet, off, on, .g7 condition)
+    constants: dict[str, int] = field(default_factory=dict)  # upper-case name -> value (VAR CONSTANT)
+    constant_durations: dict[str, str] = field(default_factory=dict)  # upper-case name -> .g7 duration
+    one_scan: dict[str, str] = field(default_factory=dict)  # step left at once -> its receptivities
+    current_step: str = ""  # the step whose actions are being read
+    action_refs: list[str] = field(default_factory=list)  # names an action block references (outputs)
+
+    def every_scan(self, statement: str, action: str, where: Location) -> None:
+        """``statement`` (data read) runs at every PLC scan while its step is active: an error,
+        unless the step lasts one scan (:mod:`synth.codegen.plcopen_scan`): then a warning."""
+        step = self.current_step
+        if step not in self.one_scan:
+            raise InputError(f"{statement} in {action}, run at every PLC scan while its step is active: .g7 assigns "
+                             "once, on activation, on deactivation or on an event (use P1 or P0, or IF condition "
+                             "THEN ... END_IF)", where)
+        self.warnings.append(InputError(
+            f"{statement} in {action} runs at every PLC scan while step {step} is active; the step is left at the "
+            f"first scan (its transitions' receptivities {self.one_scan[step]} always hold), so it runs once: read "
+            "as an assignment on activation", where, severity=Severity.WARNING))
 
     def find(self, name: str) -> DataVar | None:
         v = self.vars.get(name.upper())
@@ -108,6 +130,17 @@ class DataScope:
             self.warnings.append(InputError(
                 f"the global {dotted} is {'assigned' if output else 'read'} here: .g7 names have no dot, so it is "
                 f"the {'output' if output else 'input'} {flat}", where, severity=Severity.WARNING))
+        return flat
+
+    def member_read(self, dotted: str, where: Location) -> str:
+        """``Inst.X``, a member of a variable of the POU (a block instance), read: the input ``Inst_X``."""
+        flat = dotted.replace(".", "_")
+        if dotted not in self.globals_in:
+            self.globals_in[dotted] = flat
+            self.warnings.append(InputError(
+                f"{dotted}, a member of {dotted.split('.')[0]} (a variable of POU {self.pou}), is read here: .g7 names "
+                f"have no dot, so it is the input {flat} (bind it to the member's value)", where,
+                severity=Severity.WARNING))
         return flat
 
     def input_written(self, name: str, where: Location) -> str:
@@ -146,6 +179,7 @@ def data_scope(pou: Any, q: Callable[[str], str], at: Callable[[Any], Location],
         scope.spelling.setdefault(str(v.get("name", "")).upper(), str(v.get("name", "")))
     scope.global_lists = {str(g.get("name", "")).upper() for g in pou.getroottree().iter(q("globalVars"))
                           if g.get("name")}
+    _constants(scope, pou, q)
     written = set().union(*(assigned_names(b) for b in bodies)) if bodies else set()
     scope.inputs = {str(v.get("name", "")).upper() for v in pou.iterfind(f"{q('interface')}/{q('inputVars')}/{q('variable')}")}
     outputs = list(pou.iterfind(f"{q('interface')}/{q('outputVars')}/{q('variable')}"))
@@ -176,6 +210,40 @@ def data_scope(pou: Any, q: Callable[[str], str], at: Callable[[Any], Location],
     return scope
 
 
+_MS = {"ms": 1, "s": 1000, "m": 60_000, "h": 3_600_000, "d": 86_400_000}
+
+
+def duration(text: str) -> str | None:
+    """A TIME literal as a ``.g7`` duration, or None when ``text`` is not one."""
+    m = re.fullmatch(r"\s*(?:T|TIME)#((?:\d+(?:\.\d+)?(?:ms|s|m|h|d)_?)+)\s*", text, re.I)
+    if m is None:
+        return None
+    parts = re.findall(r"(\d+(?:\.\d+)?)(ms|s|m|h|d)", m[1].lower())
+    if len(parts) == 1 and parts[0][1] != "d":
+        number, unit = parts[0]
+        return f"{number}{'min' if unit == 'm' else unit}"
+    total = sum(float(n) * _MS[u] for n, u in parts)
+    return f"{int(total)}ms" if total == int(total) else None
+
+
+def _constants(scope: DataScope, pou: Any, q: Callable[[str], str]) -> None:
+    """The constants in reach of ``pou`` (its ``VAR CONSTANT`` and the project's constant global
+    variables, ``constant="true"``) with an integer or TIME initial value."""
+    sections = [g for g in pou.getroottree().iter(q("globalVars")) if g.get("constant") in ("true", "1")]
+    sections += [s for s in pou.iterfind(f"{q('interface')}/{q('localVars')}") if s.get("constant") in ("true", "1")]
+    for section in sections:
+        for var in section.iterfind(q("variable")):
+            init = var.find(f"{q('initialValue')}/{q('simpleValue')}")
+            if init is None:
+                continue
+            name, raw = str(var.get("name", "")).upper(), str(init.get("value", ""))
+            number = _value(raw, False)
+            if number is not None:
+                scope.constants.setdefault(name, number)
+            elif (d := duration(raw)) is not None:
+                scope.constant_durations.setdefault(name, d)
+
+
 def sum_text(scope: DataScope, target: DataVar, rhs: str, where: Callable[[int, int], Location]) -> str:
     """The ``.g7`` right side of ``target := rhs`` (``rhs``: ST text): a sum of integer
     literals and integer internal variables, or for a Boolean ``TRUE``/``FALSE``/another one."""
@@ -198,6 +266,12 @@ def sum_text(scope: DataScope, target: DataVar, rhs: str, where: Callable[[int, 
         term = m[3]
         if re.fullmatch(r"\d+", term.replace("_", "")):
             term = term.replace("_", "")
+        elif term.upper() in scope.constants and not m[2] and scope.vars.get(term.upper()) is None:
+            term = str(scope.constants[term.upper()])
+            if term.startswith("-"):
+                m_sign = "+" if m[1] == "-" else "-"
+                out += (f" {m_sign} " if out else ("-" if m_sign == "-" else "")) + term[1:]
+                continue
         else:
             v = scope.find(term)
             if v is None or v.boolean or m[2]:

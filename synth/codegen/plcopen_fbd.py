@@ -16,6 +16,7 @@ from __future__ import annotations
 
 from typing import Any, Callable
 
+from synth.codegen.plcopen_blocks import FBD_FUNCTION_BLOCKS, sel, ton_output, trigger
 from synth.codegen.st_condition import ExprReader
 from synth.errors import InputError
 
@@ -32,7 +33,7 @@ def _negated(el: Any) -> bool:
 
 
 def fbd_condition(cond: Any, elements: dict[int, Any], q: Callable[[str], str], src: Any,
-                  steps: dict[str, str]) -> str:
+                  steps: dict[str, str], sources: tuple[str, ...] = ()) -> str:
     """The receptivity of ``<condition><connectionPointIn>`` wired to an FBD network."""
     from lxml import etree
 
@@ -60,10 +61,12 @@ def fbd_condition(cond: Any, elements: dict[int, Any], q: Callable[[str], str], 
             return f"!({expr})" if _negated(el) else expr
         if kind == "block":
             name = (el.get("typeName") or "").upper()
-            if name not in _BLOCKS:
-                raise InputError(f"an FBD block {el.get('typeName')} in a transition condition: only AND, OR and NOT "
-                                 "have a Boolean meaning in .g7", src.at(el), expected=tuple(_BLOCKS))
-            args = []
+            if name not in _BLOCKS and name not in FBD_FUNCTION_BLOCKS:
+                raise InputError(f"an FBD block {el.get('typeName')} in a transition condition: only AND, OR, NOT, "
+                                 "SEL, R_TRIG, F_TRIG and TON have a Boolean or step-timer meaning in .g7",
+                                 src.at(el), expected=(*_BLOCKS, *FBD_FUNCTION_BLOCKS))
+            args: list[str] = []
+            params: dict[str, tuple[str, Any]] = {}
             for var in el.iterfind(f"{q('inputVariables')}/{q('variable')}"):
                 cp = var.find(q("connectionPointIn"))
                 if cp is None:
@@ -74,11 +77,14 @@ def fbd_condition(cond: Any, elements: dict[int, Any], q: Callable[[str], str], 
                 ref = int(conns[0].get("refLocalId"))
                 if ref not in elements:
                     raise InputError(f"connection to unknown localId {ref}", src.at(conns[0]))
+                if name == "TON" and str(var.get("formalParameter", "")).upper() == "PT":
+                    ex = elements[ref].find(q("expression"))
+                    params["PT"] = ((ex.text or "") if ex is not None else "", elements[ref])
+                    continue
                 arg = node(ref, seen | {lid})
                 args.append(f"!({arg})" if _negated(var) else f"({arg})")
-            if not args or (name == "NOT" and len(args) != 1):
-                raise InputError(f"an FBD {name} block with {len(args)} inputs", src.at(el))
-            out = f"!{args[0]}" if name == "NOT" else _BLOCKS[name].join(args)
+                params[str(var.get("formalParameter", "")).upper()] = (args[-1], var)
+            out = _function_block(name, el, args, params)
             outs = el.find(f"{q('outputVariables')}/{q('variable')}")
             return f"!({out})" if _negated(outs) else out
         if kind == "leftPowerRail":
@@ -113,11 +119,29 @@ def fbd_condition(cond: Any, elements: dict[int, Any], q: Callable[[str], str], 
         raise InputError(f"<{kind}> in a transition condition: .g7 reads inVariables, AND/OR/NOT blocks and LD "
                          "contacts", src.at(el))
 
+    def _function_block(name: str, el: Any, args: list[str], params: dict[str, tuple[str, Any]]) -> str:
+        if name in _BLOCKS:
+            if not args or (name == "NOT" and len(args) != 1):
+                raise InputError(f"an FBD {name} block with {len(args)} inputs", src.at(el))
+            return f"!{args[0]}" if name == "NOT" else _BLOCKS[name].join(args)
+        wanted = {"SEL": ("G", "IN0", "IN1"), "R_TRIG": ("CLK",), "F_TRIG": ("CLK",), "TON": ("IN", "PT")}[name]
+        missing = [p for p in wanted if p not in params]
+        if missing:
+            raise InputError(f"an FBD {name} block without its input {missing[0]}", src.at(el))
+        instance = str(el.get("instanceName") or name)
+        if name == "SEL":
+            return sel(*(params[p][0] for p in wanted))
+        if name == "TON":
+            return ton_output(instance, params["IN"][0], params["PT"][0], list(sources), src.at(el), elements,
+                              steps, src.at(params["PT"][1]))
+        return trigger(name, instance, params["CLK"][0], src.at(el))
+
     cp = cond.find(q("connectionPointIn"))
     return one_source(cp, cond)
 
 
-def fbd_transition(transition: Any, fbd: Any, q: Callable[[str], str], src: Any, steps: dict[str, str]) -> str:
+def fbd_transition(transition: Any, fbd: Any, q: Callable[[str], str], src: Any, steps: dict[str, str],
+                   sources: tuple[str, ...] = ()) -> str:
     """The receptivity of a named transition whose body is FBD: the network wired to the
     ``<outVariable>`` that carries the transition's name."""
     from lxml import etree
@@ -134,4 +158,4 @@ def fbd_transition(transition: Any, fbd: Any, q: Callable[[str], str], src: Any,
             target = el
     if target is None:
         raise InputError(f"the FBD body of transition {name} has no <outVariable> {name}", src.at(transition))
-    return fbd_condition(target, elements, q, src, steps)
+    return fbd_condition(target, elements, q, src, steps, sources)

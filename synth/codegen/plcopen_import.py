@@ -175,8 +175,8 @@ def import_sfc(data: bytes | str, file: str = "<xml>", pou: str | None = None,
         charts[-1].warnings.extend(action_warnings + scope.warnings)
         charts[-1].internals = scope.declarations()
         charts[-1].outputs[:] = [o for o in charts[-1].outputs if o.upper() not in scope.used]
-        charts[-1].outputs.extend(n for n in [*scope.globals_out.values(), *scope.inputs_out.values()]
-                                  if n not in charts[-1].outputs)
+        charts[-1].outputs.extend(n for n in [*scope.action_refs, *scope.globals_out.values(), *scope.inputs_out.values()]
+                                  if n not in charts[-1].outputs and n.upper() not in scope.used)
     _feedback(charts, src)
     if warnings is not None:
         warnings += [w for c in charts for w in c.warnings]
@@ -332,6 +332,8 @@ def _one_action(a: Any, src: Source, steps: dict[str, str], q: Any, qualifier: s
     ref, inline = a.find(q("reference")), a.find(q("inline"))
     if ref is not None:
         name = ref.get("name", "")
+        if (scope := DATA.get()) is not None and name not in scope.action_refs:
+            scope.action_refs.append(name)  # an output, even when the POU declares it local
         if qualifier == Qualifier.N:
             return name
         if qualifier == Qualifier.S:
@@ -348,6 +350,8 @@ def _one_action(a: Any, src: Source, steps: dict[str, str], q: Any, qualifier: s
     scope = DATA.get()
     data = re.fullmatch(r"(\w+)\s*:=\s*([^;]*?)\s*;?", body, re.S)
     target = scope.find(data[1]) if scope is not None and data is not None else None
+    if qualifier in (Qualifier.P0, Qualifier.P1) and len([x for x in body.split(";") if x.strip()]) > 1:
+        return ", ".join(action_body(f"{qualifier} (inline)", st_text(st), IecQualifier(qualifier), where, steps))
     if qualifier in (Qualifier.P0, Qualifier.P1) and target is not None and data is not None and scope is not None:
         raw = st_text(st)
         value = sum_text(scope, target, data[2], lambda o, w: where(raw.find(data[2]) + o, w))
@@ -376,9 +380,7 @@ def _one_action(a: Any, src: Source, steps: dict[str, str], q: Any, qualifier: s
             raw = st_text(st)
             value = sum_text(scope, target, cm[2], lambda o, w: where(raw.find(cm[2]) + o, w))
             if re.search(r"[A-Za-z]", value):
-                raise InputError(f"{body.strip()} in an N action, run at every PLC scan while its step is active: .g7 "
-                                 "assigns once, on activation, on deactivation or on an event (use P1 or P0, or IF "
-                                 "condition THEN ... END_IF)", where(0, len(cm[1])))
+                scope.every_scan(body.strip(), "an N action", where(0, len(cm[1])))
             return f"{target.name} := {value}"
         if cm:
             raw = st_text(st)

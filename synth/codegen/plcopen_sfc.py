@@ -19,6 +19,8 @@ from dataclasses import dataclass, field
 from typing import Any, Callable
 
 from synth.codegen.plcopen_data import DATA
+from synth.codegen.plcopen_ids import number_ids
+from synth.codegen.plcopen_scan import one_scan_steps
 from synth.codegen.plcopen_timers import ton_chart
 from synth.codegen.plcopen_vendor import step_actions
 from synth.codegen.plcopen_fbd import FBD_ELEMENTS, fbd_condition, fbd_transition
@@ -167,7 +169,8 @@ def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
     from lxml import etree
 
     pou_actions = {str(x.get("name")): x for x in pou.iterfind(f"{q('actions')}/{q('action')}")}
-    inputs = [v.get("name") for v in pou.iterfind(f"{q('interface')}/{q('inputVars')}/{q('variable')}")]
+    inputs = [v.get("name") for v in pou.iterfind(f"{q('interface')}/{q('inputVars')}/{q('variable')}")
+              if v.find(f"{q('type')}/{q('derived')}") is None]  # a block instance is no Boolean input
     outputs = [v.get("name") for v in pou.iterfind(f"{q('interface')}/{q('outputVars')}/{q('variable')}")]
     named_conditions: dict[str, tuple[Any, str]] = {}
     named_fbd: dict[str, tuple[Any, Any]] = {}
@@ -182,6 +185,7 @@ def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
         else:
             raise InputError("a named transition whose body is neither ST nor FBD", src.at(t))
 
+    number_ids(sfc, q, src.at)
     elements: dict[int, Any] = {}  # localId -> lxml element
     for el in sfc:
         if not isinstance(el.tag, str):
@@ -322,10 +326,12 @@ def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
             holder = None
         else:
             raise InputError("a transition condition with neither ST nor a connection", src.at(cond))
+        if DATA.get() is not None:
+            DATA.get().sources = tuple(sources)  # type: ignore[union-attr]
         if holder is None and fbd_named is not None:
-            expr = fbd_transition(fbd_named[0], fbd_named[1], q, src, by_sfc_name)
+            expr = fbd_transition(fbd_named[0], fbd_named[1], q, src, by_sfc_name, tuple(sources))
         elif holder is None:
-            expr = fbd_condition(cond, elements, q, src, by_sfc_name)
+            expr = fbd_condition(cond, elements, q, src, by_sfc_name, tuple(sources))
         else:
             reader = ExprReader(ctext, lambda off, w, h=holder, t=ctext: src.text_at(h, t, off, w), by_sfc_name)
             expr = reader.whole()
@@ -368,7 +374,11 @@ def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
             severity=Severity.WARNING, notes=tuple(rewritten)))
 
     # actions: CODESYS/TwinCAT step actions (vendor addData), then the action blocks
+    if scope is not None:
+        scope.one_scan = one_scan_steps(transitions, scope)
     for st in steps.values():
+        if scope is not None:
+            scope.current_step = st.name
         for which, name, attr in step_actions(st.el, q):
             st.actions.extend(read_action(attr, src, by_sfc_name, q, pou_actions, st.name, (which.qualifier, name)))
     for lid, el in elements.items():
@@ -378,6 +388,8 @@ def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
         if len(owners) != 1:
             raise InputError("an action block must be connected to exactly one step", src.at(el))
         owner = steps[owners[0]]
+        if scope is not None:
+            scope.current_step = owner.name
         for a in el.iterfind(q("action")):
             owner.actions.extend(read_action(a, src, by_sfc_name, q, pou_actions, owner.name))
 

@@ -21,28 +21,12 @@ from __future__ import annotations
 import re
 from typing import Any, Callable
 
-from synth.codegen.plcopen_data import DataScope, data_scope, strip_comments
+from synth.codegen.plcopen_data import DataScope, data_scope, duration, strip_comments
 from synth.codegen.plcopen_vendor import IecQualifier, StepAction, step_actions
 from synth.codegen.st_condition import st_text
 from synth.errors import InputError, Location, Severity
 
 __all__ = ["duration", "prepare_scope", "ton_chart"]
-
-_MS = {"ms": 1, "s": 1000, "m": 60_000, "h": 3_600_000, "d": 86_400_000}
-
-
-def duration(text: str) -> str | None:
-    """A TIME literal as a ``.g7`` duration, or None when ``text`` is not one."""
-    m = re.fullmatch(r"\s*(?:T|TIME)#((?:\d+(?:\.\d+)?(?:ms|s|m|h|d)_?)+)\s*", text, re.I)
-    if m is None:
-        return None
-    parts = re.findall(r"(\d+(?:\.\d+)?)(ms|s|m|h|d)", m[1].lower())
-    if len(parts) == 1 and parts[0][1] != "d":
-        number, unit = parts[0]
-        return f"{number}{'min' if unit == 'm' else unit}"
-    total = sum(float(n) * _MS[u] for n, u in parts)
-    return f"{int(total)}ms" if total == int(total) else None
-
 
 def _locals(pou: Any, q: Callable[[str], str]) -> dict[str, tuple[str, Any]]:
     """Local variables (upper-case name -> (type name, element))."""
@@ -57,11 +41,37 @@ def _locals(pou: Any, q: Callable[[str], str]) -> dict[str, tuple[str, Any]]:
     return out
 
 
+def _same(a: str, b: str) -> bool:
+    """Two ST conditions equal up to spaces, case, outer parentheses and ``= TRUE``."""
+    def norm(x: str) -> str:
+        x = re.sub(r"\s+", "", x).upper()
+        while True:
+            y = re.sub(r"=TRUE$", "", x)
+            if y.startswith("(") and y.endswith(")") and _balanced(y[1:-1]):
+                y = y[1:-1]
+            if y == x:
+                return x
+            x = y
+    return norm(a) == norm(b)
+
+
+def _balanced(x: str) -> bool:
+    depth = 0
+    for ch in x:
+        depth += {"(": 1, ")": -1}.get(ch, 0)
+        if depth < 0:
+            return False
+    return depth == 0
+
+
 def _timer_idiom(text: str, local: dict[str, tuple[str, Any]],
-                 q: Callable[[str], str]) -> tuple[str, str, str, str] | None:
-    """(T, V, duration, IN) when ``text`` calls the TON ``T(IN:=x, PT:=D)`` (x not FALSE)
-    and assigns ``V := T.Q``."""
-    statements = [" ".join(s.split()) for s in strip_comments(text).split(";") if s.strip()]
+                 q: Callable[[str], str]) -> tuple[str, str, str, str, bool] | None:
+    """(T, V, duration, IN, guarded) when ``text`` calls the TON ``T(IN:=x, PT:=D)`` (x not
+    FALSE) and assigns ``V := T.Q``, alone or as the whole of ``IF c THEN … END_IF`` (then
+    IN is ``c AND x``, or ``x`` when ``c`` is ``x``, and ``guarded`` is true)."""
+    clean = strip_comments(text).strip()
+    guard = re.fullmatch(r"IF\b(.*?)\bTHEN\b(.*?)\bEND_IF\s*;?", clean, re.I | re.S)
+    statements = [" ".join(s.split()) for s in (guard[2] if guard else clean).split(";") if s.strip()]
     for i, statement in enumerate(statements):
         call = re.fullmatch(r"(\w+) ?\( ?IN ?:= ?(.+?) ?, ?PT ?:= ?([\w#.]+) ?\)", statement, re.I)
         if call is None or call[2].upper() == "FALSE" or local.get(call[1].upper(), ("",))[0] != "TON":
@@ -73,7 +83,10 @@ def _timer_idiom(text: str, local: dict[str, tuple[str, Any]],
             init = local[call[3].upper()][1].find(f"{q('initialValue')}/{q('simpleValue')}")
             pt = duration(str(init.get("value", ""))) if init is not None else None
         if len(alias) == 1 and pt is not None:
-            return call[1], alias[0][1], pt, call[2]
+            cond = call[2]
+            if guard is not None and not _same(guard[1], cond):
+                cond = f"({' '.join(guard[1].split())}) AND ({cond})"
+            return call[1], alias[0][1], pt, cond, guard is not None
     return None
 
 
@@ -86,7 +99,7 @@ def prepare_scope(pou: Any, sfc: Any, q: Callable[[str], str], at: Callable[[Any
     inline = [st for st in sfc.iter(q("ST")) if st.getparent() is not None and st.getparent().tag == q("inline")
               and st.getparent().getparent() is not None and st.getparent().getparent().tag == q("action")]
     local = _locals(pou, q)
-    found: dict[str, list[tuple[str, str, str, Any, str, str, str]]] = {}  # V -> (T, step, duration, action, text, IN, V)
+    found: dict[str, list[tuple[str, str, str, Any, str, str, str, bool]]] = {}  # V -> (T, step, PT, action, text, IN, V, IF)
     for step in sfc.iterfind(q("step")):
         sname = str(step.get("name", ""))
         g7 = prefix + (sname[1:] if re.fullmatch(r"S\d+", sname) else sname)
@@ -101,31 +114,43 @@ def prepare_scope(pou: Any, sfc: Any, q: Callable[[str], str], at: Callable[[Any
         for name, el in runs:
             idiom = _timer_idiom(bodies.get(name, ""), local, q)
             if idiom is not None:
-                t, v, pt, cond = idiom
-                found.setdefault(v.upper(), []).append((t, g7, pt, actions[name], bodies[name], cond, v))
+                t, v, pt, cond, guarded = idiom
+                found.setdefault(v.upper(), []).append((t, g7, pt, actions[name], bodies[name], cond, v, guarded))
     scope = DataScope(str(pou.get("name", "")), at)
     for v, uses in found.items():
-        if len({(u[0].upper(), u[1]) for u in uses}) != 1:
-            continue  # one alias timing two steps: not a step timer
-        t, step, pt, el, text, cond, alias = uses[0]
-        st = el.find(f"{q('body')}/{q('ST')}")
-        where = where_text(st, text, text.upper().find(t.upper()), len(t))
-        if cond.upper() == "TRUE":
-            scope.timers[v] = f"{pt}/X{step}"
-            what = f"the step timer {pt}/X{step}"
-        else:  # the TON as a partial grafcet: its step on is active while step and IN hold
-            on = f"{prefix}{t}_on"
-            scope.timers[v] = f"{pt}/X{on}"
-            scope.ton_charts.append((f"{t}_TON", f"{prefix}{t}_off", on, step, cond, st, text))
-            what = (f"{pt}/X{on}, the timer of step {on} of the partial grafcet {t}_TON, active while step "
-                    f"{step} is and {cond} holds")
-        scope.timer_blocks.add(t.upper())
-        scope.warnings.append(InputError(
-            f"the TON {t} called with IN:={cond} in action {el.get('name')} of step {step}: {alias} is read as {what} (a "
-            "TON keeps Q until it is called with IN FALSE; a .g7 timer restarts at each activation of its step)",
-            where, severity=Severity.WARNING))
-    full = data_scope(pou, q, at, list(bodies.values()) + [st_text(st) for st in inline], set(scope.timers))
+        by_step = {u[1]: u for u in uses}
+        if len({(u[0].upper(), u[1]) for u in uses}) != len(by_step):
+            continue  # two TONs behind one alias in one step: not a step timer
+        several = len(by_step) > 1  # the alias is read after each step: the timer of the step left
+        for step, (t, _, pt, el, text, cond, alias, guarded) in by_step.items():
+            st = el.find(f"{q('body')}/{q('ST')}")
+            where = where_text(st, text, text.upper().find(t.upper()), len(t))
+            if _same(cond, "TRUE"):
+                timer = f"{pt}/X{step}"
+                what = f"the step timer {timer}"
+            else:  # the TON as a partial grafcet: its step on is active while step and IN hold
+                base = f"{t}_{step}" if several else f"{prefix}{t}"
+                on = f"{base}_on"
+                timer = f"{pt}/X{on}"
+                scope.ton_charts.append((f"{base.removeprefix(prefix)}_TON", f"{base}_off", on, step, cond, st, text))
+                what = (f"{timer}, the timer of step {on} of the partial grafcet {base.removeprefix(prefix)}_TON, "
+                        f"active while step {step} is and {cond} holds")
+            if several:
+                scope.step_timers.setdefault(v, {})[step] = timer
+                what += f" in the transitions leaving step {step}"
+            else:
+                scope.timers[v] = timer
+            scope.timer_blocks.add(t.upper())
+            scope.warnings.append(InputError(
+                f"the TON {t} called with IN:={cond} in action {el.get('name')} of step {step}: {alias} is read as "
+                f"{what} (a TON keeps Q until it is called with IN FALSE; a .g7 timer restarts at each activation of "
+                "its step" + ("; the PLC calls it only while the IF condition holds, so it does not restart when the "
+                              "condition falls" if guarded else "") + ")", where, severity=Severity.WARNING))
+    full = data_scope(pou, q, at, list(bodies.values()) + [st_text(st) for st in inline],
+                      set(scope.timers) | set(scope.step_timers))
     full.timers, full.timer_blocks, full.ton_charts = scope.timers, scope.timer_blocks, scope.ton_charts
+    full.step_timers = scope.step_timers
+    full.prefix = prefix
     full.warnings = scope.warnings + full.warnings
     return full
 
@@ -141,5 +166,7 @@ def ton_chart(scope: DataScope, steps: dict[str, str], at: Callable[[Any, str, i
         start = text.upper().find("IN")
         c = ExprReader(cond, lambda o, w, h=st, t=text, s=start: at(h, t, s + o, w), steps, "a TON's IN").whole()
         both = f"X{step} & " + (c if re.fullmatch(r"[!\w]+", c) else f"({c})")
+        out.append((name, [(off, True), (on, False)], [([off], [on], both), ([on], [off], f"!({both})")]))
+    for name, off, on, both in scope.helper_charts:
         out.append((name, [(off, True), (on, False)], [([off], [on], both), ([on], [off], f"!({both})")]))
     return out

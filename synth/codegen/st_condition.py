@@ -14,7 +14,7 @@ import contextvars
 import re
 
 from synth.codegen.plcopen_data import DATA
-from synth.errors import InputError, Location, close_names
+from synth.errors import InputError, Location, Severity, close_names
 
 __all__ = ["st_text", "ExprReader", "PREDICATES", "predicate_name"]
 
@@ -84,11 +84,21 @@ class ExprReader:
         return tok
 
     def expr(self) -> str:
-        parts = [self.conj()]
+        parts = [self.xor()]
         while self.peek()[1].upper() == "OR":
             self.take()
-            parts.append(self.conj())
+            parts.append(self.xor())
         return " | ".join(parts)
+
+    def xor(self) -> str:
+        """``a XOR b`` (between OR and AND in ST): ``a & !b | !a & b``."""
+        out = self.conj()
+        while self.peek()[1].upper() == "XOR":
+            self.take()
+            right = self.conj()
+            a, b = (x if re.fullmatch(r"[!\w↑↓/.]+", x) else f"({x})" for x in (out, right))
+            out = f"{a} & !{b} | !{a} & {b}"
+        return out
 
     def conj(self) -> str:
         parts = [self.unary()]
@@ -132,6 +142,8 @@ class ExprReader:
         if kind == "name" and scope is not None and "." not in value:
             if value.upper() in scope.timers:
                 return scope.timers[value.upper()]
+            if value.upper() in scope.step_timers:
+                return self.step_timer(value, offset)
             known = scope.vars.get(value.upper())
             if known is not None:
                 if not known.boolean:
@@ -142,6 +154,9 @@ class ExprReader:
         if kind == "name" and scope is not None and "." in value and value.split(".")[0] not in self.steps \
                 and value.split(".")[0].upper() in scope.global_lists:
             return scope.global_name(value, False, self.where(offset, len(value)))
+        if kind == "name" and scope is not None and "." in value and value.split(".")[0] not in self.steps \
+                and value.split(".")[0].upper() in scope.spelling and value.split(".")[1].upper() not in ("X", "T"):
+            return scope.member_read(value, self.where(offset, len(value)))
         if following in _COMPARE and PREDICATES.get() is not None and (kind == "num" or (kind == "name" and "." not in value)):
             return self.predicate(kind, value, offset)
         if kind == "num" and value in ("0", "1"):
@@ -151,7 +166,7 @@ class ExprReader:
             if up in ("TRUE", "FALSE"):
                 return "1" if up == "TRUE" else "0"
             if up in ("AND", "OR", "NOT", "XOR", "MOD"):
-                raise self.error(offset, f"{up} is not supported in a .g7 receptivity" if up in ("XOR", "MOD")
+                raise self.error(offset, f"{up} is not supported in a .g7 receptivity" if up == "MOD"
                                  else f"expected a variable, not {up}", width=len(value))
             if "." in value:
                 step_name, member = value.split(".")
@@ -162,21 +177,55 @@ class ExprReader:
                 if member.upper() == "X":
                     return f"X{step}"
                 if member.upper() == "T":
-                    k, v, o = self.take()
-                    if v != ">=":
-                        raise self.error(o, f"a step time {value} is read as '{value} >= T#…' (a timer)",
-                                         expected=("'>='",))
-                    k, dur, o = self.take()
-                    m = re.fullmatch(r"T#(\d+(?:\.\d+)?)(ms|s|m|h)", dur, re.I)
-                    if not m:
-                        raise self.error(o, "expected a duration such as T#2s or T#500ms", width=max(1, len(dur)))
-                    return f"{m[1]}{_UNIT[m[2].lower()]}/X{step}"
+                    k, op, o = self.take()
+                    k, dur, o2 = self.take()
+                    return self.step_time(value, step, op, dur, o, o2, offset)
                 raise self.error(offset, f"unsupported step member .{member} (use .X or .T)", width=len(value))
             if value.startswith("_RE_") or value.startswith("_FE_"):
                 return ("↑" if value.startswith("_RE_") else "↓") + value[4:]
             return value
+        if kind == "dur" and following in _COMPARE and self.i + 1 < len(self.tokens) and \
+                re.fullmatch(r"\w+\.T", self.tokens[self.i + 1][1], re.I) and \
+                self.tokens[self.i + 1][1].split(".")[0] in self.steps:  # T#2s < Step0.t
+            _, op, o = self.take()
+            _, name, o2 = self.take()
+            return self.step_time(name, self.steps[name.split(".")[0]], _FLIP[op], value, o, offset, o2)
         raise self.error(offset, f"expected a variable, a step flag or '(' in {self.what}, not '{value or 'end'}'",
                          width=max(1, len(value)))
+
+    def step_time(self, member: str, step: str, op: str, dur: str, at_op: int, at_dur: int, start: int) -> str:
+        """``S.T op D`` (``member`` is ``S.T``): the step timer ``D/XS`` or its negation."""
+        if op not in ("<", "<=", ">", ">="):
+            raise self.error(at_op, f"a step time {member} is compared with '{op or 'nothing'}': only < <= > >= with a "
+                             "duration have a step-timer meaning (D/XS, or its negation)", expected=("'>='", "'>'",
+                                                                                                   "'<'", "'<='"))
+        m = re.fullmatch(r"T(?:IME)?#(\d+(?:\.\d+)?)(ms|s|m|h)", dur, re.I)
+        if not m:
+            raise self.error(at_dur, "expected a duration such as T#2s or T#500ms", width=max(1, len(dur)))
+        timer = f"{m[1]}{_UNIT[m[2].lower()]}/X{step}"
+        scope = DATA.get()
+        first = min(start, at_dur)
+        text = " ".join(self.text[first:max(start + len(member), at_dur + len(dur))].split())
+        if op != ">=" and scope is not None:
+            scope.warnings.append(InputError(
+                f"{text} is read as {'' if op.startswith('>') else '!'}{timer}: {op} and "
+                f"{'>=' if op.startswith('>') else '<' if op == '<=' else '<='} differ only at the instant the step has "
+                "been active exactly that long, the same at this abstraction (a step timer elapses once)",
+                self.where(first, len(text)), severity=Severity.WARNING))
+        return timer if op.startswith(">") else f"!{timer}"
+
+    def step_timer(self, value: str, offset: int) -> str:
+        """A TON alias set in several steps (``interconnect := T.Q`` after each): the timer of
+        the step the transition being read leaves."""
+        scope = DATA.get()
+        assert scope is not None
+        timers = scope.step_timers[value.upper()]
+        found = [timers[s] for s in scope.sources if s in timers]
+        if len(found) != 1:
+            raise self.error(offset, f"{value} stands for a TON's Q in steps {', '.join(timers)}: read here "
+                             f"{'outside a transition' if not scope.sources else 'by a transition leaving ' + ', '.join(scope.sources)}"
+                             ", it has no one step timer", width=len(value))
+        return found[0]
 
     def compare(self, kind: str, value: str) -> str | None:
         """``Cnt >= 5`` (or ``5 <= Cnt``) of integer internal variables
@@ -192,12 +241,18 @@ class ExprReader:
         k2, v2, _ = self.tokens[j]
         left = scope.vars.get(value.upper()) if kind == "name" else None
         right = scope.vars.get(v2.upper()) if k2 == "name" else None
+        if k2 == "name" and right is None and v2.upper() in scope.constants:  # VAR CONSTANT: its value
+            number = scope.constants[v2.upper()] * (-1 if sign == "-" else 1)
+            k2, v2, sign = "num", str(abs(number)), "-" if number < 0 else ""
         if left is not None and not left.boolean and k2 == "num" and v2.isdigit():
             text = f"{left.name} {op} {sign}{int(v2)}"
         elif left is not None and not left.boolean and right is not None and not right.boolean and not sign:
             text = f"{left.name} {op} {right.name}"
         elif kind == "num" and value.isdigit() and right is not None and not right.boolean and not sign:
             text = f"{right.name} {_FLIP[op]} {int(value)}"
+        elif kind == "name" and left is None and value.upper() in scope.constants and right is not None \
+                and not right.boolean and not sign:  # VAR CONSTANT on the left
+            text = f"{right.name} {_FLIP[op]} {scope.constants[value.upper()]}"
         else:
             return None
         for v in (left, right):
@@ -231,5 +286,9 @@ class ExprReader:
         out = self.expr()
         kind, value, offset = self.peek()
         if kind != "end":
+            before = self.tokens[self.i - 1] if self.i else None
+            if kind == "name" and before is not None and before[0] == "name":
+                raise self.error(offset, f"unexpected '{value}' in {self.what}: '{before[1]} {value}' is two names in a "
+                                 "row, not an ST expression (an operator is missing)", width=len(value))
             raise self.error(offset, f"unexpected '{value}' in {self.what}", width=len(value))
         return out
