@@ -14,37 +14,39 @@ Example
 
 from __future__ import annotations
 
-import re
 from typing import Any
 
 from synth.codegen.plcopen_data import DataScope
+from synth.errors import SynthError
+from synth.grafcet.language_reader import parse_receptivity
+from synth.logic.expr import Compare, evaluate, names
 
 __all__ = ["always", "one_scan_steps"]
 
-_PY = {"&": " and ", "|": " or ", "!": " not ", "=": "==", "<>": "!=", "(": "(", ")": ")", ">=": ">=", "<=": "<=",
-       ">": ">", "<": "<"}
 _LIMIT = 70_000  # values of the one variable tried
 
 
 def always(expr: str, ranges: dict[str, tuple[int, int]]) -> bool:
     """Whether the ``.g7`` receptivity ``expr`` (constants, comparisons of at most one integer
     internal variable of ``ranges`` with integers, ``& | !``) holds for every value."""
-    tokens = re.findall(r"<>|>=|<=|[&|!()<>=]|-?\d+|[A-Za-z_]\w*|\S", expr)
-    names = {t for t in tokens if re.fullmatch(r"[A-Za-z_]\w*", t)}
-    if len(names) > 1 or any(n not in ranges for n in names):
-        return False
-    if any(t not in _PY and not re.fullmatch(r"-?\d+|[A-Za-z_]\w*", t) for t in tokens):
-        return False
-    code = "".join(_PY.get(t, f" {t} ") for t in tokens).strip()
     try:
-        compiled = compile(code, "<receptivity>", "eval")
-    except SyntaxError:
+        e = parse_receptivity(expr, "<receptivity>")
+    except SynthError:
         return False
-    low, high = next(iter(ranges[n] for n in names)) if names else (0, 0)
+    atoms = list(names(e))
+    comparisons = {a.name: a for a in atoms if isinstance(a, Compare)}
+    variables = {x for c in comparisons.values() for x in c.operands()}
+    if len(comparisons) != len(atoms) or len(variables) > 1 or not variables <= ranges.keys():
+        return False  # a level, an edge, a step, or two variables: not decided here
+    name = next(iter(variables), "")
+    low, high = ranges[name] if name else (0, 0)
     if high - low > _LIMIT:
         return False
-    name = next(iter(names), "_")
-    return all(bool(eval(compiled, {"__builtins__": {}}, {name: v})) for v in range(low, high + 1))  # noqa: S307
+
+    def holds_for(v: int) -> bool:
+        return bool(evaluate(e, lambda n: comparisons[n].holds({name: v})))
+
+    return all(holds_for(v) for v in range(low, high + 1))
 
 
 def one_scan_steps(transitions: list[tuple[str, list[str], list[str], str, Any]], scope: DataScope) -> dict[str, str]:

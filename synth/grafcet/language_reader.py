@@ -29,7 +29,7 @@ from synth.grafcet.language import (
 from synth.logic.expr import Compare, Const, Expr, Var
 from synth.syntax import ExprTransformer, Token, VectorKind, parse_tree
 
-__all__ = ["VectorDecl", "InternalDecl", "StepRef", "StepDecl", "TransitionDecl", "GrafcetDecl", "grafcet_items"]
+__all__ = ["parse_receptivity", "VectorDecl", "InternalDecl", "StepRef", "StepDecl", "TransitionDecl", "GrafcetDecl", "grafcet_items"]
 
 
 @dataclass(frozen=True)
@@ -235,3 +235,14 @@ class _ToModel(ExprTransformer):
 def grafcet_items(source: str, file: str) -> list[VectorDecl | InternalDecl | GrafcetDecl]:
     """The top-level items of a ``.g7`` text, in file order."""
     return parse_tree("grafcet", source, file, _ToModel(file, source))
+
+
+def parse_receptivity(source: str, file: str) -> Expr:
+    """One receptivity in ``.g7`` syntax (comparisons included), its names located in ``file``.
+
+    >>> parse_receptivity("cnt < 4 | X2", "r").text()
+    'cnt < 4 | X2'
+    """
+    from synth.syntax import parse_expression
+
+    return parse_expression(source, file, "grafcet", _ToModel(file, source))
