@@ -10,6 +10,8 @@ Example
 -------
 >>> always("1", {}), always("cnt < 4 | cnt >= 4", {"cnt": (0, 9)}), always("cnt < 4", {"cnt": (0, 9)})
 (True, True, False)
+>>> always("cnt < 4 | cnt > 6 & !(cnt < 4) | cnt < 7 & cnt > 3", {"cnt": (0, 9)})  # an atom read twice
+True
 """
 
 from __future__ import annotations
@@ -36,7 +38,7 @@ def always(expr: str, ranges: dict[str, tuple[int, int]]) -> bool:
     atoms = list(names(e))
     comparisons = {a.name: a for a in atoms if isinstance(a, Compare)}
     variables = {x for c in comparisons.values() for x in c.operands()}
-    if len(comparisons) != len(atoms) or len(variables) > 1 or not variables <= ranges.keys():
+    if not all(isinstance(a, Compare) for a in atoms) or len(variables) > 1 or not variables <= ranges.keys():
         return False  # a level, an edge, a step, or two variables: not decided here
     name = next(iter(variables), "")
     low, high = ranges[name] if name else (0, 0)
