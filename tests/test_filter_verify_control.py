@@ -49,6 +49,7 @@ outputs Q1
 safety FROM_REST "push only from rest": ↑Q1 & !v10
 safety TO_END "do not stop before the end": ↓Q1 & !v11
 """
+DOC = (ROOT / "docs" / "filter.md").read_text(encoding="utf-8")
 HALF = "inputs v10, v11\noutputs Q1\nsafety FROM_REST \"push only from rest\": ↑Q1 & !v10\n"
 
 
@@ -96,6 +97,12 @@ def test_generated_st_has_the_grafcets_verdict(tri):
     assert (g.states, g.plant_states, g.cycles, g.corrected) == (90, 90, 370, 0)
     assert (c.states, c.plant_states, c.cycles, c.corrected) == (134, 90, 524, 0)
     assert c.source == f"PROGRAM tri of {tri / 'tri.st'}"
+    assert "**134 nodes and 524 cycles instead of 90 and 370**" in " ".join(DOC.split())
+    # K = 2: the Grafcet reacts to each event, the program scans once after both
+    g2 = verify(f, str(TRI), str(ROOT / "grafcets" / "tri.g7"), events_per_cycle=2)
+    c2 = verify(f, str(TRI), control=_st(tri / "tri.st"), events_per_cycle=2)
+    assert [(v.safe, v.coherent, v.states, v.plant_states, set(v.findings)) for v in (g2, c2)] == [
+        (True, True, 154, 131, {"transient"}), (True, True, 586, 317, {"transient"})]
 
 
 def test_the_programs_own_variables_split_exactly_the_extra_states(tri):
@@ -170,6 +177,7 @@ def test_toggle_without_the_end_constraint_is_unsafe(cli, cyl):
         ("-", "{v10,Q1}", "{Q1_prev}", ("Q1",), ("Q1",), ""),
         ("-", "{v10}", "{}", (), (), "output event forbidden"),
     ]
+    assert trace_text(edge.trace) in DOC
     code, out, _ = cli("filter", "verify", cyl / "half.filter", "--plant", cyl / "c.rules", "--control", TOGGLE)
     assert code == 1
     assert out.splitlines()[0] == (f"closed loop: {cyl / 'half.filter'} on {cyl / 'c.rules'}, requests from PROGRAM "
@@ -198,6 +206,7 @@ def test_a_ton_elapses_as_an_event_and_fairly(cyl):
         "3  ↓v10               {Q1}      {}              requests: Q1  orders: Q1",
         "4  ↑v11               {v11}     {}              requests: -  orders: -",
     ]
+    assert "\n".join(trace_text(ex.trace(end)).splitlines()[:3]) in DOC
 
 
 # ---------------------------------------------------------------- bad input, budget
