@@ -202,7 +202,7 @@ def test_a_ton_elapses_as_an_event_and_fairly(cyl):
     assert trace_text(ex.trace(end)).splitlines() == [
         "0  initial            {v10}     {}",
         "1  -                  {v10}     {rest running}  requests: -  orders: -",
-        "2  timer rest (T#2s)  {v10,Q1}  {rest.Q}        requests: Q1  orders: Q1",
+        "2  timer rest (T#2s)  {v10,Q1}  {rest elapsed}  requests: Q1  orders: Q1",
         "3  ↓v10               {Q1}      {}              requests: Q1  orders: Q1",
         "4  ↑v11               {v11}     {}              requests: -  orders: -",
     ]

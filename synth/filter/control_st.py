@@ -32,7 +32,7 @@ from typing import Any, Callable, Mapping, Protocol, Sequence
 
 from synth.errors import InputError, Location, close_names
 
-__all__ = ["CONTROL_OPTION", "TIMER_PREFIX", "split_control", "StVariable", "StPou", "StInstance", "StModule",
+__all__ = ["CONTROL_OPTION", "TIMER_PREFIX", "split_control", "StVariable", "StPou", "StClock", "StInstance", "StModule",
            "StSource", "Snapshot", "StControl"]
 
 
@@ -63,6 +63,13 @@ class StPou(Protocol):
     def variable(self, name: str) -> StVariable | None: ...
 
 
+class StClock(Protocol):
+    """What an instance reads of its module: the clock (ms) of its timers."""
+
+    @property
+    def clock_ms(self) -> int: ...
+
+
 class StInstance(Protocol):
     """An instance: its variables by name (case-insensitive) and a cycle."""
 
@@ -74,6 +81,8 @@ class StInstance(Protocol):
     def values(self) -> dict[str, Any]: ...
     @property
     def _state(self) -> dict[str, Any]: ...
+    @property
+    def module(self) -> StClock: ...
     def __getitem__(self, name: str) -> Any: ...
     def cycle(self, inputs: Mapping[str, Any] | None = None) -> object: ...
 
@@ -163,7 +172,8 @@ class Snapshot:
             elif isinstance(x, int):
                 parts += [f"{v.name}={x}"] if x else []
             elif _is_instance(x) and x.type in _TIMERS and _TIMERS[x.type] in x._state:
-                parts.append(f"{v.name}.Q" if x.values["Q"] != (x.type == "TOF") else f"{v.name} running")
+                since = inst.module.clock_ms - x._state[_TIMERS[x.type]]
+                parts.append(f"{v.name} {'elapsed' if since >= int(x.values['PT']) else 'running'}")
         return "{" + ", ".join(parts) + "}"
 
 
