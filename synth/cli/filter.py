@@ -221,6 +221,8 @@ def register_verify(commands: "argparse._SubParsersAction") -> None:
     v.add_argument("--plant", metavar="P.rules", required=True, help="the plant's rules file")
     source = v.add_mutually_exclusive_group(required=True)
     source.add_argument("--grafcet", metavar="G.g7", help="the requests are this Grafcet's orders")
+    source.add_argument("--control", metavar="PROG.st[:NAME]",
+                        help="the requests are the VAR_OUTPUTs of this cyclic ST PROGRAM, run each scan")
     source.add_argument("--any-control", action="store_true", help="the requests are any vector, every cycle")
     _algorithm_mode(v)
     v.add_argument("--atomic-outputs", action="store_true",
@@ -248,9 +250,18 @@ def cmd_verify(args: argparse.Namespace) -> int:
     from synth.output.filter_text import verification_json, verification_text
 
     f = _load(args.filter)
+    control = None
+    if args.control is not None:
+        from synth.codegen.check import require_blark
+        from synth.codegen.interpreter import load_st
+        from synth.filter.control_st import StSource
+
+        require_blark("synth filter verify --control")
+        control = StSource(args.control, load_st)
     v = verify(f, args.plant, args.grafcet, any_control=args.any_control, algorithm=Algorithm(args.algorithm),
                mode=Mode(args.mode), atomic=args.atomic_outputs, strict=args.strict, require_sup=args.require_sup,
-               max_states=args.max_states, events_per_cycle=args.events_per_cycle, progress=args.progress)
+               max_states=args.max_states, events_per_cycle=args.events_per_cycle, progress=args.progress,
+               control=control)
     if args.junit or args.sarif:
         from synth.output.ci import filter_verify_report, write_ci
 
@@ -258,6 +269,7 @@ def cmd_verify(args: argparse.Namespace) -> int:
     if args.json:
         out = verification_json(v)
         out["events_per_cycle"] = v.events_per_cycle
+        out["control"] = v.control.json()
         if args.progress is not None:
             out["progress"] = _progress_json(v)
         print_json(out)

@@ -64,12 +64,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from synth.errors import InputError, close_names
+from synth.filter.control_st import StSource
 from synth.filter.cycle import Algorithm, Mode
 from synth.filter.explorer import Explorer
 from synth.filter.language import Filter
 from synth.filter.outcomes import trace_row
 from synth.filter.product import Product
-from synth.filter.verification import ANY_CONTROL, FindingKind, Progress, ProgressFailure, TraceRow, Verification
+from synth.filter.verification import (ANY_CONTROL, Control, ControlKind, FindingKind, Progress, ProgressFailure,
+                                       TraceRow, Verification)
 from synth.logic.events import Event
 from synth.logic.expr import Edge, Expr, evaluate, names
 
@@ -82,16 +84,18 @@ GOAL_FILE = "--progress"
 def verify(f: Filter, rules_path: str, grafcet: str | None = None, *, any_control: bool = False,
            algorithm: Algorithm = Algorithm.ALGEBRAIC, mode: Mode = Mode.SUPERVISOR, atomic: bool = False,
            strict: bool = False, require_sup: bool = False, max_states: int = 1_000_000,
-           events_per_cycle: int = 1, progress: str | None = None) -> Verification:
-    """Explore the closed loop (see the module docstring)."""
-    if (grafcet is None) == (not any_control):
-        raise InputError("verify needs a request source: --grafcet G.g7 or --any-control (one of them)", None)
+           events_per_cycle: int = 1, progress: str | None = None, control: StSource | None = None
+           ) -> Verification:
+    """Explore the closed loop (see the module docstring); ``control``: ``--control PROG.st[:NAME]``."""
+    if (grafcet is not None) + any_control + (control is not None) != 1:
+        raise InputError("verify needs a request source: --grafcet G.g7, --control PROG.st or --any-control "
+                         "(one of them)", None)
     if events_per_cycle < 0:
         raise InputError(f"--events-per-cycle is a number of plant events, 0 or more, not {events_per_cycle}", None)
     if max_states < 1:
         raise InputError(f"--max-states is a number of states, 1 or more, not {max_states}", None)
     started = time.perf_counter()
-    pr = Product(f, rules_path, grafcet, Algorithm(algorithm), Mode(mode), atomic)
+    pr = Product(f, rules_path, grafcet, Algorithm(algorithm), Mode(mode), atomic, control)
     goal = goal_of(progress, pr) if progress is not None else None
     ex = Explorer(pr, max_states, events_per_cycle, edges=goal is not None)
     ex.run()
@@ -99,11 +103,18 @@ def verify(f: Filter, rules_path: str, grafcet: str | None = None, *, any_contro
     findings = ex.findings()
     if not require_sup:
         findings.pop(FindingKind.OUTSIDE_SUP, None)
+    if pr.control is not None:
+        source, how = f"PROGRAM {pr.control.program} of {pr.control.file}", Control(
+            ControlKind.ST, pr.control.file, pr.control.program)
+    elif grafcet is not None:
+        source, how = grafcet, Control(ControlKind.GRAFCET, grafcet)
+    else:
+        source, how = ANY_CONTROL, Control(ControlKind.ANY)
     return Verification(
-        f.file, rules_path, grafcet if grafcet is not None else ANY_CONTROL, pr.cycle.algorithm, pr.cycle.mode,
+        f.file, rules_path, source, pr.cycle.algorithm, pr.cycle.mode,
         atomic, strict, len(ex.seen_keys), len({k % pr.size for k in ex.seen_keys}), ex.cycles, ex.complete,
         time.perf_counter() - started, len(ex.outside_sup), findings, ex.corrected, ex.max_distance,
-        events_per_cycle, prog)
+        events_per_cycle, prog, how)
 
 
 @dataclass(frozen=True)
@@ -209,10 +220,10 @@ def _enabled(ex: Explorer, keys: np.ndarray) -> np.ndarray:
     out = np.zeros(keys.size, dtype=np.uint64)
     for e, nxt in pr.uncontrollable:
         out |= (nxt[codes] >= 0).astype(np.uint64) << np.uint64(ex.fair[e])
-    if pr.machine is not None:
+    if pr.controlled:
         auxes = keys // size
         for aux in np.unique(auxes).tolist():
-            for t in pr.machine.timers(ex.aux_list[aux][2]):
+            for t in pr.timers(ex.aux_list[aux][2]):
                 out[auxes == aux] |= np.uint64(ex.bit(t))
     return out
 

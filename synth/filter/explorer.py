@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+from synth.filter.control_st import TIMER_PREFIX
 from synth.filter.cycle import ACK, Memory, Mode
 from synth.errors import LimitExceeded
 from synth.filter.outcomes import Outcome, OutcomeArrays, lane_bits, react, situation_text, trace_row, unpack
@@ -82,7 +83,7 @@ class Explorer:
         self.complete = True
         p = pr.plant
         init = {v.name: v.initial for v in pr.rules.variables if v.is_input}
-        sit0 = pr.machine.initial({n: init[n] for n in pr.grafcet_inputs}) if pr.machine else None
+        sit0 = pr.initial_situation(init)
         memory = pr.cycle.initial()
         self.key0 = self.intern((tuple(memory.previous[i] for i in pr.used_index), False, sit0)) * self.size \
             + p.initial_index
@@ -154,12 +155,11 @@ class Explorer:
         fixed = {n: values[n] for n in pr.filter.inputs}
         free: list[str] = []
         passed: dict[str, bool] = {}
-        if sit is not None and pr.machine is not None:
-            for step in pr.steps:
-                fixed[f"X{step}"] = step in sit.steps
-            orders = pr.machine.orders(sit, {n: values[n] for n in pr.grafcet_inputs})
-            fixed.update({r: pr.held.get(o, o in orders) for o, r in zip(cyc.outputs, cyc.requests)})
-            passed = {o: pr.held.get(o, o in orders) for o in pr.passthrough}
+        requested = pr.requested(sit, values)
+        if requested is not None:
+            fixed.update(requested[0])
+            fixed.update({r: requested[1][o] for o, r in zip(cyc.outputs, cyc.requests)})
+            passed = {o: requested[1][o] for o in pr.passthrough}
         else:
             fixed.update({r: pr.held[o] for o, r in zip(cyc.outputs, cyc.requests) if o in pr.held})
             passed = {o: pr.held[o] for o in pr.passthrough if o in pr.held}
@@ -210,6 +210,7 @@ class Explorer:
         fi = np.arange(frontier.size, dtype=np.int64)
         post, seq, mask = codes0, np.zeros(frontier.size, dtype=np.int64), np.zeros(frontier.size, dtype=np.uint64)
         parts = [(fi, post, seq, mask)]
+        by_events = pr.machine is not None  # a Grafcet reacts to each event; a program scans once
         for _ in range(self.k):
             found = []
             for ev, nxt in pr.uncontrollable:
@@ -222,19 +223,18 @@ class Explorer:
                 found.append((fi[ok], dst[ok], ids[inv.ravel()], mask[ok] | np.uint64(self.bit(ev))))
             if not found:
                 break
-            fi, post, seq, mask = _merge([np.concatenate(c) for c in zip(*found)], size, frontier,
-                                          pr.machine is not None)
+            fi, post, seq, mask = _merge([np.concatenate(c) for c in zip(*found)], size, frontier, by_events)
             bad = pr.illegal[post] & ~pr.illegal[codes0[fi]]
             self.record(FindingKind.TRANSIENT, bad, post, frontier[fi], seq, None, post,
                         lambda i: pr.violated(int(post[i])))
             parts.append((fi, post, seq, mask))
-        fi, post, seq, mask = _merge([np.concatenate(c) for c in zip(*parts)], size, frontier, pr.machine is not None)
-        if pr.machine is not None:
+        fi, post, seq, mask = _merge([np.concatenate(c) for c in zip(*parts)], size, frontier, by_events)
+        if pr.controlled:
             timed = [(fi, post, seq, mask)]
             auxes = frontier // size
             for aux in np.unique(auxes).tolist():
                 where = np.nonzero(auxes == aux)[0]
-                for tev in pr.machine.timers(self.aux_list[aux][2]):
+                for tev in pr.timers(self.aux_list[aux][2]):
                     timed.append((where, codes0[where], np.full(where.size, self.intern_seq((tev,)), dtype=np.int64),
                                   np.full(where.size, self.bit(tev), dtype=np.uint64)))
             fi, post, seq, mask = (np.concatenate(c) for c in zip(*timed))
@@ -248,8 +248,11 @@ class Explorer:
         ybits = np.zeros(post.size, dtype=np.int64)
         for i, n in enumerate(pr.ynames):
             ybits |= pr.val[n][post].astype(np.int64) << i
-        if pr.machine is None:  # the events matter only to a Grafcet
+        if not pr.controlled:  # the events matter only to a controller
             event = np.zeros_like(event)
+        elif pr.control is not None:  # a program scans once after the plant's events: only a timer matters
+            timer = np.array([bool(q) and q[0].startswith(TIMER_PREFIX) for q in self.seqs], dtype=bool)
+            event = np.where(timer[event], event, 0)
         combo = ((node // self.size) * len(self.events) + event) * (1 << width) + ybits
         uniq, inverse = np.unique(combo, return_inverse=True)
         class_ids = np.empty(uniq.size, dtype=np.int64)
@@ -257,7 +260,7 @@ class Explorer:
             yb, rest = c % (1 << width), c >> width
             ei, aux = rest % len(self.events), rest // len(self.events)
             sit = self.aux_list[aux][2]
-            if pr.machine is not None:
+            if pr.controlled:
                 sit = react(pr, sit, self.seqs[ei], yb)
             class_ids[u] = self.outcomes_for(yb, aux, sit)
         return class_ids[inverse]
@@ -338,7 +341,7 @@ class Explorer:
         for kind, mask in ((FindingKind.REFUSED, refused), (FindingKind.FALLBACK, fallback[oid]),
                            (FindingKind.OUTSIDE_CARE, outside[oid]), (FindingKind.TRANSIENT, middle_bad)):
             self.record(kind, mask, post, node, event, oid, shown)
-        if pr.machine is not None and oid.size:
+        if pr.controlled and oid.size:
             dist = (requests[oid] != targets).sum(axis=1)
             self.corrected += int((dist > 0).sum())
             self.max_distance = max(self.max_distance, int(dist.max()))

@@ -82,10 +82,13 @@ class OutcomeArrays:
 def react(pr: "Product", sit: Any, events: tuple[str, ...], ybits: int) -> Any:
     """The Grafcet's stable situation after a cycle's ``events``: a timer, or plant events
     (none, one, or up to ``--events-per-cycle``); the Grafcet reacts to each event on one
-    of its inputs in turn, with the inputs as they were just after it."""
-    assert pr.machine is not None
+    of its inputs in turn, with the inputs as they were just after it. An ST program
+    (``--control``) runs one scan on the inputs after the events."""
     values = {n: bool((ybits >> i) & 1) for i, n in enumerate(pr.ynames)}
     inputs = {n: values[n] for n in pr.grafcet_inputs}
+    if pr.control is not None:  # one scan on the inputs after every event (or a timer)
+        return pr.control.react(sit, events, inputs)
+    assert pr.machine is not None
     if len(events) == 1 and Event(events[0]).kind is EventKind.TIMER:
         return pr.machine.fire_timer(sit, events[0], inputs)
     after: list[dict[str, bool]] = []

@@ -1,6 +1,7 @@
 """The closed loop's parts for ``synth filter verify``: the plant of a rules file as flat
 arrays over its state codes (variables, controllable and uncontrollable moves), the
-filter cycle, the Grafcet that makes the requests (if any), and the constraints' grids
+filter cycle, the controller that makes the requests (a Grafcet, an ST program of
+:mod:`~synth.filter.control_st`, or none: any control), and the constraints' grids
 from :class:`~synth.sup.supervisor.Supervisor` (illegal states, states outside SUP,
 edge events forbidden).
 
@@ -16,6 +17,8 @@ Example
 
 from __future__ import annotations
 
+from typing import Any, Mapping
+
 import numpy as np
 
 from synth.errors import InputError, LimitExceeded
@@ -27,6 +30,8 @@ TYPE_CHECKING = False  # typing.TYPE_CHECKING: the Grafcet modules load only wit
 if TYPE_CHECKING:
     from synth.grafcet.language import Grafcet
     from synth.grafcet.machine import GrafcetMachine
+    from synth.filter.control_st import StControl, StSource
+    from synth.filter.control_st import StControl
 
 __all__ = ["PLANT_LIMIT", "Product"]
 
@@ -39,7 +44,7 @@ class Product:
     none: any control), checked against each other and laid out as arrays."""
 
     def __init__(self, f: Filter, rules_path: str, grafcet_path: str | None, algorithm: Algorithm,
-                 mode: Mode, atomic: bool) -> None:
+                 mode: Mode, atomic: bool, control: StSource | None = None) -> None:
         from synth.plant.composition import plant
         from synth.plant.rules_check import load_rules
         from synth.sup.supervisor import Supervisor
@@ -65,11 +70,23 @@ class Product:
 
             self.grafcet = load_grafcet(grafcet_path, inputs=rs.inputs, outputs=rs.outputs)
             self.machine = GrafcetMachine(self.grafcet)
+        self.control: StControl | None = None
+        if control is not None:
+            from synth.filter.control_st import StControl
+
+            self.control = StControl(control, rs.inputs, p.outputs, f.outputs, f.file)
+        # the inputs the controller reads: the Grafcet's, or the program's VAR_INPUTs (plant names)
         self.grafcet_inputs: tuple[str, ...] = () if self.grafcet is None else tuple(self.grafcet.inputs)
+        if self.control is not None:
+            self.grafcet_inputs = tuple(self.control.inputs)
         self.steps: tuple[str, ...] = () if self.grafcet is None else tuple(s.name for s in self.grafcet.steps)
         observable = {f"X{s}" for s in self.steps}
+        self.program_observers = tuple(d.name for d in f.observers if d.definition is None)
         for d in f.observers:
-            if d.name not in observable and d.definition is None:
+            if self.control is not None and d.definition is None and d.name.upper() not in self.control.observable:
+                raise InputError(f"observer {d.name} has no value in verify: define it (`observer {d.name} := "
+                                 f"EXPR`) or make it a BOOL variable of PROGRAM {self.control.program}", d.loc)
+            if self.control is None and d.name not in observable and d.definition is None:
                 raise InputError(f"observer {d.name} has no value in verify: define it (`observer {d.name} := "
                                  "EXPR`) or make it a step variable of the --grafcet Grafcet", d.loc)
         size, shape = p.size, p.shape
@@ -99,6 +116,37 @@ class Product:
         self.outside_sup: np.ndarray = self.sup.removed.ravel()
         self.forbid: dict[str, np.ndarray] = {ev: g.ravel() for ev, g in self.sup.forbid.items()}
         self.used_index = [self.cycle.remembered.index(n) for n in self.cycle.used]
+
+    @property
+    def controlled(self) -> bool:
+        """A controller (a Grafcet or an ST program) makes the requests: it has a state."""
+        return self.machine is not None or self.control is not None
+
+    def initial_situation(self, inputs: Mapping[str, bool]) -> Any:
+        """The controller's state at start (``inputs``: the plant's initial inputs)."""
+        if self.control is not None:
+            return self.control.initial()
+        if self.machine is not None:
+            return self.machine.initial({n: inputs[n] for n in self.grafcet_inputs})
+        return None
+
+    def timers(self, sit: Any) -> tuple[str, ...]:
+        """The controller's timers that may elapse in the cycle (instead of plant events)."""
+        if self.control is not None:
+            return self.control.timers(sit)
+        return self.machine.timers(sit) if self.machine is not None else ()
+
+    def requested(self, sit: Any, values: Mapping[str, bool]) -> tuple[dict[str, bool], dict[str, bool]] | None:
+        """The controller's observers (step variables, program variables) and its requests
+        for every plant order, in ``sit`` after its reaction to ``values`` (None: any control)."""
+        if self.control is not None:
+            req = self.control.orders(sit)
+            return (self.control.observe(sit, self.program_observers),
+                    {o: self.held.get(o, req.get(o, False)) for o in self.orders})
+        if self.machine is None:
+            return None
+        orders = self.machine.orders(sit, {n: values[n] for n in self.grafcet_inputs})
+        return {f"X{s}": s in sit.steps for s in self.steps}, {o: self.held.get(o, o in orders) for o in self.orders}
 
     def label(self, code: int) -> str:
         return self.plant.label(self.plant.local(code))

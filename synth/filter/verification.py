@@ -17,11 +17,36 @@ from enum import StrEnum
 
 from synth.filter.cycle import Algorithm, Mode
 
-__all__ = ["ANY_CONTROL", "FindingKind", "UNSAFE", "INCOHERENT", "TraceRow", "Finding", "ProgressFailure",
+__all__ = ["ANY_CONTROL", "ControlKind", "Control", "FindingKind", "UNSAFE", "INCOHERENT", "TraceRow", "Finding", "ProgressFailure",
            "Progress", "Verification"]
 
 ANY_CONTROL = "any control"
-"""The request source of ``--any-control`` (otherwise the source is the Grafcet's file)."""
+"""The request source of ``--any-control`` (otherwise the Grafcet's file, or ``PROGRAM P of F.st``)."""
+
+
+class ControlKind(StrEnum):
+    """What makes the requests of each scan."""
+
+    ANY = "any"  # --any-control: every request vector
+    GRAFCET = "grafcet"  # --grafcet G.g7: the Grafcet's orders
+    ST = "st"  # --control PROG.st: a cyclic IEC 61131-3 PROGRAM run by the ST interpreter
+
+
+@dataclass(frozen=True)
+class Control:
+    """The request source of a verification (the ``control`` key of the JSON)."""
+
+    kind: ControlKind
+    file: str | None = None
+    program: str | None = None
+
+    def json(self) -> dict[str, str]:
+        out = {"kind": str(self.kind)}
+        if self.file is not None:
+            out["file"] = self.file
+        if self.program is not None:
+            out["program"] = self.program
+        return out
 
 
 class FindingKind(StrEnum):
@@ -114,6 +139,7 @@ class Verification:
     max_distance: int = 0
     events_per_cycle: int = 1  # the plant makes 0..K events between two scans
     progress: Progress | None = None  # with --progress (None: not asked, or the exploration stopped)
+    control: Control = Control(ControlKind.ANY)
 
     @property
     def safe(self) -> bool:
