@@ -119,7 +119,7 @@ class _FilterChecker(Checker):
                 self.fail(
                     f"unknown variable '{base}' in {what}",
                     v.loc,
-                    suggestions=close_names(base, self.declared),
+                    suggestions=close_names(base, self.levels()),
                 )
                 ok = False
             elif base in self.integers:
@@ -131,6 +131,11 @@ class _FilterChecker(Checker):
                 ok = False
         return ok
 
+    def levels(self) -> list[str]:
+        """The declared names but the integer observers' bits (the names to suggest)."""
+        bits = {b for i in self.integers.values() for b in i.bits}
+        return [n for n in self.declared if n not in bits]
+
     def comparison(self, c: Compare, what: str) -> bool:
         """``cpt >= 2``: integer observers (or their past values) compared with a constant
         in their range or with each other."""
@@ -139,7 +144,7 @@ class _FilterChecker(Checker):
             d = self.declared.get(base)
             if d is None:
                 self.fail(f"unknown variable '{base}' in the comparison {c.text()} in {what}", c.loc,
-                          suggestions=close_names(base, self.declared),
+                          suggestions=close_names(base, self.integers) or close_names(base, self.levels()),
                           notes=(f"declare it: observer {base} : 0..3",))
                 return False
             if base not in self.integers:

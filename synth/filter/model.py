@@ -101,40 +101,47 @@ class IntegerEngine(Engine):
         terms equal but for those bits are merged, the legal values they allow split into
         maximal intervals (kept as bits when that takes more terms than the cubes)."""
         obs, bits = self.bits(operand)
-        groups: dict[tuple, tuple[Cube, tuple[tuple[int, str], ...], list["_Term"], set[int]]] = {}
-        out: list[_Term | tuple] = []
+        groups: dict[tuple, _Group] = {}
+        slots: list[list[_Term]] = []  # a term kept as it is, or the place of a group's terms
         for rest, lits in terms:
             fixed = {b: rest[b] for b in bits if b in rest}
             if not fixed:
-                out.append((rest, lits))
+                slots.append([(rest, lits)])
                 continue
             other = {n: v for n, v in rest.items() if n not in fixed}
             key = (tuple(other.items()), lits)
             if key not in groups:
-                groups[key] = (other, lits, [], set())
-                out.append(key)
-            groups[key][2].append((rest, lits))
-            groups[key][3].update(v for v in range(obs.low, obs.high + 1)
-                                  if all(obs.values(v)[bits.index(b)] == x for b, x in fixed.items()))
-        merged: list[_Term] = []
-        for item in out:
-            if not isinstance(item[0], tuple):
-                merged.append(item)  # type: ignore[arg-type]
+                groups[key] = _Group(other, lits)
+                slots.append(groups[key].out)
+            g = groups[key]
+            g.cubes.append((rest, lits))
+            g.allowed.update(v for v in range(obs.low, obs.high + 1)
+                             if all(obs.values(v)[bits.index(b)] == x for b, x in fixed.items()))
+        at = min(order.get(b, 0) for b in bits)
+        for g in groups.values():
+            runs = _runs(sorted(g.allowed))
+            if len(runs) > len(g.cubes):
+                g.out += g.cubes
                 continue
-            other, lits, cubes, allowed = groups[item]  # type: ignore[index]
-            runs = _runs(sorted(allowed))
-            if len(runs) > len(cubes):
-                merged += cubes
-                continue
-            at = min(order.get(b, 0) for b in bits)
             for a, z in runs:
                 texts = ([f"{operand} = {a}"] if a == z else
                          [f"{operand} >= {a}"] * (a > obs.low) + [f"{operand} <= {z}"] * (z < obs.high))
-                merged.append((dict(other), (*lits, *((at, t) for t in texts))))
-        return merged
+                g.out.append((dict(g.other), (*g.lits, *((at, t) for t in texts))))
+        return [t for slot in slots for t in slot]
 
 
 _Term = tuple[Cube, tuple[tuple[int, str], ...]]  # the bits left to print, the comparisons printed
+
+
+@dataclass
+class _Group:
+    """Terms equal but for one integer's bits: the legal values they allow together."""
+
+    other: Cube
+    lits: tuple[tuple[int, str], ...]
+    cubes: list[_Term] = field(default_factory=list)
+    allowed: set[int] = field(default_factory=set)
+    out: list[_Term] = field(default_factory=list)
 
 
 def _runs(values: Sequence[int]) -> list[tuple[int, int]]:
@@ -153,6 +160,12 @@ def filter_engine(f: Filter, order: Iterable[str] = (), text_order: Iterable[str
     return IntegerEngine(f.integers, order, text_order) if f.integers else Engine(order, text_order)
 
 
+def _exprs(f: Filter) -> list[Expr]:
+    """The constraints, assumptions, equations and stated criteria of ``f``."""
+    exprs = [s.expr for s in f.safeties] + [a.expr for a in f.assumptions] + [q.expr for q in f.equations]
+    return exprs + [c.expr for c in f.criteria if isinstance(c, Criterion)]
+
+
 def variable_order(f: Filter) -> list[str]:
     """The text order: requests, then read-only variables with their past values, then
     past outputs, then the outputs at t. Every equation and counterexample is built and
@@ -161,8 +174,7 @@ def variable_order(f: Filter) -> list[str]:
     for x in (*f.observer_names, *f.inputs):
         order += [pre_name(x), x]
     order += [pre_name(o) for o in f.outputs]
-    exprs = [s.expr for s in f.safeties] + [a.expr for a in f.assumptions] + [q.expr for q in f.equations]
-    exprs += [c.expr for c in f.criteria if isinstance(c, Criterion)]
+    exprs = _exprs(f)
     mentioned = [n for e in exprs for v in names(e) if isinstance(v, Var)
                  for n in (v.reads if isinstance(v, Comparison) else (v.name,))]
     order += [n for n in mentioned if n not in order and base_name(n) not in f.outputs]
@@ -181,8 +193,7 @@ def bdd_order(f: Filter) -> list[str]:
     (:func:`~synth.logic.bdd.interleaved_order` over the constraints, assumptions, stated
     criteria and equations; ``R_o`` and ``o^-1`` belong to ``o``), so the admissible set
     S(O,Y) never carries every output's constraints across one cut."""
-    exprs = [s.expr for s in f.safeties] + [a.expr for a in f.assumptions] + [q.expr for q in f.equations]
-    exprs += [c.expr for c in f.criteria if isinstance(c, Criterion)]
+    exprs = _exprs(f)
     supports = [expr_names(e) for e in exprs]
     supports += [{o for o in f.outputs if any(c.output == o for c in s.forced)} | expr_names(s.expr) for s in f.combined]
     owner = {r: o for r, o in zip(f.requests, f.outputs)} | {pre_name(o): o for o in f.outputs}
@@ -235,9 +246,7 @@ def functions(f: Filter) -> FilterFunctions:
     e = filter_engine(f, bdd_order(f), text_order=variable_order(f))
     assumed = e.conjunction(e.expr(a.expr) for a in f.assumptions)
     if isinstance(e, IntegerEngine):  # the domain assumption: only legal codes, now and before
-        exprs = [s.expr for s in f.safeties] + [a.expr for a in f.assumptions] + [q.expr for q in f.equations]
-        exprs += [c.expr for c in f.criteria if isinstance(c, Criterion)]
-        read = {n for x in exprs for n in expr_names(x)}
+        read = {n for x in _exprs(f) for n in expr_names(x)}
         for i in f.integer_observers:
             assumed &= e.domain(i.name)
             if any(pre_name(b) in read for b in i.bits):
