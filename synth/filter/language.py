@@ -87,10 +87,6 @@ class IntegerObserver:
         code = value - self.low
         return tuple(bool((code >> k) & 1) for k in range(self.width))
 
-    def value(self, bits: "tuple[bool, ...] | list[bool]") -> int:
-        """The value whose code the bits spell (maybe past ``high`` on an illegal code)."""
-        return self.low + sum(1 << k for k, b in enumerate(bits) if b)
-
 
 @dataclass(frozen=True)
 class Comparison(Compare):
