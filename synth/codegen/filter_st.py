@@ -1,7 +1,8 @@
 """A safety logic filter as one IEC 61131-3 ``FUNCTION_BLOCK`` (FILTER.md §1.7, §3.3).
 
 ``VAR_INPUT``: the requests ``R_<o>`` (the program's orders), the inputs and observers
-(and ``Ack`` in blocking mode); ``VAR_OUTPUT``: the filtered outputs (and ``Fallback``
+(and ``Ack`` in blocking mode), an integer observer as an ``INT`` (compared as written,
+decoded into its bits ``cpt_b0 …`` when an equation reads them); ``VAR_OUTPUT``: the filtered outputs (and ``Fallback``
 for the loop, ``Blocked`` in blocking mode); ``VAR``: the previous cycle's values
 ``x_1`` of every name the filter reads as ``x^-1`` or through an edge, stored at the
 end of the body.
@@ -52,23 +53,25 @@ from synth.codegen.st import (
     header,
     indent,
     pou_lines,
-    st_expression,
+    st_expr,
     st_identifier_problem,
 )
+from synth.codegen.st_internals import compare_text
 from synth.errors import InputError, Location, ModelError
 from synth.filter.cycle import Algorithm, Mode
-from synth.filter.language import Filter, request_name
+from synth.filter.language import Filter, IntegerObserver, request_name
 
 TYPE_CHECKING = False
 if TYPE_CHECKING:
     from synth.filter.solve import Synthesis
 from synth.logic.past import base_name, is_pre, pre_name, st_past_name
-from synth.logic.expr import Edge, Expr, names
+from synth.logic.expr import Compare, Edge, Expr, Var, names
 
 __all__ = ["filter_function_block", "filter_block_name", "FilterBlock", "filter_block", "split_blocks"]
 
 ACK, BLOCKED, FALLBACK = "Ack", "Blocked", "Fallback"
 _GATED = "G_"  # the request after the blocking latch
+_LOOP_LOCALS = ("fs0", "fs1", "fc0", "fc1", "g1", "SI", "V", "MC0", "MC1", "Flag", "Cpt", "k", "i")
 
 
 def filter_block_name(f: Filter, name: str | None = None) -> str:
@@ -97,8 +100,12 @@ class _Writer:
         self.f = f
         self.gated = gated
         self.past: set[str] = set()
+        self.owner = {b: i for i in f.integer_observers for b in i.bits}
+        self.decoded: set[str] = set()  # the integer observers whose bits are read
 
     def name(self, n: str) -> str:
+        if base_name(n) in self.owner:
+            self.decoded.add(self.owner[base_name(n)].name)
         if is_pre(n):
             self.past.add(base_name(n))
             return st_past_name(n)
@@ -113,27 +120,54 @@ class _Writer:
         def name(n: str) -> str:
             return at_t[n] if n in at_t else self.name(n)
 
-        def edge(x: Edge) -> str:
+        def ref(x: Expr) -> str:
+            if isinstance(x, Compare):
+                return compare_text(x, self.name)
+            if isinstance(x, Var):
+                return name(x.name)
+            assert isinstance(x, Edge)
             now, before = name(x.name), self.name(pre_name(x.name))
             return f"{now} AND NOT {before}" if x.rising else f"NOT {now} AND {before}"
 
-        return st_expression(e, name, edge)
+        return st_expr(e, ref)
+
+    def decoding(self) -> tuple[list[str], list[Declaration]]:
+        """The bits of the integer observers read as bits: ``cpt_b1 := ((cpt - 1) / 2) MOD 2 = 1;``."""
+        lines: list[str] = []
+        decls: list[Declaration] = []
+        for i in self.f.integer_observers:
+            if i.name not in self.decoded:
+                continue
+            code = i.name if i.low == 0 else f"({i.name} - {i.low})" if i.low > 0 else f"({i.name} + {-i.low})"
+            for k, b in enumerate(i.bits):
+                shifted = code if k == 0 else f"({code} / {1 << k})"
+                lines.append(f"{b} := {shifted} MOD 2 = 1;")
+                decls.append(Declaration(b, comment=f"bit {k} of {code}"))
+        return lines, decls
+
+
+def _boolean_observers(f: Filter) -> tuple[str, ...]:
+    """The observers the block reads as ``BOOL`` inputs (an integer observer's bits are local)."""
+    bits = {b for i in f.integer_observers for b in i.bits}
+    return tuple(n for n in f.observer_names if n not in bits)
 
 
 def _check_names(f: Filter, extra: tuple[str, ...]) -> None:
     """Every name the block declares must be a distinct IEC 61131-3 identifier."""
-    declared = [*f.requests, *f.inputs, *f.observer_names, *f.outputs, *extra]
-    declared += [st_past_name(pre_name(n)) for n in (*f.inputs, *f.observer_names, *f.outputs)]
+    ints = tuple(i.name for i in f.integer_observers)
+    declared = [*f.requests, *f.inputs, *f.observer_names, *ints, *f.outputs, *extra]
+    declared += [st_past_name(pre_name(n)) for n in (*f.inputs, *f.observer_names, *ints, *f.outputs)]
     seen: dict[str, str] = {}
     for n in declared:
         problem = st_identifier_problem(n)
-        if problem is None and n.upper() in seen and seen[n.upper()] != n:
+        mine = n in extra and n.upper() in seen  # the user's name is the one to blame
+        if problem is None and mine:
+            problem = f"{seen[n.upper()]} is a name the generated block needs for itself ({n})"
+        elif problem is None and n.upper() in seen and seen[n.upper()] != n:
             problem = f"{n} and {seen[n.upper()]} are the same name in IEC 61131-3 (case does not matter)"
-        elif problem is None and n.upper() in seen and n in extra:
-            problem = f"{n} is a name the generated block needs for itself"
         if problem is not None:
-            raise InputError(f"cannot write the filter as Structured Text: {problem}", _location(f, n),
-                             notes=("rename it in the .filter file",))
+            raise InputError(f"cannot write the filter as Structured Text: {problem}",
+                             _location(f, seen[n.upper()] if mine else n), notes=("rename it in the .filter file",))
         seen[n.upper()] = n
 
 
@@ -158,6 +192,9 @@ def filter_block(f: Filter, algorithm: Algorithm | str = Algorithm.ALGEBRAIC, mo
     extra = ((FALLBACK,) if algorithm is Algorithm.LOOP else ()) + ((ACK, BLOCKED) if blocking else ())
     extra += tuple(_GATED + o for o in f.outputs) if blocking else ()
     _check_names(f, extra)
+    if algorithm is Algorithm.LOOP:  # an INT input named like a local of the loop
+        _check_names(f, extra + tuple(n for n in _LOOP_LOCALS
+                                      if n.upper() in {i.name.upper() for i in f.integer_observers}))
     w = _Writer(f, blocking)
     notes: list[str] = []
     body: list[str] = []
@@ -179,12 +216,17 @@ def filter_block(f: Filter, algorithm: Algorithm | str = Algorithm.ALGEBRAIC, mo
         lines, decls = _loop(f, w, synthesis)
         body += lines
         local += decls
-    stored = [x for x in (*f.inputs, *f.observer_names, *f.outputs) if x in w.past]
+    ints = {i.name: i for i in f.integer_observers}
+    stored = [x for x in (*f.inputs, *f.observer_names, *ints, *f.outputs) if x in w.past]
     if stored:
         body += ["(* the previous cycle's values *)"] + [f"{st_past_name(pre_name(x))} := {x};" for x in stored]
-    local = [Declaration(st_past_name(pre_name(x)), comment=f"{x} at the previous cycle") for x in stored] + local
+    decode, bits = w.decoding()
+    if decode:
+        body = ["(* the integer observers' bits *)", *decode, *body]
+    local = [_past(x, ints.get(x)) for x in stored] + bits + local
     inputs = [Declaration(r, comment=f"request of {o}") for r, o in zip(f.requests, f.outputs)]
-    inputs += [Declaration(x) for x in (*f.inputs, *f.observer_names)]
+    inputs += [Declaration(x) for x in (*f.inputs, *_boolean_observers(f))]
+    inputs += [Declaration(i.name, "INT", comment=f"integer observer {i.low}..{i.high}") for i in ints.values()]
     if blocking:
         inputs.append(Declaration(ACK, comment="acknowledge: releases the latch"))
     outputs = [Declaration(o) for o in f.outputs]
@@ -198,6 +240,14 @@ def filter_block(f: Filter, algorithm: Algorithm | str = Algorithm.ALGEBRAIC, mo
     pou = Pou(PouKind.FUNCTION_BLOCK, fb, sections, tuple(body))
     lines = [*header(f"Safety logic filter {fb}", [f.file], details), *pou_lines(pou), ""]
     return FilterBlock(fb, tuple(d.name for d in inputs), tuple(d.name for d in outputs), "\n".join(lines), pou, notes)
+
+
+def _past(x: str, integer: IntegerObserver | None) -> Declaration:
+    """The variable of ``x^-1``; an integer observer's starts at its low value (its bits all FALSE)."""
+    if integer is None:
+        return Declaration(st_past_name(pre_name(x)), comment=f"{x} at the previous cycle")
+    return Declaration(st_past_name(pre_name(x)), "INT", str(integer.low) if integer.low else None,
+                       comment=f"{x} at the previous cycle")
 
 
 def split_blocks(f: Filter, algorithm: Algorithm | str = Algorithm.ALGEBRAIC, mode: Mode | str = Mode.SUPERVISOR,

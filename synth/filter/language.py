@@ -9,6 +9,9 @@ Example
 -------
 >>> request_name("A2")
 'R_A2'
+>>> cpt = IntegerObserver("cpt", 0, 4)
+>>> cpt.bits, cpt.values(3)
+(('cpt_b0', 'cpt_b1', 'cpt_b2'), (True, True, False))
 """
 
 from __future__ import annotations
@@ -17,11 +20,17 @@ from dataclasses import dataclass, field
 from enum import StrEnum
 
 from synth.errors import InputError, Location
-from synth.logic.expr import Expr
+from synth.logic.expr import Compare, Expr
+from synth.logic.past import base_name, is_pre, pre_name
 
 __all__ = [
     "REQUEST_PREFIX",
     "request_name",
+    "BIT_INFIX",
+    "MAX_BITS",
+    "bit_name",
+    "IntegerObserver",
+    "Comparison",
     "VarKind",
     "ConstraintKind",
     "Sense",
@@ -43,6 +52,58 @@ def request_name(output: str) -> str:
     return REQUEST_PREFIX + output
 
 
+BIT_INFIX = "_b"
+MAX_BITS = 10
+"""An integer observer has at most ``2**MAX_BITS`` values (a located error past it)."""
+
+
+def bit_name(integer: str, k: int) -> str:
+    """The Boolean observer holding bit ``k`` (0: the least significant) of the code
+    ``value - low`` of an integer observer: ``cpt_b0``."""
+    return f"{integer}{BIT_INFIX}{k}"
+
+
+@dataclass(frozen=True)
+class IntegerObserver:
+    """``observer cpt : 0..3``: a read-only integer the program supplies every cycle,
+    encoded as the Boolean observers :attr:`bits` (the binary code of ``value - low``)."""
+
+    name: str
+    low: int
+    high: int
+    loc: Location | None = field(default=None, compare=False)
+
+    @property
+    def width(self) -> int:
+        """ceil(log2(high - low + 1)) bits, at least one."""
+        return max(1, (self.high - self.low).bit_length())
+
+    @property
+    def bits(self) -> tuple[str, ...]:
+        return tuple(bit_name(self.name, k) for k in range(self.width))
+
+    def values(self, value: int) -> tuple[bool, ...]:
+        """The bits of ``value`` (in ``low..high``), least significant first."""
+        code = value - self.low
+        return tuple(bool((code >> k) & 1) for k in range(self.width))
+
+
+@dataclass(frozen=True)
+class Comparison(Compare):
+    """A checked comparison of integer observers: ``reads`` are the Boolean variables it is
+    a function of (the bits of its operands, ``cpt_b0^-1`` for ``cpt^-1``)."""
+
+    reads: tuple[str, ...] = field(default=(), compare=False)
+
+    @staticmethod
+    def resolved(c: Compare, integers: "dict[str, IntegerObserver]") -> "Comparison":
+        reads: list[str] = []
+        for x in c.operands():
+            obs = integers[base_name(x)]
+            reads += [pre_name(b) if is_pre(x) else b for b in obs.bits]
+        return Comparison(c.name, c.loc, c.left, c.op, c.right, tuple(reads))
+
+
 class VarKind(StrEnum):
     """What a declared name is. Only outputs at t are controllable; the rest is Y."""
 
@@ -50,6 +111,7 @@ class VarKind(StrEnum):
     OUTPUT = "output"
     OBSERVER = "observer"
     REQUEST = "request"
+    INTEGER = "integer observer"
 
 
 class ConstraintKind(StrEnum):
@@ -165,6 +227,14 @@ class Filter:
     plant: str | None = None
     warnings: tuple[InputError, ...] = ()
     declarations: tuple[Declared, ...] = field(default=(), compare=False)  # inputs, outputs, observers, with locations
+    integers: tuple[IntegerObserver, ...] = ()  # their bits are among the observers
+
+    @property
+    def integer_observers(self) -> tuple[IntegerObserver, ...]:
+        """The integer observers whose bits this filter reads (all of a file's; those a
+        cluster of outputs uses, in a cluster's filter)."""
+        mine = set(self.observer_names)
+        return tuple(i for i in self.integers if any(b in mine for b in i.bits))
 
     @property
     def requests(self) -> tuple[str, ...]:

@@ -15,21 +15,24 @@ from typing import TYPE_CHECKING
 
 from synth.errors import InputError, Location, Severity, close_names, location_in
 from synth.filter.language import (
+    MAX_BITS,
     Assumption,
+    Comparison,
     ConstraintKind,
     Criterion,
     Declared,
     Equation,
     Filter,
     Forcing,
+    IntegerObserver,
     Safety,
     SimCriterion,
     VarKind,
     request_name,
 )
-from synth.filter.language_reader import Use, Vector, filter_items
-from synth.logic.past import base_name
-from synth.logic.expr import And, Edge, Expr, Not, Or, Var, names
+from synth.filter.language_reader import IntegerDecl, Use, Vector, filter_items
+from synth.logic.past import base_name, is_pre
+from synth.logic.expr import And, Compare, Edge, Expr, Not, Or, Var, names
 from synth.syntax import Checker, read_source
 
 if TYPE_CHECKING:
@@ -70,6 +73,7 @@ class _FilterChecker(Checker):
         self.warnings: list[InputError] = []
         self.plant: str | None = None
         self.engine: "Engine | None" = None
+        self.integers: dict[str, IntegerObserver] = {}
 
     # ---- declarations
     def declare(self, name: str, kind: VarKind, loc: Location | None, grafcet: str | None = None,
@@ -107,15 +111,52 @@ class _FilterChecker(Checker):
     def known(self, e: Expr, what: str) -> bool:
         ok = True
         for v in names(e):
+            if isinstance(v, Compare):
+                ok = self.comparison(v, what) and ok
+                continue
             base = base_name(v.name) if isinstance(v, Var) else v.name
             if base not in self.declared:
                 self.fail(
                     f"unknown variable '{base}' in {what}",
                     v.loc,
-                    suggestions=close_names(base, self.declared),
+                    suggestions=close_names(base, self.levels()),
                 )
                 ok = False
+            elif base in self.integers:
+                i = self.integers[base]
+                level = f"the edge {v.text()} is" if isinstance(v, Edge) else f"'{v.name}' is"
+                self.fail(f"{level} not a Boolean level: '{base}' is an integer observer ({i.low}..{i.high})", v.loc,
+                          notes=(f"compare it, e.g. {base} >= {min(i.high, i.low + 1)}"
+                                 + (f" or {base}^-1 < {base}" if isinstance(v, Edge) else ""),))
+                ok = False
         return ok
+
+    def levels(self) -> list[str]:
+        """The declared names but the integer observers' bits (the names to suggest)."""
+        bits = {b for i in self.integers.values() for b in i.bits}
+        return [n for n in self.declared if n not in bits]
+
+    def comparison(self, c: Compare, what: str) -> bool:
+        """``cpt >= 2``: integer observers (or their past values) compared with a constant
+        in their range or with each other."""
+        for x in c.operands():
+            base = base_name(x)
+            d = self.declared.get(base)
+            if d is None:
+                self.fail(f"unknown variable '{base}' in the comparison {c.text()} in {what}", c.loc,
+                          suggestions=close_names(base, self.integers) or close_names(base, self.levels()),
+                          notes=(f"declare it: observer {base} : 0..3",))
+                return False
+            if base not in self.integers:
+                self.fail(f"'{base}' is a Boolean {d.kind.value}: read it as a level ({base} or !{base}), "
+                          f"not in the comparison {c.text()}", c.loc)
+                return False
+        i = self.integers[base_name(c.left)]
+        if isinstance(c.right, int) and not i.low <= c.right <= i.high:
+            self.fail(f"the constant {c.right} in {c.text()} is outside the range {i.low}..{i.high} of '{i.name}'",
+                      c.loc)
+            return False
+        return True
 
     def outputs_at_t(self, e: Expr) -> tuple[str, ...]:
         outs = self.of_kind(VarKind.OUTPUT)
@@ -191,10 +232,10 @@ class _FilterChecker(Checker):
         return self.relieving(s, tuple(forced))
 
     def relieving(self, s: Safety, forced: tuple[Forcing, ...]) -> tuple[Forcing, ...] | None:
-        from synth.logic.bdd import Engine
+        from synth.filter.model import filter_engine
 
         if self.engine is None:  # one manager for the file: creating one costs ~10 ms
-            self.engine = Engine()
+            self.engine = filter_engine(self.partial())
         engine = self.engine
         u = engine.expr(s.expr)
         if engine.let({f.output: f.value for f in forced}, u) != engine.false:
@@ -210,6 +251,12 @@ class _FilterChecker(Checker):
             return
         observers = self.of_kind(VarKind.OBSERVER)
         for v in names(d.definition):
+            now = [x for x in v.operands() if not is_pre(x)] if isinstance(v, Compare) else []
+            if now:
+                self.fail(f"observer {d.name} cannot read the integer observer '{now[0]}' at t", v.loc,
+                          notes=(f"an observer is computed from the inputs, the requests and past values: "
+                                 f"compare {now[0]}^-1",))
+                return
             if v.name in self.of_kind(VarKind.OUTPUT) or v.name in observers:
                 what = "output" if v.name not in observers else "observer"
                 self.fail(f"observer {d.name} cannot read the {what} '{v.name}' at t", v.loc,
@@ -250,6 +297,42 @@ class _FilterChecker(Checker):
         done[q.output] = q
         return q if self.known(q.expr, f"the equation of {q.output}") else None
 
+    def integer(self, d: IntegerDecl) -> None:
+        """``observer cpt : LOW..HIGH``: a non-empty range of at most 2^MAX_BITS values."""
+        if d.low > d.high:
+            self.fail(f"the range {d.low}..{d.high} of '{d.name}' is empty", d.range_loc,
+                      notes=("write LOW..HIGH with LOW <= HIGH, e.g. 0..3",))
+            return
+        if (d.high - d.low).bit_length() > MAX_BITS:
+            self.fail(f"the range {d.low}..{d.high} of '{d.name}' has more than {1 << MAX_BITS} values",
+                      d.range_loc, notes=(f"an integer observer is encoded in at most {MAX_BITS} bits",))
+            return
+        self.declare(d.name, VarKind.INTEGER, d.loc)
+        if self.declared[d.name].kind is VarKind.INTEGER and d.name not in self.integers:
+            self.integers[d.name] = IntegerObserver(d.name, d.low, d.high, d.loc)
+
+    def partial(self) -> Filter:
+        """What the checks need of the filter being checked: its integer observers."""
+        return Filter(self.file, (), (), integers=tuple(self.integers.values()))
+
+    def resolved(self, f: Filter) -> Filter:
+        """The comparisons of every expression resolved (:class:`Comparison`)."""
+        if not self.integers:
+            return f
+        from dataclasses import replace
+
+        r = self.integers
+        return replace(
+            f,
+            observers=tuple(replace(d, definition=_resolved(d.definition, r)) if d.definition is not None else d
+                            for d in f.observers),
+            assumptions=tuple(replace(a, expr=_resolved(a.expr, r)) for a in f.assumptions),
+            safeties=tuple(replace(s, expr=_resolved(s.expr, r)) for s in f.safeties),
+            criteria=tuple(replace(c, expr=_resolved(c.expr, r)) if isinstance(c, Criterion) else c
+                           for c in f.criteria),
+            equations=tuple(replace(q, expr=_resolved(q.expr, r)) for q in f.equations),
+        )
+
     def check(self, items: list) -> Filter:
         for it in items:
             if isinstance(it, Use):
@@ -260,6 +343,8 @@ class _FilterChecker(Checker):
                     self.declare(n, it.kind, loc)
             elif isinstance(it, Declared):
                 self.declare(it.name, it.kind, it.loc, it.grafcet, it.definition)
+            elif isinstance(it, IntegerDecl):
+                self.integer(it)
         outputs = self.of_kind(VarKind.OUTPUT)
         for o in outputs:
             r = request_name(o)
@@ -267,6 +352,13 @@ class _FilterChecker(Checker):
                 self.fail(f"'{r}' is the implicit request of output {o}; it cannot be declared", self.declared[r].loc)
             else:
                 self.declared[r] = Declared(r, VarKind.REQUEST, None)
+        for i in self.integers.values():
+            for k, b in enumerate(i.bits):
+                if b in self.declared:
+                    self.fail(f"'{b}' is bit {k} of the integer observer {i.name}; it cannot be declared",
+                              self.declared[b].loc or i.loc)
+                else:
+                    self.declared[b] = Declared(b, VarKind.OBSERVER, i.loc)
         if not outputs:
             self.fail("no outputs declared", location_in(self.file, self.source, 1, 1),
                       notes=("declare them with `outputs A0, A1, ...` or `use` a plant",))
@@ -291,7 +383,7 @@ class _FilterChecker(Checker):
             elif isinstance(it, Equation):
                 equations.append(self.equation(it, eqs))
         self.raise_errors()  # every None above came with an error
-        return Filter(
+        return self.resolved(Filter(
             self.file,
             self.of_kind(VarKind.INPUT),
             outputs,
@@ -303,7 +395,19 @@ class _FilterChecker(Checker):
             self.plant,
             tuple(self.warnings),
             tuple(d for d in self.declared.values() if d.kind is not VarKind.REQUEST),
-        )
+            tuple(self.integers.values()),
+        ))
+
+
+def _resolved(e: Expr, integers: dict[str, IntegerObserver]) -> Expr:
+    """``e`` with each comparison a :class:`Comparison` that knows the bits it reads."""
+    if isinstance(e, Compare):
+        return Comparison.resolved(e, integers)
+    if isinstance(e, Not):
+        return Not(_resolved(e.arg, integers), e.loc)
+    if isinstance(e, (And, Or)):
+        return type(e)(tuple(_resolved(a, integers) for a in e.args), e.loc)
+    return e
 
 
 def parse_filter(source: str, file: str = "<filter>", base: Path | None = None) -> Filter:

@@ -9,6 +9,9 @@ Example
 ['Vector', 'Safety']
 >>> items[1].expr.text()
 'O1 & O2^-1'
+>>> decl, assumption = filter_items("observer cpt : 0..3\nassume cpt^-1 <= cpt", "x.filter")
+>>> decl.text(), assumption.expr.text(), assumption.expr.loc.column, assumption.expr.loc.width
+('observer cpt : 0..3', 'cpt^-1 <= cpt', 8, 13)
 """
 
 from __future__ import annotations
@@ -28,10 +31,11 @@ from synth.filter.language import (
     VarKind,
 )
 from synth.logic.past import pre_name
-from synth.logic.expr import Expr, Var
+from synth.grafcet.language_reader import _CMP_SPELLING
+from synth.logic.expr import Compare, Expr, Var
 from synth.syntax import ExprTransformer, Token, parse_tree
 
-__all__ = ["filter_items", "filter_expression", "Use", "Vector"]
+__all__ = ["filter_items", "filter_expression", "Use", "Vector", "IntegerDecl"]
 
 
 @dataclass(frozen=True)
@@ -40,6 +44,20 @@ class Use:
 
     path: str
     loc: Location
+
+
+@dataclass(frozen=True)
+class IntegerDecl:
+    """``observer cpt : LOW..HIGH`` as written (checked later)."""
+
+    name: str
+    low: int
+    high: int
+    loc: Location
+    range_loc: Location
+
+    def text(self) -> str:
+        return f"observer {self.name} : {self.low}..{self.high}"
 
 
 @dataclass(frozen=True)
@@ -76,6 +94,24 @@ class _ToFilter(ExprTransformer):
     def defined(self, items: list) -> Declared:
         name, e = items
         return Declared(str(name), VarKind.OBSERVER, self._loc(name), None, e)
+
+    def integer(self, items: list) -> IntegerDecl:
+        name, low, high = items
+        width = high.end_pos - low.start_pos if high.end_pos is not None and low.start_pos is not None else None
+        return IntegerDecl(str(name), int(low), int(high), self._loc(name), self._loc(low, width=width))
+
+    def cmp_right(self, items: list) -> tuple[str | int, Token]:
+        tok, pre = items[0], items[1] if len(items) > 1 else None
+        if tok.type == "SIGNED":
+            return int(tok), tok
+        return (pre_name(str(tok)), pre) if pre is not None else (str(tok), tok)
+
+    def compare(self, items: list) -> Compare:
+        """``cpt >= 2``, ``cpt^-1 < cpt``: located on the whole comparison."""
+        left, pre, op, (right, last) = items
+        name = pre_name(str(left)) if pre is not None else str(left)
+        width = last.end_pos - left.start_pos if last.end_pos is not None and left.start_pos is not None else None
+        return Compare.of(name, _CMP_SPELLING.get(str(op), str(op)), right, self._loc(left, width=width))
 
     def assume(self, items: list) -> Assumption:
         (e,) = items

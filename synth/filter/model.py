@@ -13,13 +13,157 @@ Example
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Iterable, Mapping, Sequence
 
-from synth.logic.bdd import Engine, Function, interleaved_order
-from synth.filter.language import Criterion, Filter
-from synth.logic.past import base_name, pre_name
-from synth.logic.expr import Edge, Expr, Var, names
+from synth.logic.bdd import Cube, Engine, Function, _factored, _literals, interleaved_order
+from synth.filter.language import Comparison, Criterion, Filter, IntegerObserver
+from synth.logic.past import base_name, is_pre, pre_name
+from synth.logic.expr import Compare, Edge, Expr, Var, names
 
-__all__ = ["FilterFunctions", "functions", "variable_order", "bdd_order", "expr_names", "edge_rule", "equation_functions"]
+__all__ = ["FilterFunctions", "functions", "variable_order", "bdd_order", "expr_names", "edge_rule", "equation_functions",
+           "IntegerEngine", "filter_engine"]
+
+_FLIPPED = {">=": "<=", "<=": ">=", "<": ">", ">": "<", "=": "=", "<>": "<>"}
+
+
+class IntegerEngine(Engine):
+    """An :class:`Engine` that reads comparisons of integer observers (docs/filter.md,
+    "Integer observers"): ``cpt`` is the bits ``cpt_b0 …`` of its code ``cpt - low``
+    (``cpt^-1`` the bits' past values), a comparison the Boolean function of the bits, and
+    a cover is printed with each cube's literals on one integer's bits written as the
+    comparison they spell over its legal values, when they spell an interval."""
+
+    def __init__(self, integers: Iterable[IntegerObserver], order: Iterable[str] = (),
+                 text_order: Iterable[str] | None = None) -> None:
+        super().__init__(order, text_order)
+        self.integers = {i.name: i for i in integers}
+
+    def bits(self, operand: str) -> tuple[IntegerObserver, list[str]]:
+        """The integer observer of ``cpt`` or ``cpt^-1`` and the names of its bits."""
+        obs = self.integers[base_name(operand)]
+        return obs, [pre_name(b) if is_pre(operand) else b for b in obs.bits]
+
+    def at_most(self, bits: Sequence[str], code: int) -> Function:
+        """``code(bits) <= code`` over every code the bits spell (least significant first)."""
+        if code < 0:
+            return self.false
+        if code >= (1 << len(bits)) - 1:
+            return self.true
+        u = self.true  # the low k bits spell at most the low k bits of code
+        for k, b in enumerate(bits):
+            x = self.var(b)
+            u = (~x | u) if (code >> k) & 1 else (~x & u)
+        return u
+
+    def constant(self, operand: str, op: str, value: int) -> Function:
+        """``operand op value`` for a constant ``value``."""
+        obs, bits = self.bits(operand)
+        c = value - obs.low
+        le, lt = self.at_most(bits, c), self.at_most(bits, c - 1)
+        return {"<=": le, "<": lt, ">": ~le, ">=": ~lt, "=": le & ~lt, "<>": ~(le & ~lt)}[op]
+
+    def comparison(self, c: Compare) -> Function:
+        if not isinstance(c.right, str):
+            return self.constant(c.left, c.op, c.right)
+        obs, bits = self.bits(c.left)
+        out = self.false
+        for v in range(obs.low, obs.high + 1):  # left = v and v op right
+            out |= self.cube(dict(zip(bits, obs.values(v)))) & self.constant(c.right, _FLIPPED[c.op], v)
+        return out
+
+    def domain(self, operand: str) -> Function:
+        """The legal codes of ``cpt`` (or ``cpt^-1``): ``code <= high - low``."""
+        obs, bits = self.bits(operand)
+        return self.at_most(bits, obs.high - obs.low)
+
+    def expr(self, e: Expr) -> Function:
+        if isinstance(e, Compare):
+            return self.comparison(e)
+        return super().expr(e)
+
+    def text(self, lower: Function, upper: Function | None = None, limit: int | None = None) -> str:
+        if not self.integers or lower == self.false:
+            return super().text(lower, upper, limit)
+        cubes = self.cover(lower, upper, limit)
+        if cubes == [{}]:
+            return "1"
+        order = {n: self.rank(n) for n in self.names}
+        terms: list[_Term] = [(dict(c), ()) for c in cubes]
+        for obs in self.integers.values():
+            for operand in (obs.name, pre_name(obs.name)):
+                terms = self._merged(terms, operand, order)
+        if not terms:
+            return "0"
+        return _factored([sorted([*lits, *_literals(rest, order)]) for rest, lits in terms], top=True)
+
+    def _merged(self, terms: list["_Term"], operand: str, order: Mapping[str, int]) -> list["_Term"]:
+        """The terms with their literals on ``operand``'s bits written as comparisons:
+        terms equal but for those bits are merged, the legal values they allow split into
+        maximal intervals (kept as bits when that takes more terms than the cubes)."""
+        obs, bits = self.bits(operand)
+        groups: dict[tuple, _Group] = {}
+        slots: list[list[_Term]] = []  # a term kept as it is, or the place of a group's terms
+        for rest, lits in terms:
+            fixed = {b: rest[b] for b in bits if b in rest}
+            if not fixed:
+                slots.append([(rest, lits)])
+                continue
+            other = {n: v for n, v in rest.items() if n not in fixed}
+            key = (tuple(other.items()), lits)
+            if key not in groups:
+                groups[key] = _Group(other, lits)
+                slots.append(groups[key].out)
+            g = groups[key]
+            g.cubes.append((rest, lits))
+            g.allowed.update(v for v in range(obs.low, obs.high + 1)
+                             if all(obs.values(v)[bits.index(b)] == x for b, x in fixed.items()))
+        at = min(order.get(b, 0) for b in bits)
+        for g in groups.values():
+            runs = _runs(sorted(g.allowed))
+            if len(runs) > len(g.cubes):
+                g.out += g.cubes
+                continue
+            for a, z in runs:
+                texts = ([f"{operand} = {a}"] if a == z else
+                         [f"{operand} >= {a}"] * (a > obs.low) + [f"{operand} <= {z}"] * (z < obs.high))
+                g.out.append((dict(g.other), (*g.lits, *((at, t) for t in texts))))
+        return [t for slot in slots for t in slot]
+
+
+_Term = tuple[Cube, tuple[tuple[int, str], ...]]  # the bits left to print, the comparisons printed
+
+
+@dataclass
+class _Group:
+    """Terms equal but for one integer's bits: the legal values they allow together."""
+
+    other: Cube
+    lits: tuple[tuple[int, str], ...]
+    cubes: list[_Term] = field(default_factory=list)
+    allowed: set[int] = field(default_factory=set)
+    out: list[_Term] = field(default_factory=list)
+
+
+def _runs(values: Sequence[int]) -> list[tuple[int, int]]:
+    """The maximal intervals of sorted integers: ``[0, 1, 3]`` is ``[(0, 1), (3, 3)]``."""
+    runs: list[tuple[int, int]] = []
+    for v in values:
+        if runs and runs[-1][1] == v - 1:
+            runs[-1] = (runs[-1][0], v)
+        else:
+            runs.append((v, v))
+    return runs
+
+
+def filter_engine(f: Filter, order: Iterable[str] = (), text_order: Iterable[str] | None = None) -> Engine:
+    """The engine of a filter's functions: an :class:`IntegerEngine` when it declares integer observers."""
+    return IntegerEngine(f.integers, order, text_order) if f.integers else Engine(order, text_order)
+
+
+def _exprs(f: Filter) -> list[Expr]:
+    """The constraints, assumptions, equations and stated criteria of ``f``."""
+    exprs = [s.expr for s in f.safeties] + [a.expr for a in f.assumptions] + [q.expr for q in f.equations]
+    return exprs + [c.expr for c in f.criteria if isinstance(c, Criterion)]
 
 
 def variable_order(f: Filter) -> list[str]:
@@ -30,16 +174,18 @@ def variable_order(f: Filter) -> list[str]:
     for x in (*f.observer_names, *f.inputs):
         order += [pre_name(x), x]
     order += [pre_name(o) for o in f.outputs]
-    exprs = [s.expr for s in f.safeties] + [a.expr for a in f.assumptions] + [q.expr for q in f.equations]
-    exprs += [c.expr for c in f.criteria if isinstance(c, Criterion)]
-    mentioned = [v.name for e in exprs for v in names(e) if isinstance(v, Var)]
+    exprs = _exprs(f)
+    mentioned = [n for e in exprs for v in names(e) if isinstance(v, Var)
+                 for n in (v.reads if isinstance(v, Comparison) else (v.name,))]
     order += [n for n in mentioned if n not in order and base_name(n) not in f.outputs]
     return order + list(f.outputs)
 
 
 def expr_names(e: Expr) -> set[str]:
-    """The BDD variables of ``e``: its names, and ``x^-1`` for an edge of ``x``."""
-    return {n for v in names(e) for n in ((v.name, pre_name(v.name)) if isinstance(v, Edge) else (v.name,))}
+    """The BDD variables of ``e``: its names, ``x^-1`` for an edge of ``x``, the bits of
+    the integer observers a (checked) comparison reads."""
+    return {n for v in names(e) for n in ((v.name, pre_name(v.name)) if isinstance(v, Edge) else
+                                         v.reads if isinstance(v, Comparison) else (v.name,))}
 
 
 def bdd_order(f: Filter) -> list[str]:
@@ -47,8 +193,7 @@ def bdd_order(f: Filter) -> list[str]:
     (:func:`~synth.logic.bdd.interleaved_order` over the constraints, assumptions, stated
     criteria and equations; ``R_o`` and ``o^-1`` belong to ``o``), so the admissible set
     S(O,Y) never carries every output's constraints across one cut."""
-    exprs = [s.expr for s in f.safeties] + [a.expr for a in f.assumptions] + [q.expr for q in f.equations]
-    exprs += [c.expr for c in f.criteria if isinstance(c, Criterion)]
+    exprs = _exprs(f)
     supports = [expr_names(e) for e in exprs]
     supports += [{o for o in f.outputs if any(c.output == o for c in s.forced)} | expr_names(s.expr) for s in f.combined]
     owner = {r: o for r, o in zip(f.requests, f.outputs)} | {pre_name(o): o for o in f.outputs}
@@ -98,9 +243,15 @@ class FilterFunctions:
 
 def functions(f: Filter) -> FilterFunctions:
     """The BDDs of a checked filter."""
-    e = Engine(bdd_order(f), text_order=variable_order(f))
-    m = FilterFunctions(f, e, {s.id: e.expr(s.expr) for s in f.safeties},
-                        e.conjunction(e.expr(a.expr) for a in f.assumptions))
+    e = filter_engine(f, bdd_order(f), text_order=variable_order(f))
+    assumed = e.conjunction(e.expr(a.expr) for a in f.assumptions)
+    if isinstance(e, IntegerEngine):  # the domain assumption: only legal codes, now and before
+        read = {n for x in _exprs(f) for n in expr_names(x)}
+        for i in f.integer_observers:
+            assumed &= e.domain(i.name)
+            if any(pre_name(b) in read for b in i.bits):
+                assumed &= e.domain(pre_name(i.name))
+    m = FilterFunctions(f, e, {s.id: e.expr(s.expr) for s in f.safeties}, assumed)
     for o in f.outputs:
         for value in (False, True):
             parts = []

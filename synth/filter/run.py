@@ -3,7 +3,9 @@ with :class:`~synth.filter.cycle.FilterCycle` (:mod:`synth.output.filter_text` p
 
 The CSV's header names every input, observer and request ``R_o`` of the filter (and
 ``Ack`` in blocking mode), in any order; each following line is one PLC cycle, its cells
-``0`` or ``1``. Blank lines and lines starting with ``#`` are skipped.
+``0`` or ``1``; an integer observer ``cpt : LOW..HIGH`` has one column ``cpt`` whose cells
+are integers in its range (the cycle reads its bits). Blank lines and lines starting with
+``#`` are skipped.
 
 Example
 -------
@@ -13,26 +15,33 @@ Example
 >>> rows = read_trace("R_o1,R_o2\\n1,1\\n0,1\\n", "t.csv", FilterCycle(f, Algorithm.LOOP).reads)
 >>> [r.outputs for r in run(FilterCycle(f, Algorithm.LOOP), rows)]
 [(True, False), (False, True)]
+>>> g = parse_filter("observer n : 1..3\\noutputs o\\nsafety S: o & n = 3", "n.filter")
+>>> rows = read_trace("n,R_o\\n3,1\\n2,1\\n", "t.csv", FilterCycle(g).reads, g.integer_observers)
+>>> rows[0].values, rows[0].numbers, [r.outputs for r in run(FilterCycle(g), rows)]
+((('n_b0', False), ('n_b1', True), ('R_o', True)), (('n', 3),), [(False,), (True,)])
 """
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from typing import Sequence
 
 from synth.errors import InputError, Location, close_names
 from synth.filter.cycle import Algorithm, CycleResult, FilterCycle, Mode
-from synth.filter.language import Filter
+from synth.filter.language import Filter, IntegerObserver
 
 __all__ = ["Row", "read_trace", "load_trace", "run", "Run", "run_trace"]
 
 
 @dataclass(frozen=True)
 class Row:
-    """One cycle of the trace: its line in the file and the values read."""
+    """One cycle of the trace: its line in the file and the values read (the bits of an
+    integer observer, whose value is in ``numbers``)."""
 
     line: int
     values: tuple[tuple[str, bool], ...]
+    numbers: tuple[tuple[str, int], ...] = ()
 
     def value(self, name: str) -> bool:
         return dict(self.values)[name]
@@ -48,8 +57,17 @@ def _cells(text: str) -> list[tuple[str, int]]:
     return out
 
 
-def read_trace(text: str, file: str, reads: Sequence[str]) -> list[Row]:
-    """The rows of a CSV trace whose header must name exactly ``reads`` (any order)."""
+def _columns(reads: Sequence[str], integers: Sequence[IntegerObserver]) -> list[str]:
+    """``reads`` with the bits of each integer observer replaced by its name."""
+    owner = {b: i.name for i in integers for b in i.bits}
+    return list(dict.fromkeys(owner.get(n, n) for n in reads))
+
+
+def read_trace(text: str, file: str, reads: Sequence[str], integers: Sequence[IntegerObserver] = ()) -> list[Row]:
+    """The rows of a CSV trace whose header must name exactly ``reads`` (any order), an
+    integer observer's bits by its one column."""
+    ints = {i.name: i for i in integers}
+    reads = _columns(reads, integers)
     lines = [(i, line.rstrip("\r")) for i, line in enumerate(text.split("\n"), 1)]
     lines = [(i, line) for i, line in lines if line.strip() and not line.lstrip().startswith("#")]
     if not lines:
@@ -81,21 +99,30 @@ def read_trace(text: str, file: str, reads: Sequence[str]) -> list[Row]:
             raise InputError(f"{len(cells)} cells, the header has {len(header)}",
                              Location(file, no, len(line) + 1 if len(cells) < len(header) else cells[len(header)][1],
                                       line, 1))
-        values = []
+        values: list[tuple[str, bool]] = []
+        numbers: list[tuple[str, int]] = []
         for (name, _), (cell, col) in zip(header, cells):
+            if name in ints:
+                i = ints[name]
+                if not re.fullmatch(r"-?[0-9]+", cell) or not i.low <= int(cell) <= i.high:
+                    raise InputError(f"an integer in {i.low}..{i.high} expected for {name}, got '{cell}'",
+                                     Location(file, no, col, line, max(1, len(cell))))
+                numbers.append((name, int(cell)))
+                values += zip(i.bits, i.values(int(cell)))
+                continue
             if cell not in ("0", "1"):
                 raise InputError(f"0/1 expected for {name}, got '{cell}'",
                                  Location(file, no, col, line, max(1, len(cell))))
             values.append((name, cell == "1"))
-        rows.append(Row(no, tuple(values)))
+        rows.append(Row(no, tuple(values), tuple(numbers)))
     return rows
 
 
-def load_trace(path: str, reads: Sequence[str]) -> list[Row]:
+def load_trace(path: str, reads: Sequence[str], integers: Sequence[IntegerObserver] = ()) -> list[Row]:
     """:func:`read_trace` on a file (a missing file is an input error)."""
     from synth.syntax import read_source
 
-    return read_trace(read_source(path), path, reads)
+    return read_trace(read_source(path), path, reads, integers)
 
 
 def run(cycle: FilterCycle, rows: Sequence[Row]) -> list[CycleResult]:
@@ -127,5 +154,5 @@ def run_trace(f: Filter, path: str, algorithm: Algorithm = Algorithm.ALGEBRAIC,
               mode: Mode = Mode.SUPERVISOR) -> Run:
     """The filter's cycle on the CSV trace ``path`` (:func:`load_trace`, then :func:`run`)."""
     cycle = FilterCycle(f, Algorithm(algorithm), Mode(mode))
-    rows = load_trace(path, cycle.reads)
+    rows = load_trace(path, cycle.reads, f.integer_observers)
     return Run(cycle, path, tuple(rows), tuple(run(cycle, rows)))
