@@ -31,8 +31,7 @@ from synth.filter.language import (
     VarKind,
 )
 from synth.logic.past import pre_name
-from synth.grafcet.language_reader import _CMP_SPELLING
-from synth.logic.expr import Compare, Expr, Var
+from synth.logic.expr import CMP_SPELLINGS, Compare, Expr, Var
 from synth.syntax import ExprTransformer, Token, parse_tree
 
 __all__ = ["filter_items", "filter_expression", "Use", "Vector", "IntegerDecl"]
@@ -111,7 +110,7 @@ class _ToFilter(ExprTransformer):
         left, pre, op, (right, last) = items
         name = pre_name(str(left)) if pre is not None else str(left)
         width = last.end_pos - left.start_pos if last.end_pos is not None and left.start_pos is not None else None
-        return Compare.of(name, _CMP_SPELLING.get(str(op), str(op)), right, self._loc(left, width=width))
+        return Compare.of(name, CMP_SPELLINGS.get(str(op), str(op)), right, self._loc(left, width=width))
 
     def assume(self, items: list) -> Assumption:
         (e,) = items

@@ -15,7 +15,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Iterable, Mapping, Sequence
 
-from synth.logic.bdd import Cube, Engine, Function, _factored, _literals, interleaved_order
+from synth.logic.bdd import Cube, Engine, Function, factored, cube_literals, interleaved_order
 from synth.filter.language import Comparison, Criterion, Filter, IntegerObserver
 from synth.logic.past import base_name, is_pre, pre_name
 from synth.logic.expr import Compare, Edge, Expr, Var, names
@@ -94,7 +94,7 @@ class IntegerEngine(Engine):
                 terms = self._merged(terms, operand, order)
         if not terms:
             return "0"
-        return _factored([sorted([*lits, *_literals(rest, order)]) for rest, lits in terms], top=True)
+        return factored([sorted([*lits, *cube_literals(rest, order)]) for rest, lits in terms], top=True)
 
     def _merged(self, terms: list["_Term"], operand: str, order: Mapping[str, int]) -> list["_Term"]:
         """The terms with their literals on ``operand``'s bits written as comparisons:

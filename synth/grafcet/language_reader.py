@@ -26,7 +26,7 @@ from synth.grafcet.language import (
     Sum,
     timer_id,
 )
-from synth.logic.expr import Compare, Const, Expr, Var
+from synth.logic.expr import CMP_SPELLINGS, Compare, Const, Expr, Var
 from synth.syntax import ExprTransformer, Token, VectorKind, parse_tree
 
 __all__ = ["parse_receptivity", "VectorDecl", "InternalDecl", "StepRef", "StepDecl", "TransitionDecl", "GrafcetDecl", "grafcet_items"]
@@ -52,9 +52,6 @@ class InternalDecl:
     loc: Location
     range_loc: Location
     initial_loc: Location | None
-
-
-_CMP_SPELLING = {"!=": "<>", "≠": "<>", "≥": ">=", "≤": "<="}
 
 
 @dataclass(frozen=True)
@@ -145,7 +142,7 @@ class _ToModel(ExprTransformer):
     def compare(self, items: list) -> Compare:
         left, op, right = items
         value: int | str = str(right) if right.type == "NAME" else int(right)
-        return Compare.of(str(left), _CMP_SPELLING.get(str(op), str(op)), value, self._loc(left))
+        return Compare.of(str(left), CMP_SPELLINGS.get(str(op), str(op)), value, self._loc(left))
 
     def operand(self, items: list) -> tuple[int | str, Location]:
         (tok,) = items

@@ -57,7 +57,8 @@ def _dd_backend() -> Any:
 
 _backend = _dd_backend()
 
-__all__ = ["Engine", "Function", "Cube", "CoverTooLarge", "cube_text", "interleaved_order", "BACKEND", "CUDD"]
+__all__ = ["Engine", "Function", "Cube", "CoverTooLarge", "cube_text", "cube_literals", "factored", "interleaved_order",
+           "BACKEND", "CUDD"]
 
 BACKEND: str = _backend.__name__
 CUDD: bool = BACKEND == "dd.cudd"  # whether the fast native operations (and-abstract, node counts) exist
@@ -395,14 +396,14 @@ class Engine:
         if cubes == [{}]:
             return "1"
         order = {n: self.rank(n) for n in self.names}
-        return _factored([_literals(c, order) for c in cubes], top=True)
+        return factored([cube_literals(c, order) for c in cubes], top=True)
 
 
 # ---- printing a cover: literals with edges recognised, then greedy factoring
 _Lit = tuple[int, str]  # (sort key, text)
 
 
-def _literals(cube: Cube, order: Mapping[str, int]) -> list[_Lit]:
+def cube_literals(cube: Cube, order: Mapping[str, int]) -> list[_Lit]:
     lits: list[_Lit] = []
     done: set[str] = set()
     for n, v in cube.items():
@@ -421,7 +422,7 @@ def _literals(cube: Cube, order: Mapping[str, int]) -> list[_Lit]:
     return sorted(lits)
 
 
-def _factored(terms: Sequence[list[_Lit]], top: bool = False) -> str:
+def factored(terms: Sequence[list[_Lit]], top: bool = False) -> str:
     """Greedy algebraic factoring: take out the literal common to most terms."""
     terms = [t for t in terms]
     if any(not t for t in terms):
@@ -438,11 +439,11 @@ def _factored(terms: Sequence[list[_Lit]], top: bool = False) -> str:
     inner = [[lit for lit in t if lit != best] for t in terms if best in t]
     rest = [t for t in terms if best not in t]
     if any(not t for t in inner):  # x | x & y: cannot happen in an irredundant cover
-        factored = best[1]
+        head = best[1]
     else:
-        sub = _factored(inner)
-        factored = f"{best[1]} & {sub}" if len(inner) > 1 else best[1] + " & " + sub
+        sub = factored(inner)
+        head = f"{best[1]} & {sub}" if len(inner) > 1 else best[1] + " & " + sub
     if not rest:
-        return factored
-    out = factored + " | " + _factored(rest, top=True)
+        return head
+    out = head + " | " + factored(rest, top=True)
     return out if top else f"({out})"

@@ -35,6 +35,7 @@ __all__ = [
     "Const",
     "Compare",
     "CMP_OPS",
+    "CMP_SPELLINGS",
     "Not",
     "And",
     "Or",
@@ -79,6 +80,9 @@ CMP_OPS: dict[str, Callable[[int, int], bool]] = {
     ">=": operator.ge, "<=": operator.le, "<>": operator.ne, "=": operator.eq, "<": operator.lt, ">": operator.gt,
 }
 """The comparison operators of :class:`Compare`, by canonical spelling (IEC 61131-3's)."""
+
+CMP_SPELLINGS = {"!=": "<>", "≠": "<>", "≥": ">=", "≤": "<="}
+"""Other spellings of the comparison operators, and the canonical one each stands for."""
 
 
 @dataclass(frozen=True)
