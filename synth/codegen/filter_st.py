@@ -4,7 +4,8 @@
 (and ``Ack`` in blocking mode); ``VAR_OUTPUT``: the filtered outputs (and ``Fallback``
 for the loop, ``Blocked`` in blocking mode); ``VAR``: the previous cycle's values
 ``x_1`` of every name the filter reads as ``x^-1`` or through an edge, stored at the
-end of the body.
+end of the body, and the observers declared with their equation (``observer P := EXPR``),
+computed first, from the raw requests, as ``filter run`` and ``verify`` compute them.
 
 - *algebraic*: the chained equations of ``synth filter solve`` in their order (an output
   may use the outputs computed before it, as seed 004's eq. (30) does), from the model
@@ -162,6 +163,12 @@ def filter_block(f: Filter, algorithm: Algorithm | str = Algorithm.ALGEBRAIC, mo
     notes: list[str] = []
     body: list[str] = []
     local: list[Declaration] = []
+    defined = [d for d in f.observers if d.definition is not None]
+    if defined:
+        observed = _Writer(f, False)
+        body += [f"{d.name} := {observed.expression(d.definition)};" for d in defined if d.definition is not None]
+        w.past |= observed.past
+        local += [Declaration(d.name, comment="observer, computed from its equation") for d in defined]
     if blocking:
         raw = _Writer(f, False)
         violated = [raw.expression(_requested(s.expr, f.outputs)) for s in f.safeties]
@@ -184,7 +191,8 @@ def filter_block(f: Filter, algorithm: Algorithm | str = Algorithm.ALGEBRAIC, mo
         body += ["(* the previous cycle's values *)"] + [f"{st_past_name(pre_name(x))} := {x};" for x in stored]
     local = [Declaration(st_past_name(pre_name(x)), comment=f"{x} at the previous cycle") for x in stored] + local
     inputs = [Declaration(r, comment=f"request of {o}") for r, o in zip(f.requests, f.outputs)]
-    inputs += [Declaration(x) for x in (*f.inputs, *f.observer_names)]
+    computed = {d.name for d in defined}
+    inputs += [Declaration(x) for x in (*f.inputs, *f.observer_names) if x not in computed]
     if blocking:
         inputs.append(Declaration(ACK, comment="acknowledge: releases the latch"))
     outputs = [Declaration(o) for o in f.outputs]
