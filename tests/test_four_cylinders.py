@@ -168,3 +168,29 @@ def test_four_pallets_never_move(cli):
         "",
         "shortest trace (progress):",
         "0  initial  {b1,b2,b3,b4,i1,i2,i3,i4}  {X101, X201, X301, X401}   GOAL cannot be reached from here"]
+
+
+def test_the_grafcet_with_three_events_per_cycle(cli):
+    code, out, _ = cli("filter", "verify", FILTER, "--plant", PLANTS[1], "--grafcet", GRAFCET,
+                       "--events-per-cycle", "3")
+    assert code == 1
+    assert _lines(out)[1:3] == [
+        "explored 881 states (593 plant states), 17009 cycles",
+        "unsafe: a plant state violates a constraint once the outputs are written (32 plant states): K2"]
+    assert _trace(out, "a plant state violates a constraint once the outputs are written") == [
+        "0  initial        {b1,b2,b3,b4,i1}        {X101, X200, X300, X400}",
+        "1  -              {b1,b2,b3,b4,i1,Q1}     {X101, X200, X300, X400}  requests: Q1  orders: Q1",
+        "2  ↓b1, ↑t2, ↓i1  {b2,b3,b4,t2,Q1}        {X101, X200, X300, X400}  requests: Q1  orders: Q1",
+        "3  ↑i2            {b2,b3,b4,i2,t2,Q1,Q2}  {X101, X201, X300, X400}  requests: Q1, Q2  orders: Q1, Q2",
+        "4  ↓b2            {b3,b4,i2,t2,Q1,Q2}     {X101, X201, X300, X400}  requests: Q1, Q2  orders: Q1, Q2"]
+
+
+def test_the_doc_shows_the_three_event_trace():
+    doc = (ROOT / "docs" / "filter.md").read_text(encoding="utf-8")
+    section = doc[doc.index("## The four cylinders (seed 000 §6)"):doc.index("## Not yet")]
+    assert "\n".join([
+        "0  initial        {b1,b2,b3,b4,i1}",
+        "1  -              {b1,b2,b3,b4,i1,Q1}  requests: Q1  orders: Q1",
+        "2  ↓b1, ↑t2, ↓i1  {b2,b3,b4,t2,Q1,Q2}  requests: Q2  orders: Q1, Q2   requests violate CSs1_6",
+        "3  ↓b2            {b3,b4,t2,Q1,Q2}     requests: Q2  orders: Q1, Q2   requests violate CSs1_6"]) in section
+    assert "observer X31 := Q4^-1 & (i4 | X31^-1)" in (ROOT / "plants" / "four_cylinders.filter").read_text()
