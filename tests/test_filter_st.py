@@ -42,6 +42,10 @@ def _random_run(f, fb, cycles: int, seed: int, blocking: bool = False):
         r = {req: rnd.random() < 0.6 for req in f.requests}
         ack = rnd.random() < 0.2
         point = {**y, **r, **{pre_name(x): past.get(x, False) for x in (*f.inputs, *f.observer_names, *f.outputs)}}
+        for d in f.observers:  # `observer P := EXPR`: the block computes it, from the raw requests
+            if d.definition is not None:
+                x = e.expr(d.definition)
+                y[d.name] = point[d.name] = e.value(x, {v: point.get(v, False) for v in e.support(x)})
         if blocking:
             if ack:
                 blocked = False

@@ -153,7 +153,7 @@ def test_symbolic_refuses_and_auto_is_explicit(cli, tmp_path):
     assert (data["plant"]["states"], data["states"]) == (18, 12)  # {p1}: 5 C1 states (not (0,h)), {p1,p2}: (1,h), {p2}: 6
 
 
-FOUR = ROOT / "plants" / "four_cylinders.rules"
+FOUR = ROOT / "plants" / "four_cylinders_pallet.rules"
 
 
 def test_four_cylinders_plant_by_hand(cli):

@@ -5,7 +5,8 @@
 decoded into its bits ``cpt_b0 …`` when an equation reads them); ``VAR_OUTPUT``: the filtered outputs (and ``Fallback``
 for the loop, ``Blocked`` in blocking mode); ``VAR``: the previous cycle's values
 ``x_1`` of every name the filter reads as ``x^-1`` or through an edge, stored at the
-end of the body.
+end of the body, and the observers declared with their equation (``observer P := EXPR``),
+computed first, from the raw requests, as ``filter run`` and ``verify`` compute them.
 
 - *algebraic*: the chained equations of ``synth filter solve`` in their order (an output
   may use the outputs computed before it, as seed 004's eq. (30) does), from the model
@@ -199,6 +200,12 @@ def filter_block(f: Filter, algorithm: Algorithm | str = Algorithm.ALGEBRAIC, mo
     notes: list[str] = []
     body: list[str] = []
     local: list[Declaration] = []
+    defined = [d for d in f.observers if d.definition is not None]
+    if defined:
+        observed = _Writer(f, False)
+        body += [f"{d.name} := {observed.expression(d.definition)};" for d in defined if d.definition is not None]
+        w.past |= observed.past
+        local += [Declaration(d.name, comment="observer, computed from its equation") for d in defined]
     if blocking:
         raw = _Writer(f, False)
         violated = [raw.expression(_requested(s.expr, f.outputs)) for s in f.safeties]
@@ -225,7 +232,8 @@ def filter_block(f: Filter, algorithm: Algorithm | str = Algorithm.ALGEBRAIC, mo
         body = ["(* the integer observers' bits *)", *decode, *body]
     local = [_past(x, ints.get(x)) for x in stored] + bits + local
     inputs = [Declaration(r, comment=f"request of {o}") for r, o in zip(f.requests, f.outputs)]
-    inputs += [Declaration(x) for x in (*f.inputs, *_boolean_observers(f))]
+    computed = {d.name for d in defined}
+    inputs += [Declaration(x) for x in (*f.inputs, *_boolean_observers(f)) if x not in computed]
     inputs += [Declaration(i.name, "INT", comment=f"integer observer {i.low}..{i.high}") for i in ints.values()]
     if blocking:
         inputs.append(Declaration(ACK, comment="acknowledge: releases the latch"))
