@@ -85,8 +85,8 @@ grafcet G1 {
 
 @pytest.mark.parametrize("old, new, first", [
     ('<block localId="9" typeName="AND">', '<block localId="9" typeName="CTU">',
-     "x.xml:73:13: error: an FBD block CTU in a transition condition: only AND, OR, NOT, SEL, R_TRIG, F_TRIG and TON "
-     "have a Boolean or step-timer meaning in .g7"),
+     "x.xml:73:13: error: an FBD block CTU in a transition condition: only AND, OR, NOT, SEL, R_TRIG, F_TRIG, TON, "
+     "SR and RS have a Boolean or step-timer meaning in .g7"),
     ('<block localId="9" typeName="AND">', '<block localId="9" typeName="TON">',
      "x.xml:73:13: error: an FBD TON block without its input IN"),
     ('<reference name="LOWER" />', "<inline><ST><xhtml xmlns=\"http://www.w3.org/1999/xhtml\">Cnt := Cnt + 1;</xhtml>"
