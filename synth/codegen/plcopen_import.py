@@ -322,6 +322,10 @@ def _pou_action(a: Any, name: str, action: Any, qualifier: IecQualifier, src: So
     if st is None and qualifier == IecQualifier.N and (scope := DATA.get()) is not None and \
             name.upper() in scope.blink_actions:
         return []  # its partial grafcet (plcopen_blink) does it
+    if st is None and action.find(f"{q('body')}/{q('LD')}") is not None:
+        raise InputError(f"action {name} referenced here has an LD body that is not a blinker run by an N action "
+                         "(two TONs that set and reset one variable, each timing its other value): .g7 reads the ST "
+                         "bodies' Boolean assignments", src.at(a))
     if st is None:
         raise InputError(f"action {name} referenced here has no ST body: .g7 reads Boolean assignments only",
                          src.at(a))

@@ -28,7 +28,7 @@ from __future__ import annotations
 import re
 
 from synth.codegen.plcopen_blocks import _warn
-from synth.codegen.plcopen_data import DATA
+from synth.codegen.plcopen_data import DATA, HelperChart
 from synth.errors import InputError, Location
 
 __all__ = ["LATCH_BLOCKS", "conjunction", "latch_step", "latch_chart"]
@@ -86,7 +86,7 @@ def latch_chart(kind: str, instance: str, set_in: str, reset_in: str, sources: l
         set_c, reset_c = conjunction(f"X{step}", s, f"!({r})"), conjunction(f"X{step}", r)
         rule = "reset dominant: Q1 := NOT R1 AND (S OR Q1)"
     name = f"{instance}_{kind}"
-    chart = (name, [(off, True, []), (on, False, [])], [([off], [on], set_c), ([on], [off], reset_c)])
+    chart: HelperChart = (name, [(off, True, []), (on, False, [])], [([off], [on], set_c), ([on], [off], reset_c)])
     if any(c[0] == name and c != chart for c in scope.extra_charts):
         raise InputError(f"{kind} {instance} is read in the conditions of transitions leaving different steps: .g7 "
                          "reads one latch per step", where)
