@@ -85,8 +85,8 @@ grafcet G1 {
 
 @pytest.mark.parametrize("old, new, first", [
     ('<block localId="9" typeName="AND">', '<block localId="9" typeName="CTU">',
-     "x.xml:73:13: error: an FBD block CTU in a transition condition: only AND, OR, NOT, SEL, R_TRIG, F_TRIG and TON "
-     "have a Boolean or step-timer meaning in .g7"),
+     "x.xml:73:13: error: an FBD block CTU in a transition condition: only AND, OR, NOT, SEL, R_TRIG, F_TRIG, TON, "
+     "SR and RS have a Boolean or step-timer meaning in .g7"),
     ('<block localId="9" typeName="AND">', '<block localId="9" typeName="TON">',
      "x.xml:73:13: error: an FBD TON block without its input IN"),
     ('<reference name="LOWER" />', "<inline><ST><xhtml xmlns=\"http://www.w3.org/1999/xhtml\">Cnt := Cnt + 1;</xhtml>"
@@ -544,3 +544,109 @@ def test_a_ton_in_if_then_and_one_alias_timing_two_steps():
         "Check is and xPart holds in the transitions leaving step Check (a TON keeps Q until it is called with IN FALSE; "
         "a .g7 timer restarts at each activation of its step; the PLC calls it only while the IF condition holds, so it "
         "does not restart when the condition falls)"]
+
+
+def test_an_sr_latch_an_ld_blinker_and_d_flags_are_helper_grafcets_and_step_timers():
+    """Beremiz traffic-light shape: SR(S1:=btn, R:=HOLD.Q) feeding TON HOLD(IN:=SR.Q1) in an FBD
+    transition (a loop through the latch), an LD action that blinks LAMP with two TONs and two
+    R_TRIGs, a local Boolean that is only a D action, and a P action LAMP := 1."""
+    warnings: list[InputError] = []
+    text = import_sfc((DATA / "beremiz_latch_blink.xml").read_bytes(), "l.xml", warnings=warnings)
+    assert text.split("\n", 1)[1] == """inputs go, btn
+outputs LAMP
+
+grafcet G1 {
+  initial step Idle: set LAMP on activation
+  step Run: reset LAMP
+  transition Idle -> Run when go
+  transition Run -> Idle when (2s/XHOLD_on) | (5s/XRun)
+}
+grafcet HOLD_TON {
+  initial step HOLD_off
+  step HOLD_on
+  transition HOLD_off -> HOLD_on when XRun & XASKED_on
+  transition HOLD_on -> HOLD_off when !(XRun & XASKED_on)
+}
+grafcet BLINK {
+  initial step BLINK_off
+  step BLINK_on: set LAMP on activation, reset LAMP on deactivation
+  transition BLINK_off -> BLINK_on when XIdle & 700ms/XBLINK_off
+  transition BLINK_on -> BLINK_off when XIdle & 300ms/XBLINK_on
+}
+grafcet ASKED_SR {
+  initial step ASKED_off
+  step ASKED_on
+  transition ASKED_off -> ASKED_on when XRun & btn
+  transition ASKED_on -> ASKED_off when XRun & 2s/XHOLD_on & !btn
+}
+"""
+    assert [w.render().splitlines()[0] for w in warnings] == [
+        "l.xml:184:15: warning: DONE, a local Boolean that is only the action D T#5s of step Run, is read as the step "
+        "timer 5s/XRun: IEC 61131-3 makes it TRUE from 5s after the step's activation until its deactivation, as the "
+        "timer",
+        "l.xml:47:17: warning: the LD action BLINK (run while XIdle holds) blinks LAMP: T_OFF (IN:=NOT LAMP, "
+        "PT:=T#700ms) sets it, T_ON (IN:=LAMP, PT:=T#300ms) resets it; read as the partial grafcet BLINK, whose steps "
+        "BLINK_off and BLINK_on (LAMP set on its activation, reset on its deactivation) alternate after 700ms and "
+        "300ms while XIdle holds (the PLC's phase is LAMP itself, which other steps may set or reset; the grafcet's "
+        "phase is its step, and its timers run while the action is not called, as a TON called again with IN still "
+        "TRUE counts from when IN rose)",
+        "l.xml:198:13: warning: the TON HOLD wired with IN:=XASKED_on to the condition of a transition leaving step "
+        "Run: HOLD.Q is read as 2s/XHOLD_on, the timer of step HOLD_on of the partial grafcet HOLD_TON, active while "
+        "step Run is and XASKED_on holds (a TON keeps Q until it is called with IN FALSE; a .g7 timer restarts at "
+        "each activation of its step)",
+        "l.xml:229:13: warning: the SR ASKED wired to the condition of a transition leaving step Run: ASKED.Q1 is read "
+        "as XASKED_on, the activity of step ASKED_on of the partial grafcet ASKED_SR, set when XRun & btn and reset "
+        "when XRun & 2s/XHOLD_on & !btn (set dominant: Q1 := S1 OR (NOT R AND Q1)); the PLC calls ASKED only while "
+        "the transition is evaluated and reads the outputs of the blocks it calls after the latch from the previous "
+        "scan, .g7 sets and resets the latch in the evolution where its conditions hold (one scan earlier)"]
+    ass = _ass(parse_grafcet(text, "l.g7"))
+    assert len(ass["states"]) == 14
+    assert ass["states"][0]["situation"] == ["ASKED_off", "BLINK_off", "HOLD_off", "Idle"]
+    assert ass["states"][0]["stored"] == ["LAMP"]
+    assert [(t["event"], t["condition"]) for t in ass["transitions"] if t["source"] == 0] == [
+        ("↑go", "!btn"), ("↑go", "btn"), ("700ms/XBLINK_off", "any")]
+    held = [s["situation"] for s in ass["states"] if "HOLD_on" in s["situation"]]
+    assert held and all("Run" in s and "ASKED_on" in s for s in held)  # the TON runs while Run and the latch hold
+
+
+def test_an_rs_latch_is_reset_dominant():
+    xml = (DATA / "beremiz_latch_blink.xml").read_text()
+    rs = xml.replace('typeName="SR"', 'typeName="RS"').replace('formalParameter="S1"', 'formalParameter="S"') \
+        .replace('<variable formalParameter="R">', '<variable formalParameter="R1">')
+    warnings: list[InputError] = []
+    text = import_sfc(rs.encode(), "l.xml", warnings=warnings)
+    assert text.endswith("""grafcet ASKED_RS {
+  initial step ASKED_off
+  step ASKED_on
+  transition ASKED_off -> ASKED_on when XRun & btn & !2s/XHOLD_on
+  transition ASKED_on -> ASKED_off when XRun & 2s/XHOLD_on
+}
+""")
+    assert "(reset dominant: Q1 := NOT R1 AND (S OR Q1))" in warnings[-1].message
+    parse_grafcet(text, "l.g7")
+
+
+@pytest.mark.parametrize("old, new, first", [
+    ('<variable formalParameter="R">', '<variable formalParameter="X">',
+     "l.xml:229:13: error: an FBD SR block without its input R"),
+    ('<variable>LAMP</variable>\n                </coil>\n                <rightPowerRail localId="14"',
+     '<variable>GO</variable>\n                </coil>\n                <rightPowerRail localId="14"',
+     "l.xml:166:15: error: action BLINK referenced here has an LD body that is not a blinker run by an N action (two "
+     "TONs that set and reset one variable, each timing its other value): .g7 reads the ST bodies' Boolean "
+     "assignments"),
+    ('<expression>T#300ms</expression>', '<expression>Delay</expression>',
+     "l.xml:166:15: error: action BLINK referenced here has an LD body that is not a blinker run by an N action (two "
+     "TONs that set and reset one variable, each timing its other value): .g7 reads the ST bodies' Boolean "
+     "assignments"),
+    ('<action localId="0"><relPosition x="0" y="0"/><reference name="BLINK"/>',
+     '<action localId="0" qualifier="S"><relPosition x="0" y="0"/><reference name="BLINK"/>',
+     "l.xml:166:15: error: action BLINK referenced here has an LD body that is not a blinker run by an N action (two "
+     "TONs that set and reset one variable, each timing its other value): .g7 reads the ST bodies' Boolean "
+     "assignments"),
+])
+def test_what_is_not_a_latch_or_a_blinker_is_located(old, new, first):
+    xml = (DATA / "beremiz_latch_blink.xml").read_text()
+    assert xml.count(old) == 1
+    with pytest.raises(InputError) as info:
+        import_sfc(xml.replace(old, new).encode(), "l.xml")
+    assert info.value.render().splitlines()[0] == first

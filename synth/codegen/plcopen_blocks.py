@@ -23,8 +23,7 @@ import re
 from typing import Any, Callable
 
 from synth.codegen.plcopen_actions import rising
-from synth.codegen.plcopen_data import DATA
-from synth.codegen.plcopen_timers import duration
+from synth.codegen.plcopen_data import DATA, duration
 from synth.errors import InputError, Location, Severity
 
 __all__ = ["FBD_FUNCTION_BLOCKS", "sel", "trigger", "ton_output"]
@@ -122,7 +121,8 @@ def ton_output(instance: str, c: str, pt_text: str, sources: list[str], where: L
         on = f"{scope.prefix}{instance}_on"
         timer = f"{pt}/X{on}"
         both = f"X{step} & " + (c if re.fullmatch(r"[!\w]+", c) else f"({c})")
-        scope.helper_charts.append((f"{instance}_TON", f"{scope.prefix}{instance}_off", on, both))
+        if (chart := (f"{instance}_TON", f"{scope.prefix}{instance}_off", on, both)) not in scope.helper_charts:
+            scope.helper_charts.append(chart)  # read twice: an SR latch's loop
         what = (f"{timer}, the timer of step {on} of the partial grafcet {instance}_TON, active while step {step} is "
                 f"and {c} holds")
     _warn(f"the TON {instance} wired with IN:={given} to the condition of a transition leaving step {step}: {instance}.Q "

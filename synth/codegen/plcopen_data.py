@@ -26,7 +26,11 @@ from typing import Any, Callable
 from synth.errors import InputError, Location, Severity
 
 __all__ = ["duration", "IEC_RANGES", "DataVar", "DataScope", "DATA", "data_scope", "assigned_names", "strip_comments",
-           "sum_text"]
+           "sum_text", "HelperChart"]
+
+HelperChart = tuple[str, list[tuple[str, bool, list[str]]], list[tuple[list[str], list[str], str]]]
+"""A partial grafcet the import adds: (name, steps (name, initial, actions), transitions
+(sources, targets, receptivity))."""
 
 IEC_RANGES: dict[str, tuple[int, int]] = {
     "BOOL": (0, 1), "SINT": (-128, 127), "USINT": (0, 255), "INT": (-32768, 32767), "UINT": (0, 65535),
@@ -93,6 +97,8 @@ class DataScope:
     one_scan: dict[str, str] = field(default_factory=dict)  # step left at once -> its receptivities
     current_step: str = ""  # the step whose actions are being read
     action_refs: list[str] = field(default_factory=list)  # names an action block references (outputs)
+    extra_charts: list[HelperChart] = field(default_factory=list)  # SR/RS latches, LD blinkers
+    blink_actions: set[str] = field(default_factory=set)  # upper-case LD actions read as a blinker
 
     def every_scan(self, statement: str, action: str, where: Location) -> None:
         """``statement`` (data read) runs at every PLC scan while its step is active: an error,

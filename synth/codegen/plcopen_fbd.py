@@ -17,6 +17,7 @@ from __future__ import annotations
 from typing import Any, Callable
 
 from synth.codegen.plcopen_blocks import FBD_FUNCTION_BLOCKS, sel, ton_output, trigger
+from synth.codegen.plcopen_latch import LATCH_BLOCKS, latch_chart, latch_step
 from synth.codegen.st_condition import ExprReader
 from synth.errors import InputError
 
@@ -37,6 +38,8 @@ def fbd_condition(cond: Any, elements: dict[int, Any], q: Callable[[str], str], 
     """The receptivity of ``<condition><connectionPointIn>`` wired to an FBD network."""
     from lxml import etree
 
+    latches: dict[int, str] = {}  # an SR/RS block being read -> its output (its state: no loop)
+
     def one_source(cp: Any, owner: Any) -> str:
         conns = cp.findall(q("connection"))
         if len(conns) != 1:
@@ -49,6 +52,8 @@ def fbd_condition(cond: Any, elements: dict[int, Any], q: Callable[[str], str], 
     def node(lid: int, seen: frozenset[int]) -> str:
         el = elements[lid]
         kind = etree.QName(el).localname
+        if lid in latches:
+            return latches[lid]
         if lid in seen:
             raise InputError("an FBD condition that loops back on itself", src.at(el))
         if kind == "inVariable":
@@ -61,10 +66,16 @@ def fbd_condition(cond: Any, elements: dict[int, Any], q: Callable[[str], str], 
             return f"!({expr})" if _negated(el) else expr
         if kind == "block":
             name = (el.get("typeName") or "").upper()
-            if name not in _BLOCKS and name not in FBD_FUNCTION_BLOCKS:
+            if name not in _BLOCKS and name not in FBD_FUNCTION_BLOCKS and name not in LATCH_BLOCKS:
                 raise InputError(f"an FBD block {el.get('typeName')} in a transition condition: only AND, OR, NOT, "
-                                 "SEL, R_TRIG, F_TRIG and TON have a Boolean or step-timer meaning in .g7",
-                                 src.at(el), expected=(*_BLOCKS, *FBD_FUNCTION_BLOCKS))
+                                 "SEL, R_TRIG, F_TRIG, TON, SR and RS have a Boolean or step-timer meaning in .g7",
+                                 src.at(el), expected=(*_BLOCKS, *FBD_FUNCTION_BLOCKS, *LATCH_BLOCKS))
+            outs = el.find(f"{q('outputVariables')}/{q('variable')}")
+            inner = seen | {lid}
+            if name in LATCH_BLOCKS:  # its inputs may read its output back
+                latches[lid] = latch_step(str(el.get("instanceName") or name))
+                latches[lid] = f"!({latches[lid]})" if _negated(outs) else latches[lid]
+                inner = frozenset({lid})
             args: list[str] = []
             params: dict[str, tuple[str, Any]] = {}
             for var in el.iterfind(f"{q('inputVariables')}/{q('variable')}"):
@@ -81,11 +92,12 @@ def fbd_condition(cond: Any, elements: dict[int, Any], q: Callable[[str], str], 
                     ex = elements[ref].find(q("expression"))
                     params["PT"] = ((ex.text or "") if ex is not None else "", elements[ref])
                     continue
-                arg = node(ref, seen | {lid})
+                arg = node(ref, inner)
                 args.append(f"!({arg})" if _negated(var) else f"({arg})")
                 params[str(var.get("formalParameter", "")).upper()] = (args[-1], var)
             out = _function_block(name, el, args, params)
-            outs = el.find(f"{q('outputVariables')}/{q('variable')}")
+            if name in LATCH_BLOCKS:
+                return latches[lid]
             return f"!({out})" if _negated(outs) else out
         if kind == "leftPowerRail":
             return "1"
@@ -124,13 +136,17 @@ def fbd_condition(cond: Any, elements: dict[int, Any], q: Callable[[str], str], 
             if not args or (name == "NOT" and len(args) != 1):
                 raise InputError(f"an FBD {name} block with {len(args)} inputs", src.at(el))
             return f"!{args[0]}" if name == "NOT" else _BLOCKS[name].join(args)
-        wanted = {"SEL": ("G", "IN0", "IN1"), "R_TRIG": ("CLK",), "F_TRIG": ("CLK",), "TON": ("IN", "PT")}[name]
+        wanted = {"SEL": ("G", "IN0", "IN1"), "R_TRIG": ("CLK",), "F_TRIG": ("CLK",), "TON": ("IN", "PT"),
+                  **LATCH_BLOCKS}[name]
         missing = [p for p in wanted if p not in params]
         if missing:
             raise InputError(f"an FBD {name} block without its input {missing[0]}", src.at(el))
         instance = str(el.get("instanceName") or name)
         if name == "SEL":
             return sel(*(params[p][0] for p in wanted))
+        if name in LATCH_BLOCKS:
+            latch_chart(name, instance, params[wanted[0]][0], params[wanted[1]][0], list(sources), src.at(el))
+            return ""
         if name == "TON":
             return ton_output(instance, params["IN"][0], params["PT"][0], list(sources), src.at(el), elements,
                               steps, src.at(params["PT"][1]))

@@ -302,6 +302,8 @@ def _read_action(a: Any, src: Source, steps: dict[str, str], q: Any, pou_actions
     if named is not None:
         raise InputError(f"step action {name} is not an action of this POU", src.at(a),
                          expected=tuple(pou_actions) or ("(the POU has no actions)",))
+    if qualifier == IecQualifier.D and (scope := DATA.get()) is not None and str(name).upper() in scope.timers:
+        return []  # a local Boolean read as its step timer (plcopen_delayed)
     if qualifier in (IecQualifier.D, IecQualifier.L):
         m = re.fullmatch(r"\s*T#(\d+(?:\.\d+)?)(ms|s|m|h)\s*", a.get("duration", ""), re.I)
         if name is None or m is None:
@@ -317,6 +319,13 @@ def _pou_action(a: Any, name: str, action: Any, qualifier: IecQualifier, src: So
     """A reference to a POU action: its ST body's Boolean assignments
     (:func:`~synth.codegen.plcopen_actions.action_body`)."""
     st = action.find(f"{q('body')}/{q('ST')}")
+    if st is None and qualifier == IecQualifier.N and (scope := DATA.get()) is not None and \
+            name.upper() in scope.blink_actions:
+        return []  # its partial grafcet (plcopen_blink) does it
+    if st is None and action.find(f"{q('body')}/{q('LD')}") is not None:
+        raise InputError(f"action {name} referenced here has an LD body that is not a blinker run by an N action "
+                         "(two TONs that set and reset one variable, each timing its other value): .g7 reads the ST "
+                         "bodies' Boolean assignments", src.at(a))
     if st is None:
         raise InputError(f"action {name} referenced here has no ST body: .g7 reads Boolean assignments only",
                          src.at(a))
@@ -346,7 +355,7 @@ def _one_action(a: Any, src: Source, steps: dict[str, str], q: Any, qualifier: s
     st = inline.find(q("ST"))
     body = st_text(st).strip()
     where = lambda off, w, h=st, t=st_text(st): src.text_at(h, t, off, w)  # noqa: E731
-    m = re.fullmatch(r"(\w+)\s*:=\s*(TRUE|FALSE)\s*;?", body, re.I)
+    m = re.fullmatch(r"(\w+)\s*:=\s*(TRUE|FALSE|1|0)\s*;?", body, re.I)  # 1, 0: BOOL literals
     scope = DATA.get()
     data = re.fullmatch(r"(\w+)\s*:=\s*([^;]*?)\s*;?", body, re.S)
     target = scope.find(data[1]) if scope is not None and data is not None else None
@@ -360,7 +369,7 @@ def _one_action(a: Any, src: Source, steps: dict[str, str], q: Any, qualifier: s
         if not m:
             raise InputError(f"a {qualifier} action body must be 'NAME := TRUE;' or 'NAME := FALSE;' (or assign an "
                              "integer local variable)", where(0, 1))
-        verb = "set" if m[2].upper() == "TRUE" else "reset"
+        verb = "set" if m[2].upper() in ("TRUE", "1") else "reset"
         return f"{verb} {m[1]} on {'deactivation' if qualifier == Qualifier.P0 else 'activation'}"
     if qualifier == Qualifier.N:
         ev = re.fullmatch(r"IF\s+(.*?)\s+THEN\s+(\w+)\s*:=\s*(.*?)\s*;\s*END_IF\s*;?", body, re.I | re.S)

@@ -353,7 +353,7 @@ def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
     helpers: list[_ImportedStep] = []
     scope = DATA.get()
     for gname, hsteps, htrans in ton_chart(scope, by_sfc_name, src.text_at) if scope is not None else []:
-        helpers += [_ImportedStep(n, initial, [], gname, pou) for n, initial in hsteps]
+        helpers += [_ImportedStep(n, initial, list(acts), gname, pou) for n, initial, acts in hsteps]
         transitions += [("", a, b, expr, pou) for a, b, expr in htrans]
     _declare_predicates(inputs, warnings)
     _check_names(pou, q, src, transitions, {st.name for st in [*steps.values(), *helpers]}, inputs, outputs, warnings)

@@ -21,7 +21,9 @@ from __future__ import annotations
 import re
 from typing import Any, Callable
 
-from synth.codegen.plcopen_data import DataScope, data_scope, duration, strip_comments
+from synth.codegen.plcopen_blink import blink_charts
+from synth.codegen.plcopen_delayed import delayed_flags
+from synth.codegen.plcopen_data import DataScope, HelperChart, data_scope, duration, strip_comments
 from synth.codegen.plcopen_vendor import IecQualifier, StepAction, step_actions
 from synth.codegen.st_condition import st_text
 from synth.errors import InputError, Location, Severity
@@ -146,27 +148,29 @@ def prepare_scope(pou: Any, sfc: Any, q: Callable[[str], str], at: Callable[[Any
                 f"{what} (a TON keeps Q until it is called with IN FALSE; a .g7 timer restarts at each activation of "
                 "its step" + ("; the PLC calls it only while the IF condition holds, so it does not restart when the "
                               "condition falls" if guarded else "") + ")", where, severity=Severity.WARNING))
+    delayed_flags(pou, sfc, q, at, prefix, scope)
     full = data_scope(pou, q, at, list(bodies.values()) + [st_text(st) for st in inline],
                       set(scope.timers) | set(scope.step_timers))
     full.timers, full.timer_blocks, full.ton_charts = scope.timers, scope.timer_blocks, scope.ton_charts
     full.step_timers = scope.step_timers
     full.prefix = prefix
     full.warnings = scope.warnings + full.warnings
+    blink_charts(pou, sfc, q, at, prefix, full)
     return full
 
 
 def ton_chart(scope: DataScope, steps: dict[str, str], at: Callable[[Any, str, int, int], Location]
-              ) -> list[tuple[str, list[tuple[str, bool]], list[tuple[list[str], list[str], str]]]]:
-    """The partial grafcets of the TONs called with ``IN:=c`` (not TRUE): (name, steps
-    (name, initial), transitions (sources, targets, receptivity))."""
+              ) -> list[HelperChart]:
+    """The partial grafcets the import adds: those of the TONs called with ``IN:=c`` (not
+    TRUE), then the latches and blinkers of ``scope.extra_charts``."""
     from synth.codegen.st_condition import ExprReader
 
-    out = []
+    out: list[HelperChart] = []
     for name, off, on, step, cond, st, text in scope.ton_charts:
         start = text.upper().find("IN")
         c = ExprReader(cond, lambda o, w, h=st, t=text, s=start: at(h, t, s + o, w), steps, "a TON's IN").whole()
         both = f"X{step} & " + (c if re.fullmatch(r"[!\w]+", c) else f"({c})")
-        out.append((name, [(off, True), (on, False)], [([off], [on], both), ([on], [off], f"!({both})")]))
+        out.append((name, [(off, True, []), (on, False, [])], [([off], [on], both), ([on], [off], f"!({both})")]))
     for name, off, on, both in scope.helper_charts:
-        out.append((name, [(off, True), (on, False)], [([off], [on], both), ([on], [off], f"!({both})")]))
-    return out
+        out.append((name, [(off, True, []), (on, False, [])], [([off], [on], both), ([on], [off], f"!({both})")]))
+    return out + scope.extra_charts
