@@ -110,6 +110,9 @@ def test_lib_lists_models_with_orders_and_sensors(capsys):
     assert [(m["model"], m["use"], m["orders"], m["sensors"]) for m in data] == [
         ("conveyor", "lib/conveyor.rules", ["TAPIS"], ["small", "large"]),
         ("double_acting", "lib/double_acting.rules", ["AVANCER", "RECULER"], ["v0", "v1"]),
+        ("pusher", "lib/four_cylinders.rules", ["Q"], ["b", "h"]),  # seed 000's square: a pusher and its cells
+        ("cell", "lib/four_cylinders.rules", [], ["i", "t"]),
+        ("full_cell", "lib/four_cylinders.rules", [], ["i", "t"]),
         ("single_acting", "lib/single_acting.rules", ["AVANCER"], ["v0", "v1"]),
     ]
     assert data[1]["initial"] == {"AVANCER": 0, "RECULER": 0, "v0": 1, "v1": 0}
