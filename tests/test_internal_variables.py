@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from synth.errors import InputErrors, SynthError
+from synth.errors import InputError, InputErrors, SynthError
 from synth.grafcet.ass import stable_situation_automaton
 from synth.grafcet.language_check import parse_grafcet
 from synth.grafcet.machine import GrafcetMachine
@@ -193,3 +193,37 @@ def test_random_counting_cases_are_not_trivial(tmp_path):
         _write_case(seed, tmp_path)
         kinds.append(_outcome(validate, tmp_path, ("X0",) if seed % 2 else ())[0].split(":")[0])
     assert kinds.count("PASS") >= 1 and kinds.count("FAIL") >= 5 and kinds.count("out of range") >= 2, kinds
+
+
+def test_a_boolean_takes_an_expression_of_boolean_internal_variables(cli, tmp_path):
+    text = ("internal p : bool\ninternal q : bool = 1\ngrafcet G { initial step 0\n"
+            " step 1: p := (q & !p | !q & p), q := (!q)\n transition 0 -> 1 when ↑a\n transition 1 -> 0 when ↓a }\n")
+    (tmp_path / "b.g7").write_text(text)
+    code, out, _ = cli("run", tmp_path / "b.g7", "--events", "↑a,↓a,↑a,↓a,↑a")
+    assert code == 0 and [line.split()[3:5] for line in out.splitlines()] == [
+        ["p=0", "q=1"], ["p=1", "q=0"], ["p=1", "q=0"], ["p=1", "q=1"], ["p=1", "q=1"], ["p=0", "q=0"]]
+    assert "IF _Enter[2] THEN _Next_p := q AND NOT p OR NOT q AND p; END_IF;" in cli("st", tmp_path / "b.g7")[1]
+    pytest.importorskip("blark")
+    assert cli("st", "--check", "--depth", "6", tmp_path / "b.g7")[0] == 0
+    assert errors("internal k : 0..3\ninternal b : bool\ngrafcet G { initial step 0: k := (b), b := (↑x & b) }") == [
+        "g.g7:3:29: error: 'k' is an integer: assign a sum such as k + 1, not a Boolean expression | ",
+        "g.g7:3:39: error: unknown internal variable 'x' in the assignment to b | ",
+        "g.g7:3:46: error: an edge in the assignment to b: ↑x | ",
+    ]
+
+
+def test_import_reads_a_boolean_expression_and_refuses_a_sequential_read():
+    from synth.codegen.plcopen_import import import_sfc
+
+    xml = (ROOT / "tests/data/plcopen/beremiz_counter.xml").read_text()
+    xml = xml.replace('<variable name="Cnt"><type><INT/></type></variable>',
+                      '<variable name="A"><type><BOOL/></type></variable><variable name="B"><type><BOOL/></type></variable>')
+    body = xml.replace("Cnt := Cnt + 1;", "A := B XOR A; B := NOT B;").replace("Cnt := 0;", "A := FALSE;")
+    body = body.replace("NOT go AND 3 <= Cnt", "NOT go AND A").replace("NOT go AND Cnt < 3", "NOT go AND NOT A")
+    text = import_sfc(body.encode(), "x.xml")
+    assert "  step Count: A := (B & !A | !B & A), B := (!B)\n" in text
+    with pytest.raises(InputError) as info:
+        import_sfc(body.replace("A := B XOR A; B := NOT B;", "B := NOT B; A := B XOR A;").encode(), "x.xml")
+    assert info.value.render().splitlines()[0] == (
+        "x.xml:66:51: error: A := … in action P1 (inline) reads B, assigned before it in the same body: the PLC runs "
+        "the statements in sequence, .g7 the assignments of a phase at once (each reads the values before the phase)")

@@ -121,6 +121,7 @@ def action_body(name: str, text: str, qualifier: IecQualifier, where: Callable[[
         elif (m := _DATA.match(clean, pos)) and (found := _data(m, 0, where)) is not None:
             if found[1] and qualifier == IecQualifier.N and (scope := DATA.get()) is not None:
                 scope.every_scan(statement, f"action {name}", where(pos, len(m[1])))
+            _in_sequence(found[0], [o.split(" := ")[0] for o in out if " := " in o], name, where(pos, len(m[1])))
             out.append(found[0] + when)
         elif (m := _IF.match(clean, pos)) and qualifier == IecQualifier.N:
             out += _level_if(name, m, where, steps)
@@ -188,3 +189,15 @@ def _level_if(name: str, m: re.Match[str], where: Callable[[int, int], Location]
             f"action on the rising edge {edge}: if the condition already holds when the step becomes active, the PLC "
             "assigns at once and .g7 waits for the edge", where(m.start(), 2), severity=Severity.WARNING))
     return [f"{a} on {edge}" for a in actions]
+
+
+def _in_sequence(assignment: str, before: list[str], name: str, at: Location) -> None:
+    """A PLC runs a body's statements in sequence, ``.g7`` the assignments of one phase at once:
+    they differ when a right side reads a variable an earlier statement of the body assigned."""
+    target, value = assignment.split(" := ", 1)
+    read = [b for b in before if re.search(rf"\b{re.escape(b)}\b", value)]
+    if read:
+        raise InputError(f"{assignment.split(' := ')[0]} := … in action {name} reads {', '.join(read)}, assigned before "
+                         "it in the same body: the PLC runs the statements in sequence, .g7 the assignments of a phase "
+                         "at once (each reads the values before the phase)", at,
+                         notes=(f"write the assignment to {target} first, or use the value it computes",))

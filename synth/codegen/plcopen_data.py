@@ -259,10 +259,9 @@ def sum_text(scope: DataScope, target: DataVar, rhs: str, where: Callable[[int, 
         if text.upper() in ("TRUE", "FALSE"):
             return "1" if text.upper() == "TRUE" else "0"
         other = scope.find(text) if re.fullmatch(r"\w+", text) else None
-        if other is None or not other.boolean:
-            raise InputError(f"{target.name} is a Boolean internal variable: assign TRUE, FALSE or another Boolean "
-                             f"internal variable, not '{text}'", where(lead, max(1, len(text))))
-        return other.name
+        if other is not None and other.boolean:
+            return other.name
+        return _boolean_rhs(scope, target, text, lambda off, w: where(lead + off, w))
     out = ""
     pos = 0
     for i, m in enumerate(re.finditer(r"\s*([-+]?)\s*(\w+#)?(\w+)\s*", text)):
@@ -290,3 +289,18 @@ def sum_text(scope: DataScope, target: DataVar, rhs: str, where: Callable[[int, 
         raise InputError(f"the assignment to {target.name} is not a sum of integers and internal variables "
                          f"('{text}'): .g7 assigns sums such as {target.name} + 1", where(lead + pos, 1))
     return out
+
+
+def _boolean_rhs(scope: DataScope, target: DataVar, text: str, where: Callable[[int, int], Location]) -> str:
+    """A Boolean expression of Boolean internal variables (``QX2 XOR QX1``) as the ``.g7`` right
+    side ``(…)``; anything else it reads is a located error."""
+    from synth.codegen.st_condition import ExprReader
+
+    g7 = ExprReader(text, where, {}, f"the assignment to {target.name}").whole()
+    for name in dict.fromkeys(re.findall(r"[A-Za-z_]\w*", g7)):
+        v = scope.find(name)
+        if v is None or not v.boolean:
+            at = text.upper().find(name.upper())
+            raise InputError(f"{target.name} is a Boolean internal variable: its right side reads Boolean internal "
+                             f"variables only, not '{name}'", where(max(0, at), max(1, len(name))))
+    return g7 if g7.startswith("(") and g7.endswith(")") else f"({g7})"

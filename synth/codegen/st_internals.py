@@ -25,9 +25,9 @@ from __future__ import annotations
 
 from typing import Callable
 
-from synth.codegen.st import Declaration
+from synth.codegen.st import Declaration, st_expr
 from synth.grafcet.language import ASSIGN, Action, Grafcet, Internal, Sum, step_key
-from synth.logic.expr import Compare
+from synth.logic.expr import Compare, Var
 
 __all__ = ["declarations", "compare_text", "assignment_phase", "assigned", "sum_text"]
 
@@ -63,6 +63,8 @@ def compare_text(c: Compare, st: Callable[[str], str]) -> str:
 
 def sum_text(v: Internal, e: Sum, st: Callable[[str], str]) -> str:
     """The right side of an assignment to ``v`` in ST."""
+    if e.expr is not None:
+        return st_expr(e.expr, lambda x: st(x.name) if isinstance(x, Var) else x.text())
     if v.boolean and len(e.terms) == 1 and isinstance(e.terms[0][1], int):
         return _literal(v, e.terms[0][1])
     return Sum(tuple((sign, st(x) if isinstance(x, str) else x) for sign, x in e.terms)).text()

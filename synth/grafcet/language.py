@@ -30,7 +30,7 @@ from enum import StrEnum
 from typing import Collection, Iterator, Mapping, Sequence
 
 from synth.errors import Location
-from synth.logic.expr import Expr, Var, names
+from synth.logic.expr import Expr, Var, evaluate, names
 
 __all__ = [
     "STEP_PREFIX",
@@ -174,8 +174,11 @@ class Sum:
 
     terms: tuple[tuple[int, int | str], ...]
     loc: Location | None = field(default=None, compare=False)
+    expr: Expr | None = None  # a Boolean's right side written as an expression: ``(a & !b)``
 
     def text(self) -> str:
+        if self.expr is not None:
+            return f"({self.expr.text()})"
         out = ""
         for i, (sign, x) in enumerate(self.terms):
             if i:
@@ -186,9 +189,13 @@ class Sum:
         return out
 
     def names(self) -> tuple[str, ...]:
+        if self.expr is not None:
+            return tuple(dict.fromkeys(n.name for n in names(self.expr)))
         return tuple(x for _, x in self.terms if isinstance(x, str))
 
     def value(self, values: Mapping[str, int]) -> int:
+        if self.expr is not None:
+            return int(bool(evaluate(self.expr, lambda n: values[n] != 0)))
         return sum(sign * (values[x] if isinstance(x, str) else x) for sign, x in self.terms)
 
 

@@ -334,6 +334,10 @@ class GrafcetChecker(Checker):
                       a.loc, notes=(f"write {a.order} := … on activation (or on deactivation, on ↑x)",))
             return a
         assert a.assign is not None
+        if a.assign.expr is not None and not v.boolean:
+            self.fail(f"'{a.order}' is an integer: assign a sum such as {a.order} + 1, not a Boolean expression",
+                      a.assign.loc)
+            return a
         for x in a.assign.names():
             w = self.internals.get(x)
             if w is None:
@@ -343,6 +347,12 @@ class GrafcetChecker(Checker):
             elif w.boolean != v.boolean:
                 self.fail(f"'{x}' is {'a Boolean' if w.boolean else 'an integer'} and '{a.order}' "
                           f"{'a Boolean' if v.boolean else 'an integer'}", a.assign.loc)
+        if a.assign.expr is not None:
+            for n in names(a.assign.expr):
+                if isinstance(n, Edge):
+                    self.fail(f"an edge in the assignment to {a.order}: {n.text()}", n.loc,
+                              notes=("an assignment reads levels; put the event after on: ... on ↑x",))
+            return a
         terms = a.assign.terms
         if v.boolean and not (len(terms) == 1 and terms[0][0] > 0 and terms[0][1] in (0, 1) or isinstance(terms[0][1], str)):
             self.fail(f"'{a.order}' is a Boolean: assign 0, 1 or another Boolean internal variable", a.assign.loc)

@@ -157,6 +157,11 @@ class _ToModel(ExprTransformer):
             terms[0] = (-1, -terms[0][1])
         return Sum(tuple(terms), first[1])
 
+    def assign_bool_action(self, items: list) -> Action:
+        tok, expr, when = items
+        moment, cond = when if when is not None else (ON_ACTIVATION, None)
+        return Action(ASSIGN, str(tok), cond, True, moment, self._loc(tok), Sum((), self._loc(tok), expr))
+
     def assign_action(self, items: list) -> Action:
         tok, value, when = items
         moment, cond = when if when is not None else (ON_ACTIVATION, None)
