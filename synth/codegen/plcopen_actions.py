@@ -22,7 +22,8 @@ import contextvars
 import re
 from typing import Any, Callable
 
-from synth.codegen.plcopen_data import DATA, sum_text
+from synth.codegen.plcopen_assign import sum_text
+from synth.codegen.plcopen_data import DATA
 from synth.codegen.plcopen_vendor import IecQualifier
 from synth.codegen.st_condition import ExprReader
 from synth.errors import InputError, Location, Severity

@@ -37,7 +37,8 @@ from dataclasses import dataclass
 from typing import Any
 
 from synth.codegen.plcopen_actions import ACTION_WARNINGS, action_body
-from synth.codegen.plcopen_data import DATA, sum_text
+from synth.codegen.plcopen_assign import sum_text
+from synth.codegen.plcopen_data import DATA
 from synth.codegen.plcopen_sfc import Chart, Source, read_chart
 from synth.codegen.plcopen_timers import prepare_scope
 from synth.codegen.plcopen_vendor import IecQualifier
