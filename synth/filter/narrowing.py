@@ -171,6 +171,11 @@ class _Race:
         self.effect = True
 
 
+POINT_DEFAULTS = (False, True)
+"""The points tried per race: one of its undecided part, the variables it leaves free
+first all false, then all true (requests and sensors on: where the priorities meet)."""
+
+
 def _shown_at_points(p: Partition, goods: Sequence[Function], races: Sequence[_Race]) -> None:
     """Set ``effect`` on the races that, run at one valuation Y0 of the variables other
     than the outputs, show an effect there (the symbolic race would too: it is the same
@@ -184,11 +189,11 @@ def _shown_at_points(p: Partition, goods: Sequence[Function], races: Sequence[_R
     others = [e.declare(n) for n in e.names if e.declare(n) not in anchors]
     base = p.relation(p.initial)
     reads = [[v for v in bdd.support(g) if v not in anchors] for g in goods]
-    for first in races:
+    for first, default in ((r, d) for d in POINT_DEFAULTS for r in races):
         if first.effect is not None:
             continue
         picked = bdd.pick(first.undecided)
-        point = {v: picked.get(v, False) for v in others}
+        point = {v: picked.get(v, default) for v in others}
         at = [bdd.let({v: point[v] for v in r}, g) if r else g for g, r in zip(goods, reads)]  # outputs only
         s = bdd.let(point, base)
         states, bests = [], []
