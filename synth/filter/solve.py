@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 from typing import Sequence
 
 from synth.errors import InputError, LimitExceeded
-from synth.logic.bdd import CoverTooLarge, Cube, Engine, Function, cube_text
+from synth.logic.bdd import CoverTooLarge, Cube, Function, cube_text
 from synth.filter.language import Criterion, Filter, Sense, SimCriterion, request_name
 from synth.logic.past import pre_name
 from synth.filter import narrowing
