@@ -29,9 +29,10 @@ from dataclasses import dataclass, field
 from typing import Sequence
 
 from synth.errors import InputError, LimitExceeded
-from synth.logic.bdd import CoverTooLarge, Cube, Engine, Function, cube_text
+from synth.logic.bdd import CoverTooLarge, Cube, Function, cube_text
 from synth.filter.language import Criterion, Filter, Sense, SimCriterion, request_name
 from synth.logic.past import pre_name
+from synth.filter import narrowing
 from synth.filter.model import FilterFunctions, equation_functions, functions
 from synth.logic.expr import And, Const, Edge, Expr, Not, Or, Var
 
@@ -188,26 +189,21 @@ class Synthesis:
 
 
 def synthesis(f: Filter | FilterFunctions, order: Sequence[str] | None = None, *, flat: bool = False,
-              applied: Sequence[Criterion] | None = None) -> Synthesis:
+              applied: Sequence[Criterion] | None = None, partitioned: bool = True) -> Synthesis:
     """Solve the filter's constraints with its criteria (the relational semantics of 004).
     ``flat``: write every Y-only equation (:class:`LimitExceeded` past FLAT_LIMIT cubes),
     not only those of at most FLAT_PROBE cubes. ``applied``: the criteria to apply instead
-    of :func:`criteria` (a cluster's share of its whole filter's, :mod:`synth.filter.clusters`)."""
+    of :func:`criteria` (a cluster's share of its whole filter's, :mod:`synth.filter.clusters`).
+    ``partitioned``: keep each admissible set as a conjunction of factors, one BDD otherwise
+    (:mod:`synth.filter.narrowing`; the same result)."""
     m = f if isinstance(f, FilterFunctions) else functions(f)
     e, outs = m.engine, m.outputs
     steps = [(c, e.expr(c.expr)) for c in (criteria(m.filter, order) if applied is None else applied)]
 
-    inner = [e.declare(o) for o in outs]
     goods = [u if c.sense is Sense.MAX else ~u for c, u in steps]  # Min(c) is Max(!c)
-    states, bests = [m.assumed & ~m.forbidden], []
-    for g in goods:  # Max(g): S := S ∧ (g ↔ ∃O.(S∧g)), the ∃ in one and-abstract pass
-        bests.append(e.and_exists(states[-1], g, inner))
-        states.append(states[-1] & g.equiv(bests[-1]))
-    admissible = states[-1]
-    verdicts = [Applied(c, states[i + 1] != states[i], _effect(i, goods, states, bests, e, inner))
-                for i, (c, _) in enumerate(steps)]
-    care = e.exists(outs, admissible)
-    result = Synthesis(m, admissible, care, verdicts)
+    chain = (narrowing.partitioned if partitioned else narrowing.monolithic)(m, goods)
+    verdicts = [Applied(c, narrows, effect) for (c, _), narrows, effect in zip(steps, chain.narrows, chain.effects)]
+    result = Synthesis(m, chain.admissible, chain.care, verdicts)
     stated = any(isinstance(c, Criterion) for c in m.filter.criteria)
     if stated and any(s.has_priority for s in m.filter.combined):
         result.notes.append("the file states its criteria: the priorities of the combined constraints are not "
@@ -215,13 +211,13 @@ def synthesis(f: Filter | FilterFunctions, order: Sequence[str] | None = None, *
     for s in m.filter.combined:
         if not s.has_priority:
             result.notes.append(f"{s.id} has no priority: the criteria order decides how it is relieved")
+    care = chain.care
     stuck = m.assumed & ~care
     if stuck != e.false:
         result.inconsistent = e.witness(stuck, m.assumed)
         result.inconsistent_text = e.text(stuck, stuck | ~m.assumed)
     for o in outs:
-        one = e.exists(outs, admissible & e.var(o))
-        zero = e.exists(outs, admissible & ~e.var(o))
+        one, zero = chain.ones[o], chain.zeros[o]
         if (one & zero) != e.false:
             free = e.minimal_cube(one & zero)
             assert free is not None  # one & zero is not false
@@ -236,32 +232,6 @@ def synthesis(f: Filter | FilterFunctions, order: Sequence[str] | None = None, *
                                     "terms; the chained equations (solve without --flat) are the filter") from None
     result.chained = chained_equations(result)
     return result
-
-
-def _effect(i: int, goods: Sequence[Function], states: Sequence[Function], bests: Sequence[Function],
-            e: Engine, inner: Sequence[str]) -> bool:
-    """Whether the final filter differs without criterion ``i`` (each criterion read as
-    ``Max(g)``, ``Min(c)`` as ``Max(!c)``; ``bests[j]`` is ``∃O.(S_j ∧ g_j)``).
-
-    Narrowing acts on each Y alone. Where ``i`` narrows, it splits ``S_i(Y)`` into the kept
-    part (the chain goes on with it) and the dropped part ``Z``; without ``i`` the later
-    criteria narrow their union, and they keep the chain's part alone (no effect there) as
-    soon as a criterion finds a solution in the chain's part and none in ``Z``, while the
-    filter differs as soon as one finds a solution in ``Z`` and none in the chain's part,
-    or when ``Z`` survives to the end. So ``Z`` is narrowed alongside the chain, each Y
-    dropped once decided: most criteria are decided within a step or two, on a ``Z``
-    much smaller than the chain's sets."""
-    if states[i + 1] == states[i]:
-        return False
-    dropped = states[i] & ~states[i + 1]
-    for j in range(i + 1, len(goods)):
-        own = e.and_exists(dropped, goods[j], inner)
-        if (own & ~bests[j]) != e.false:
-            return True
-        dropped &= ~(bests[j] & ~own) & goods[j].equiv(own)
-        if dropped == e.false:
-            return False
-    return True
 
 
 def chained_equations(s: Synthesis) -> dict[str, str]:
