@@ -15,6 +15,7 @@ import pytest
 
 from conftest import ROOT
 from schemas import assert_valid
+from test_filter_verify_cycle import SINGLE_ACTING
 from synth.codegen.interpreter import load_st
 from synth.errors import InputError
 from synth.filter.closed_loop import verify
@@ -29,18 +30,7 @@ from synth.output.filter_text import trace_text
 DATA = ROOT / "tests" / "data" / "filter"
 TRI = ROOT / "plants" / "tri.rules"
 TOGGLE = DATA / "toggle.st"
-CYLINDER = """model single_acting {
-    order   Q = 0
-    sensors b = 1, h = 0
-    incoherent b & h
-    ↑Q [b]        -> ↓b
-    ↑Q [!b & !h]  -> ↑h
-    ↓Q [h]        -> ↓h
-    ↓Q [!b & !h]  -> ↑b
-    ↑Q: ↓b < ↑h
-    ↓Q: ↓h < ↑b
-}
-element V1 = single_acting(Q=Q1, b=v10, h=v11)
+CYLINDER = SINGLE_ACTING + """element V1 = single_acting(Q=Q1, b=v10, h=v11)
 constraint REST "push only from rest": ↑Q1 & !v10 = 0
 constraint END "do not stop before the end": ↓Q1 & !v11 = 0
 """
