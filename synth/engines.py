@@ -43,7 +43,7 @@ from typing import TYPE_CHECKING, Any, Callable, Sequence
 from synth.errors import LimitExceeded, SynthError
 
 if TYPE_CHECKING:  # pragma: no cover - the engines are imported once chosen
-    from synth.grafcet.language import Grafcet
+    from synth.grafcet.language import Grafcet, Semantics
     from synth.plant.composition import Plant
     from synth.plant.rules import RuleSet
     from synth.sup.explain import Explanation
@@ -108,13 +108,14 @@ def validate(
     max_states: int | None = None,
     max_nodes: int | None = None,
     progress: Callable[[str], None] | None = None,
-    semantics: str = "grafcet",
+    semantics: "Semantics | str" = "grafcet",
 ) -> Validation:
     """``synth validate``: load, choose the engine, run it. ``needs_listing``: ``--report``
     or ``--cor`` will list every aggregated state (explicit engine only; with ``--engine
     symbolic`` an error before any input is read); ``max_states`` bounds the explicit
     engine, ``max_nodes`` the symbolic one; ``progress`` receives progress lines;
     ``semantics`` ``sfc`` (one evolution per PLC scan) runs on the explicit engine."""
+    from synth.grafcet.language import Semantics
     from synth.grafcet.language_check import load_grafcet
     from synth.plant.composition import plant
     from synth.plant.rules_check import load_rules
@@ -124,7 +125,7 @@ def validate(
     p = plant(rs)
     g = load_grafcet(grafcet_path, inputs=p.inputs, outputs=p.outputs, semantics=semantics)
     estimate = p.size * max(1, len(g.steps))
-    if (p.reads or semantics != "grafcet") and asked == EngineChoice.AUTO:  # explicit engine only
+    if (p.reads or g.semantics is not Semantics.GRAFCET) and asked == EngineChoice.AUTO:  # explicit engine only
         asked = EngineChoice.EXPLICIT
     if asked != EngineChoice.EXPLICIT and choose(asked, estimate, width=concurrency(g)) == EngineChoice.SYMBOLIC:
         from synth.grafcet.situation import OutOfRange
