@@ -23,7 +23,7 @@ ROOT = Path(__file__).resolve().parent.parent
 BUNDLED = [p for p in sorted(ROOT.glob("grafcets/*.g7")) + sorted(ROOT.glob("tests/data/**/*.g7"))
            if "codegen" not in p.parts]
 DEPTH = {"tri.g7": 3, "tri_missing_order.g7": 3}  # 11 inputs: 1 335 sequences at depth 3
-RANDOM_SEEDS = range(200)
+RANDOM_SEEDS = range(120)  # 1 000 more nightly
 
 
 @pytest.mark.slow  # about 60 s: blark parses each program (about 1 ms per character)
@@ -67,30 +67,30 @@ def _random_programs(seeds: range) -> list[tuple[int, int, int, str]]:
     return results
 
 
-@pytest.mark.slow  # about 70 s on 2 cores: 200 programs for blark to parse
+@pytest.mark.slow  # about 45 s on 2 cores: 120 programs for blark to parse
 def test_random_grafcets():
     results = _random_programs(RANDOM_SEEDS)
-    assert sum(cycles for _, _, cycles, _ in results) > 5000
+    assert sum(cycles for _, _, cycles, _ in results) > 3000
 
 
 @pytest.mark.nightly  # about 6 min on 2 cores: pytest -m nightly
 def test_random_grafcets_nightly():
-    """The same differential on 1 000 more random Grafcets (seeds 200 to 1 199)."""
-    results = _random_programs(range(200, 1200))
+    """The same differential on 1 000 more random Grafcets (seeds 120 to 1 119)."""
+    results = _random_programs(range(120, 1120))
     assert sum(cycles for _, _, cycles, _ in results) > 25000
 
 
 def test_random_grafcets_cover_every_construct():
     texts = [random_grafcet(seed) for seed in RANDOM_SEEDS]
     gs = [parse_grafcet(t, f"random{i}.g7") for i, t in enumerate(texts)]
-    assert sum(any(len(t.targets) > 1 for t in g.transitions) for g in gs) >= 20  # AND divergences
-    assert sum(any(len(t.sources) > 1 for t in g.transitions) for g in gs) >= 20  # AND convergences
-    assert sum(len({t.sources for t in g.transitions}) < len(g.transitions) for g in gs) >= 30  # OR divergences
-    assert sum(bool(g.timers) for g in gs) >= 100
-    assert sum("↑" in t or "↓" in t for t in texts) >= 150
+    assert sum(any(len(t.targets) > 1 for t in g.transitions) for g in gs) >= 10  # AND divergences
+    assert sum(any(len(t.sources) > 1 for t in g.transitions) for g in gs) >= 10  # AND convergences
+    assert sum(len({t.sources for t in g.transitions}) < len(g.transitions) for g in gs) >= 20  # OR divergences
+    assert sum(bool(g.timers) for g in gs) >= 70
+    assert sum("↑" in t or "↓" in t for t in texts) >= 100
     assert sum(" on ↑" in t or " on ↓" in t for t in texts) >= 30  # stored actions on events
-    assert sum(" on deactivation" in t for t in texts) >= 25
-    assert sum(" if " in t for t in texts) >= 50  # conditional actions
+    assert sum(" on deactivation" in t for t in texts) >= 12
+    assert sum(" if " in t for t in texts) >= 35  # conditional actions
     assert sum(len(g.grafcets) > 1 for g in gs) >= 40  # step variables across partial grafcets
 
 

@@ -119,6 +119,7 @@ def test_without_the_observers_one_event_per_cycle_is_unsafe(cli, tmp_path):
         "5  ↓b2      {b3,b4,t2,Q1,Q2}     requests: Q2  orders: Q1, Q2   requests violate CSs1_6"]
 
 
+@pytest.mark.nightly  # 4 s: a model the square no longer uses (pytest -m nightly)
 def test_the_pallet_model_moving_after_the_stroke_is_unsafe(cli):
     # four_cylinders_pallet.rules: the pallet reaches cell 2 only after h1, once Q1 may have
     # dropped (X32 then resets): cylinder 2 extends while the pallet is still arriving.

@@ -95,9 +95,9 @@ def test_st_runs_one_evolution_per_cycle_and_equals_synth_run(cli, chain):
 
 def test_random_grafcets_in_sfc_semantics_st_equals_synth_run():
     pytest.importorskip("blark")
-    results = [check_seed(seed, 3, data=seed % 2 == 1, semantics="sfc") for seed in range(8)]
+    results = [check_seed(seed, 3, data=seed % 2 == 1, semantics="sfc") for seed in range(5)]
     assert [r[3] for r in results if r[3]] == []
-    assert sum(r[2] for r in results) > 150
+    assert sum(r[2] for r in results) > 80
 
 
 def test_the_compiled_program_in_sfc_semantics_equals_synth_run(tmp_path):
