@@ -38,7 +38,7 @@ from typing import Any
 
 from synth.codegen.plcopen_actions import ACTION_WARNINGS, action_body
 from synth.codegen.plcopen_assign import sum_text
-from synth.codegen.plcopen_data import DATA
+from synth.codegen.plcopen_data import DATA, duration
 from synth.codegen.plcopen_sfc import Chart, Source, read_chart
 from synth.codegen.plcopen_timers import prepare_scope
 from synth.codegen.plcopen_vendor import IecQualifier
@@ -271,7 +271,6 @@ def _paired(actions: list[str]) -> list[str]:
                                        and a[len("reset "):-len(" on deactivation")] in conditional)]
 
 
-_UNITS = {"ms": "ms", "s": "s", "m": "min", "h": "h"}
 
 
 def _read_action(a: Any, src: Source, steps: dict[str, str], q: Any, pou_actions: dict[str, Any], step: str,
@@ -306,11 +305,11 @@ def _read_action(a: Any, src: Source, steps: dict[str, str], q: Any, pou_actions
     if qualifier == IecQualifier.D and (scope := DATA.get()) is not None and str(name).upper() in scope.timers:
         return []  # a local Boolean read as its step timer (plcopen_delayed)
     if qualifier in (IecQualifier.D, IecQualifier.L):
-        m = re.fullmatch(r"\s*T#(\d+(?:\.\d+)?)(ms|s|m|h)\s*", a.get("duration", ""), re.I)
-        if name is None or m is None:
+        d = duration(a.get("duration", ""))
+        if name is None or d is None:
             raise InputError(f"a {qualifier} action needs a reference to an output and a duration such as T#2s",
                              src.at(a))
-        timer = f"{m[1]}{_UNITS[m[2].lower()]}/X{step}"
+        timer = f"{d}/X{step}"
         return [f"{name} if {timer}" if qualifier == IecQualifier.D else f"{name} if !{timer}"]
     return [_one_action(a, src, steps, q, qualifier)]
 

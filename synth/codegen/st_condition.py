@@ -13,7 +13,7 @@ from __future__ import annotations
 import contextvars
 import re
 
-from synth.codegen.plcopen_data import DATA
+from synth.codegen.plcopen_data import DATA, duration
 from synth.errors import InputError, Location, Severity, close_names
 
 __all__ = ["st_text", "ExprReader", "PREDICATES", "predicate_name"]
@@ -29,7 +29,6 @@ def st_text(el) -> str:
 _TOKEN = re.compile(r"\s*(?:(?P<dur>T#[0-9A-Za-z_.]+)|(?P<name>[A-Za-z_]\w*(?:\.[A-Za-z_]\w*)?)"
                     r"|(?P<num>\d+(?:\.\d+)?(?:[eE][+-]?\d+)?)"
                     r"|(?P<op>>=|<=|<>|:=|[()&>=<;+\-*/]))", re.I)
-_UNIT = {"ms": "ms", "s": "s", "m": "min", "h": "h"}
 _COMPARE = {">": "gt", ">=": "ge", "<": "lt", "<=": "le", "=": "eq", "<>": "ne"}
 _FLIP = {">": "<", ">=": "<=", "<": ">", "<=": ">=", "=": "=", "<>": "<>"}
 
@@ -199,10 +198,10 @@ class ExprReader:
             raise self.error(at_op, f"a step time {member} is compared with '{op or 'nothing'}': only < <= > >= with a "
                              "duration have a step-timer meaning (D/XS, or its negation)", expected=("'>='", "'>'",
                                                                                                    "'<'", "'<='"))
-        m = re.fullmatch(r"T(?:IME)?#(\d+(?:\.\d+)?)(ms|s|m|h)", dur, re.I)
-        if not m:
+        d = duration(dur)
+        if d is None:
             raise self.error(at_dur, "expected a duration such as T#2s or T#500ms", width=max(1, len(dur)))
-        timer = f"{m[1]}{_UNIT[m[2].lower()]}/X{step}"
+        timer = f"{d}/X{step}"
         scope = DATA.get()
         first = min(start, at_dur)
         text = " ".join(self.text[first:max(start + len(member), at_dur + len(dur))].split())
