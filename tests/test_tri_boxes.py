@@ -9,6 +9,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import pytest
+
 from conftest import ROOT
 from synth.plant.composition import plant
 from synth.plant.rules_check import load_rules, parse_rules
@@ -17,6 +19,13 @@ from synth.sup.supervisor import supremal_controllable
 BOXES = ROOT / "plants" / "tri_boxes.rules"
 TRI = ROOT / "grafcets" / "tri.g7"
 FIXED = ROOT / "grafcets" / "tri_boxes.g7"
+DOC = (ROOT / "docs" / "rules.md").read_text(encoding="utf-8")
+
+
+def _doc_stats(d: dict) -> str:
+    """The counts as docs/rules.md's table writes them."""
+    s = d["stats"]
+    return f"SYNC {s['sync_states']}, aggregated {s['aggregated_states']} / {s['aggregated_transitions']}"
 
 
 def _validate(cli, grafcet: Path, rules: Path) -> tuple[int, dict]:
@@ -58,6 +67,7 @@ def test_tri_fails_next_box_before_memory_clear(cli):
     assert d["stats"] == {"plant_states": 228096, "sync_states": 227, "aggregated_states": 138,
                           "aggregated_transitions": 396}
     assert d["prohibited"] == []
+    assert f"FAIL: 4 blocking, 0 prohibited; {_doc_stats(d)} |" in DOC
     blocking = [(b["situation"], [n for n, v in b["E"].items() if v]) for b in d["blocking"]]
     assert blocking == [
         (["X1", "X116", "X200", "X300"], ["dcy", "v10", "v20", "v30", "v40", "cp11"]),
@@ -82,6 +92,7 @@ def test_corrected_grafcet_passes(cli):
     assert code == 0 and d["verdict"] == "pass"
     assert d["stats"] == {"plant_states": 228096, "sync_states": 336, "aggregated_states": 184,
                           "aggregated_transitions": 550}
+    assert f"| PASS, {_doc_stats(d)} |" in DOC
     # ... and it needs the real boxes: on the memory model the memory never clears
     code, out, _ = cli("validate", FIXED, "--plant", ROOT / "plants" / "tri.rules")
     assert code == 1 and out.startswith("FAIL: 2 blocking situation(s), 4 situation(s) with prohibited orders")
@@ -121,13 +132,17 @@ def test_trap_pusher_not_reading_the_box(cli, tmp_path):
     assert "↑cp11 (element BOX) cannot be produced from its current state" in "\n".join(d["blocking"][0]["diagnosis"]["details"])
 
 
-def test_skeleton_filter_with_the_grafcets(cli, tmp_path):
+def _skeleton(cli, tmp_path: Path) -> Path:
     f = tmp_path / "plants" / "tri_boxes.filter"
     f.parent.mkdir()
     (tmp_path / "plants" / "tri_boxes.rules").symlink_to(BOXES)
-    (tmp_path / "plants" / "lib").symlink_to(ROOT / "plants" / "lib")
     code, _, _ = cli("filter", "from-rules", tmp_path / "plants" / "tri_boxes.rules", "-o", f)
     assert code == 0 and 'safety C2_8 "V4 must not start without a large box": ↑AVANCER4 & !cp12' in f.read_text()
+    return f
+
+
+def test_skeleton_filter_with_the_grafcets(cli, tmp_path):
+    f = _skeleton(cli, tmp_path)
     for grafcet, states, cycles in ((TRI, "138 states (134 plant states)", 534),
                                     (FIXED, "184 states (184 plant states)", 734)):
         code, out, _ = cli("filter", "verify", f, "--plant", BOXES, "--grafcet", grafcet)
@@ -135,6 +150,22 @@ def test_skeleton_filter_with_the_grafcets(cli, tmp_path):
         assert code == 0 and lines[1].startswith(f"explored {states}, {cycles} cycles")
         assert "safe: no constraint is violated once the outputs are written" in lines
         assert f"transparency: 0 of {cycles} cycles correct the requests, largest Hamming distance 0" in lines
+    # seed 004's benchmark filter is another machine
+    code, _, err = cli("filter", "verify", ROOT / "plants" / "tri.filter", "--plant", BOXES, "--any-control")
+    assert code == 2 and "is not an input of the plant" in err
+
+
+@pytest.mark.nightly  # about 8 s: pytest -m nightly
+def test_skeleton_filter_any_control(cli, tmp_path):
+    code, out, _ = cli("filter", "verify", _skeleton(cli, tmp_path), "--plant", BOXES, "--any-control")
+    lines = out.splitlines()
+    assert code == 0 and lines[1].startswith("explored 46692 states (46692 plant states), 9511968 cycles")
+    assert lines[2:6] == [
+        "safe: no constraint is violated once the outputs are written",
+        "transient: 5904 plant states violate a constraint between the plant's event and the end of the write (C2_5)",
+        "outside SUP: 7932 explored plant states can reach a violation by uncontrollable events alone",
+        "coherent: Y never leaves the care set",
+    ]
 
 
 def test_box_moves_only_with_the_cylinders():
