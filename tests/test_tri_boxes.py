@@ -93,6 +93,9 @@ def test_corrected_grafcet_passes(cli):
     assert d["stats"] == {"plant_states": 228096, "sync_states": 336, "aggregated_states": 184,
                           "aggregated_transitions": 550}
     assert f"| PASS, {_doc_stats(d)} |" in DOC
+    code, out, _ = cli("validate", FIXED, "--plant", BOXES, "--semantics", "sfc")
+    assert code == 0 and out.startswith("PASS") and "SYNC 367 states, aggregated 219 states / 644 transitions" in out
+    assert "tri_boxes.g7 PASS, SYNC 367, aggregated 219 / 644" in DOC
     # ... and it needs the real boxes: on the memory model the memory never clears
     code, out, _ = cli("validate", FIXED, "--plant", ROOT / "plants" / "tri.rules")
     assert code == 1 and out.startswith("FAIL: 2 blocking situation(s), 4 situation(s) with prohibited orders")
