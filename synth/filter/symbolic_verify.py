@@ -32,7 +32,7 @@ from synth.filter.cycle import Algorithm, Mode
 from synth.filter.language import Filter
 from synth.filter.verification import ANY_CONTROL, Control, ControlKind, Finding, FindingKind, Verification
 
-__all__ = ["verify_symbolic", "choose_engine", "SYMBOLIC_ABOVE", "TRACE_BUDGET"]
+__all__ = ["verify_symbolic", "choose_engine", "plant_size", "SYMBOLIC_ABOVE", "TRACE_BUDGET"]
 
 SYMBOLIC_ABOVE = 2_000_000
 """``--engine auto`` runs the symbolic engine when the plant has more states than this."""
@@ -60,6 +60,14 @@ def choose_engine(engine: EngineChoice, *, any_control: bool, progress: bool, pl
     if engine is EngineChoice.AUTO:
         return EngineChoice.SYMBOLIC if supported and plant_size > SYMBOLIC_ABOVE else EngineChoice.EXPLICIT
     return engine
+
+
+def plant_size(rules_path: str) -> int:
+    """The number of states of the plant's grid (what the explicit engine's arrays cover)."""
+    from synth.plant.composition import plant
+    from synth.plant.rules_check import load_rules
+
+    return int(plant(load_rules(rules_path)).size)
 
 
 def explicit_findings(f: Filter, rules_path: str, algorithm: Algorithm, mode: Mode, atomic: bool, k: int,
@@ -112,4 +120,4 @@ def verify_symbolic(f: Filter, rules_path: str, *, algorithm: Algorithm = Algori
     return Verification(
         f.file, rules_path, ANY_CONTROL, Algorithm(algorithm), Mode(mode), atomic, strict, loop.states,
         loop.plant_states, loop.cycles, loop.complete, time.perf_counter() - started, loop.outside_sup, findings,
-        0, 0, events_per_cycle, None, Control(ControlKind.ANY))
+        0, 0, events_per_cycle, None, Control(ControlKind.ANY), EngineChoice.SYMBOLIC)
