@@ -29,7 +29,9 @@ Example
 from __future__ import annotations
 
 import copy
-from typing import Mapping
+from typing import Callable, Iterable, Mapping
+
+import numpy as np
 
 from synth.errors import InputError
 from synth.filter.cycle import Algorithm, Cover, FilterCycle, Mode
@@ -181,7 +183,7 @@ class SymbolicCycle:
 
             cudd.reorder(e.bdd, {e.declare(n): i for i, n in enumerate(order)})
 
-    def _terms(self, terms) -> Function:  # type: ignore[no-untyped-def]
+    def _terms(self, terms: Iterable[Iterable[tuple[int, np.ndarray]]]) -> Function:
         """The union of product terms, each a tuple of (element, local states it allows)."""
         enc = self.enc
         out = self.engine.false
@@ -252,7 +254,8 @@ class SymbolicCycle:
             rel &= e.var(next_name(BLOCKED)).equiv(blocked)
         return e.exists(self.free, rel)
 
-    def _loop(self, values: dict[str, Function], g1: list[Function], ev) -> tuple[list[Function], Function]:  # type: ignore[no-untyped-def]
+    def _loop(self, values: dict[str, Function], g1: list[Function],
+              ev: Callable[[Cover, Mapping[str, Function]], Function]) -> tuple[list[Function], Function]:
         """The correction loop of :meth:`FilterCycle._loop` (not the literal one), lane by
         lane as functions: ``flag`` is where the loop still iterates."""
         e, cyc = self.engine, self.cycle
