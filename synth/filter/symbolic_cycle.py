@@ -150,7 +150,8 @@ class SymbolicCycle:
                 self.forbid[t.event] = self.forbid.get(t.event, e.false) | self._terms([t.factors])
         self.moves: tuple[Move, ...] = guarded_moves(enc, p)
         self.uncontrollable = tuple(m for m in self.moves if not m.controllable)
-        self.removed = self._backward(self.illegal)
+        self.removed = self.backward(self.illegal)
+        self._by_constraint = terms
         self.outcome = self._outcome()
         self._write()
 
@@ -194,7 +195,20 @@ class SymbolicCycle:
             out |= term
         return out
 
-    def _backward(self, target: Function) -> Function:
+    def constraint_terms(self) -> tuple[dict[str, Function], dict[str, dict[str, Function]]]:
+        """Per constraint id: its level terms; per output event, per id: its edge terms."""
+        level: dict[str, Function] = {}
+        edge: dict[str, dict[str, Function]] = {}
+        for t in self._by_constraint:
+            u = self._terms([t.factors])
+            if t.event is None:
+                level[t.constraint] = level.get(t.constraint, self.engine.false) | u
+            else:
+                at = edge.setdefault(t.event, {})
+                at[t.constraint] = at.get(t.constraint, self.engine.false) | u
+        return level, edge
+
+    def backward(self, target: Function) -> Function:
         """The states from which uncontrollable events lead into ``target`` (SUP's
         *removed* states when ``target`` is the illegal ones)."""
         reach, frontier = target, target
@@ -252,6 +266,7 @@ class SymbolicCycle:
             rel &= e.var(next_name(m)).equiv(with_outputs[n])
         if self.blocking:
             rel &= e.var(next_name(BLOCKED)).equiv(blocked)
+        self.relation: Function = rel  # with the requests: a trace's witness
         return e.exists(self.free, rel)
 
     def _loop(self, values: dict[str, Function], g1: list[Function],
