@@ -157,12 +157,12 @@ class Walk:
             rows = self.path(node, d + 1)
             if kind is FindingKind.VIOLATION:
                 return self.violated(node, self.level_terms()), rows
-            ids = self.violated(node, {i: sc.backward(u) for i, u in self.level_terms().items()})
+            threatened = self.violated(node, {i: sc.backward(u) for i, u in self.level_terms().items()})
             last = rows[-1]
-            note = "; ".join(x for x in (last.note, "outside SUP: uncontrollable events can lead to " + ", ".join(ids))
-                             if x)
+            note = "; ".join(x for x in (last.note, "outside SUP: uncontrollable events can lead to "
+                                         + ", ".join(threatened)) if x)
             rows[-1] = TraceRow(last.event, last.state, last.situation, last.requests, last.orders, note, last.ran)
-            return ids, rows
+            return threatened, rows
         frontier = loop.levels[d]
         if kind is FindingKind.TRANSIENT:  # the plant's events first, as the explicit engine records them
             moved, layer = e.false, frontier & ~sc.illegal
