@@ -21,6 +21,7 @@ from synth.filter.cycle import Algorithm, Mode
 from synth.filter.from_rules import skeleton
 from synth.filter.language_check import load_filter, parse_filter
 from synth.filter.symbolic_verify import verify_symbolic
+from synth.filter.verification import FindingKind
 
 DATA = ROOT / "tests" / "data" / "filter"
 FOUR = ROOT / "plants" / "four_cylinders.filter"
@@ -170,3 +171,44 @@ def test_the_ring_generator_gives_the_four_cylinders(tmp_path):
     (tmp_path / "ring4.rules").write_text(ring_rules(4))
     v = verify_symbolic(parse_filter(ring_filter(4), str(tmp_path / "ring4.filter")), str(tmp_path / "ring4.rules"))
     assert (v.safe, v.states, v.plant_states, v.cycles) == (True, 2160, 1584, 16376)
+
+
+# ---------------------------------------------------------------- the walk back (no explicit engine)
+
+@pytest.mark.parametrize("name, rules, kw", [
+    ("two_no_edge.filter", "two.rules", {"require_sup": True}),
+    ("two_assume.filter", "two.rules", {"mode": Mode.BLOCKING}),
+    ("three_cycle.filter", "three.rules", {"algorithm": Algorithm.LOOP}),
+])
+def test_walk_back_traces_are_shortest(name, rules, kw):
+    # trace_budget=0: the explicit engine may not render the traces; the walk back gives
+    # traces of the same length, the same constraints, the same finding noted last (the
+    # requests, hence "requests violate ...", may be another shortest trace's)
+    f = load_filter(DATA / name)
+    shown = verify_symbolic(f, str(DATA / rules), **kw)
+    walked = verify_symbolic(f, str(DATA / rules), trace_budget=0, **kw)
+    assert list(walked.findings) == list(shown.findings) and walked.findings
+    for k, a in shown.findings.items():
+        b = walked.findings[k]
+        last = (b.trace[-1].note.split("; ")[-1], b.trace[-1].ran)
+        assert (b.count, b.constraints, len(b.trace), b.trace[0], last) == (
+            a.count, a.constraints, len(a.trace), a.trace[0], (a.trace[-1].note.split("; ")[-1], a.trace[-1].ran))
+
+
+def test_walk_back_edge_trace():
+    # another shortest trace than the explicit engine's (↑s first, then the drop of A), a real one
+    v = verify_symbolic(load_filter(DATA / "two_assume.filter"), str(DATA / "two.rules"), trace_budget=0)
+    assert [(r.event, r.state, r.requests, r.orders, r.note) for r in v.findings[FindingKind.EDGE].trace] == [
+        ("initial", "{}", (), (), ""),
+        ("-", "{A}", ("A",), ("A",), ""),
+        ("↑s", "{s}", (), (), "requests violate K, E; output event forbidden")]
+
+
+@pytest.mark.nightly  # 4 s
+def test_walk_back_four_cylinders_three_events():
+    v = verify_symbolic(load_filter(FOUR), str(FOUR_RULES), events_per_cycle=3, trace_budget=0)
+    rows = [(r.event, r.state, r.orders) for r in v.findings[FindingKind.VIOLATION].trace]
+    assert rows == [("initial", "{b1,b2,b3,b4,i1}", ()), ("-", "{b1,b2,b3,b4,i1,Q1}", ("Q1",)),
+                    ("↓b1, ↑t2, ↓i1", "{b2,b3,b4,t2,Q1,Q2}", ("Q1", "Q2")),
+                    ("↓b2, ↑h2", "{b3,b4,h2,t2,Q1}", ("Q1",))]  # t2 & !b2: K2
+    assert v.findings[FindingKind.VIOLATION].constraints == ("K2",)
