@@ -212,3 +212,27 @@ def test_walk_back_four_cylinders_three_events():
                     ("↓b1, ↑t2, ↓i1", "{b2,b3,b4,t2,Q1,Q2}", ("Q1", "Q2")),
                     ("↓b2, ↑h2", "{b3,b4,h2,t2,Q1}", ("Q1",))]  # t2 & !b2: K2
     assert v.findings[FindingKind.VIOLATION].constraints == ("K2",)
+
+
+@pytest.fixture
+def held(tmp_path):
+    # tri_annex.rules holds TAPIS = 1 (requested at 1; a filter dropping it is refused) and
+    # the held.filter declares no other order (passed through: O = R, any R)
+    annex = ROOT / "plants" / "tri_annex.rules"
+    held = tmp_path / "held.filter"
+    held.write_text(f'use "{annex.as_posix()}"\nsafety H "stop the conveyor on a small box": TAPIS & cp11\n')
+    return held, annex
+
+
+@pytest.mark.nightly  # 2-4 s: the explicit engine on tri_annex
+def test_held_and_passed_through_orders(held):
+    _same(load_filter(held[0]), str(held[1]))
+
+
+def test_held_order_refused_walk_back(held):
+    held, annex = held
+    walked = verify_symbolic(load_filter(held), str(annex), trace_budget=0)
+    assert walked.findings[FindingKind.REFUSED].count == 5184
+    assert [(r.event, r.state, r.requests, r.orders, r.note) for r in walked.findings[FindingKind.REFUSED].trace] == [
+        ("initial", "{v10,v20,v30,v40,TAPIS}", (), (), ""),
+        ("↑cp11", "{v10,v20,v30,v40,cp11,TAPIS}", ("TAPIS",), (), "requests violate H; output change refused")]
