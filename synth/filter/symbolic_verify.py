@@ -5,10 +5,11 @@ engine, and the choice of engine (``--engine auto``).
 The symbolic search knows at which level each kind of finding first appears; the
 explicit engine (:class:`~synth.filter.explorer.Explorer`) then runs that many levels
 only, so every trace is exactly the one the explicit engine prints, found in the part
-of the closed loop before the first finding. When that part is larger than the
-``--max-states`` budget (or the plant too large for the explicit arrays), the findings
-are reported without their traces' choice being the explicit one: see
-:func:`verify_symbolic`.
+of the closed loop before the first finding. When that part is larger than
+:data:`TRACE_BUDGET` nodes, or the plant has more than :data:`SYMBOLIC_ABOVE` states
+(the explicit arrays), the traces are walked back through the rings
+(:class:`~synth.filter.symbolic_walk.Walk`): shortest ones, not necessarily the explicit
+engine's choice.
 
 Example
 -------
@@ -27,7 +28,7 @@ import time
 import numpy as np
 
 from synth.engines import EngineChoice
-from synth.errors import InputError, LimitExceeded
+from synth.errors import InputError
 from synth.filter.cycle import Algorithm, Mode
 from synth.filter.language import Filter
 from synth.filter.verification import ANY_CONTROL, Control, ControlKind, Finding, FindingKind, Verification
@@ -73,14 +74,14 @@ def plant_size(rules_path: str) -> int:
 def explicit_findings(f: Filter, rules_path: str, algorithm: Algorithm, mode: Mode, atomic: bool, k: int,
                       levels: int, budget: int) -> dict[FindingKind, Finding] | None:
     """The explicit engine's findings after ``levels`` levels of its search (None: the
-    plant or the part explored does not fit the budget)."""
+    plant has more than :data:`SYMBOLIC_ABOVE` states, or the part explored does not fit
+    the budget)."""
     from synth.filter.explorer import Explorer
     from synth.filter.product import Product
 
-    try:
-        pr = Product(f, rules_path, None, algorithm, mode, atomic)
-    except LimitExceeded:
+    if plant_size(rules_path) > SYMBOLIC_ABOVE:  # its arrays over the plant's grid: GiB at 10^7 states
         return None
+    pr = Product(f, rules_path, None, algorithm, mode, atomic)
     ex = Explorer(pr, budget, k)
     frontier = np.array([ex.key0], dtype=np.int64)
     for _ in range(levels):
@@ -95,9 +96,9 @@ def verify_symbolic(f: Filter, rules_path: str, *, algorithm: Algorithm = Algori
                     require_sup: bool = False, max_states: int | None = None, events_per_cycle: int = 1,
                     trace_budget: int = TRACE_BUDGET) -> Verification:
     """The closed loop under any control on the symbolic engine. Every count is the
-    explicit engine's; each finding's trace is the explicit engine's shortest one, or,
-    when the explicit engine cannot reach it within ``trace_budget`` nodes,
-    :class:`~synth.errors.LimitExceeded` (the verdict and counts are printed first by the CLI)."""
+    explicit engine's; each finding's trace is the explicit engine's shortest one or, when
+    the explicit engine cannot render it within ``trace_budget`` nodes (see the module
+    docstring), a shortest one walked back through the rings."""
     from synth.filter.symbolic_loop import SymbolicLoop
 
     started = time.perf_counter()
