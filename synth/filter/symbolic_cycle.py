@@ -21,7 +21,10 @@ Example
 >>> from synth.plant.composition import _plants
 >>> from synth.filter.from_rules import skeleton
 >>> sk = skeleton(_plants("tri.rules"), _plants("F.filter"))  # the text only: nothing is written
->>> c = SymbolicCycle(sk.filter, _plants("tri.rules"), Algorithm.ALGEBRAIC, Mode.SUPERVISOR, False)
+>>> from synth.plant.composition import plant
+>>> from synth.plant.rules_check import load_rules
+>>> rs = load_rules(_plants("tri.rules"))
+>>> c = SymbolicCycle(sk.filter, rs, plant(rs), Algorithm.ALGEBRAIC, Mode.SUPERVISOR, False)
 >>> c.outcome != c.engine.false, c.refused != c.engine.true
 (True, True)
 """

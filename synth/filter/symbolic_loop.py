@@ -18,7 +18,7 @@ write. What the explicit engine counts is counted here exactly, on the same sets
   the plant's events that violates a constraint the node did not.
 
 The level at which each kind of finding first appears is kept: the shortest traces come
-from the explicit engine run for that many levels only (:mod:`synth.filter.symbolic_trace`).
+from the explicit engine run for that many levels only (:mod:`synth.filter.symbolic_verify`).
 
 Example
 -------
@@ -27,8 +27,8 @@ Example
 >>> sk = skeleton(_plants("tri.rules"), _plants("F.filter"))  # the text only: nothing is written
 >>> loop = SymbolicLoop(sk.filter, _plants("tri.rules"), Algorithm.ALGEBRAIC, Mode.SUPERVISOR, False, 1)
 >>> loop.run()
->>> loop.complete, loop.states > 1000, loop.first_level
-(True, True, {})
+>>> loop.complete, loop.states, loop.cycles, sorted(map(str, loop.first_level))
+(True, 12996, 2357952, ['outside_sup', 'transient'])
 """
 
 from __future__ import annotations

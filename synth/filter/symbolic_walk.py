@@ -21,7 +21,7 @@ Example
 >>> loop.run()
 >>> ids, rows = Walk(loop).finding(FindingKind.EDGE)
 >>> ids, len(rows), rows[-1].note
-(('E',), 3, 'output event forbidden')
+(('E',), 3, 'requests violate K; output event forbidden')
 """
 
 from __future__ import annotations
