@@ -73,6 +73,15 @@ class SymbolicLoop:
         self.cycle_vars = [*names, *(v + Copy.AUX.value for v in names), *sc.state_memory, *targets,
                            *self.after, *self.flags]
         self.targets = targets
+        # the relational products of one level: (post, memory) with the outcome, quantified at once
+        inner = e.declare
+        self.q_kind = [inner(n) for n in [*sc.state_memory, *targets]]
+        flag_of = {FindingKind.EDGE: sc.edge_bad, FindingKind.REFUSED: sc.refused,
+                   FindingKind.FALLBACK: e.var(FALLBACK), FindingKind.OUTSIDE_CARE: e.var(OUTSIDE),
+                   FindingKind.TRANSIENT: sc.middle_bad}
+        self.by_kind = {k: e.exists([*self.after, *self.flags], sc.outcome & u) for k, u in flag_of.items()}
+        self.q_written = [inner(n) for n in [*sc.state_memory, *sc.orders]]
+        self.written = e.exists(self.flags, sc.outcome & ~sc.refused)
         self.reach: Function = self.initial
         self.levels: list[Function] = [self.initial]  # the rings
         self.found: dict[FindingKind, Function] = {k: e.false for k in FindingKind}
@@ -120,15 +129,9 @@ class SymbolicLoop:
         pairs |= moved
         self.cycles += self.count(pairs & sc.outcome, self.cycle_vars)
         post = enc.exists(pairs, Copy.AUX)
-        joint = post & sc.outcome
-        flags = e.exists(self.after, joint)
-        self.note(FindingKind.EDGE, self.plant_part(flags & sc.edge_bad), depth)
-        self.note(FindingKind.REFUSED, self.plant_part(flags & sc.refused), depth)
-        self.note(FindingKind.FALLBACK, self.plant_part(flags & e.var(FALLBACK)), depth)
-        self.note(FindingKind.OUTSIDE_CARE, self.plant_part(flags & e.var(OUTSIDE)), depth)
-        self.note(FindingKind.TRANSIENT, self.plant_part(flags & sc.middle_bad), depth)
-        written = e.exists([*sc.state_memory, *self.flags], joint & ~sc.refused)
-        written = enc.exists(written, Copy.CURRENT, sc.orders)
+        for kind, rel in self.by_kind.items():  # the post states where some request vector shows it
+            self.note(kind, e.and_exists(post, rel, self.q_kind), depth)
+        written = e.and_exists(post, self.written, self.q_written)  # (x but the orders, targets, memory after)
         written = enc.rename(written, Copy.NEXT, Copy.CURRENT, sc.orders)
         succ = e.let(dict(zip(self.after, sc.state_memory)), written) if self.after else written
         self.note(FindingKind.VIOLATION, self.plant_part(succ & sc.illegal), depth)
