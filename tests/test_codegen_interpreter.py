@@ -131,8 +131,8 @@ def test_unknown_variable_is_reported_where_it_is_read() -> None:
      "n.st:3:6", "HexInteger is outside the subset synth executes"),  # a subclass of Integer is not Integer
     ("PROGRAM P\nVAR x : REAL; END_VAR\nx := 1.5;\nEND_PROGRAM\n",
      "n.st:3:6", "Real is outside the subset synth executes"),
-    ("PROGRAM P\nVAR_TEMP x : INT; END_VAR\nx := 1;\nEND_PROGRAM\n",
-     "n.st:2:1", "TemporaryVariableDeclarations is outside the subset synth executes"),
+    ("PROGRAM P\nVAR_EXTERNAL x : INT; END_VAR\nx := 1;\nEND_PROGRAM\n",
+     "n.st:2:1", "ExternalVariableDeclarations is outside the subset synth executes"),
     ("PROGRAM P\nEND_PROGRAM\nFUNCTION F : INT\nF := 1;\nEND_FUNCTION\n",
      "n.st:3:1", "Function is outside the subset synth executes (PROGRAM, FUNCTION_BLOCK)"),
 ])
@@ -140,3 +140,16 @@ def test_node_types_outside_the_subset_are_located(text: str, where: str, messag
     with pytest.raises(InputError) as e:
         load_st(text, "n.st")
     assert (str(e.value.location), e.value.message) == (where, message)
+
+
+def test_var_temp_is_initialised_again_at_every_call() -> None:
+    """IEC 61131-3: a VAR_TEMP keeps nothing between calls (MATIEC's iec2c sets it at the
+    start of every call); a VAR keeps its value."""
+    from synth.codegen.interpreter import load_st
+
+    m = load_st("PROGRAM P\nVAR_INPUT a : BOOL; END_VAR\nVAR n : INT; END_VAR\nVAR_TEMP r : INT := 2; "
+                "f : ARRAY[1..2] OF BOOL; END_VAR\nr := r + 1;\nIF a THEN f[1] := TRUE; END_IF;\n"
+                "IF f[1] THEN n := n + 10; END_IF;\nn := n + r;\nEND_PROGRAM\n", "t.st")
+    p = m.instance("P")
+    seen = [(p.cycle({"a": a})["n"], p["r"]) for a in (True, False, False)]
+    assert seen == [(13, 3), (16, 3), (19, 3)]

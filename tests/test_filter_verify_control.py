@@ -1,7 +1,7 @@
 """`synth filter verify --control PROG.st` (issue 23, item 3, "what runs is what was proven"):
 the requests of each scan computed by a cyclic ST PROGRAM run by synth's interpreter. The ST
-that `synth st` generates for the box sorting gives the Grafcet's verdict (its counts differ
-by exactly the states the program's own variables split, as docs/filter.md says); the
+that `synth st` generates for the box sorting gives the Grafcet's verdict and counts, state for
+state (its evolution's bookkeeping is VAR_TEMP, the power-up scan is not a cycle); the
 seed's toggling controller on one cylinder, safe and unsafe with the exact counterexample; a
 TON in the loop (it elapses as a cycle's event, fairly); the bad inputs (exit 2, located)."""
 
@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import functools
 import json
-from collections import Counter
 
 import pytest
 
@@ -85,46 +84,44 @@ def test_generated_st_has_the_grafcets_verdict(tri):
     assert (g.safe, g.coherent, g.complete, set(g.findings)) == (c.safe, c.coherent, c.complete, set(c.findings)) \
         == (True, True, True, set())
     assert (g.states, g.plant_states, g.cycles, g.corrected) == (90, 90, 370, 0)
-    assert (c.states, c.plant_states, c.cycles, c.corrected) == (134, 90, 524, 0)
+    assert (c.states, c.plant_states, c.cycles, c.corrected) == (90, 90, 370, 0)
     assert c.source == f"PROGRAM tri of {tri / 'tri.st'}"
-    assert "**134 nodes and 524 cycles instead of 90 and 370**" in " ".join(DOC.split())
+    assert "the same **90 states and 370 cycles**" in " ".join(DOC.split())
     # K = 2: the Grafcet reacts to each event, the program scans once after both
     g2 = verify(f, str(TRI), str(ROOT / "grafcets" / "tri.g7"), events_per_cycle=2)
     c2 = verify(f, str(TRI), control=_st(tri / "tri.st"), events_per_cycle=2)
     assert [(v.safe, v.coherent, v.states, v.plant_states, set(v.findings)) for v in (g2, c2)] == [
-        (True, True, 154, 131, {"transient"}), (True, True, 586, 317, {"transient"})]
+        (True, True, 154, 131, {"transient"}), (True, True, 372, 317, {"transient"})]
 
 
-def test_the_programs_own_variables_split_exactly_the_extra_states(tri):
-    """docs/filter.md: 134 = 90 + 1 + 43 states, 524 = 370 + 154 cycles. Keyed by (plant
-    state, filter memory, Blocked, active steps X*) the 134 states are the Grafcet's 90;
-    the fresh instance (_FirstCycle) is one more, and _Rounds = 1 or 2 (the rounds of the
-    scan that led there) 43 more; each of the 44 is explored again, with its 1 + enabled
-    plant events + running timers cycles."""
-    pr = Product(load_filter(tri / "F.filter"), str(TRI), None, Algorithm.ALGEBRAIC, Mode.SUPERVISOR, False,
-                 _st(tri / "tri.st"))
+def test_the_programs_states_are_the_grafcets_states(tri):
+    """docs/filter.md: keyed by (plant state, filter memory, Blocked, active steps), the 90
+    states of the program are the Grafcet's 90, one for one: the program keeps nothing else
+    from a scan to the next (its evolution's bookkeeping is VAR_TEMP, its inputs are given
+    at every scan), and its fresh instance (the PLC before the power-up scan) is the
+    traces' first row, not a state."""
+    f = load_filter(tri / "F.filter")
+    pr = Product(f, str(TRI), None, Algorithm.ALGEBRAIC, Mode.SUPERVISOR, False, _st(tri / "tri.st"))
     ex = Explorer(pr, 10_000)
     ex.run()
-    size = ex.size
+    gr = Product(f, str(TRI), str(ROOT / "grafcets" / "tri.g7"), Algorithm.ALGEBRAIC, Mode.SUPERVISOR, False)
+    eg = Explorer(gr, 10_000)
+    eg.run()
 
-    def sit(k):
-        return ex.aux_list[k // size][2].instance.values
+    def program(k):
+        mem, blocked, snap = ex.aux_list[k // ex.size]
+        return k % ex.size, mem, blocked, frozenset(n[1:] for n, x in snap.instance.values.items()
+                                                    if n.startswith("X") and x is True)
 
-    def group(k):
-        mem, blocked, _ = ex.aux_list[k // size]
-        return k % size, mem, blocked, tuple(n for n, x in sit(k).items() if n.startswith("X") and x is True)
+    def grafcet(k):
+        mem, blocked, sit = eg.aux_list[k // eg.size]
+        return k % eg.size, mem, blocked, frozenset(sit.steps)
 
-    def cycles(k):
-        code = k % size
-        return 1 + sum(int(nxt[code] >= 0) for _, nxt in pr.uncontrollable) + len(pr.timers(ex.aux_list[k // size][2]))
-
-    groups = {group(k) for k in ex.order}
-    plain = [k for k in ex.order if sit(k)["_Rounds"] == 0 and not sit(k)["_FirstCycle"]]
-    assert sorted(group(k) for k in plain) == sorted(groups)  # one in each group
-    extra = [k for k in ex.order if k not in set(plain)]
-    assert (len(ex.order), len(groups), len(extra), sum(cycles(k) for k in extra), ex.cycles) == (134, 90, 44, 154, 524)
-    assert Counter(sit(k)["_Rounds"] for k in extra) == {1: 30, 2: 13, 0: 1}
-    assert [k for k in ex.order if sit(k)["_FirstCycle"]] == [ex.key0]
+    states = [program(k) for k in ex.order if k != ex.prelude]
+    assert (ex.states, len(states), len(set(states))) == (90, 90, 90)
+    assert set(states) == {grafcet(k) for k in eg.order}
+    assert ex.trace(ex.order[1])[1].event == "power-up"
+    assert not ex.reentered and ex.aux_list[ex.prelude // ex.size][2].text() == "{X0, X100, X200, X300, _FirstCycle}"
 
 
 def test_cli_json_names_the_program(cli, tri):
@@ -132,7 +129,7 @@ def test_cli_json_names_the_program(cli, tri):
     data = json.loads(out)
     assert_valid("filter_verify", data)
     assert (code, data["control"], data["states"], data["cycles"], data["safe"]) == (
-        0, {"kind": "st", "file": str(tri / "tri.st"), "program": "tri"}, 134, 524, True)
+        0, {"kind": "st", "file": str(tri / "tri.st"), "program": "tri"}, 90, 370, True)
     code, out, _ = cli("filter", "verify", tri / "F.filter", "--plant", TRI, "--grafcet", ROOT / "grafcets" / "tri.g7",
                        "--json")
     data = json.loads(out)
@@ -148,7 +145,7 @@ def test_toggle_is_made_safe_by_the_filter(cli, cyl):
     until the end of the stroke and keeps it off away from rest."""
     v = verify(load_filter(cyl / "c.filter"), str(cyl / "c.rules"), control=_st(TOGGLE))
     assert (v.safe, v.coherent, v.complete, set(v.findings)) == (True, True, True, set())
-    assert (v.states, v.plant_states, v.cycles, v.corrected, v.max_distance) == (11, 6, 19, 6, 1)
+    assert (v.states, v.plant_states, v.cycles, v.corrected, v.max_distance) == (10, 6, 18, 6, 1)
     code, out, _ = cli("filter", "verify", cyl / "c.filter", "--plant", cyl / "c.rules", "--control",
                        f"{TOGGLE}:toggle", "--json")
     data = json.loads(out)
@@ -159,12 +156,12 @@ def test_toggle_is_made_safe_by_the_filter(cli, cyl):
 
 def test_toggle_without_the_end_constraint_is_unsafe(cli, cyl):
     v = verify(load_filter(cyl / "half.filter"), str(cyl / "c.rules"), control=_st(TOGGLE))
-    assert (v.safe, v.states, v.plant_states, v.cycles, v.corrected, set(v.findings)) == (False, 5, 3, 8, 1, {"edge"})
+    assert (v.safe, v.states, v.plant_states, v.cycles, v.corrected, set(v.findings)) == (False, 4, 3, 7, 1, {"edge"})
     edge = v.findings["edge"]
     assert (edge.constraints, edge.count) == (("END",), 2)
     assert _rows(edge.trace) == [
         ("initial", "{v10}", "{}", (), (), ""),
-        ("-", "{v10,Q1}", "{Q1_prev}", ("Q1",), ("Q1",), ""),
+        ("power-up", "{v10,Q1}", "{Q1_prev}", ("Q1",), ("Q1",), ""),
         ("-", "{v10}", "{}", (), (), "output event forbidden"),
     ]
     assert trace_text(edge.trace) in DOC
@@ -173,16 +170,16 @@ def test_toggle_without_the_end_constraint_is_unsafe(cli, cyl):
     assert out.splitlines()[0] == (f"closed loop: {cyl / 'half.filter'} on {cyl / 'c.rules'}, requests from PROGRAM "
                                    f"Toggle of {TOGGLE} (algebraic, supervisor, ordered outputs)")
     assert out.endswith("shortest trace (an output event breaks an edge constraint):\n"
-                        "0  initial  {v10}     {}\n"
-                        "1  -        {v10,Q1}  {Q1_prev}  requests: Q1  orders: Q1\n"
-                        "2  -        {v10}     {}         requests: -  orders: -   output event forbidden\n")
+                        "0  initial   {v10}     {}\n"
+                        "1  power-up  {v10,Q1}  {Q1_prev}  requests: Q1  orders: Q1\n"
+                        "2  -         {v10}     {}         requests: -  orders: -   output event forbidden\n")
 
 
 def test_a_ton_elapses_as_an_event_and_fairly(cyl):
     """The clock does not advance; the running TON may elapse instead of a plant event, and
     --progress counts it among the events that cannot be postponed forever."""
     v = verify(load_filter(cyl / "c.filter"), str(cyl / "c.rules"), control=_st(DATA / "timed.st"), progress="↑v11")
-    assert (v.safe, v.states, v.plant_states, v.cycles, v.corrected) == (True, 7, 5, 13, 0)
+    assert (v.safe, v.states, v.plant_states, v.cycles, v.corrected) == (True, 6, 5, 12, 0)
     assert v.progress is not None and v.progress.holds
     pr = Product(load_filter(cyl / "c.filter"), str(cyl / "c.rules"), None, Algorithm.ALGEBRAIC, Mode.SUPERVISOR,
                  False, _st(DATA / "timed.st"))
@@ -191,7 +188,7 @@ def test_a_ton_elapses_as_an_event_and_fairly(cyl):
     end = next(k for k in ex.order if pr.val["v11"][k % ex.size])
     assert trace_text(ex.trace(end)).splitlines() == [
         "0  initial            {v10}     {}",
-        "1  -                  {v10}     {rest running}  requests: -  orders: -",
+        "1  power-up           {v10}     {rest running}  requests: -  orders: -",
         "2  timer rest (T#2s)  {v10,Q1}  {rest elapsed}  requests: Q1  orders: Q1",
         "3  ↓v10               {Q1}      {}              requests: Q1  orders: Q1",
         "4  ↑v11               {v11}     {}              requests: -  orders: -",
@@ -254,7 +251,7 @@ def test_the_state_budget_stops_a_counter(cli, cyl):
 def test_observers_read_the_programs_variables(cyl):
     (cyl / "o.filter").write_text(FILTER + "observer Q1_prev\nsafety HOLD: ↓Q1 & Q1_prev\n", encoding="utf-8")
     v = verify(load_filter(cyl / "o.filter"), str(cyl / "c.rules"), control=_st(TOGGLE))
-    assert (v.safe, v.states, v.cycles, v.corrected) == (True, 11, 19, 6)
+    assert (v.safe, v.states, v.cycles, v.corrected) == (True, 10, 18, 6)
     (cyl / "p.filter").write_text(FILTER + "observer P\nsafety HOLD: ↓Q1 & P\n", encoding="utf-8")
     with pytest.raises(InputError, match="observer P has no value in verify: define it .* or make it a BOOL variable "
                                          "of PROGRAM Toggle"):

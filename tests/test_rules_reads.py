@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from conftest import ROOT
+from synth.logic.events import Event
 from synth.logic.expr import evaluate
 from synth.plant.composition import Plant, plant
 from synth.plant.rules import RuleSet
@@ -66,6 +67,18 @@ def test_transfer_successors_exact():
     # h1 = 0: the pallet in transit does not leave cell 1
     assert _succ(p, "b1,p1,p2") == [("↑A1", "{b1,p1,p2,A1}")]
     assert _succ(p, "h1,p1,p2") == [("↑A1", "{h1,p1,p2,A1}"), ("↓h1", "{p1,p2}"), ("↓p1", "{h1,p2}")]
+
+
+def test_drifts_to_reads_the_guards_in_the_plant():
+    # CELLS' own automaton keeps ↑p2 from {p1} (some value of h1 allows it); in the plant it
+    # needs C1 out, so with A1 = 0 and C1 at rest it never comes by uncontrollable moves alone
+    p = plant(parse_rules(TRANSFER, "transfer.rules"))
+    cells = p.element("CELLS")
+    assert cells.produces(0, Event.rise("p2"))
+    assert not p.drifts_to(p.parse_state("b1,p1"), Event.rise("p2"))
+    assert p.drifts_to(p.parse_state("b1,p1,A1"), Event.rise("p2"))  # ↓b1 ↑h1 ↑p2
+    assert p.drifts_to(p.parse_state("b1,p1,A1"), Event.fall("p1"))
+    assert p.drifts_to(p.parse_state("h1,p1"), Event.rise("p2"))  # while h1, before ↓h1
 
 
 def test_chain_reachable_states_and_successors():

@@ -56,6 +56,7 @@ VALIDATE_CASES = [
     ("grafcets/tri.g7", "plants/tri_overstrict.rules"),
     ("grafcets/tri.g7", "plants/tri_overstrict.rules", "--expert"),
     ("tests/data/or_conflict.g7", "plants/tri.rules"),
+    ("grafcets/tri.g7", "plants/tri_boxes.rules"),
 ]
 
 

@@ -24,7 +24,7 @@ from synth.grafcet.language_check import load_grafcet, parse_grafcet
 GRAFCETS = [p for p in sorted((ROOT / "grafcets").glob("*.g7")) if p.name != "source_sink.g7"]
 # MATIEC reads a step's flag S12.X only after the step's declaration; Beremiz writes the steps
 # depth-first from the initial steps, so a flag of a step written later does not compile
-MATIEC_FORWARD_STEP_FLAGS = {"tri.g7", "tri_missing_order.g7"}
+MATIEC_FORWARD_STEP_FLAGS = {"tri.g7", "tri_missing_order.g7", "tri_counting.g7"}
 
 
 def interpreted(program: StProgram):

@@ -195,30 +195,31 @@ class _Writer:
         outputs.append(D("Unstable", comment="a transient evolution did not stabilise within _MAX_ROUNDS rounds; latched"))
         local = [D(self.st(s.variable), init="TRUE" if s.initial else None, comment=f"step {s.name} of {s.grafcet}")
                  for s in self.steps]
-        local += internal_declarations(g, self.st)
+        kept = internal_declarations(g, self.st)  # VAR_TEMP: written before read in every scan (docs/codegen.md)
+        temp = [d for d in kept if d.name.startswith("_Next_")]
+        local += [d for d in kept if d not in temp]
         for t in g.timers:
             k = self.timer_index[t.id]
-            local += [D(f"_Tmr{k}", "TON", comment=t.id), D(f"_TE{k}", comment=f"{t.id} has elapsed")]
+            local.append(D(f"_Tmr{k}", "TON", comment=t.id))
+            temp.append(D(f"_TE{k}", comment=f"{t.id} has elapsed"))
         local += [D(f"_Mem_{self.st(o)}", comment=f"stored action memory of {self.st(o)}") for o in self.stored]
         local += [D(f"_Prev_{self.st(i)}", comment=f"{self.st(i)} in the previous cycle") for i in self.prev]
-        local += [D(f"_RE_{self.st(i)}", comment=f"\u2191{self.st(i)}") for i in self.rising]
-        local += [D(f"_FE_{self.st(i)}", comment=f"\u2193{self.st(i)}") for i in self.falling]
-        if g.transitions:
+        temp += [D(f"_RE_{self.st(i)}", comment=f"\u2191{self.st(i)}") for i in self.rising]
+        temp += [D(f"_FE_{self.st(i)}", comment=f"\u2193{self.st(i)}") for i in self.falling]
+        if g.transitions:  # arrays stay VAR: MATIEC's iec2c writes broken C for an array in VAR_TEMP
             local.append(D("_Fire", f"ARRAY[1..{len(g.transitions)}] OF BOOL", comment="fireable transitions of the round"))
         if self.steps and self.needs_flags:
             n = len(self.steps)
             local += [D("_Leave", f"ARRAY[1..{n}] OF BOOL", comment="steps deactivated (and not activated)"),
                       D("_Enter", f"ARRAY[1..{n}] OF BOOL", comment="steps activated (and not active)")]
-        local += [D("_Fired"), D("_Rounds", "INT")]
-        if self.event_actions:
-            local.append(D("_InputEvent"))
+        temp += [D("_Fired"), D("_Rounds", "INT")] + ([D("_InputEvent")] if self.event_actions else [])
         local.append(D("_FirstCycle", init="TRUE"))
         if self.filt is not None:
             local.append(D(self.filt.instance, self.filt.fb_type))
-            local += [D(f"_Order_{self.st(o)}", comment=f"the Grafcet's order, the filter's request R_{self.st(o)}")
-                      for o in g.outputs]
+            temp += [D(f"_Order_{self.st(o)}", comment=f"the Grafcet's order, the filter's request R_{self.st(o)}")
+                     for o in g.outputs]
         self.sections = (VarSection(SectionKind.INPUT, tuple(inputs)), VarSection(SectionKind.OUTPUT, tuple(outputs)),
-                         VarSection(SectionKind.LOCAL, tuple(local)),
+                         VarSection(SectionKind.LOCAL, tuple(local)), VarSection(SectionKind.TEMP, tuple(temp)),
                          VarSection(SectionKind.CONSTANT, (D("_MAX_ROUNDS", "INT", str(self.max_rounds)),)))
 
     def stored_update(self, o: str, sets: list[str], resets: list[str], indent: int) -> None:

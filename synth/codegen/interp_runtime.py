@@ -18,6 +18,7 @@ Example
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 from enum import StrEnum
 from typing import Any, Callable, Mapping, Protocol
 
@@ -39,6 +40,7 @@ class VarSection(StrEnum):
     OUTPUT = "VAR_OUTPUT"
     IN_OUT = "VAR_IN_OUT"
     GLOBAL = "VAR_GLOBAL"
+    TEMP = "VAR_TEMP"  # initialised again at every call: no memory from one scan to the next
 
 
 class LoopExit(Exception):
@@ -113,6 +115,11 @@ class Pou:
     variables: tuple[Variable, ...]
     body: Action
 
+    @cached_property
+    def temporaries(self) -> tuple[Variable, ...]:
+        """The ``VAR_TEMP`` variables, initialised again at every call."""
+        return tuple(v for v in self.variables if v.section is VarSection.TEMP)
+
     def variable(self, name: str) -> Variable | None:
         for v in self.variables:
             if v.name.upper() == name.upper():
@@ -158,6 +165,8 @@ class Instance:
 
     def run(self) -> None:
         if self.pou is not None:
+            for v in self.pou.temporaries:
+                self.values[v.name] = v.initial(self.module)
             try:
                 self.pou.body(self)
             except BodyReturn:

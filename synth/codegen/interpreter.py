@@ -59,6 +59,7 @@ _SECTIONS: dict[type, VarSection] = {
     tf.VariableDeclarations: VarSection.LOCAL, tf.InputDeclarations: VarSection.INPUT,
     tf.OutputDeclarations: VarSection.OUTPUT, tf.InputOutputDeclarations: VarSection.IN_OUT,
     tf.StaticDeclarations: VarSection.LOCAL, tf.GlobalVariableDeclarations: VarSection.GLOBAL,
+    tf.TemporaryVariableDeclarations: VarSection.TEMP,
 }
 _POU_KINDS: dict[type, str] = {tf.Program: "PROGRAM", tf.FunctionBlock: "FUNCTION_BLOCK"}
 

@@ -10,7 +10,10 @@ lacks is an error located at ``--control``; a pass-through plant output it lacks
 
 The program's whole state is part of the closed loop's state: a :class:`Snapshot` is the
 instance after a scan, compared by the canonical tuple of every variable (nested function
-block instances, arrays, and the hidden memory of ``TON``/``TOF``/``TP``/``R_TRIG``/...). The
+block instances, arrays, and the hidden memory of ``TON``/``TOF``/``TP``/``R_TRIG``/...) but
+those no scan reads before writing them: the ``VAR_INPUT`` s the loop gives and the
+``VAR_TEMP`` s (initialised again at every call; the ST synth generates keeps its evolution's
+bookkeeping there). The
 PLC clock does not advance; a *running* timer (``TON``/``TP`` started, ``TOF`` falling, its
 preset not reached) may instead **elapse** as a cycle's event, like a Grafcet's ``2s/X1``: its
 start is moved back by its preset, then one scan runs with the inputs unchanged. So a timer's
@@ -212,6 +215,9 @@ class StControl:
                                  f"of {filter_file}", _at(option), suggestions=close_names(o, have))
         self.observable = frozenset(v.name.upper() for v in pou.variables if v.type == "BOOL" and not v.constant)
         self.pou = pou
+        # written before they are read in every scan: the VAR_INPUTs the loop gives, the VAR_TEMPs
+        given = {v.upper() for v in self.inputs.values()}
+        self.rewritten = tuple(v.section == "VAR_TEMP" or v.name.upper() in given for v in pou.variables)
         self.known: dict[tuple, Snapshot] = {}
 
     def _program(self, name: str | None, option: str) -> StPou:
@@ -240,7 +246,8 @@ class StControl:
 
     # ------------------------------------------------------------------ the closed loop's side
     def snapshot(self, inst: StInstance) -> Snapshot:
-        key = _canon(inst)
+        values, state = _canon(inst)  # the program's own variables, but for what no scan reads before writing
+        key = tuple(x for x, skip in zip(values, self.rewritten) if not skip), state
         snap = self.known.get(key)
         if snap is None:
             snap = self.known[key] = Snapshot(key, inst)

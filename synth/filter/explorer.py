@@ -27,10 +27,13 @@ from synth.filter.cycle import ACK, Memory, Mode
 from synth.errors import LimitExceeded
 from synth.filter.outcomes import Outcome, OutcomeArrays, lane_bits, react, situation_text, trace_row, unpack
 from synth.filter.product import Product
+from synth.filter.writes import merge_events, write
 from synth.filter.verification import Finding, FindingKind, TraceRow
-from synth.logic.events import Event
 
-__all__ = ["Explorer"]
+__all__ = ["POWER_UP", "Explorer"]
+
+POWER_UP = "power-up"
+"""The event of a program's first cycle: its first scan, on the plant's initial state."""
 
 
 _NOTES = {FindingKind.VIOLATION: "", FindingKind.EDGE: "output event forbidden",
@@ -88,6 +91,11 @@ class Explorer:
         self.key0 = self.intern((tuple(memory.previous[i] for i in pr.used_index), False, sit0)) * self.size \
             + p.initial_index
         self.admit_one(self.key0)
+        # a program's fresh instance: the PLC before its power-up scan (see run)
+        self.prelude: int | None = self.key0 if pr.control is not None else None
+        self.prelude_cycles = self.prelude_corrected = 0
+        self.powered: set[int] = set()  # the states the power-up scan leads to
+        self.reentered = False
         if pr.illegal[p.initial_index]:
             self.counts[FindingKind.VIOLATION].add(p.initial_index)
 
@@ -223,12 +231,12 @@ class Explorer:
                 found.append((fi[ok], dst[ok], ids[inv.ravel()], mask[ok] | np.uint64(self.bit(ev))))
             if not found:
                 break
-            fi, post, seq, mask = _merge([np.concatenate(c) for c in zip(*found)], size, frontier, by_events)
+            fi, post, seq, mask = merge_events([np.concatenate(c) for c in zip(*found)], size, frontier, by_events)
             bad = pr.illegal[post] & ~pr.illegal[codes0[fi]]
             self.record(FindingKind.TRANSIENT, bad, post, frontier[fi], seq, None, post,
                         lambda i: pr.violated(int(post[i])))
             parts.append((fi, post, seq, mask))
-        fi, post, seq, mask = _merge([np.concatenate(c) for c in zip(*parts)], size, frontier, by_events)
+        fi, post, seq, mask = merge_events([np.concatenate(c) for c in zip(*parts)], size, frontier, by_events)
         if pr.controlled:
             timed = [(fi, post, seq, mask)]
             auxes = frontier // size
@@ -265,42 +273,6 @@ class Explorer:
             class_ids[u] = self.outcomes_for(yb, aux, sit)
         return class_ids[inverse]
 
-    def write(self, post: np.ndarray, targets: np.ndarray
-              ) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[str], np.ndarray]:
-        """Step 5 for arrays of (state, target orders): the state after the write (-1 when
-        refused), refused, edge constraint broken (and by which events), and an
-        intermediate state violating a constraint."""
-        pr = self.pr
-        cur, before = post.copy(), post
-        bits = np.stack([pr.val[z][post] for z in pr.orders], axis=1)  # the orders now
-        refused = np.zeros(post.size, dtype=bool)
-        edge_bad = np.zeros(post.size, dtype=bool)
-        edge_events: list[str] = []
-        middle_bad = np.zeros(post.size, dtype=bool)
-        for rising in (False, True):  # falls first, then rises, each in output order
-            for z, name in enumerate(pr.orders):
-                idx = np.nonzero((targets[:, z] == rising) & (bits[:, z] != rising) & ~refused)[0]
-                if not idx.size:
-                    continue
-                ev = Event.edge(name, rising)
-                c = cur[idx]
-                if ev in pr.forbid:
-                    hit = pr.forbid[ev][before[idx] if pr.atomic else c]
-                    if hit.any():
-                        edge_bad[idx[hit]] = True
-                        edge_events.append(ev)
-                nxt = pr.toggle[ev][c]
-                no = nxt < 0
-                if no.any():
-                    refused[idx[no]] = True
-                    cur[idx[no]] = -1
-                    idx, nxt = idx[~no], nxt[~no]
-                cur[idx] = nxt
-                bits[idx, z] = rising
-                if not pr.atomic:
-                    middle_bad[idx] |= pr.illegal[nxt]
-        return cur, refused, edge_bad, edge_events, middle_bad
-
     def level(self, frontier: np.ndarray) -> np.ndarray:
         """Every cycle from the nodes of ``frontier``; returns the new nodes."""
         pr, size = self.pr, self.size
@@ -325,7 +297,7 @@ class Explorer:
         oid = np.array(self.flat, dtype=np.int64)[offsets[cls][entry] + within]
         targets, fallback, outside, aux_after, requests = self.arrays.update(self.outcomes)
         post, node, event, targets = post[entry], node[entry], event[entry], targets[oid]
-        cur, refused, edge_bad, edge_events, middle_bad = self.write(post, targets)
+        cur, refused, edge_bad, edge_events, middle_bad = write(pr, post, targets)
         ok = cur >= 0
         final = np.where(ok, cur, 0)
         violation = ok & pr.illegal[final]
@@ -373,8 +345,11 @@ class Explorer:
             sel = uk_aux == a
             fresh[sel] = ~self.seen_array(a)[uk[sel] % size]
         new: list[int] = []
+        if self.prelude is not None and not self.reentered and self.prelude in uk:
+            self.reentered = True  # a scan gives the fresh instance back: a state like any other
+            new.append(self.prelude)
         for k, i in zip(uk[fresh].tolist(), first[fresh].tolist()):
-            if len(self.seen_keys) >= self.max_states:
+            if self.states >= self.max_states:
                 self.complete = False
                 break
             self.admit_one(k)
@@ -384,8 +359,26 @@ class Explorer:
 
     def run(self) -> None:
         frontier = np.array([self.key0], dtype=np.int64)
+        if self.prelude is not None:  # the power-up scan reads the plant's initial state: no event before it
+            k, self.k = self.k, 0
+            frontier = self.level(frontier)
+            self.powered = set(frontier.tolist())
+            self.k, self.prelude_cycles, self.prelude_corrected = k, self.cycles, self.corrected
         while frontier.size and self.complete:
             frontier = self.level(frontier)
+
+    @property
+    def states(self) -> int:
+        """The nodes found: the closed loop after a PLC cycle (a program's fresh instance, the
+        PLC before its power-up scan, is the traces' first row, not a state unless a scan gives
+        it back)."""
+        return len(self.seen_keys) - (self.prelude is not None and not self.reentered)
+
+    @property
+    def loop_cycles(self) -> tuple[int, int]:
+        """The cycles explored from the states, and those where the filter corrects the
+        requests (the power-up cycle is not one of them; its findings are findings)."""
+        return self.cycles - self.prelude_cycles, self.corrected - self.prelude_corrected
 
     # ------------------------------------------------------------------ traces
     def trace(self, key: int) -> list[TraceRow]:
@@ -393,6 +386,7 @@ class Explorer:
         rows = []
         while key in self.parent:
             pk, ev, g = self.parent[key]
+            ev = POWER_UP if key in self.powered else ev
             rows.append(trace_row(self.pr, self.outcomes[g], ev, key % self.size, self.aux_list[key // self.size][2]))
             key = pk
         rows.append(TraceRow("initial", self.pr.label(key % self.size),
@@ -423,19 +417,3 @@ class Explorer:
                 n for n in (rows[-1].note, "outside SUP: uncontrollable events can lead to " + ", ".join(ids)) if n))
             out[FindingKind.OUTSIDE_SUP] = Finding(FindingKind.OUTSIDE_SUP, ids, tuple(rows), len(self.outside_sup))
         return {k: out[k] for k in FindingKind if k in out}
-
-
-def _merge(arrays: list[np.ndarray], size: int, frontier: np.ndarray, by_events: bool) -> list[np.ndarray]:
-    """(node index, state, events id, bits) with one row per (node index, state) -- and
-    events, ``by_events`` (a Grafcet reacts to the events) --: the first row's events, the
-    union of the rows' bits; in the search's order (by the node's aux, the events, the node)."""
-    fi, post, seq, mask = arrays
-    order = np.lexsort((np.arange(fi.size), seq if by_events else np.zeros_like(seq), post, fi))
-    same = (fi[order][1:] == fi[order][:-1]) & (post[order][1:] == post[order][:-1])
-    if by_events:
-        same &= seq[order][1:] == seq[order][:-1]
-    starts = np.flatnonzero(np.concatenate(([True], ~same)))
-    first = order[starts]
-    fi, post, seq, mask = fi[first], post[first], seq[first], np.bitwise_or.reduceat(mask[order], starts)
-    again = np.lexsort((fi, seq, frontier[fi] // size))
-    return [fi[again], post[again], seq[again], mask[again]]

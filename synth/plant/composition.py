@@ -306,6 +306,22 @@ class Plant:
                 nxt[t.axis] = t.dst
                 yield t, tuple(nxt)
 
+    def drifts_to(self, local: tuple[int, ...], event: Event) -> bool:
+        """Whether ``event`` can occur from ``local`` through uncontrollable moves only (the
+        orders as they are), each guard read in the state where the move occurs: exact where
+        an element's own automaton, which keeps a move some value of its reads allows, is not."""
+        seen, todo = {local}, [local]
+        while todo:
+            for t, nxt in self.successors(todo.pop()):
+                if t.controllable:
+                    continue
+                if t.event == event:
+                    return True
+                if nxt not in seen:
+                    seen.add(nxt)
+                    todo.append(nxt)
+        return False
+
     def slices(self, t: LocalTransition) -> tuple[tuple, tuple]:
         """Grid index tuples selecting the sources and targets of ``t`` (views, no copy)."""
         pre = (slice(None),) * t.axis

@@ -146,7 +146,8 @@ def _element_cause(sync: Sync, node: Node, event: Event) -> Cause:
         return Cause(event, a.name, producible_now=True, free=True)
     rules = tuple(r.text() for r in spec.rules if r.consequence.event == event)
     k = node.plant[axis]
-    if a.produces(k, event):  # no order change needed: it happens with the orders as they are
+    # no order change needed: it happens with the orders as they are (in the plant, if a reads)
+    if a.produces(k, event) and (a.guards is None or p.drifts_to(node.plant, event)):
         return Cause(event, a.name, (), rules, emitted=True, authorised=True, producible_now=True)
     best = _fewest_changes(a, k, event, [v.name for v in spec.orders if not v.held])
     if best is None:
