@@ -136,6 +136,9 @@ def test_what_the_symbolic_engine_refuses(cli):
     assert code == 2 and "supports --any-control only" in err and "--engine explicit" in err
     code, _, err = cli(*base, "--any-control", "--progress", "A", "--engine", "symbolic")
     assert code == 2 and "(--progress need --engine explicit)" in err
+    code, _, err = cli("filter", "verify", ROOT / "plants" / "tri.filter", "--plant", ROOT / "plants" / "tri.rules",
+                       "--any-control", "--engine", "symbolic")  # the explicit engine's checks, the same message
+    assert code == 2 and "the filter's input C0, C1" in err and "is not an input of the plant" in err
     code, out, _ = cli(*base, "--grafcet", DATA / "two.g7", "--json")  # auto: explicit there
     assert json.loads(out)["engine"] == "explicit"
     code, out, _ = cli(*base, "--any-control", "--json")  # auto: a small plant stays explicit
