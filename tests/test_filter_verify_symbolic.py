@@ -234,8 +234,7 @@ def held(tmp_path):
     return held, annex
 
 
-@pytest.mark.nightly  # 2-4 s: the explicit engine on tri_annex
-def test_held_and_passed_through_orders(held):
+def test_held_and_passed_through_orders(held):  # 1 s (the explicit engine on tri_annex)
     _same(load_filter(held[0]), str(held[1]))
 
 
