@@ -96,13 +96,17 @@ FORBIDDEN = {
     "synth.output": ("synth.cli",),
 }
 
+# (room, module) exceptions: the symbolic closed loop of ``filter verify`` (synth.filter.symbolic_*)
+# encodes the plant with the symbolic engine's BDD layer, and only with it (issue 23, build 2)
+ALLOWED = {("synth.filter", "synth.symbolic.encoding"), ("synth.filter", "synth.symbolic.relation")}
+
 
 @pytest.mark.parametrize("room", sorted(FORBIDDEN))
 def test_rooms_import_only_what_lies_below(room: str) -> None:
     graph = import_graph()
     bad = sorted(
         (m, t) for m, ts in graph.items() if m == room or m.startswith(room + ".")
-        for t in ts if any(t == f or t.startswith(f + ".") for f in FORBIDDEN[room])
+        for t in ts if any(t == f or t.startswith(f + ".") for f in FORBIDDEN[room]) and (room, t) not in ALLOWED
     )
     assert bad == []
 

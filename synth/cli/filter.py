@@ -231,8 +231,12 @@ def register_verify(commands: "argparse._SubParsersAction") -> None:
                    help="a violation before the PLC writes its outputs also makes the loop unsafe")
     v.add_argument("--require-sup", action="store_true",
                    help="a state outside SUP (uncontrollable events alone lead to a violation) makes the loop unsafe")
-    v.add_argument("--max-states", type=int, default=1_000_000, metavar="N",
-                   help="stop the exploration after N states (default 1000000)")
+    v.add_argument("--max-states", type=int, default=None, metavar="N",
+                   help="stop the exploration after N states (explicit engine: default 1000000; symbolic: after "
+                        "the first level past N, default no limit)")
+    v.add_argument("--engine", choices=("auto", "explicit", "symbolic"), default="auto",
+                   help="explicit: node by node; symbolic: BDDs, level by level (--any-control only, without "
+                        "--progress); auto (default): symbolic there on a plant of more than 2000000 states")
     v.add_argument("--events-per-cycle", type=int, default=1, metavar="K",
                    help="the plant makes 0..K events between two PLC scans (default 1)")
     v.add_argument("--progress", metavar="GOAL",
@@ -245,7 +249,8 @@ def register_verify(commands: "argparse._SubParsersAction") -> None:
 
 def cmd_verify(args: argparse.Namespace) -> int:
     from synth.output.summary import print_json
-    from synth.filter.closed_loop import verify
+    from synth.engines import EngineChoice
+    from synth.filter.closed_loop import DEFAULT_MAX_STATES, verify
     from synth.filter.cycle import Algorithm, Mode
     from synth.output.filter_text import verification_json, verification_text
 
@@ -261,7 +266,7 @@ def cmd_verify(args: argparse.Namespace) -> int:
     v = verify(f, args.plant, args.grafcet, any_control=args.any_control, algorithm=Algorithm(args.algorithm),
                mode=Mode(args.mode), atomic=args.atomic_outputs, strict=args.strict, require_sup=args.require_sup,
                max_states=args.max_states, events_per_cycle=args.events_per_cycle, progress=args.progress,
-               control=control)
+               control=control, engine=EngineChoice(args.engine))
     if args.junit or args.sarif:
         from synth.output.ci import filter_verify_report, write_ci
 
@@ -270,6 +275,7 @@ def cmd_verify(args: argparse.Namespace) -> int:
         out = verification_json(v)
         out["events_per_cycle"] = v.events_per_cycle
         out["control"] = v.control.json()
+        out["engine"] = str(v.engine)
         if args.progress is not None:
             out["progress"] = _progress_json(v)
         print_json(out)
@@ -282,7 +288,7 @@ def cmd_verify(args: argparse.Namespace) -> int:
     if not (v.safe and v.coherent) or (v.progress is not None and not v.progress.holds):
         return 1
     if not v.complete:
-        print(f"stopped: the exploration reached --max-states {args.max_states} before covering every "
+        print(f"stopped: the exploration reached --max-states {args.max_states or DEFAULT_MAX_STATES} before covering every "
               "reachable state; nothing wrong was found in the explored part"
               + (" (progress needs every state: not checked)" if args.progress is not None else ""), file=sys.stderr)
         return 2

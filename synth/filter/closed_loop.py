@@ -63,6 +63,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from synth.engines import EngineChoice
 from synth.errors import InputError, close_names
 from synth.filter.control_st import StSource
 from synth.filter.cycle import Algorithm, Mode
@@ -75,7 +76,10 @@ from synth.filter.verification import (ANY_CONTROL, Control, ControlKind, Findin
 from synth.logic.events import Event
 from synth.logic.expr import Edge, Expr, evaluate, names
 
-__all__ = ["verify", "Goal", "goal_of"]
+__all__ = ["verify", "Goal", "goal_of", "DEFAULT_MAX_STATES"]
+
+DEFAULT_MAX_STATES = 1_000_000
+"""The explicit engine's default ``--max-states``."""
 
 GOAL_FILE = "--progress"
 """The file name of the located errors of a ``--progress`` expression."""
@@ -83,17 +87,31 @@ GOAL_FILE = "--progress"
 
 def verify(f: Filter, rules_path: str, grafcet: str | None = None, *, any_control: bool = False,
            algorithm: Algorithm = Algorithm.ALGEBRAIC, mode: Mode = Mode.SUPERVISOR, atomic: bool = False,
-           strict: bool = False, require_sup: bool = False, max_states: int = 1_000_000,
-           events_per_cycle: int = 1, progress: str | None = None, control: StSource | None = None
-           ) -> Verification:
-    """Explore the closed loop (see the module docstring); ``control``: ``--control PROG.st[:NAME]``."""
+           strict: bool = False, require_sup: bool = False, max_states: int | None = DEFAULT_MAX_STATES,
+           events_per_cycle: int = 1, progress: str | None = None, control: StSource | None = None,
+           engine: EngineChoice = EngineChoice.EXPLICIT) -> Verification:
+    """Explore the closed loop (see the module docstring); ``control``: ``--control PROG.st[:NAME]``.
+    ``engine``: ``symbolic`` (or ``auto`` on a large plant) runs
+    :func:`~synth.filter.symbolic_verify.verify_symbolic` (``--any-control`` only; there
+    ``max_states=None`` is no limit, explicitly it is 1000000)."""
     if (grafcet is not None) + any_control + (control is not None) != 1:
         raise InputError("verify needs a request source: --grafcet G.g7, --control PROG.st or --any-control "
                          "(one of them)", None)
     if events_per_cycle < 0:
         raise InputError(f"--events-per-cycle is a number of plant events, 0 or more, not {events_per_cycle}", None)
-    if max_states < 1:
+    if max_states is not None and max_states < 1:
         raise InputError(f"--max-states is a number of states, 1 or more, not {max_states}", None)
+    engine = EngineChoice(engine)
+    if engine is not EngineChoice.EXPLICIT:
+        from synth.filter.symbolic_verify import choose_engine, plant_size, verify_symbolic
+
+        size = plant_size(rules_path) if engine is EngineChoice.AUTO and any_control and progress is None else 0
+        if choose_engine(engine, any_control=any_control, progress=progress is not None,
+                         plant_size=size) is EngineChoice.SYMBOLIC:
+            return verify_symbolic(f, rules_path, algorithm=algorithm, mode=mode, atomic=atomic, strict=strict,
+                                   require_sup=require_sup, max_states=max_states, events_per_cycle=events_per_cycle)
+    if max_states is None:
+        max_states = DEFAULT_MAX_STATES
     started = time.perf_counter()
     pr = Product(f, rules_path, grafcet, Algorithm(algorithm), Mode(mode), atomic, control)
     goal = goal_of(progress, pr) if progress is not None else None

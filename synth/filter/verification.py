@@ -15,6 +15,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from enum import StrEnum
 
+from synth.engines import EngineChoice
 from synth.filter.cycle import Algorithm, Mode
 
 __all__ = ["ANY_CONTROL", "ControlKind", "Control", "FindingKind", "UNSAFE", "INCOHERENT", "TraceRow", "Finding", "ProgressFailure",
@@ -140,6 +141,7 @@ class Verification:
     events_per_cycle: int = 1  # the plant makes 0..K events between two scans
     progress: Progress | None = None  # with --progress (None: not asked, or the exploration stopped)
     control: Control = Control(ControlKind.ANY)
+    engine: EngineChoice = EngineChoice.EXPLICIT  # the engine that explored (--engine)
 
     @property
     def safe(self) -> bool:
