@@ -1,0 +1,237 @@
+"""SYNC on BDDs with the situations in the BDD: a breadth-first level is a few operations.
+
+The per-situation engine (:mod:`synth.symbolic.sync`) keeps each stable situation an
+explicit object and pays a few tens of BDD operations per situation and turn; with the
+situation's steps as BDD variables (:mod:`synth.symbolic.steps`) every set below is one
+BDD over (steps X, plant state x), and the exploration, the edges and the fixpoints
+handle all the situations of a level at once. Same semantics as :mod:`synth.symbolic.sync`
+(outputs first, :mod:`synth.validation.sync`):
+
+- *regions*: an element's region moves depend on the orders emitted for it, which are a
+  function of X; per element and set of its own orders (a few), the closure of its region
+  moves is computed once (``SymbolicSync._element_region``) and selected by the step
+  variables: ``closure(X, x, x')`` is the product over the elements; ``settled`` states
+  have no region move left;
+- *exploration*: from the frontier F(X, x), each uncontrollable move gives entries
+  E(X, n) (kept by SUP); the Grafcet's reaction ``react(X, n, X')`` (the machine's
+  receptivities, search for stability) gives the target situations; the entries not
+  entered before settle through the closure into the next frontier;
+- *edges* per move: ``edge(X, x, X', x')`` = the reaction from the entry n = x moved,
+  and n settling in x' under X'; counted exactly (the aggregated transitions);
+- *coreachability* and *held* nodes are fixpoints over the edges.
+
+Example
+-------
+>>> from synth.plant.rules_check import load_rules
+>>> from synth.plant.composition import plant, _plants
+>>> from synth.grafcet.language_check import load_grafcet
+>>> from synth.grafcet.machine import GrafcetMachine
+>>> rs = load_rules(_plants("tri.rules"))
+>>> p = plant(rs)
+>>> m = GrafcetMachine(load_grafcet(_plants("../grafcets/tri.g7"), inputs=p.inputs, outputs=p.outputs))
+>>> s = step_sync(p, rs.constraints, m)
+>>> s.aggregated_states > 0, s.backward(s.initial) == s.nodes
+(True, True)
+"""
+
+from __future__ import annotations
+
+from typing import Callable, Sequence
+
+from synth.grafcet.machine import GrafcetMachine, Situation
+from synth.logic.bdd import Function
+from synth.plant.composition import Plant
+from synth.plant.rules import Constraint
+from synth.symbolic.encoding import Copy, NodeBudget, _exact_count, live_nodes
+from synth.symbolic.relation import Move, flipped, image
+from synth.symbolic.steps import StepEncoding, Unsupported, anchors, unsupported
+from synth.symbolic.supervisor import SymbolicSupervisor
+from synth.symbolic.sync import SymbolicSync
+
+__all__ = ["StepSync", "step_sync", "MAX_OWN_ORDERS"]
+
+MAX_OWN_ORDERS = 6
+"""An element with more orders than this goes to the per-situation engine (2^k region
+closures per element)."""
+
+
+class StepSync:
+    """The explored SYNC over (steps, plant state): see the module docstring."""
+
+    def __init__(self, sup: SymbolicSupervisor, machine: GrafcetMachine,
+                 progress: Callable[[str], None] | None = None) -> None:
+        self.sup = sup
+        self.enc = sup.enc
+        self.engine = sup.enc.engine
+        self.plant: Plant = sup.plant
+        self.machine = machine
+        self.steps = StepEncoding(machine, sup.enc)
+        self.helper = SymbolicSync(sup, machine)  # its per-element region closures, cached
+        self.progress = progress
+        self.false, self.true = self.engine.false, self.engine.true
+        self.initial = self.nodes = self.members = self.entered = self.false
+        self.initial_situation: Situation | None = None
+        self.reacted: dict[int, tuple[Move, Function]] = {}
+        self.edges: list[tuple[Move, Function]] = []
+        self.edge_count = 0
+        self._inputs = frozenset(n for n in machine.inputs if n in self.plant.owner)
+        self._moves = tuple(m for m in sup.moves if not m.controllable)
+        e = self.engine
+        self._current = [e.declare(v) for v in self.enc.variables] + self.steps.names(Copy.CURRENT)
+        self._next = [e.declare(v + Copy.NEXT.value) for v in self.enc.variables] + self.steps.names(Copy.NEXT)
+        self.closure, self.moving, self.refused = self._regions()
+
+    # ---- regions
+    def _regions(self) -> tuple[Function, Function, Function]:
+        """``closure(X, x, x')``: x' reachable from x by region moves under the orders of X;
+        ``moving(X, x)``: a region move is left; ``refused(X, x)``: SUP refuses an order's
+        move that X emits (a prohibited order)."""
+        emitted = self.steps.orders()
+        helper = self.helper
+        closure, moving, refused = self.true, self.false, self.false
+        for axis in range(self.plant.ndim):
+            own_all = sorted(helper._orders_of[axis])
+            if len(own_all) > MAX_OWN_ORDERS:
+                raise Unsupported(f"an element with more than {MAX_OWN_ORDERS} orders")
+            piece = self.false
+            for bits in range(1 << len(own_all)):
+                own = frozenset(o for k, o in enumerate(own_all) if bits >> k & 1)
+                select = self.engine.conjunction(
+                    emitted.get(o, self.false) if o in own else ~emitted.get(o, self.false) for o in own_all)
+                if select == self.false:
+                    continue
+                rel, can, bad = helper._element_intra(axis, own)
+                others = helper._other_orders[axis]
+                if rel != self.false and any(n in others for n in self.engine.support(rel)):
+                    raise Unsupported("region moves that read other elements' orders")
+                piece |= select & helper._element_region(axis, rel)
+                moving |= select & can
+                for b in bad.values():
+                    refused |= select & b
+            closure &= piece
+        return closure, moving, refused
+
+    def _enter(self, entries: Function) -> Function:
+        """Settle ``entries`` (X, n): their members join ``members``; the settled states."""
+        members = self.enc.rename(self.enc.and_exists(entries, self.closure, Copy.CURRENT), Copy.NEXT, Copy.CURRENT)
+        self.members |= members
+        return members & ~self.moving
+
+    # ---- exploration
+    def explore(self) -> "StepSync":
+        p = self.plant
+        init = self.enc.state(p.initial)
+        if (init & self.sup.kept) == self.false:
+            raise Unsupported("SUP is empty")
+        values = {n: v for n, v in p.valuation(p.initial).items() if n in self._inputs}
+        s0 = self.initial_situation = self.machine.initial(values)
+        self.entered = self.steps.cube(s0) & init
+        frontier = self.initial = self.nodes = self._enter(self.entered)
+        level = 0
+        while frontier != self.false:
+            targets = self.false
+            for m in self._moves:
+                entries = image(self.enc, frontier, m) & self.sup.kept
+                if entries == self.false:
+                    continue
+                r = self.steps.react(entries, m.event if m.variable in self._inputs else None)
+                old = self.reacted.get(m.key)
+                self.reacted[m.key] = (m, r if old is None else old[1] | r)
+                targets |= self.steps.rename(self.steps.exists(r, Copy.CURRENT), Copy.NEXT, Copy.CURRENT)
+            new = targets & ~self.entered
+            self.entered |= new
+            frontier = self._enter(new) & ~self.nodes
+            self.nodes |= frontier
+            level += 1
+            self.enc.check(f"exploring level {level} of SYNC")
+            if self.progress is not None and level % 10 == 0:
+                self.progress(f"exploring SYNC symbolically: level {level}, {live_nodes(self.engine)} BDD nodes")
+        settled = self.closure & ~self.enc.rename(self.moving, Copy.CURRENT, Copy.NEXT)
+        target = self.steps.rename(settled, Copy.CURRENT, Copy.NEXT)  # (X', n, x')
+        for key in sorted(self.reacted):
+            m, r = self.reacted[key]
+            self.edges.append((m, flipped(self.enc, r & target, m)))
+        self.reacted = {}
+        self.edge_count = sum(self.count(e, self._current + self._next) for _, e in self.edges)
+        return self
+
+    # ---- counts
+    def count(self, u: Function, inner: Sequence[str]) -> int:
+        """Models of ``u`` over the manager's variables ``inner`` (``u`` depends on no other)."""
+        if u == self.false:
+            return 0
+        fast = self.engine.bdd.count(u, nvars=len(inner))
+        if fast < 2**50:
+            return int(fast)
+        return _exact_count(u, sorted(self.engine.bdd.level_of_var(v) for v in inner), self.engine)
+
+    @property
+    def sync_states(self) -> int:
+        return self.count(self.members, self._current)
+
+    @property
+    def aggregated_states(self) -> int:
+        return self.count(self.nodes, self._current)
+
+    @property
+    def situations(self) -> int:
+        """The number of stable situations met (with a node)."""
+        return self.count(self.enc.exists(self.nodes, Copy.CURRENT), self.steps.names(Copy.CURRENT))
+
+    def reached_steps(self) -> frozenset[str]:
+        return frozenset(s for s in self.steps.steps if (self.nodes & self.steps.var(s)) != self.false)
+
+    # ---- fixpoints
+    def _primed(self, u: Function) -> Function:
+        return self.enc.rename(self.steps.rename(u, Copy.CURRENT, Copy.NEXT), Copy.CURRENT, Copy.NEXT)
+
+    def pre(self, u: Function) -> Function:
+        """Nodes with an edge into ``u``."""
+        target = self._primed(u)
+        out = self.false
+        for _, e in self.edges:
+            out |= self.engine.and_exists(e, target, self._next)
+        return out
+
+    def post(self, u: Function) -> Function:
+        """Nodes an edge leads to from ``u``."""
+        out = self.false
+        for _, e in self.edges:
+            out |= self.engine.and_exists(e, u, self._current)
+        return self.enc.rename(self.steps.rename(out, Copy.NEXT, Copy.CURRENT), Copy.NEXT, Copy.CURRENT)
+
+    def backward(self, targets: Function) -> Function:
+        """Nodes from which ``targets`` can be reached (targets included)."""
+        reached = frontier = targets
+        while frontier != self.false:
+            frontier = self.pre(frontier) & ~reached
+            reached |= frontier
+        return reached
+
+    def held(self, node: Function) -> bool:
+        """Whether no node with other active steps is reachable from ``node`` (one node)."""
+        steps = self.enc.exists(node, Copy.CURRENT)
+        reached = frontier = node
+        while frontier != self.false:
+            nxt = self.post(frontier)
+            if (nxt & ~steps) != self.false:
+                return False
+            frontier = nxt & ~reached
+            reached |= frontier
+        return True
+
+
+def step_sync(
+    p: Plant,
+    constraints: Sequence[Constraint],
+    machine: GrafcetMachine,
+    *,
+    budget: NodeBudget | None = None,
+    progress: Callable[[str], None] | None = None,
+) -> StepSync:
+    """Explore SYNC with the steps in the BDD (raises :class:`Unsupported` when it cannot)."""
+    why = unsupported(machine, p)
+    if why is not None:
+        raise Unsupported(why)
+    sup = SymbolicSupervisor(p, constraints, budget, anchors(machine, p))
+    return StepSync(sup, machine, progress).explore()
