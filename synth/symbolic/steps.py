@@ -40,6 +40,7 @@ True
 
 from __future__ import annotations
 
+from functools import partial
 from typing import Mapping, cast
 
 from synth.grafcet.language import CONTINUOUS, Semantics
@@ -191,7 +192,7 @@ class StepEncoding:
             rest = self.engine.true
             while rest != self.engine.false:
                 point = _walk(self.engine, rest)
-                inputs = InputRecorder(lambda point=point: {n: point.get(n, False) for n in self.inputs})
+                inputs = InputRecorder(partial(_inputs, point, self.inputs))
                 steps = _Steps({s: point.get(step_name(s), False) for s in self.steps})
                 answer = fn(inputs, cast(frozenset[str], steps), frozenset(), event, {})
                 cell = self.engine.cube({**inputs.cell(), **{step_name(s): steps.values.get(s, False) for s in steps.read}})
@@ -256,6 +257,10 @@ class StepEncoding:
             work = self.rename(moved, Copy.AUX, Copy.NEXT)
             ev = None
         raise Unsupported(f"a search for stability longer than {MAX_ROUNDS} rounds")
+
+
+def _inputs(point: Mapping[str, bool], inputs: frozenset[str]) -> dict[str, bool]:
+    return {n: point.get(n, False) for n in inputs}
 
 
 def _walk(engine: Engine, u: Function) -> dict[str, bool]:

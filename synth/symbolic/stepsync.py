@@ -68,8 +68,12 @@ class StepSync:
         self.steps = StepEncoding(machine, sup.enc)
         self.helper = SymbolicSync(sup, machine)  # its per-element region closures, cached
         self.progress = progress
-        self.false, self.true = self.engine.false, self.engine.true
-        self.initial = self.nodes = self.members = self.entered = self.false
+        self.false: Function = self.engine.false
+        self.true: Function = self.engine.true
+        self.initial: Function = self.false
+        self.nodes: Function = self.false
+        self.members: Function = self.false
+        self.entered: Function = self.false
         self.initial_situation: Situation | None = None
         self.reacted: dict[int, tuple[Move, Function]] = {}
         self.edges: list[tuple[Move, Function]] = []
@@ -94,10 +98,10 @@ class StepSync:
             if len(own_all) > MAX_OWN_ORDERS:
                 raise Unsupported(f"an element with more than {MAX_OWN_ORDERS} orders")
             piece = self.false
+            wanted: dict[str, Function] = {o: emitted[o] if o in emitted else self.false for o in own_all}
             for bits in range(1 << len(own_all)):
                 own = frozenset(o for k, o in enumerate(own_all) if bits >> k & 1)
-                select = self.engine.conjunction(
-                    emitted.get(o, self.false) if o in own else ~emitted.get(o, self.false) for o in own_all)
+                select = self.engine.conjunction(w if o in own else ~w for o, w in wanted.items())
                 if select == self.false:
                     continue
                 rel, can, bad = helper._element_intra(axis, own)
