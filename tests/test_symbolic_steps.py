@@ -1,8 +1,9 @@
-"""The steps in the BDD (synth/symbolic/steps.py, stepsync.py, stepvalidate.py).
+"""The steps in the BDD (synth/symbolic/steps.py, stepsync.py, stepreach.py, stepvalidate.py).
 
 The exploration over (steps, plant state) must give the per-situation engine's counts;
-a passing model is decided on it and its report is the explicit engine's, byte for byte;
-a failing or unsupported model goes to the per-situation engine (same report again).
+a model it covers is decided on it (verdicts, components, first nodes, traces) and its
+report is the explicit engine's, byte for byte; an unsupported model goes to the
+per-situation engine (same report again).
 """
 
 from __future__ import annotations
@@ -79,32 +80,35 @@ def _same(grafcet: Path, rules: Path, homes=(), expert=False) -> None:
 
 
 @pytest.mark.parametrize("family,n", [("par", 3), ("steep", 3)])
-def test_passing_families_take_the_step_path(family, n, tmp_path, monkeypatch):
+def test_families_take_the_step_path(family, n, tmp_path, monkeypatch):
     r, g, missing = _paths(family, n, tmp_path)
     taken = _probe(monkeypatch)
     _same(g, r)
     _same(g, r, expert=True)
-    _same(missing, r)  # blocks: the per-situation engine shows the trace
-    assert taken == [True, True, False]
+    _same(missing, r)  # blocks: component, first node and trace on the step path
+    _same(missing, r, expert=True)
+    assert taken == [True, True, True, True]
 
 
-@pytest.mark.parametrize("grafcet,homes,path", [
-    ("production_loop.g7", (), False),  # a livelock without --home
-    ("production_loop.g7", ("X1",), True),
-    ("production_loop.g7", ("X2 & v1",), True),
-    ("no_restart.g7", (), False),  # blocks
-    ("never_leaves.g7", (), False),  # never leaves its initial step
+@pytest.mark.parametrize("grafcet,homes", [
+    ("production_loop.g7", ()),  # a livelock without --home
+    ("production_loop.g7", ("X1",)),
+    ("production_loop.g7", ("X2 & v1",)),
+    ("no_restart.g7", ()),  # blocks
+    ("never_leaves.g7", ()),  # never leaves its initial step
 ])
-def test_home_examples(grafcet, homes, path, monkeypatch):
+@pytest.mark.parametrize("expert", [False, True])
+def test_home_examples(grafcet, homes, expert, monkeypatch):
     taken = _probe(monkeypatch)
-    _same(H / grafcet, H / "cylinder.rules", homes)
-    assert taken == [path]
+    _same(H / grafcet, H / "cylinder.rules", homes, expert)
+    assert taken == [True]
 
 
-def test_prohibited_orders_go_per_situation(monkeypatch):
+@pytest.mark.parametrize("rules", ["cylinder_no_advance_at_rest.rules", "cylinder.rules"])
+def test_prohibited_orders(rules, monkeypatch):
     taken = _probe(monkeypatch)
-    _same(H / "prohibited_initial.g7", H / "cylinder_no_advance_at_rest.rules")
-    assert taken == [False]
+    _same(H / "prohibited_initial.g7", H / rules)
+    assert taken == [True]
 
 
 def test_unsupported_models():

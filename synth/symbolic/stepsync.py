@@ -40,6 +40,7 @@ from typing import Callable, Sequence
 
 from synth.grafcet.machine import GrafcetMachine, Situation
 from synth.logic.bdd import Function
+from synth.logic.events import Event
 from synth.plant.composition import Plant
 from synth.plant.rules import Constraint
 from synth.symbolic.encoding import Copy, NodeBudget, _exact_count, live_nodes
@@ -77,6 +78,8 @@ class StepSync:
         self.initial_situation: Situation | None = None
         self.reacted: dict[int, tuple[Move, Function]] = {}
         self.edges: list[tuple[Move, Function]] = []
+        self.rings: list[Function] = []  # the nodes by distance from the initial nodes (the levels)
+        self.refused_by: dict[Event, Function] = {}  # per order event, where SUP refuses it (X, x)
         self.edge_count = 0
         self._inputs = frozenset(n for n in machine.inputs if n in self.plant.owner)
         self._moves = tuple(m for m in sup.moves if not m.controllable)
@@ -110,8 +113,9 @@ class StepSync:
                     raise Unsupported("region moves that read other elements' orders")
                 piece |= select & helper._element_region(axis, rel)
                 moving |= select & can
-                for b in bad.values():
+                for event, b in bad.items():
                     refused |= select & b
+                    self.refused_by[event] = self.refused_by.get(event, self.false) | (select & b)
             closure &= piece
         return closure, moving, refused
 
@@ -133,6 +137,7 @@ class StepSync:
         frontier = self.initial = self.nodes = self._enter(self.entered)
         level = 0
         while frontier != self.false:
+            self.rings.append(frontier)
             targets = self.false
             for m in self._moves:
                 entries = image(self.enc, frontier, m) & self.sup.kept
@@ -189,26 +194,41 @@ class StepSync:
     def _primed(self, u: Function) -> Function:
         return self.enc.rename(self.steps.rename(u, Copy.CURRENT, Copy.NEXT), Copy.CURRENT, Copy.NEXT)
 
-    def pre(self, u: Function) -> Function:
-        """Nodes with an edge into ``u``."""
+    def pre(self, u: Function, edges: Sequence[Function] | None = None) -> Function:
+        """Nodes with an edge (of ``edges``, default all) into ``u``."""
         target = self._primed(u)
         out = self.false
-        for _, e in self.edges:
+        for e in (self._edge_relations if edges is None else edges):
             out |= self.engine.and_exists(e, target, self._next)
         return out
 
-    def post(self, u: Function) -> Function:
-        """Nodes an edge leads to from ``u``."""
+    def post(self, u: Function, edges: Sequence[Function] | None = None) -> Function:
+        """Nodes an edge (of ``edges``, default all) leads to from ``u``."""
         out = self.false
-        for _, e in self.edges:
+        for e in (self._edge_relations if edges is None else edges):
             out |= self.engine.and_exists(e, u, self._current)
         return self.enc.rename(self.steps.rename(out, Copy.NEXT, Copy.CURRENT), Copy.NEXT, Copy.CURRENT)
 
-    def backward(self, targets: Function) -> Function:
-        """Nodes from which ``targets`` can be reached (targets included)."""
+    @property
+    def _edge_relations(self) -> list[Function]:
+        return [e for _, e in self.edges]
+
+    def backward(self, targets: Function, within: Function | None = None) -> Function:
+        """Nodes from which ``targets`` can be reached (targets included; only through
+        nodes of ``within`` when given)."""
         reached = frontier = targets
         while frontier != self.false:
             frontier = self.pre(frontier) & ~reached
+            if within is not None:
+                frontier &= within
+            reached |= frontier
+        return reached
+
+    def forward(self, sources: Function) -> Function:
+        """Nodes reachable from ``sources`` (included)."""
+        reached = frontier = sources
+        while frontier != self.false:
+            frontier = self.post(frontier) & ~reached
             reached |= frontier
         return reached
 

@@ -1,18 +1,19 @@
-"""``validate --engine symbolic`` with the steps in the BDD: the verdict without the per-situation loop.
+"""``validate --engine symbolic`` with the steps in the BDD: the report without the per-situation loop.
 
 :class:`~synth.symbolic.stepsync.StepSync` explores SYNC over (steps, plant state) level
-by level; this module decides from it what the report needs when the model passes:
-the counts, the coreachability of every node (a backward fixpoint from the homes), the
-absence of prohibited orders, and the few explicit nodes a passing report shows (the
-initial nodes), built by :class:`~synth.symbolic.explicit.ExplicitNodes` and handed to
-the existing diagnosis and output, as :mod:`synth.symbolic.validate` does.
+by level; :class:`~synth.symbolic.stepreach.StepReach` finds what the report shows:
+coreachability from the homes, stuck nodes and their terminal components, held nodes,
+prohibited orders, each finding's first node (distance, then the explicit exploration's
+order) and its shortest trace. Those nodes are made explicit by
+:class:`~synth.symbolic.explicit.ExplicitNodes` and handed to the existing diagnosis and
+output, in the order :mod:`synth.symbolic.validate` asks for them, so the report is the
+explicit engine's, byte for byte.
 
-A report that shows more — a blocking component, a prohibited order, a Grafcet that
-never leaves its initial steps, more than :data:`MAX_HELD_ASKED` initial nodes — needs
-the traces, the onion rings and the tie-breaking by exploration order of the
-per-situation engine: :func:`validate_steps` then answers None and the caller runs that
-engine (so does a model :mod:`synth.symbolic.steps` does not cover). Reports are
-therefore those of the explicit engine, byte for byte, on either path.
+:func:`validate_steps` answers None when the model is outside the step encoding
+(:func:`~synth.symbolic.steps.unsupported`, or :class:`~synth.symbolic.steps.Unsupported`
+met while exploring: an OR-divergence conflict, a long search for stability, region moves
+reading other elements' orders, an empty SUP); the caller then runs the per-situation
+engine.
 
 Example
 -------
@@ -41,19 +42,22 @@ from synth.plant.composition import Plant
 from synth.plant.rules import RuleSet
 from synth.sup.constraints import CompiledConstraints
 from synth.symbolic.encoding import Copy, live_nodes
-from synth.symbolic.explicit import ExplicitNodes
-from synth.symbolic.reachability import MAX_LISTED
+from synth.symbolic.explicit import ExplicitNodes, Key
+from synth.symbolic.stepreach import StepReach
 from synth.symbolic.stepsync import StepSync
 from synth.symbolic.steps import Unsupported, unsupported
 from synth.symbolic.supervisor import SymbolicSupervisor
-from synth.validation.analysis import Analysis
+from synth.validation.analysis import Analysis, Trace
 from synth.validation.diagnosis import diagnose_all
 from synth.validation.result import Validation, home_conditions
-from synth.validation.sync import Sync
+from synth.validation.sync import Edge, Sync
 
 __all__ = ["validate_steps", "MAX_HELD_ASKED"]
 
 MAX_HELD_ASKED = 1000
+"""Above this many listed nodes the held set is computed at once (else node by node)."""
+
+PathKey = tuple[tuple[int, int, int], ...]  # a shortest path, in the explicit exploration's order
 """Above this many listed nodes the per-situation engine computes the held set at once."""
 
 
@@ -96,35 +100,72 @@ def validate_steps(
     except Unsupported:
         return None
     false = s.false
+    r = StepReach(s)
+    ex = ExplicitNodes(s.helper, oracle)
+    initial_keys = r.listed(s.initial)
+    initial = tuple(ex.node(k) for k in initial_keys)
     home = _homes(s, homes, p, g)
     back = s.backward(home)
-    if (s.nodes & ~back) != false or (s.nodes & s.refused) != false:
-        return None  # blocking or prohibited orders: traces and components per situation
+    stuck = s.nodes & ~back
+    proh_sets = r.prohibited()
+    held = r.held() if proh_sets else None
+
+    found: list[tuple[int, PathKey, Key, list[Key]]] = []
+    by_steps: dict[tuple[str, ...], Function] = {}
+    for (steps, _), u in proh_sets.items():
+        assert held is not None
+        v = u & held
+        if v != false:
+            by_steps[steps] = by_steps.get(steps, false) | v
+    for u in by_steps.values():
+        key, depth, path = r.first_node(u)
+        found.append((depth, path, key, r.listed(u)))
+    for comp in r.terminal_components(stuck):
+        if all(sit.steps in by_steps for sit in r.situations_of(comp)):
+            continue
+        key, depth, path = r.first_node(comp)
+        found.append((depth, path, key, r.listed(comp)))
+    found.sort(key=lambda f: (f[0], f[1]))
+    blocking: list[int] = []
+    components: dict[int, tuple[int, ...]] = {}
+    traces: dict[int, Trace] = {}
+    no_return: dict[int, int] = {}
+    for _, _, key, members in found:
+        b = ex.node(key)
+        blocking.append(b)
+        components[b] = tuple(sorted(ex.node(k) for k in members))
+        traces[b] = _trace(r, ex, key)
+        no_return[b] = next((n for n in traces[b].nodes if (r.cube(_keys(ex)[n]) & back) == false), b)
+    firsts: dict[Key, tuple[int, PathKey]] = {}
+    for u in proh_sets.values():
+        key, depth, path = r.first_node(u)
+        firsts[key] = (depth, path)
+    prohibited = [ex.node(k) for k in sorted(firsts, key=lambda k: firsts[k])]
+    for i in prohibited:
+        traces.setdefault(i, _trace(r, ex, _keys(ex)[i]))
     assert s.initial_situation is not None
-    first = s.steps.cube(s.initial_situation)
-    if (s.enc.exists(s.nodes, Copy.CURRENT) & ~first) == false:
-        return None  # never leaves its initial steps: one node per situation is shown
-    initial_states = list(s.enc.states(s.steps.exists(s.initial, Copy.CURRENT), MAX_LISTED))
-    if len(initial_states) > MAX_HELD_ASKED:
-        return None
-    s.helper.situation(s.initial_situation)  # situation 0 of the explicit nodes
-    ex = ExplicitNodes(s.helper, oracle)
-    initial = tuple(ex.node((0, local)) for local in initial_states)
-    cubes = [first & s.enc.state(local) for local in initial_states]
+    never = all(sit.steps == s.initial_situation.steps for sit in r.situations_of(s.nodes))
+    if never:  # the explicit diagnosis reads the situation of every node: one node per situation
+        for sit in r.situations_of(s.nodes):
+            ex.node((s.helper.situation(sit), s.enc.one(r.within(s.nodes, sit))))
     stats = {
         "plant_states": p.size,
         "sync_states": s.sync_states,
         "aggregated_states": s.aggregated_states,
         "aggregated_transitions": s.edge_count,
     }
-    sync = Sync(p, oracle, machine, tuple(ex.nodes), (), initial, (), stats["sync_states"])
+    sync = Sync(p, oracle, machine, tuple(ex.nodes), tuple(ex.edges), initial, (), stats["sync_states"])
+    keys = _keys(ex)
+    cubes = [r.cube(keys[i]) for i in range(len(ex.nodes))]
+    if held is None and len(cubes) > MAX_HELD_ASKED:
+        held = r.held()
     analysis = Analysis(
-        (), {}, {},
+        tuple(blocking), traces, no_return,
         frozenset(i for i, u in enumerate(cubes) if (u & back) != false),
-        (), {},
+        tuple(prohibited), components,
         frozenset(i for i, u in enumerate(cubes) if (u & home) != false),
-        frozenset(i for i, u in enumerate(cubes) if s.held(u)),
-        False,
+        frozenset(i for i, u in enumerate(cubes) if ((u & held) != false if held is not None else s.held(u))),
+        never,
     )
     diagnoses, never_d, prohibitions = diagnose_all(sync, analysis, expert=expert)
     elements = p.elements
@@ -134,3 +175,18 @@ def validate_steps(
     return Validation(rs, p, g, sync, analysis, diagnoses, expert, not oracle.kept(p.initial), tuple(homes), never_d,
                       prohibitions, counts=stats, reached_steps=s.reached_steps(), engine_stats=engine_stats)
 
+
+
+def _keys(ex: ExplicitNodes) -> dict[int, Key]:
+    return {v: k for k, v in ex.index.items()}
+
+
+def _trace(r: StepReach, ex: ExplicitNodes, key: Key) -> Trace:
+    """The trace to ``key`` (:meth:`StepReach.shortest_trace`), its nodes and edges made explicit."""
+    path = r.shortest_trace(key)
+    ids = [ex.node(k) for k in path.nodes]
+    for a, e, b in zip(ids, path.events, ids[1:]):
+        if (a, e, b) not in ex._edges:
+            ex._edges.add((a, e, b))
+            ex.edges.append(Edge(a, e, b))
+    return Trace(tuple(ids), tuple(path.events))
