@@ -30,7 +30,7 @@ Example
 >>> r = StepReach(step_sync(p, rs.constraints, GrafcetMachine(g)))
 >>> stuck = r.s.nodes & ~r.s.backward(r.s.initial)
 >>> [len(r.listed(c)) for c in r.terminal_components(stuck)]
-[1]
+[2]
 """
 
 from __future__ import annotations

@@ -33,8 +33,11 @@ Example
 >>> from synth.grafcet.language_check import load_grafcet
 >>> from synth.grafcet.machine import GrafcetMachine
 >>> p = plant(load_rules(_plants("tri.rules")))
->>> m = GrafcetMachine(load_grafcet(_plants("../grafcets/tri.g7"), inputs=p.inputs, outputs=p.outputs))
->>> unsupported(m, p) is None
+>>> unsupported(GrafcetMachine(load_grafcet(_plants("../grafcets/tri.g7"), inputs=p.inputs, outputs=p.outputs)), p)
+'timers'
+>>> p = plant(load_rules(_plants("../tests/data/home/cylinder.rules")))
+>>> g = load_grafcet(_plants("../tests/data/home/production_loop.g7"), inputs=p.inputs, outputs=p.outputs)
+>>> unsupported(GrafcetMachine(g), p) is None
 True
 """
 

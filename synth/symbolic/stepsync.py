@@ -26,12 +26,14 @@ Example
 >>> from synth.plant.composition import plant, _plants
 >>> from synth.grafcet.language_check import load_grafcet
 >>> from synth.grafcet.machine import GrafcetMachine
->>> rs = load_rules(_plants("tri.rules"))
+>>> rs = load_rules(_plants("../tests/data/home/cylinder.rules"))
 >>> p = plant(rs)
->>> m = GrafcetMachine(load_grafcet(_plants("../grafcets/tri.g7"), inputs=p.inputs, outputs=p.outputs))
+>>> m = GrafcetMachine(load_grafcet(_plants("../tests/data/home/production_loop.g7"), inputs=p.inputs, outputs=p.outputs))
 >>> s = step_sync(p, rs.constraints, m)
->>> s.aggregated_states > 0, s.backward(s.initial) == s.nodes
-(True, True)
+>>> s.sync_states, s.aggregated_states, s.edge_count, s.situations
+(17, 9, 21, 3)
+>>> s.backward(s.initial) == s.nodes  # a livelock: the initial node is never met again
+False
 """
 
 from __future__ import annotations
