@@ -20,7 +20,7 @@ The reading of IEC 60848 is the machine's (:class:`~synth.grafcet.machine.Grafce
 
 What this encoding does not cover raises :class:`Unsupported`, and the caller falls back
 to the per-situation engine (:mod:`synth.symbolic.sync`), which calls the machine on
-each situation: stored actions, assignments, conditional or event actions, timers,
+each situation: stored actions, assignments, event actions, timers,
 internal variables, ``--semantics sfc`` (:func:`unsupported`), and, met while exploring,
 transitions leaving one step fired in the same round (an OR-divergence conflict the
 report must show) or a search for stability longer than :data:`MAX_ROUNDS` rounds (a
@@ -46,10 +46,10 @@ from __future__ import annotations
 from functools import partial
 from typing import Mapping, cast
 
-from synth.grafcet.language import CONTINUOUS, Semantics
+from synth.grafcet.language import CONDITIONAL, CONTINUOUS, Semantics
 from synth.grafcet.machine import GrafcetMachine, Situation
 from synth.grafcet.recorder import InputRecorder
-from synth.grafcet.situation import sorted_steps
+from synth.grafcet.situation import CompiledFn, sorted_steps
 from synth.logic.bdd import Engine, Function
 from synth.logic.events import Event
 from synth.logic.expr import Var, names
@@ -83,10 +83,12 @@ def unsupported(machine: GrafcetMachine, p: Plant) -> str | None:
         return "internal variables"
     for s in g.steps:
         for a in s.actions:
-            if a.kind != CONTINUOUS:
+            if a.kind not in (CONTINUOUS, CONDITIONAL):
                 return f"{a.kind} actions"
     if any(n not in p.owner for n in machine.inputs):
         return "Grafcet inputs that are not plant variables"
+    if set(machine.inputs) & set(p.outputs):  # a region move would change what the machine reads
+        return "Grafcet inputs that are orders"
     return None
 
 
@@ -176,11 +178,15 @@ class StepEncoding:
         return Situation(sorted_steps({s for s in self.steps if active.get(step_name(s), False)}))
 
     def orders(self) -> dict[str, Function]:
-        """Per order some step emits, the situations emitting it (continuous actions only)."""
+        """Per order some step emits, where it is emitted (X, x): its step active, and for a
+        conditional action its condition true (the machine's compiled condition, on cells)."""
         out: dict[str, Function] = {}
         for s in self.machine.grafcet.steps:
-            for a in s.actions:
-                out[a.order] = out.get(a.order, self.engine.false) | self.var(s.name)
+            for i, a in enumerate(s.actions):
+                where = self.var(s.name)
+                if a.kind == CONDITIONAL:
+                    where &= self._cells(self.machine._cond[(s.name, i)], None)
+                out[a.order] = out.get(a.order, self.engine.false) | where
         return out
 
     # ---- receptivities, from the machine's compiled functions on recorded cells
@@ -190,24 +196,28 @@ class StepEncoding:
         key = (i, event)
         hit = self._recs.get(key)
         if hit is None:
-            fn = self.machine._rec[i]
-            true = false = self.engine.false
-            rest = self.engine.true
-            while rest != self.engine.false:
-                point = _walk(self.engine, rest)
-                inputs = InputRecorder(partial(_inputs, point, self.inputs))
-                steps = _Steps({s: point.get(step_name(s), False) for s in self.steps})
-                answer = fn(inputs, cast(frozenset[str], steps), frozenset(), event, {})
-                cell = self.engine.cube({**inputs.cell(), **{step_name(s): steps.values.get(s, False) for s in steps.read}})
-                if answer:
-                    true |= cell
-                else:
-                    false |= cell
-                rest &= ~cell
-            hit = self._recs[key] = true
+            hit = self._recs[key] = self._cells(self.machine._rec[i], event)
         if copy is Copy.CURRENT:
             return hit
         return self.rename(hit, Copy.CURRENT, copy)
+
+    def _cells(self, fn: CompiledFn, event: Event | None) -> Function:
+        """Where the machine's compiled ``fn`` (a receptivity or an action's condition)
+        holds after ``event``, over the inputs (plant, current copy) and the step variables
+        (current copy): the union of the cubes of recorded inputs and steps where a call
+        answered true, calls repeated until the cubes cover every valuation."""
+        true = self.engine.false
+        rest = self.engine.true
+        while rest != self.engine.false:
+            point = _walk(self.engine, rest)
+            inputs = InputRecorder(partial(_inputs, point, self.inputs))
+            steps = _Steps({s: point.get(step_name(s), False) for s in self.steps})
+            answer = fn(inputs, cast(frozenset[str], steps), frozenset(), event, {})
+            cell = self.engine.cube({**inputs.cell(), **{step_name(s): steps.values.get(s, False) for s in steps.read}})
+            if answer:
+                true |= cell
+            rest &= ~cell
+        return true
 
     def _round(self, event: Event | None) -> tuple[Function, Function, list[tuple[Function, Function]]]:
         """For one round (``event``: its edge, None after the first round): the states
