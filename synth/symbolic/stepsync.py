@@ -82,6 +82,8 @@ class StepSync:
         self.edges: list[tuple[Move, Function]] = []
         self.rings: list[Function] = []  # the nodes by distance from the initial nodes (the levels)
         self.refused_by: dict[Event, Function] = {}  # per order event, where SUP refuses it (X, x)
+        self.region_moves: list[Function] = []  # per element, its region moves (X, x, x', x''), x the entry
+        self.pairs: Function = self.false  # (X, n, x'): entries and their region's states, without a closure
         self.edge_count = 0
         self._inputs = frozenset(n for n in machine.inputs if n in self.plant.owner)
         self._moves = tuple(m for m in sup.moves if not m.controllable)
@@ -91,18 +93,21 @@ class StepSync:
         self.closure, self.moving, self.refused = self._regions()
 
     # ---- regions
-    def _regions(self) -> tuple[Function, Function, Function]:
-        """``closure(X, x, x')``: x' reachable from x by region moves under the orders of X;
-        ``moving(X, x)``: a region move is left; ``refused(X, x)``: SUP refuses an order's
-        move that X emits (a prohibited order)."""
+    def _regions(self) -> tuple[Function | None, Function, Function]:
+        """``closure(X, x, x')``: x' reachable from x by region moves under the orders
+        emitted in (X, x) — None when an element's region moves read other elements'
+        orders (then :meth:`_closure` walks the region moves ``self.region_moves`` per
+        entry set); ``moving(X, x)``: a region move is left; ``refused(X, x)``: SUP
+        refuses a move towards an order emitted there (a prohibited order)."""
         emitted = self.steps.orders()
         helper = self.helper
-        closure, moving, refused = self.true, self.false, self.false
+        closure: Function | None = self.true
+        moving, refused = self.false, self.false
         for axis in range(self.plant.ndim):
             own_all = sorted(helper._orders_of[axis])
             if len(own_all) > MAX_OWN_ORDERS:
                 raise Unsupported(f"an element with more than {MAX_OWN_ORDERS} orders")
-            piece = self.false
+            piece = moves = self.false
             wanted: dict[str, Function] = {o: emitted[o] if o in emitted else self.false for o in own_all}
             for bits in range(1 << len(own_all)):
                 own = frozenset(o for k, o in enumerate(own_all) if bits >> k & 1)
@@ -112,18 +117,44 @@ class StepSync:
                 rel, can, bad = helper._element_intra(axis, own)
                 others = helper._other_orders[axis]
                 if rel != self.false and any(n in others for n in self.engine.support(rel)):
-                    raise Unsupported("region moves that read other elements' orders")
-                piece |= select & helper._element_region(axis, rel)
+                    closure = None
+                if closure is not None:
+                    piece |= select & helper._element_region(axis, rel)
+                moves |= select & rel
                 moving |= select & can
                 for event, b in bad.items():
                     refused |= select & b
                     self.refused_by[event] = self.refused_by.get(event, self.false) | (select & b)
-            closure &= piece
+            self.region_moves.append(moves)
+            if closure is not None:
+                closure &= piece
         return closure, moving, refused
+
+    def _closure(self, entries: Function) -> Function:
+        """The pairs (X, n, x') of ``entries`` (X, n) and the states x' their region
+        reaches (forward over the region moves, element by element), without a
+        precomputed closure."""
+        reach = frontier = entries & self.helper.equal
+        while frontier != self.false:
+            new = self.false
+            for axis, moves in enumerate(self.region_moves):
+                if moves == self.false:
+                    continue
+                names = self.enc.element_variables[axis]
+                step = self.enc.and_exists(frontier, moves, Copy.NEXT, names)
+                new |= self.enc.rename(step, Copy.AUX, Copy.NEXT, names)
+            frontier = new & ~reach
+            reach |= frontier
+        return reach
 
     def _enter(self, entries: Function) -> Function:
         """Settle ``entries`` (X, n): their members join ``members``; the settled states."""
-        members = self.enc.rename(self.enc.and_exists(entries, self.closure, Copy.CURRENT), Copy.NEXT, Copy.CURRENT)
+        if self.closure is None:
+            pairs = self._closure(entries)
+            self.pairs |= pairs
+            members = self.enc.rename(self.enc.exists(pairs, Copy.CURRENT), Copy.NEXT, Copy.CURRENT)
+        else:
+            members = self.enc.rename(self.enc.and_exists(entries, self.closure, Copy.CURRENT), Copy.NEXT, Copy.CURRENT)
         self.members |= members
         return members & ~self.moving
 
@@ -157,12 +188,13 @@ class StepSync:
             self.enc.check(f"exploring level {level} of SYNC")
             if self.progress is not None and level % 10 == 0:
                 self.progress(f"exploring SYNC symbolically: level {level}, {live_nodes(self.engine)} BDD nodes")
-        settled = self.closure & ~self.enc.rename(self.moving, Copy.CURRENT, Copy.NEXT)
+        settled = (self.pairs if self.closure is None else self.closure) & ~self.enc.rename(self.moving, Copy.CURRENT, Copy.NEXT)
         target = self.steps.rename(settled, Copy.CURRENT, Copy.NEXT)  # (X', n, x')
         for key in sorted(self.reacted):
             m, r = self.reacted[key]
             self.edges.append((m, flipped(self.enc, r & target, m)))
         self.reacted = {}
+        self.pairs = self.false
         self.edge_count = sum(self.count(e, self._current + self._next) for _, e in self.edges)
         return self
 

@@ -95,9 +95,16 @@ def validate_steps(
     per-situation engine must run (see module docstring)."""
     if unsupported(machine, p) is not None:
         return None
+    if not oracle.kept(p.initial):  # SUP is empty: nothing to explore
+        sync = Sync(p, oracle, machine)
+        stats = {"plant_states": p.size, "sync_states": 0, "aggregated_states": 0, "aggregated_transitions": 0}
+        return Validation(rs, p, g, sync, Analysis((), {}, {}, frozenset(), (), {}), {}, expert, True, tuple(homes), None,
+                          counts=stats, reached_steps=frozenset(), engine_stats=_engine_stats(sup, 0))
     try:
         s = StepSync(sup, machine, progress).explore()
     except Unsupported:
+        return None
+    if s.initial == s.false:  # the initial region never settles: the per-situation engine's report
         return None
     false = s.false
     r = StepReach(s)
@@ -168,12 +175,15 @@ def validate_steps(
         never,
     )
     diagnoses, never_d, prohibitions = diagnose_all(sync, analysis, expert=expert)
-    elements = p.elements
-    engine_stats: dict[str, int | list[str]] = {
-        "bdd_nodes": live_nodes(s.engine), "situations": s.situations,
-        "variable_order": [elements[a].name for a in s.enc.order]}
-    return Validation(rs, p, g, sync, analysis, diagnoses, expert, not oracle.kept(p.initial), tuple(homes), never_d,
-                      prohibitions, counts=stats, reached_steps=s.reached_steps(), engine_stats=engine_stats)
+    return Validation(rs, p, g, sync, analysis, diagnoses, expert, False, tuple(homes), never_d, prohibitions,
+                      counts=stats, reached_steps=s.reached_steps(), engine_stats=_engine_stats(sup, s.situations))
+
+
+def _engine_stats(sup: SymbolicSupervisor, situations: int) -> dict[str, int | list[str]]:
+    """As :func:`synth.symbolic.validate._stats`: live BDD nodes, stable situations, element order."""
+    elements = sup.plant.elements
+    return {"bdd_nodes": live_nodes(sup.enc.engine), "situations": situations,
+            "variable_order": [elements[a].name for a in sup.enc.order]}
 
 
 
