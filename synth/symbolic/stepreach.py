@@ -159,7 +159,7 @@ class StepReach:
         layers = [self.false] * (depth + 1)
         layers[depth] = target & rings[depth]
         for k in range(depth - 1, -1, -1):
-            layers[k] = self.s.pre(layers[k + 1]) & rings[k]
+            layers[k] = self.s.pre(layers[k + 1], within=rings[k])
         return layers
 
     def _greedy(self, layers: list[Function], order: Callable[[Move], Order]) -> tuple[list[Function], list[Event], list[Order]]:
@@ -167,12 +167,14 @@ class StepReach:
         chosen, events, keys = [current], [], []
         for k in range(1, len(layers)):
             options: dict[Order, tuple[Event, Function]] = {}
+            target = self.s._primed(layers[k])
             for m, e in self.s.edges:
-                v = self.s.post(current, [e]) & layers[k]
+                v = self.s.image(current, m, e) & target
                 if v != self.false:
                     options[order(m)] = (m.event, v)
             best = min(options)
             event, current = options[best]
+            current = self.s.unprimed(current)
             events.append(event)
             keys.append(best)
             chosen.append(current)
@@ -204,7 +206,7 @@ class StepReach:
         chosen, events, _ = self._greedy(self._layers(node, depth), lambda m: m.event)
         nodes = [key]
         for k in range(depth - 1, -1, -1):
-            arcs = [e for m, e in self.s.edges if m.event == events[k]]
+            arcs = [(m, e) for m, e in self.s.edges if m.event == events[k]]
             nodes.append(self.pick(self.s.pre(self.cube(nodes[-1]), arcs) & chosen[k]))
         nodes.reverse()
         return Path(tuple(nodes), tuple(events))

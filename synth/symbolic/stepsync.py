@@ -228,20 +228,35 @@ class StepSync:
     def _primed(self, u: Function) -> Function:
         return self.enc.rename(self.steps.rename(u, Copy.CURRENT, Copy.NEXT), Copy.CURRENT, Copy.NEXT)
 
-    def pre(self, u: Function, edges: Sequence[Function] | None = None) -> Function:
-        """Nodes with an edge (of ``edges``, default all) into ``u``."""
+    def pre(self, u: Function, edges: Sequence[tuple[Move, Function]] | None = None,
+            within: Function | None = None) -> Function:
+        """Nodes (of ``within``, default all) with an edge (of ``edges``, default all) into
+        ``u``. An edge of a move ends where its flipped variable has its new value (region
+        moves flip orders only): the others are skipped without a relational product."""
         target = self._primed(u)
         out = self.false
-        for e in (self._edge_relations if edges is None else edges):
-            out |= self.engine.and_exists(e, target, self._next)
+        for m, e in (self.edges if edges is None else edges):
+            if (u & m.after) != self.false:
+                found = self.engine.and_exists(e, target, self._next)
+                out |= found if within is None else found & within
         return out
 
-    def post(self, u: Function, edges: Sequence[Function] | None = None) -> Function:
+    def image(self, u: Function, m: Move, e: Function) -> Function:
+        """Targets of the edges ``e`` of move ``m`` from ``u``, in the next copies."""
+        if (u & m.guard) == self.false:
+            return self.false
+        return self.engine.and_exists(e, u, self._current)
+
+    def unprimed(self, u: Function) -> Function:
+        """``u`` from the next copies (plant and steps) to the current ones."""
+        return self.enc.rename(self.steps.rename(u, Copy.NEXT, Copy.CURRENT), Copy.NEXT, Copy.CURRENT)
+
+    def post(self, u: Function, edges: Sequence[tuple[Move, Function]] | None = None) -> Function:
         """Nodes an edge (of ``edges``, default all) leads to from ``u``."""
         out = self.false
-        for e in (self._edge_relations if edges is None else edges):
-            out |= self.engine.and_exists(e, u, self._current)
-        return self.enc.rename(self.steps.rename(out, Copy.NEXT, Copy.CURRENT), Copy.NEXT, Copy.CURRENT)
+        for m, e in (self.edges if edges is None else edges):
+            out |= self.image(u, m, e)
+        return self.unprimed(out)
 
     @property
     def _edge_relations(self) -> list[Function]:
