@@ -164,3 +164,20 @@ def test_receptivity_from_the_machines_cells():
     assert st.receptivity(0, Event.rise("v0"), Copy.CURRENT) == ~e.var("v1")
     assert st.receptivity(0, None, Copy.NEXT) == ~e.var("v1")
     assert st.receptivity(1, None, Copy.CURRENT) == e.var("v0")
+
+
+@pytest.mark.parametrize("variant", [1, pytest.param(2, marks=pytest.mark.nightly)], ids=["branches_3x2", "branches_3x2_missing"])
+def test_ties_as_the_per_situation_path(variant, tmp_path, monkeypatch):
+    """``branches_3x2`` meets the known ties (docs/symbolic.md): the step path breaks them
+    by the smallest situation, then state, and prints the per-situation path's report."""
+    from gen_branches import write_branches
+
+    paths = write_branches(3, 2, tmp_path)
+    rules, grafcet = paths[0], paths[variant]
+    taken = _probe(monkeypatch)
+    steps = validate_symbolic(grafcet, rules)
+    monkeypatch.setattr(symbolic_validate, "unsupported", lambda m, p: "forced")
+    per_situation = validate_symbolic(grafcet, rules)
+    assert taken == [True]
+    assert validation_text(steps) == validation_text(per_situation)
+    assert not steps.passed and steps.stats == per_situation.stats
