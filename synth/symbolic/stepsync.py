@@ -80,6 +80,7 @@ class StepSync:
         self.initial_situation: Situation | None = None
         self.reacted: dict[int, tuple[Move, Function]] = {}
         self.edges: list[tuple[Move, Function]] = []
+        self.links: list[tuple[Function, Function]] = []  # per element, (where its edges end, their union)
         self.rings: list[Function] = []  # the nodes by distance from the initial nodes (the levels)
         self.refused_by: dict[Event, Function] = {}  # per order event, where SUP refuses it (X, x)
         self.region_moves: list[Function] = []  # per element, its region moves (X, x, x', x''), x the entry
@@ -196,6 +197,11 @@ class StepSync:
         self.reacted = {}
         self.pairs = self.false
         self.edge_count = sum(self.count(e, self._current + self._next) for _, e in self.edges)
+        by_axis: dict[int, tuple[Function, Function]] = {}  # per element: where its edges end, their union
+        for m, e in self.edges:
+            end, rel = by_axis.get(m.axis, (self.false, self.false))
+            by_axis[m.axis] = (end | m.after, rel | e)
+        self.links = [by_axis[a] for a in sorted(by_axis)]
         return self
 
     # ---- counts
@@ -235,8 +241,9 @@ class StepSync:
         moves flip orders only): the others are skipped without a relational product."""
         target = self._primed(u)
         out = self.false
-        for m, e in (self.edges if edges is None else edges):
-            if (u & m.after) != self.false:
+        arcs = self.links if edges is None else [(m.after, e) for m, e in edges]
+        for end, e in arcs:
+            if (u & end) != self.false:
                 found = self.engine.and_exists(e, target, self._next)
                 out |= found if within is None else found & within
         return out
