@@ -60,6 +60,7 @@ class StepReach:
         self.s = s
         self.false = s.false
         self.situations: list[Situation] = s.helper.situations  # the explicit nodes' numbering
+        self._cubes: dict[Key, Function] = {}
         assert s.initial_situation is not None
         s.helper.situation(s.initial_situation)  # situation 0
 
@@ -76,8 +77,12 @@ class StepReach:
         return sorted(found)
 
     def cube(self, key: Key) -> Function:
-        s, local = key
-        return self.s.steps.cube(self.situations[s]) & self.s.enc.state(local)
+        """The node ``key`` as a BDD (cached: traces and listings ask for a node again and again)."""
+        hit = self._cubes.get(key)
+        if hit is None:
+            s, local = key
+            hit = self._cubes[key] = self.s.steps.cube(self.situations[s]) & self.s.enc.state(local)
+        return hit
 
     def within(self, u: Function, sit: Situation) -> Function:
         """The plant states of ``u`` in situation ``sit``."""

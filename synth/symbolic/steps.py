@@ -145,6 +145,7 @@ class StepEncoding:
         self._fire: dict[Event | None, tuple[Function, Function, list[tuple[Function, Function]]]] = {}
         self._qvars = {c: [self.engine.declare(step_name(s, c)) for s in self.steps] for c in Copy}
         self._equal: dict[tuple[Copy, Copy], Function] = {}
+        self._cubes: dict[tuple[tuple[str, ...], Copy], Function] = {}
 
     # ---- variables
     def var(self, step: str, copy: Copy = Copy.CURRENT) -> Function:
@@ -170,8 +171,11 @@ class StepEncoding:
 
     def cube(self, sit: Situation, copy: Copy = Copy.CURRENT) -> Function:
         """The step variables of ``sit`` (its active steps, every other step inactive)."""
-        active = set(sit.steps)
-        return self.engine.cube({step_name(s, copy): s in active for s in self.steps})
+        hit = self._cubes.get((sit.steps, copy))
+        if hit is None:
+            active = set(sit.steps)
+            hit = self._cubes[(sit.steps, copy)] = self.engine.cube({step_name(s, copy): s in active for s in self.steps})
+        return hit
 
     def situation(self, active: Mapping[str, bool]) -> Situation:
         """The situation whose step variables (current copy, by BDD name) are ``active``."""
