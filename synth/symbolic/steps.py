@@ -232,6 +232,10 @@ class StepEncoding:
         hit = self._fire.get(event)
         if hit is not None:
             return hit
+        if event is not None and all(self.receptivity(i, event, Copy.CURRENT) == self.receptivity(i, None, Copy.CURRENT)
+                                     for i in range(len(self.machine.transitions))):
+            hit = self._fire[event] = self._round(None)  # no receptivity reads this edge
+            return hit
         fireable: list[Function] = []
         for i, t in enumerate(self.machine.transitions):
             enabled = self.engine.conjunction(self.var(s, Copy.NEXT) for s in t.sources)

@@ -19,7 +19,7 @@ Example
 -------
 >>> from synth.plant.composition import _plants
 >>> from synth.validation.result import load_model
->>> from synth.grafcet.machine import GrafcetMachine
+>>> from synth.grafcet.machine import GrafcetMachine, Situation
 >>> from synth.sup.constraints import CompiledConstraints
 >>> from synth.symbolic.steps import anchors
 >>> from synth.symbolic.supervisor import SymbolicSupervisor
@@ -35,7 +35,7 @@ from __future__ import annotations
 from typing import Callable, Sequence
 
 from synth.grafcet.language import Grafcet, step_variable
-from synth.grafcet.machine import GrafcetMachine
+from synth.grafcet.machine import GrafcetMachine, Situation
 from synth.logic.bdd import Function
 from synth.logic.expr import evaluate
 from synth.plant.composition import Plant
@@ -127,8 +127,9 @@ def validate_steps(
     for u in by_steps.values():
         key, depth, path = r.first_node(u)
         found.append((depth, path, key, r.listed(u)))
+    covered = s.steps.engine.disjunction(s.steps.cube(Situation(steps)) for steps in by_steps)
     for comp in r.terminal_components(stuck):
-        if all(sit.steps in by_steps for sit in r.situations_of(comp)):
+        if (r.steps_of(comp) & ~covered) == false:  # every situation of it has a prohibited order
             continue
         key, depth, path = r.first_node(comp)
         found.append((depth, path, key, r.listed(comp)))
@@ -151,7 +152,7 @@ def validate_steps(
     for i in prohibited:
         traces.setdefault(i, _trace(r, ex, _keys(ex)[i]))
     assert s.initial_situation is not None
-    never = all(sit.steps == s.initial_situation.steps for sit in r.situations_of(s.nodes))
+    never = (r.steps_of(s.nodes) & ~s.steps.cube(s.initial_situation)) == false  # situations are active steps here
     if never:  # the explicit diagnosis reads the situation of every node: one node per situation
         for sit in r.situations_of(s.nodes):
             ex.node((s.helper.situation(sit), s.enc.one(r.within(s.nodes, sit))))
