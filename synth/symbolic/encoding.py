@@ -102,7 +102,8 @@ class PlantEncoding:
     """BDD variables, domains and conversions for the states of one plant; ``constraints``
     choose the variable order (:func:`element_order`)."""
 
-    def __init__(self, p: Plant, budget: NodeBudget | None = None, constraints: Sequence[Constraint] = ()) -> None:
+    def __init__(self, p: Plant, budget: NodeBudget | None = None, constraints: Sequence[Constraint] = (),
+                 anchored: Mapping[int | None, Sequence[str]] | None = None) -> None:
         if p.reads:  # a move would depend on other elements' variables: not encoded here
             readers = ", ".join(e.name for e in p.elements if e.guards is not None and not e.guards.all())
             raise SynthError(
@@ -113,7 +114,13 @@ class PlantEncoding:
         self.budget = budget or NodeBudget()
         self.variables: tuple[str, ...] = tuple(v for e in p.elements for v in e.variables)
         self.order: tuple[int, ...] = element_order(p, constraints)
-        order = [v + c.value for a in self.order for v in p.elements[a].variables for c in Copy]
+        # ``anchored``: other variables (the Grafcet's steps, :mod:`synth.symbolic.steps`), in
+        # three copies too, declared just before the element they are anchored to (None: first)
+        extra = anchored or {}
+        order = [v + c.value for v in extra.get(None, ()) for c in Copy]
+        for a in self.order:
+            order += [v + c.value for v in extra.get(a, ()) for c in Copy]
+            order += [v + c.value for v in p.elements[a].variables for c in Copy]
         self.engine = Engine(order)
         self.bdd = self.engine.bdd
         self.element_variables: tuple[tuple[str, ...], ...] = tuple(e.variables for e in p.elements)

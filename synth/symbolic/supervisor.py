@@ -24,7 +24,7 @@ True
 from __future__ import annotations
 
 from functools import cached_property
-from typing import Callable, Sequence
+from typing import Callable, Mapping, Sequence
 
 import numpy as np
 
@@ -41,11 +41,12 @@ __all__ = ["SymbolicSupervisor", "symbolic_supervisor"]
 class SymbolicSupervisor:
     """Constraints and SUP of one plant as BDDs over a :class:`PlantEncoding`."""
 
-    def __init__(self, p: Plant, constraints: Sequence[Constraint], budget: NodeBudget | None = None) -> None:
+    def __init__(self, p: Plant, constraints: Sequence[Constraint], budget: NodeBudget | None = None,
+                 anchored: Mapping[int | None, Sequence[str]] | None = None) -> None:
         self.plant = p
         self.constraints = tuple(constraints)
         self.compiled = CompiledConstraints(p, constraints)
-        self.enc = PlantEncoding(p, budget, self.constraints)
+        self.enc = PlantEncoding(p, budget, self.constraints, anchored)
         self.moves: tuple[Move, ...] = plant_moves(self.enc)
         self.states: Function = self.enc.engine.false
 

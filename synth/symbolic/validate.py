@@ -43,6 +43,9 @@ from synth.symbolic.reachability import (
     stuck_nodes,
     terminal_components,
 )
+from synth.symbolic.explicit import ExplicitNodes, Key
+from synth.symbolic.steps import anchors, unsupported
+from synth.symbolic.stepvalidate import validate_steps
 from synth.symbolic.supervisor import SymbolicSupervisor
 from synth.symbolic.graph import NodeSet
 from synth.symbolic.sync import SymbolicSync
@@ -54,56 +57,7 @@ from synth.validation.result import Validation, home_conditions, load_model
 
 __all__ = ["validate_symbolic", "validate_loaded"]
 
-Key = tuple[int, tuple[int, ...]]  # a node: situation, plant state
 PathKey = tuple[tuple[int, int, int], ...]  # a shortest path, in the explicit exploration's order
-
-
-class _Explicit:
-    """The explicit nodes and edges a report needs, numbered as they are asked for."""
-
-    def __init__(self, ssync: SymbolicSync, oracle: CompiledConstraints) -> None:
-        self.ssync = ssync
-        self.p: Plant = ssync.plant
-        self.oracle = oracle
-        self.moves = _order_moves(self.p)
-        self.nodes: list[Node] = []
-        self.index: dict[Key, int] = {}
-        self.edges: list[Edge] = []
-        self._edges: set[tuple[int, str, int]] = set()
-
-    def node(self, key: Key) -> int:
-        i = self.index.get(key)
-        if i is not None:
-            return i
-        s, local = key
-        sit = self.ssync.situations[s]
-        machine = self.ssync.machine
-        inputs = {n: v for n, v in self.p.valuation(local).items() if n in machine.inputs}
-        wanted = machine.orders(sit, inputs)
-        val = self.p.valuation(local)
-        refused: list[Prohibition] = []
-        for order in sorted(self.moves):
-            if val[order] == (order in wanted):
-                continue
-            for t in self.moves[order]:
-                if t.src != local[t.axis]:
-                    continue
-                ok, why = self.oracle.move(t, local)
-                if not ok:
-                    refused.append(Prohibition(t.event, tuple(why)))
-        ords = tuple(sorted(o for o in wanted if val.get(o, False)))
-        self.index[key] = len(self.nodes)
-        self.nodes.append(Node(sit, local, frozenset(wanted), ords, tuple(sorted(refused))))
-        return self.index[key]
-
-    def trace(self, key: Key) -> Trace:
-        path = shortest_trace(self.ssync, *key)
-        ids = [self.node(k) for k in path.nodes]
-        for a, e, b in zip(ids, path.events, ids[1:]):
-            if (a, e, b) not in self._edges:
-                self._edges.add((a, e, b))
-                self.edges.append(Edge(a, e, b))
-        return Trace(tuple(ids), tuple(path.events))
 
 
 def _homes(ssync: SymbolicSync, texts: Sequence[str], p: Plant, g: Grafcet) -> NodeSet:
@@ -193,9 +147,14 @@ def _validate_loaded(
     machine = GrafcetMachine(g)
     oracle = CompiledConstraints(p, rs.constraints)
     sup_empty = not oracle.kept(p.initial)
-    sup = SymbolicSupervisor(p, rs.constraints, NodeBudget(max_nodes))
+    stepwise = unsupported(machine, p) is None  # the steps in the BDD: no loop over situations
+    sup = SymbolicSupervisor(p, rs.constraints, NodeBudget(max_nodes), anchors(machine, p) if stepwise else None)
+    if stepwise:
+        passed = validate_steps(rs, p, g, sup, machine, oracle, expert=expert, homes=homes, progress=progress)
+        if passed is not None:
+            return passed
     ssync = SymbolicSync(sup, machine, progress=progress).explore()
-    ex = _Explicit(ssync, oracle)
+    ex = ExplicitNodes(ssync, oracle)
     false = ssync.false
     stats = {
         "plant_states": p.size,
@@ -281,7 +240,7 @@ def _validate_loaded(
                       counts=stats, reached_steps=reached, engine_stats=_stats(ssync))
 
 
-def _held_listed(ssync: SymbolicSync, held: NodeSet | None, ex: _Explicit, keys: dict[int, Key]) -> frozenset[int]:
+def _held_listed(ssync: SymbolicSync, held: NodeSet | None, ex: ExplicitNodes, keys: dict[int, Key]) -> frozenset[int]:
     """The listed nodes that are held: read from ``held`` when it was computed (a
     prohibited order made it necessary) or when many nodes are listed, else asked node by
     node (a forward search that stops at the first change of active steps)."""
@@ -300,7 +259,7 @@ def _is_in(ssync: SymbolicSync, u: NodeSet, key: Key) -> bool:
     return s in u and (u[s] & ssync.enc.state(local)) != ssync.false
 
 
-def _one_per_situation(ssync: SymbolicSync, ex: _Explicit) -> None:
+def _one_per_situation(ssync: SymbolicSync, ex: ExplicitNodes) -> None:
     for s, r in enumerate(ssync.regions):
         if r.nodes != ssync.false:
             ex.node((s, ssync.enc.one(r.nodes)))

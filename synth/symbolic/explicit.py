@@ -1,0 +1,84 @@
+"""The explicit nodes and edges a symbolic report shows.
+
+Both symbolic paths (:mod:`synth.symbolic.validate`, :mod:`synth.symbolic.stepvalidate`)
+decide on BDDs, then make explicit :class:`~synth.validation.sync.Node` objects of the
+few nodes a report shows (initial nodes, trace nodes, component members), numbered as
+they are asked for, so the existing diagnosis and output run on a small
+:class:`~synth.validation.sync.Sync` unchanged.
+
+Example
+-------
+>>> from synth.plant.rules_check import load_rules
+>>> from synth.plant.composition import plant, _plants
+>>> from synth.grafcet.language_check import load_grafcet
+>>> from synth.grafcet.machine import GrafcetMachine
+>>> from synth.sup.constraints import CompiledConstraints
+>>> from synth.symbolic.sync import symbolic_sync
+>>> rs = load_rules(_plants("tri.rules"))
+>>> p = plant(rs)
+>>> s = symbolic_sync(p, rs.constraints, GrafcetMachine(load_grafcet(_plants("../grafcets/tri.g7"), inputs=p.inputs, outputs=p.outputs)))
+>>> ex = ExplicitNodes(s, CompiledConstraints(p, rs.constraints))
+>>> ex.node((0, p.initial)), ex.node((0, p.initial)), len(ex.nodes)
+(0, 0, 1)
+"""
+
+from __future__ import annotations
+
+from synth.plant.composition import Plant
+from synth.sup.constraints import CompiledConstraints
+from synth.symbolic.reachability import shortest_trace
+from synth.symbolic.sync import SymbolicSync
+from synth.validation.analysis import Trace
+from synth.validation.sync import Edge, Node, Prohibition, _order_moves
+
+__all__ = ["ExplicitNodes", "Key"]
+
+Key = tuple[int, tuple[int, ...]]  # a node: situation, plant state
+
+
+class ExplicitNodes:
+    """The explicit nodes and edges a report needs, numbered as they are asked for."""
+
+    def __init__(self, ssync: SymbolicSync, oracle: CompiledConstraints) -> None:
+        self.ssync = ssync
+        self.p: Plant = ssync.plant
+        self.oracle = oracle
+        self.moves = _order_moves(self.p)
+        self.nodes: list[Node] = []
+        self.index: dict[Key, int] = {}
+        self.edges: list[Edge] = []
+        self._edges: set[tuple[int, str, int]] = set()
+
+    def node(self, key: Key) -> int:
+        i = self.index.get(key)
+        if i is not None:
+            return i
+        s, local = key
+        sit = self.ssync.situations[s]
+        machine = self.ssync.machine
+        inputs = {n: v for n, v in self.p.valuation(local).items() if n in machine.inputs}
+        wanted = machine.orders(sit, inputs)
+        val = self.p.valuation(local)
+        refused: list[Prohibition] = []
+        for order in sorted(self.moves):
+            if val[order] == (order in wanted):
+                continue
+            for t in self.moves[order]:
+                if t.src != local[t.axis]:
+                    continue
+                ok, why = self.oracle.move(t, local)
+                if not ok:
+                    refused.append(Prohibition(t.event, tuple(why)))
+        ords = tuple(sorted(o for o in wanted if val.get(o, False)))
+        self.index[key] = len(self.nodes)
+        self.nodes.append(Node(sit, local, frozenset(wanted), ords, tuple(sorted(refused))))
+        return self.index[key]
+
+    def trace(self, key: Key) -> Trace:
+        path = shortest_trace(self.ssync, *key)
+        ids = [self.node(k) for k in path.nodes]
+        for a, e, b in zip(ids, path.events, ids[1:]):
+            if (a, e, b) not in self._edges:
+                self._edges.add((a, e, b))
+                self.edges.append(Edge(a, e, b))
+        return Trace(tuple(ids), tuple(path.events))

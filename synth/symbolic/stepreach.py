@@ -1,0 +1,218 @@
+"""Findings on the SYNC over (steps, plant state): components, first nodes, shortest traces.
+
+The reading of :mod:`synth.symbolic.reachability`, on one BDD per set instead of one BDD
+per situation (:class:`~synth.symbolic.stepsync.StepSync`):
+
+- the onion rings are the exploration's levels (a level is exactly the nodes one edge
+  beyond the previous ones not met before);
+- *terminal components* of the stuck nodes by descent (from a node of the deepest ring,
+  its forward set is terminal iff every node of it comes back);
+- the *first node* of a set: least distance, then the shortest path smallest in the
+  explicit exploration's order of events (element, variable), layer by layer; the
+  *trace* to a node: the shortest path smallest by event name (the explicit
+  breadth-first search's parent choice);
+- a node is named ``(situation index, plant state)`` for
+  :class:`~synth.symbolic.explicit.ExplicitNodes`, the situations numbered as they are
+  named (the initial one first); where several nodes tie (the known differences of
+  docs/symbolic.md), the smallest situation by its active steps (false before true,
+  step declaration order), then the smallest plant state (declaration order) is taken.
+
+Example
+-------
+>>> from synth.plant.rules_check import load_rules
+>>> from synth.plant.composition import plant, _plants
+>>> from synth.grafcet.language_check import load_grafcet
+>>> from synth.grafcet.machine import GrafcetMachine
+>>> from synth.symbolic.stepsync import step_sync
+>>> rs = load_rules(_plants("../tests/data/home/cylinder.rules"))
+>>> p = plant(rs)
+>>> g = load_grafcet(_plants("../tests/data/home/no_restart.g7"), inputs=p.inputs, outputs=p.outputs)
+>>> r = StepReach(step_sync(p, rs.constraints, GrafcetMachine(g)))
+>>> stuck = r.s.nodes & ~r.s.backward(r.s.initial)
+>>> [len(r.listed(c)) for c in r.terminal_components(stuck)]
+[2]
+"""
+
+from __future__ import annotations
+
+from typing import Callable, TypeVar
+
+from synth.errors import LimitExceeded
+from synth.grafcet.machine import Situation
+from synth.logic.bdd import Function
+from synth.logic.events import Event
+from synth.symbolic.encoding import Copy
+from synth.symbolic.explicit import Key
+from synth.symbolic.reachability import MAX_LISTED, Path
+from synth.symbolic.relation import Move
+from synth.symbolic.steps import step_name
+from synth.symbolic.stepsync import StepSync
+
+__all__ = ["StepReach"]
+
+Order = TypeVar("Order", tuple[int, int, int], Event)  # how events are ordered: by plant transition, or by name
+
+
+class StepReach:
+    """Named nodes and the searches the findings need, on an explored :class:`StepSync`."""
+
+    def __init__(self, s: StepSync) -> None:
+        self.s = s
+        self.false = s.false
+        self.situations: list[Situation] = s.helper.situations  # the explicit nodes' numbering
+        self._cubes: dict[Key, Function] = {}
+        assert s.initial_situation is not None
+        s.helper.situation(s.initial_situation)  # situation 0
+
+    # ---- naming nodes
+    def steps_of(self, u: Function) -> Function:
+        """The situations of ``u`` (the plant state quantified)."""
+        return self.s.enc.exists(u, Copy.CURRENT)
+
+    def situations_of(self, u: Function) -> list[Situation]:
+        """The situations of ``u``, sorted."""
+        st = self.s.steps
+        found = [st.situation({st.engine.name_of(v): bool(b) for v, b in point.items()})
+                 for point in st.engine.bdd.pick_iter(self.steps_of(u), care_vars=st.names(Copy.CURRENT))]
+        return sorted(found)
+
+    def cube(self, key: Key) -> Function:
+        """The node ``key`` as a BDD (cached: traces and listings ask for a node again and again)."""
+        hit = self._cubes.get(key)
+        if hit is None:
+            s, local = key
+            hit = self._cubes[key] = self.s.steps.cube(self.situations[s]) & self.s.enc.state(local)
+        return hit
+
+    def within(self, u: Function, sit: Situation) -> Function:
+        """The plant states of ``u`` in situation ``sit``."""
+        return self.s.steps.exists(u & self.s.steps.cube(sit), Copy.CURRENT)
+
+    def pick(self, u: Function) -> Key:
+        """The node of ``u`` (not empty) with the smallest situation, then the smallest state."""
+        st = self.s.steps
+        f = self.steps_of(u)
+        active: dict[str, bool] = {}
+        for name in st.steps:
+            low = f & ~st.var(name)
+            active[step_name(name)] = low == self.false
+            f = low if low != self.false else f & st.var(name)
+        sit = st.situation(active)
+        return self.s.helper.situation(sit), self.s.enc.one(self.within(u, sit))
+
+    def listed(self, u: Function, limit: int = MAX_LISTED) -> list[Key]:
+        """The nodes of ``u``, situation by situation (sorted), states in declaration order."""
+        out: list[Key] = []
+        for sit in self.situations_of(u):
+            if len(out) > limit:
+                break
+            s = self.s.helper.situation(sit)
+            out += [(s, local) for local in self.s.enc.states(self.within(u, sit), limit - len(out))]
+        if len(out) > limit:  # pragma: no cover - states() raises first
+            raise LimitExceeded(f"more than {limit} nodes to list")
+        return out
+
+    # ---- sets
+    def held(self) -> Function:
+        """Nodes from which no node with other active steps is reachable."""
+        s = self.s
+        other = ~s.steps.equal(Copy.CURRENT, Copy.NEXT)
+        changers = self.false
+        for e in s._edge_relations:
+            changers |= s.engine.and_exists(e, other, s._next)
+        return s.nodes & ~s.backward(changers)
+
+    def prohibited(self) -> dict[tuple[tuple[str, ...], Event], Function]:
+        """Per (active steps, refused order event), the nodes where SUP refuses it."""
+        out: dict[tuple[tuple[str, ...], Event], Function] = {}
+        for event, refused in self.s.refused_by.items():
+            hit = self.s.nodes & refused
+            if hit == self.false:
+                continue
+            for sit in self.situations_of(hit):
+                out[(sit.steps, event)] = hit & self.s.steps.cube(sit)
+        return dict(sorted(out.items()))
+
+    def _deepest(self, u: Function) -> Function:
+        """One node of ``u`` from the farthest ring meeting it."""
+        for ring in reversed(self.s.rings):
+            v = u & ring
+            if v != self.false:
+                return self.cube(self.pick(v))
+        raise ValueError("no node of the set is reachable")
+
+    def terminal_components(self, stuck: Function) -> list[Function]:
+        """The terminal strongly connected components of ``stuck`` (descent, as
+        :func:`synth.symbolic.reachability.terminal_components`)."""
+        comps: list[Function] = []
+        candidates = stuck
+        while candidates != self.false:
+            v = self._deepest(candidates)
+            while True:
+                fwd = self.s.forward(v)
+                below = fwd & ~self.s.backward(v, within=fwd)
+                if below == self.false:
+                    comps.append(fwd)
+                    break
+                v = self._deepest(below)
+            candidates &= ~self.s.backward(comps[-1], within=candidates)
+        return comps
+
+    # ---- paths
+    def _layers(self, target: Function, depth: int) -> list[Function]:
+        rings = self.s.rings
+        layers = [self.false] * (depth + 1)
+        layers[depth] = target & rings[depth]
+        for k in range(depth - 1, -1, -1):
+            layers[k] = self.s.pre(layers[k + 1], within=rings[k])
+        return layers
+
+    def _greedy(self, layers: list[Function], order: Callable[[Move], Order]) -> tuple[list[Function], list[Event], list[Order]]:
+        current = layers[0]
+        chosen, events, keys = [current], [], []
+        for k in range(1, len(layers)):
+            options: dict[Order, tuple[Event, Function]] = {}
+            target = self.s._primed(layers[k])
+            for m, e in self.s.edges:
+                v = self.s.image(current, m, e) & target
+                if v != self.false:
+                    options[order(m)] = (m.event, v)
+            best = min(options)
+            event, current = options[best]
+            current = self.s.unprimed(current)
+            events.append(event)
+            keys.append(best)
+            chosen.append(current)
+        return chosen, events, keys
+
+    def _key(self, m: Move) -> tuple[int, int, int]:
+        return (0, m.axis, self.s.plant.elements[m.axis].variables.index(m.variable))
+
+    def depth(self, u: Function) -> int | None:
+        for k, ring in enumerate(self.s.rings):
+            if (ring & u) != self.false:
+                return k
+        return None
+
+    def first_node(self, candidates: Function) -> tuple[Key, int, tuple[tuple[int, int, int], ...]]:
+        """The candidate the explicit engine numbers first: (node, distance, path key)."""
+        depth = self.depth(candidates)
+        if depth is None:
+            raise ValueError("no candidate is reachable")
+        chosen, _, keys = self._greedy(self._layers(candidates, depth), self._key)
+        return self.pick(chosen[-1]), depth, tuple(keys)
+
+    def shortest_trace(self, key: Key) -> Path:
+        """The shortest path from an initial node to ``key`` whose events are smallest by name."""
+        node = self.cube(key)
+        depth = self.depth(node)
+        if depth is None:
+            raise ValueError("node not reachable")
+        chosen, events, _ = self._greedy(self._layers(node, depth), lambda m: m.event)
+        nodes = [key]
+        for k in range(depth - 1, -1, -1):
+            arcs = [(m, e) for m, e in self.s.edges if m.event == events[k]]
+            nodes.append(self.pick(self.s.pre(self.cube(nodes[-1]), arcs) & chosen[k]))
+        nodes.reverse()
+        return Path(tuple(nodes), tuple(events))
+
