@@ -85,10 +85,13 @@ class Covers:
         upper = lower if upper is None else self._copy(upper)
         try:
             cubes, _ = self._isop(lower, upper, {}, limit)
+        except CoverTooLarge:
+            cubes = None  # raised again below, from a frame without the covers' BDDs
         finally:
             self._firsts.clear()
-        if limit is not None and len(cubes) > limit:
-            raise CoverTooLarge(limit)
+        if cubes is None or (limit is not None and len(cubes) > limit):
+            del lower, upper  # a caller keeping the exception keeps this frame: no BDD may outlive the manager
+            raise CoverTooLarge(limit or 0)
         primes: list[Cube] = []
         for c in (expanded(self.bdd, self._ordered(c), upper) for c in cubes):
             if c not in primes:
@@ -134,7 +137,7 @@ class Covers:
         key = (lower, upper)
         found = memo.get(key)
         if found is not None:
-            return found  # type: ignore[no-any-return]
+            return found
         a, b = self._first(lower), self._first(upper)
         v = a if b is None or (a is not None and self._rank(a) <= self._rank(b)) else b
         assert v is not None  # lower is not false, upper not true
