@@ -46,7 +46,7 @@ def expanded(bdd: Any, cube: Cube, upper: Function) -> Cube:
     kept = dict(cube)
     for n in list(cube):
         trial = {m: v for m, v in kept.items() if m != n}
-        if (bdd.cube(trial) & ~upper) == bdd.false:
+        if (bdd.let(trial, upper) if trial else upper) == bdd.true:  # the cube implies upper
             kept = trial
     return kept
 
@@ -58,23 +58,24 @@ class Covers:
     def __init__(self, source: Any, rank: Callable[[str], int]) -> None:
         self.source = source
         self.rank = rank
-        native = type(source).__module__ == "dd.cudd"
-        self.bdd = type(source)() if native else source  # dd.autoref: covers in the engine's manager
-        if native:
+        self.native = type(source).__module__ == "dd.cudd"  # complemented edges, low and high of the regular node
+        self.bdd = type(source)() if self.native else source  # dd.autoref: covers in the engine's manager
+        if self.native:
             self.bdd.configure(reordering=False)
         self._declared = 0
         self._firsts: dict[Function, str] = {}  # during one cover: no function outlives it
-        self._ranks: dict[str, int] = {}
+        self._ranks: dict[str, int] = {}  # variable -> its rank, for every variable declared
 
     def _copy(self, u: Function) -> Function:
         """``u`` in the covers' manager (the same variables, in the same order)."""
-        if self.bdd is self.source:
-            return u
         levels = len(self.source.vars)
         while self._declared < levels:  # the engine declares variables at the end only
-            self.bdd.declare(self.source.var_at_level(self._declared))
+            v = self.source.var_at_level(self._declared)
+            if self.bdd is not self.source:
+                self.bdd.declare(v)
+            self._ranks[v] = self.rank(v)
             self._declared += 1
-        return self.source.copy(u, self.bdd)
+        return u if self.bdd is self.source else self.source.copy(u, self.bdd)
 
     def cover(self, lower: Function, upper: Function | None = None, limit: int | None = None) -> list[Cube]:
         """An irredundant cover of prime implicants of some function between ``lower`` and
@@ -111,13 +112,7 @@ class Covers:
         return kept
 
     def _ordered(self, cube: Mapping[str, bool]) -> Cube:
-        return dict(sorted(cube.items(), key=lambda kv: self._rank(kv[0])))
-
-    def _rank(self, v: str) -> int:
-        r = self._ranks.get(v)
-        if r is None:
-            r = self._ranks[v] = self.rank(v)
-        return r
+        return dict(sorted(cube.items(), key=lambda kv: self._ranks[kv[0]]))
 
     def _first(self, u: Function) -> str | None:
         """The first variable of ``u`` in the text order (None for a constant)."""
@@ -125,8 +120,15 @@ class Covers:
             return None
         first = self._firsts.get(u)
         if first is None:
-            first = self._firsts[u] = min(self.bdd.support(u), key=self._rank)
+            first = self._firsts[u] = min(self.bdd.support(u), key=self._ranks.__getitem__)
         return first
+
+    def _cofactors(self, u: Function, v: str) -> tuple[Function, Function]:
+        """``u`` with ``v`` false, then true: the children when ``v`` is ``u``'s top variable."""
+        if self.native and u.var == v:
+            low, high = u.low, u.high  # the regular node's children
+            return (~low, ~high) if u.negated else (low, high)
+        return self.bdd.let({v: False}, u), self.bdd.let({v: True}, u)
 
     def _isop(self, lower: Function, upper: Function, memo: dict, limit: int | None) -> tuple[list[Cube], Function]:
         bdd = self.bdd
@@ -139,10 +141,11 @@ class Covers:
         if found is not None:
             return found
         a, b = self._first(lower), self._first(upper)
-        v = a if b is None or (a is not None and self._rank(a) <= self._rank(b)) else b
+        ranks = self._ranks
+        v = a if b is None or (a is not None and ranks[a] <= ranks[b]) else b
         assert v is not None  # lower is not false, upper not true
-        l0, l1 = bdd.let({v: False}, lower), bdd.let({v: True}, lower)
-        u0, u1 = bdd.let({v: False}, upper), bdd.let({v: True}, upper)
+        l0, l1 = self._cofactors(lower, v)
+        u0, u1 = self._cofactors(upper, v)
         c0, f0 = self._isop(l0 & ~u1, u0, memo, limit)
         c1, f1 = self._isop(l1 & ~u0, u1, memo, limit)
         cd, fd = self._isop((l0 & ~f0) | (l1 & ~f1), u0 & u1, memo, limit)
