@@ -148,6 +148,8 @@ class Covers:
         u0, u1 = self._cofactors(upper, v)
         c0, f0 = self._isop(l0 & ~u1, u0, memo, limit)
         c1, f1 = self._isop(l1 & ~u0, u1, memo, limit)
+        if limit is not None and len(c0) + len(c1) > limit:  # the cover holds them: too large already
+            raise CoverTooLarge(limit)
         cd, fd = self._isop((l0 & ~f0) | (l1 & ~f1), u0 & u1, memo, limit)
         if limit is not None and len(c0) + len(c1) + len(cd) > limit:
             raise CoverTooLarge(limit)
