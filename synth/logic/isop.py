@@ -29,6 +29,8 @@ from typing import Any, Callable, Mapping
 __all__ = ["Covers", "CoverTooLarge", "Cube", "expanded"]
 
 Cube = dict[str, bool]  # a name -> its value
+CACHE = 2 ** 14
+"""The covers' manager's first computed-table slots (CUDD's default, 2^18, is 8 MiB more per engine)."""
 Function = Any  # a dd Function
 
 
@@ -59,7 +61,8 @@ class Covers:
         self.source = source
         self.rank = rank
         self.native = type(source).__module__ == "dd.cudd"  # complemented edges, low and high of the regular node
-        self.bdd = type(source)() if self.native else source  # dd.autoref: covers in the engine's manager
+        # dd.autoref: covers in the engine's manager; CUDD's: a small cache to start with (it grows with its hits)
+        self.bdd = type(source)(initial_cache_size=CACHE) if self.native else source
         if self.native:
             self.bdd.configure(reordering=False)
         self._declared = 0
