@@ -2,9 +2,11 @@
 column of 000's MC0/MC1, so the loop algorithm reads them alike; the algebraic synthesis
 does not (004 eq. 24 minimises ``!L`` for ``keep L``, the forced outputs being off their
 values for ``force``), and the two can give different filters — on the four-cylinder square
-the ``force`` spelling starves the pallets. :func:`spelling_warnings` synthesises the filter
-with each combined constraint's relief written the other way and warns, located at the
-relief, where the equations differ.
+the ``force`` spelling starves the pallets. :func:`spelling_warnings` solves the filter with
+each combined constraint's relief written the other way and warns, located at the relief,
+where the printed equations differ. The criteria differ in one priority only, so one chain of
+narrowings serves them all: each other spelling runs from the state before its criterion,
+without the "no effect" races, and its equations are printed only when its functions differ.
 
 Example
 -------
