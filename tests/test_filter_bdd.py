@@ -135,3 +135,26 @@ def test_dd_loads_without_networkx_and_leaves_it_importable() -> None:
             "import networkx; print(b.BACKEND, loaded, networkx.__name__)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
     assert out[1:] == ["False", "networkx"] and out[0] in ("dd.cudd", "dd.autoref")
+
+
+def test_a_cover_limit_counts_the_minato_morreale_cubes():
+    """``limit`` refuses a cover by the cubes of its Minato–Morreale form (a probe may stop
+    early, the answer is the same): refused below some k, given unchanged from k on."""
+    from synth.logic.bdd import CoverTooLarge
+
+    rng = random.Random(11)
+    for _ in range(20):
+        e = Engine(ORDER)
+        lower = e.expr(_expr(_random_text(rng)))
+        upper = lower | e.expr(_expr(_random_text(rng)))
+        full = e.cover(lower, upper)
+        refused = []
+        for k in range(len(full) + 8):
+            try:
+                assert e.cover(lower, upper, k) == full
+                refused.append(False)
+            except CoverTooLarge as too_large:
+                assert too_large.limit == k
+                refused.append(True)
+        assert refused == sorted(refused, reverse=True) and not refused[-1]  # monotonic
+        assert refused.index(False) >= len(full)

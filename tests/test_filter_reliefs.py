@@ -38,3 +38,45 @@ def test_a_force_relief_is_compared_with_its_keep_spelling():
 def test_no_warning_where_the_spellings_agree_or_criteria_are_stated():
     assert spelling_warnings(parse_filter("inputs i\noutputs a, b\nsafety K: i & a & b keep a", "k.filter")) == []
     assert spelling_warnings(load_filter(ROOT / "plants/tri.filter")) == []  # explicit criteria: no priority criteria
+
+
+def _by_definition(f):
+    """The warnings' definition: synthesise the filter with each relief spelt the other way
+    and compare what ``solve`` prints (functional, consistent, the chained equations)."""
+    import dataclasses
+
+    from synth.filter.reliefs import _other
+    from synth.filter.solve import synthesis
+
+    def printed(g):
+        s = synthesis(g)
+        return s.functional, s.consistent, dict(s.chained)
+
+    base, found = printed(f), []
+    for s in f.combined:
+        other = _other(s) if s.has_priority else None
+        if other is None:
+            continue
+        t = dataclasses.replace(s, keep=other.keep, force=other.force)
+        alt = printed(dataclasses.replace(f, safeties=tuple(t if u is s else u for u in f.safeties)))
+        if alt != base:
+            found.append((s.id, [o for o in f.outputs if base[2].get(o) != alt[2].get(o)] or list(f.outputs)))
+    return found
+
+
+def test_the_warnings_follow_their_definition_on_the_bench_families():
+    """One chain, each other spelling run from the state before its criterion, texts printed
+    only where the functions differ: the same warnings as a synthesis per relief."""
+    import sys
+
+    sys.path.insert(0, str(ROOT / "bench"))
+    from filter_scale import chain_filter, grid_filter, ring_filter
+
+    texts = [ring_filter(4), chain_filter(6), grid_filter(8),
+             (ROOT / "plants/four_cylinders.filter").read_text().replace("keep Q1", "force Q2=0")]
+    for n, text in enumerate(texts):
+        f = parse_filter(text, f"f{n}.filter")
+        got = [(w.message.split("'")[0], w.message.split("equations of ")[1].split(" differ")[0].split(", "))
+               for w in spelling_warnings(f)]
+        assert got == _by_definition(f), n
+        assert got  # every family has reliefs whose spellings differ

@@ -34,7 +34,7 @@ from synth.filter.model import FilterFunctions
 from synth.logic.bdd import Function
 from synth.logic.partition import Partition, State
 
-__all__ = ["Narrowing", "monolithic", "partitioned"]
+__all__ = ["Narrowing", "monolithic", "partitioned", "layout", "decided"]
 
 
 @dataclass
@@ -98,16 +98,7 @@ def partitioned(m: FilterFunctions, goods: Sequence[Function], order: Sequence[s
     e, outs = m.engine, m.outputs
     if not outs:
         return monolithic(m, goods)
-    factors = [~u for u in m.constraint.values()] + [m.assumed]
-    named = [[o for o in e.support(g) if o in outs] for g in goods]
-    if order is None:  # the outputs as the criteria name them, unless the variable order is narrower
-        mentioned = list(dict.fromkeys(o for n in named for o in n))
-        candidates = [Partition(e, mentioned + [o for o in e.variable_order if o in outs and o not in mentioned],
-                                factors, named),
-                      Partition(e, [o for o in e.variable_order if o in outs], factors, named)]
-        p = min(candidates, key=lambda c: c.width)
-    else:
-        p = Partition(e, order, factors, named)
+    p = layout(m, goods, order)
     order = list(p.anchors)
     where = [p.position(g) for g in goods]
     states: list[State] = [p.initial]
@@ -132,14 +123,36 @@ def partitioned(m: FilterFunctions, goods: Sequence[Function], order: Sequence[s
     for r in races:
         effects[r.i] = bool(r.effect)
     final = states[-1]
-    ones = {o: p.project(final, p.position(e.var(o)), e.var(o)) for o in order}
-    zeros = {o: p.project(final, p.position(e.var(o)), ~e.var(o)) for o in order}
-    care = p.project(final, 0)
+    care, ones, zeros = decided(p, final, order)
     if all((ones[o] & zeros[o]) == e.false for o in outs):  # functional: S is care ∧ ⋀ o ↔ one_o
         admissible = care & e.conjunction(e.var(o).equiv(ones[o]) for o in order)
     else:
         admissible = p.relation(final)
     return Narrowing(narrows, effects, care, {o: ones[o] for o in outs}, {o: zeros[o] for o in outs}, admissible)
+
+
+def layout(m: FilterFunctions, goods: Sequence[Function], order: Sequence[str] | None = None) -> Partition:
+    """The partition of ``S_0`` for the chain of ``goods``: the outputs eliminated in
+    ``order``, by default as the criteria name them unless the variable order gives
+    narrower bags; each criterion's outputs in one bag."""
+    e, outs = m.engine, m.outputs
+    factors = [~u for u in m.constraint.values()] + [m.assumed]
+    named = [[o for o in e.support(g) if o in outs] for g in goods]
+    if order is not None:
+        return Partition(e, order, factors, named)
+    mentioned = list(dict.fromkeys(o for n in named for o in n))
+    candidates = [Partition(e, mentioned + [o for o in e.variable_order if o in outs and o not in mentioned],
+                            factors, named),
+                  Partition(e, [o for o in e.variable_order if o in outs], factors, named)]
+    return min(candidates, key=lambda c: c.width)
+
+
+def decided(p: Partition, s: State, outputs: Sequence[str]) -> tuple[Function, dict[str, Function], dict[str, Function]]:
+    """The care set ``∃O.S`` and each output's ``∃O.(S ∧ o)`` and ``∃O.(S ∧ !o)`` of state ``s``."""
+    e = p.engine
+    ones = {o: p.project(s, p.position(e.var(o)), e.var(o)) for o in outputs}
+    zeros = {o: p.project(s, p.position(e.var(o)), ~e.var(o)) for o in outputs}
+    return p.project(s, 0), ones, zeros
 
 
 class _Race:

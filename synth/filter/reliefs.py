@@ -2,9 +2,11 @@
 column of 000's MC0/MC1, so the loop algorithm reads them alike; the algebraic synthesis
 does not (004 eq. 24 minimises ``!L`` for ``keep L``, the forced outputs being off their
 values for ``force``), and the two can give different filters — on the four-cylinder square
-the ``force`` spelling starves the pallets. :func:`spelling_warnings` synthesises the filter
-with each combined constraint's relief written the other way and warns, located at the
-relief, where the equations differ.
+the ``force`` spelling starves the pallets. :func:`spelling_warnings` solves the filter with
+each combined constraint's relief written the other way and warns, located at the relief,
+where the printed equations differ. The criteria differ in one priority only, so one chain of
+narrowings serves them all: each other spelling runs from the state before its criterion,
+without the "no effect" races, and its equations are printed only when its functions differ.
 
 Example
 -------
@@ -22,9 +24,12 @@ import dataclasses
 from typing import Sequence
 
 from synth.errors import InputError, Severity
-from synth.filter.language import Filter, Forcing, Safety
+from synth.filter.language import Criterion, Filter, Forcing, Safety, Sense
 from synth.filter.language_check import output_polarities
+from synth.filter.narrowing import decided, layout
+from synth.logic.bdd import CoverTooLarge, Function
 from synth.logic.expr import And, Expr, Not, Var
+from synth.logic.partition import State
 
 __all__ = ["Spelling", "other_spellings", "spelling_warnings"]
 
@@ -66,29 +71,114 @@ def other_spellings(f: Filter) -> list[Spelling]:
     return []
 
 
-def _chained(f: Filter) -> tuple[bool, bool, dict[str, str]]:
-    from synth.filter.solve import synthesis
+_Printed = tuple[bool, bool, dict[str, str]]  # functional, consistent, the chained equations
 
-    s = synthesis(f)
-    return s.functional, s.consistent, dict(s.chained)
+
+class _Chain:
+    """The chain of narrowings of ``f``'s criteria in one engine and one partition, each
+    relief's other spelling run from the state before its criterion (the states before
+    it and their messages are shared): its care set and each output's function (None
+    where the output is not determined), what ``solve`` prints its equations from."""
+
+    def __init__(self, f: Filter, swapped: Sequence[tuple[Safety, Filter]]) -> None:
+        from synth.filter.model import functions
+        from synth.filter.solve import criteria
+
+        self.m = m = functions(f)
+        self.goods = self._goods(criteria(f))
+        self.alternatives: list[tuple[int, Function] | None] = []
+        for _, alt in swapped:  # at most one priority criterion differs: its position and its good
+            goods = self._goods(criteria(alt))
+            i = next((i for i, (a, b) in enumerate(zip(self.goods, goods)) if a != b), None)
+            self.alternatives.append(None if i is None else (i, goods[i]))
+        self.p = layout(m, self.goods + [a[1] for a in self.alternatives if a is not None])
+        self.where = [self.p.position(g) for g in self.goods]
+        self.states = [self.p.initial]
+        for g, k in zip(self.goods, self.where):
+            self.states.append(self._step(self.states[-1], k, g))
+        self.base = self._outcome(self.states[-1])
+        self.printed: _Printed | None = None
+        self._texts: dict[tuple[Function, Function, int | None], str | bool] = {}
+
+    def _goods(self, criteria: Sequence[Criterion]) -> list[Function]:
+        e = self.m.engine
+        return [e.expr(c.expr) if c.sense is Sense.MAX else ~e.expr(c.expr) for c in criteria]
+
+    def _step(self, s: State, k: int, g: Function) -> State:
+        return self.p.refine(s, k, g.equiv(self.p.project(s, k, g)))
+
+    def _outcome(self, s: State) -> tuple[Function, dict[str, Function], dict[str, Function]]:
+        return decided(self.p, s, self.m.outputs)
+
+    def _printed(self, outcome: tuple[Function, dict[str, Function], dict[str, Function]]) -> _Printed:
+        """What ``solve`` prints of an outcome: functional, consistent, the chained equations."""
+        from synth.filter.solve import Synthesis, printed
+
+        e = self.m.engine
+        care, ones, zeros = outcome
+        s = Synthesis(self.m, e.false, care, [])
+        printed(s, ones, zeros, text=self._text)
+        return s.functional, (self.m.assumed & ~care) == e.false, dict(s.chained)
+
+    def _text(self, lower: Function, upper: Function, limit: int | None) -> str:
+        """``Engine.text``, remembered: the two spellings share most equations."""
+        key = (lower, upper, limit)
+        found = self._texts.get(key)
+        if found is None:
+            try:
+                found = self._texts[key] = self.m.engine.text(lower, upper, limit)
+            except CoverTooLarge:
+                found = self._texts[key] = False  # not the exception: its frames hold BDDs
+        if found is False:
+            raise CoverTooLarge(limit or 0)
+        assert isinstance(found, str)
+        return found
+
+    def differ(self, n: int) -> list[str] | None:
+        """The outputs whose chained equation differs with alternative ``n`` (every output
+        when they all agree but the filters do not), None when the filters print the same."""
+        alternative = self.alternatives[n]
+        if alternative is None:  # the criteria are the file's: the spelling changes none
+            return None
+        i, g = alternative
+        mark = self.p.mark()
+        s = self._step(self.states[i], self.p.position(g), g)
+        for j in range(i + 1, len(self.goods)):
+            s = self._step(s, self.where[j], self.goods[j])
+        alt = self._outcome(s)
+        self.p.forget(mark)
+        if alt[0] == self.base[0] and all(alt[1][o] == self.base[1][o] and alt[2][o] == self.base[2][o]
+                                          for o in self.m.outputs):
+            return None  # the same functions: the same equations
+        if self.printed is None:
+            self.printed = self._printed(self.base)
+        mine = self._printed(alt)
+        if mine == self.printed:
+            return None
+        return [o for o in self.m.outputs if self.printed[2].get(o) != mine[2].get(o)] or list(self.m.outputs)
 
 
 def spelling_warnings(f: Filter, safeties: Sequence[Safety] | None = None) -> list[InputError]:
-    """A located warning for each relief whose other spelling gives a different algebraic filter."""
-    out: list[InputError] = []
-    base: tuple[bool, bool, dict[str, str]] | None = None
+    """A located warning for each relief whose other spelling gives a different algebraic
+    filter: another care set, or an output determined in one and not the other or by
+    another function (the same functions print the same equations)."""
+    swapped: list[tuple[Safety, Filter]] = []
     for s in (safeties if safeties is not None else f.combined):
         other = _other(s) if s.has_priority else None
-        if other is None:
+        if other is not None:
+            t = dataclasses.replace(s, keep=other.keep, force=other.force)
+            swapped.append((s, dataclasses.replace(f, safeties=tuple(t if u is s else u for u in f.safeties))))
+    if not swapped:
+        return []
+    chain = _Chain(f, swapped)
+    out: list[InputError] = []
+    for n, (s, _) in enumerate(swapped):
+        differ = chain.differ(n)
+        if differ is None:
             continue
-        if base is None:
-            base = _chained(f)
-        swapped = dataclasses.replace(s, keep=other.keep, force=other.force)
-        alt = _chained(dataclasses.replace(f, safeties=tuple(swapped if t is s else t for t in f.safeties)))
-        if alt == base:
-            continue
+        other = _other(s)
+        assert other is not None
         written = Spelling(s.keep, s.force if s.keep is None else ())
-        differ = [o for o in f.outputs if base[2].get(o) != alt[2].get(o)] or list(f.outputs)
         loc = s.keep.loc if isinstance(s.keep, Var) and s.keep.loc else (s.force[0].loc if s.force else s.loc)
         loop = Spelling(None, s.forced).text()
         out.append(InputError(

@@ -26,7 +26,7 @@ Example (004 eqs. 4-13)
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Sequence
+from typing import Callable, Mapping, Sequence
 
 from synth.errors import InputError, LimitExceeded
 from synth.logic.bdd import CoverTooLarge, Cube, Function, cube_text
@@ -37,7 +37,7 @@ from synth.filter.model import FilterFunctions, equation_functions, functions
 from synth.logic.expr import And, Const, Edge, Expr, Not, Or, Var
 
 __all__ = ["IMPLICIT", "FLAT_PROBE", "FLAT_LIMIT", "Applied", "Synthesis", "synthesis", "chained_equations", "criteria", "priority_criteria", "requested", "sim_expr",
-           "differences"]
+           "differences", "printed"]
 
 
 IMPLICIT = "implicit"
@@ -197,7 +197,7 @@ def synthesis(f: Filter | FilterFunctions, order: Sequence[str] | None = None, *
     ``partitioned``: keep each admissible set as a conjunction of factors, one BDD otherwise
     (:mod:`synth.filter.narrowing`; the same result)."""
     m = f if isinstance(f, FilterFunctions) else functions(f)
-    e, outs = m.engine, m.outputs
+    e = m.engine
     steps = [(c, e.expr(c.expr)) for c in (criteria(m.filter, order) if applied is None else applied)]
 
     goods = [u if c.sense is Sense.MAX else ~u for c, u in steps]  # Min(c) is Max(!c)
@@ -216,31 +216,46 @@ def synthesis(f: Filter | FilterFunctions, order: Sequence[str] | None = None, *
     if stuck != e.false:
         result.inconsistent = e.witness(stuck, m.assumed)
         result.inconsistent_text = e.text(stuck, stuck | ~m.assumed)
-    for o in outs:
-        one, zero = chain.ones[o], chain.zeros[o]
+    printed(result, chain.ones, chain.zeros, flat)
+    return result
+
+
+Text = Callable[[Function, Function, "int | None"], str]
+"""How an equation is printed: ``Engine.text`` (or a memo of it)."""
+
+
+def printed(s: Synthesis, ones: Mapping[str, Function], zeros: Mapping[str, Function], flat: bool = False,
+            text: Text | None = None) -> None:
+    """Fill ``s`` (its care set given) with the outputs ``∃O.(S∧o)`` / ``∃O.(S∧!o)`` decide:
+    the free ones with a witness, the others' functions, flat equations and chained ones."""
+    m = s.functions
+    e = m.engine
+    text = e.text if text is None else text
+    for o in m.outputs:
+        one, zero = ones[o], zeros[o]
         if (one & zero) != e.false:
             free = e.minimal_cube(one & zero)
             assert free is not None  # one & zero is not false
-            result.free[o] = free
+            s.free[o] = free
             continue
-        result.outputs[o] = one
+        s.outputs[o] = one
         try:
-            result.equations[o] = e.text(one, one | ~care, FLAT_LIMIT if flat else FLAT_PROBE)
+            s.equations[o] = text(one, one | ~s.care, FLAT_LIMIT if flat else FLAT_PROBE)
         except CoverTooLarge as too_large:
             if flat:
                 raise LimitExceeded(f"{m.filter.file}: the flat equation of {o} needs more than {too_large.limit} "
                                     "terms; the chained equations (solve without --flat) are the filter") from None
-    result.chained = chained_equations(result)
-    return result
+    s.chained = chained_equations(s, text)
 
 
-def chained_equations(s: Synthesis) -> dict[str, str]:
+def chained_equations(s: Synthesis, text: Text | None = None) -> dict[str, str]:
     """The equations in an evaluation order where each may use the outputs computed before
     it, as 004's (30) does (``A0 = R_A0 & !P01 & (!C0 | A1)``): outputs with the shortest
     flat equations first (those not written last, smallest BDD first); each keeps its flat
     text unless using earlier outputs is shorter."""
     m = s.functions
     e = m.engine
+    text = e.text if text is None else text
     width = 1 + max((len(t) for t in s.equations.values()), default=0)
     order = sorted(s.outputs, key=lambda o: (len(s.equations.get(o, "")) or width + len(s.outputs[o]),
                                              m.outputs.index(o)))
@@ -248,9 +263,9 @@ def chained_equations(s: Synthesis) -> dict[str, str]:
     agree = e.true  # the earlier outputs equal their functions
     for o in order:
         f = s.output(o)
-        text = e.text(f & agree & s.care, f | ~agree | ~s.care)
+        mine = text(f & agree & s.care, f | ~agree | ~s.care, None)
         flat = s.equations.get(o)
-        chained[o] = text if flat is None or len(text) < len(flat) else flat
+        chained[o] = mine if flat is None or len(mine) < len(flat) else flat
         agree &= e.var(o).equiv(f)
     return chained
 

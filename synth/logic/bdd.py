@@ -31,6 +31,7 @@ from typing import Any, Iterable, Mapping, Sequence
 
 from synth.logic.past import PRE_SUFFIX, pre_name
 from synth.logic.expr import And, Const, Edge, Expr, Not, Var
+from synth.logic.isop import CoverTooLarge, Covers, Cube, expanded
 
 
 
@@ -63,15 +64,6 @@ __all__ = ["Engine", "Function", "Cube", "CoverTooLarge", "cube_text", "cube_lit
 BACKEND: str = _backend.__name__
 CUDD: bool = BACKEND == "dd.cudd"  # whether the fast native operations (and-abstract, node counts) exist
 Function = Any  # a dd Function of the active backend
-Cube = dict[str, bool]  # filter name -> value
-
-
-class CoverTooLarge(Exception):
-    """An irredundant cover needs more cubes than the caller's limit (:meth:`Engine.cover`)."""
-
-    def __init__(self, limit: int) -> None:
-        super().__init__(f"more than {limit} terms")
-        self.limit = limit
 
 
 def cube_text(cube: Mapping[str, bool]) -> str:
@@ -149,6 +141,7 @@ class Engine:
         self._rank: dict[str, int] | None = None if text_order is None else {
             n: i for i, n in enumerate(dict.fromkeys(text_order))}
         self._ranks_by_inner: dict[str, int] = {}
+        self._covers: Covers | None = None
         for n in order:
             self.declare(n)
 
@@ -317,12 +310,8 @@ class Engine:
     def expanded(self, cube: Cube, upper: Function) -> Cube:
         """``cube`` (implying ``upper``) with literals dropped, in text order, while it
         still implies ``upper``: a prime implicant of ``upper``."""
-        kept = dict(cube)
-        for n in list(cube):
-            trial = {m: v for m, v in kept.items() if m != n}
-            if self.implies(self.cube(trial), upper):
-                kept = trial
-        return kept
+        kept = expanded(self.bdd, {self.declare(n): v for n, v in cube.items()}, upper)
+        return {self._outer[v]: x for v, x in kept.items()}
 
     def minimal_cube(self, u: Function) -> Cube | None:
         """A prime implicant of ``u`` (a counterexample no literal of which can be dropped)."""
@@ -340,52 +329,14 @@ class Engine:
         return dict(sorted(cube.items(), key=lambda kv: self.rank(kv[0])))
 
     # ---- covers
-    def _isop(self, lower: Function, upper: Function, memo: dict, limit: int | None = None,
-              firsts: dict[Function, str] | None = None) -> tuple[list[Cube], Function]:
-        if lower == self.false:
-            return [], self.false
-        if upper == self.true:
-            return [{}], self.true
-        key = (lower, upper)
-        if key in memo:
-            return memo[key]
-        inner = self._first((lower, upper), firsts)
-        x = self.bdd.var(inner)
-        l0, l1 = self.bdd.let({inner: False}, lower), self.bdd.let({inner: True}, lower)
-        u0, u1 = self.bdd.let({inner: False}, upper), self.bdd.let({inner: True}, upper)
-        c0, f0 = self._isop(l0 & ~u1, u0, memo, limit, firsts)
-        c1, f1 = self._isop(l1 & ~u0, u1, memo, limit, firsts)
-        cd, fd = self._isop((l0 & ~f0) | (l1 & ~f1), u0 & u1, memo, limit, firsts)
-        if limit is not None and len(c0) + len(c1) + len(cd) > limit:
-            raise CoverTooLarge(limit)
-        name = self.name_of(inner)
-        cover = [{name: False, **c} for c in c0] + [{name: True, **c} for c in c1] + cd
-        result = (cover, (~x & f0) | (x & f1) | fd)
-        memo[key] = result
-        return result
-
     def cover(self, lower: Function, upper: Function | None = None, limit: int | None = None) -> list[Cube]:
         """An irredundant cover of prime implicants of some function between ``lower`` and
-        ``upper`` (``upper`` defaults to ``lower``; the gap is the don't-care set).
-        :class:`CoverTooLarge` when the Minato–Morreale cover has more than ``limit`` cubes."""
-        upper = lower if upper is None else upper
-        cubes, _ = self._isop(lower, upper, {}, limit, {})
-        primes: list[Cube] = []
-        for c in (self.expanded(self.ordered(c), upper) for c in cubes):
-            if c not in primes:
-                primes.append(c)
-        # drop, in order, each cube the others (the kept ones before it, all after it) cover
-        functions = [self.cube(c) for c in primes]
-        after = [self.false] * (len(primes) + 1)
-        for i in range(len(primes) - 1, -1, -1):
-            after[i] = functions[i] | after[i + 1]
-        kept: list[Cube] = []
-        before = self.false
-        for i, c in enumerate(primes):
-            if not self.implies(lower, before | after[i + 1]):
-                kept.append(c)
-                before |= functions[i]
-        return kept
+        ``upper`` (``upper`` defaults to ``lower``; the gap is the don't-care set), built in
+        the text order (:class:`~synth.logic.isop.Covers`). :class:`CoverTooLarge` when the
+        Minato–Morreale cover has more than ``limit`` cubes."""
+        if self._covers is None:
+            self._covers = Covers(self.bdd, lambda inner: self._inner_ranks()[inner])
+        return [{self._outer[v]: x for v, x in c.items()} for c in self._covers.cover(lower, upper, limit)]
 
     def text(self, lower: Function, upper: Function | None = None, limit: int | None = None) -> str:
         """``u`` (or some function between ``lower`` and ``upper``) in filter syntax

@@ -1,0 +1,162 @@
+"""Irredundant covers of prime implicants (what :meth:`synth.logic.bdd.Engine.text` prints):
+the Minato–Morreale ISOP of an interval ``[lower, upper]`` built in the *text order*, each
+cube then expanded to a prime implicant (literals dropped in text order) and the cover made
+irredundant (each cube the others cover dropped, in order). A cover depends on the
+interval and the text order only, never on the manager's variable order.
+
+The covers are computed in a manager of their own (:class:`Covers`), with the same
+variable order as the engine's: a transfer there is linear (the text order would make the
+functions exponentially larger: a request first, each output's constraints last), and the
+cofactors and conjunctions of the recursion run on a small unique table, away from the
+engine's millions of nodes. The recursion splits on the first variable, in the text order,
+that ``lower`` or ``upper`` depends on, and remembers each function's first variable and
+each interval's cover (memoised on the pair of nodes).
+
+Example
+-------
+>>> from dd import autoref
+>>> b = autoref.BDD(); b.declare("x", "y")
+>>> c = Covers(b, {"x": 1, "y": 0}.__getitem__)
+>>> u = b.add_expr(r"x \\/ y")
+>>> c.cover(u)
+[{'y': True}, {'x': True}]
+"""
+
+from __future__ import annotations
+
+from typing import Any, Callable, Mapping
+
+__all__ = ["Covers", "CoverTooLarge", "Cube", "expanded"]
+
+Cube = dict[str, bool]  # a name -> its value
+CACHE = 2 ** 14
+"""The covers' manager's first computed-table slots (CUDD's default, 2^18, is 8 MiB more per engine)."""
+Function = Any  # a dd Function
+
+
+class CoverTooLarge(Exception):
+    """An irredundant cover needs more cubes than the caller's limit (:meth:`Covers.cover`)."""
+
+    def __init__(self, limit: int) -> None:
+        super().__init__(f"more than {limit} terms")
+        self.limit = limit
+
+
+def expanded(bdd: Any, cube: Cube, upper: Function) -> Cube:
+    """``cube`` (implying ``upper``, over ``bdd``'s variables) with literals dropped, in
+    its order, while it still implies ``upper``: a prime implicant of ``upper``."""
+    kept = dict(cube)
+    for n in list(cube):
+        trial = {m: v for m, v in kept.items() if m != n}
+        if (bdd.let(trial, upper) if trial else upper) == bdd.true:  # the cube implies upper
+            kept = trial
+    return kept
+
+
+class Covers:
+    """The covers of the functions of one dd manager ``source``; ``rank`` gives a
+    variable's position in the text order (variables are the manager's own names)."""
+
+    def __init__(self, source: Any, rank: Callable[[str], int]) -> None:
+        self.source = source
+        self.rank = rank
+        self.native = type(source).__module__ == "dd.cudd"  # complemented edges, low and high of the regular node
+        # dd.autoref: covers in the engine's manager; CUDD's: a small cache to start with (it grows with its hits)
+        self.bdd = type(source)(initial_cache_size=CACHE) if self.native else source
+        if self.native:
+            self.bdd.configure(reordering=False)
+        self._declared = 0
+        self._firsts: dict[Function, str] = {}  # during one cover: no function outlives it
+        self._ranks: dict[str, int] = {}  # variable -> its rank, for every variable declared
+
+    def _copy(self, u: Function) -> Function:
+        """``u`` in the covers' manager (the same variables, in the same order)."""
+        levels = len(self.source.vars)
+        while self._declared < levels:  # the engine declares variables at the end only
+            v = self.source.var_at_level(self._declared)
+            if self.bdd is not self.source:
+                self.bdd.declare(v)
+            self._ranks[v] = self.rank(v)
+            self._declared += 1
+        return u if self.bdd is self.source else self.source.copy(u, self.bdd)
+
+    def cover(self, lower: Function, upper: Function | None = None, limit: int | None = None) -> list[Cube]:
+        """An irredundant cover of prime implicants of some function between ``lower`` and
+        ``upper`` (``upper`` defaults to ``lower``; the gap is the don't-care set), each
+        cube's names in text order. :class:`CoverTooLarge` when the Minato–Morreale cover
+        has more than ``limit`` cubes."""
+        lower = self._copy(lower)
+        upper = lower if upper is None else self._copy(upper)
+        try:
+            cubes, _ = self._isop(lower, upper, {}, limit)
+        except CoverTooLarge:
+            cubes = None  # raised again below, from a frame without the covers' BDDs
+        finally:
+            self._firsts.clear()
+        if cubes is None or (limit is not None and len(cubes) > limit):
+            del lower, upper  # a caller keeping the exception keeps this frame: no BDD may outlive the manager
+            raise CoverTooLarge(limit or 0)
+        primes: list[Cube] = []
+        for c in (expanded(self.bdd, self._ordered(c), upper) for c in cubes):
+            if c not in primes:
+                primes.append(c)
+        # drop, in order, each cube the others (the kept ones before it, all after it) cover
+        bdd = self.bdd
+        functions = [bdd.cube(c) for c in primes]
+        after = [bdd.false] * (len(primes) + 1)
+        for i in range(len(primes) - 1, -1, -1):
+            after[i] = functions[i] | after[i + 1]
+        kept: list[Cube] = []
+        before = bdd.false
+        for i, c in enumerate(primes):
+            if (lower & ~(before | after[i + 1])) != bdd.false:
+                kept.append(c)
+                before |= functions[i]
+        return kept
+
+    def _ordered(self, cube: Mapping[str, bool]) -> Cube:
+        return dict(sorted(cube.items(), key=lambda kv: self._ranks[kv[0]]))
+
+    def _first(self, u: Function) -> str | None:
+        """The first variable of ``u`` in the text order (None for a constant)."""
+        if u.var is None:
+            return None
+        first = self._firsts.get(u)
+        if first is None:
+            first = self._firsts[u] = min(self.bdd.support(u), key=self._ranks.__getitem__)
+        return first
+
+    def _cofactors(self, u: Function, v: str) -> tuple[Function, Function]:
+        """``u`` with ``v`` false, then true: the children when ``v`` is ``u``'s top variable."""
+        if self.native and u.var == v:
+            low, high = u.low, u.high  # the regular node's children
+            return (~low, ~high) if u.negated else (low, high)
+        return self.bdd.let({v: False}, u), self.bdd.let({v: True}, u)
+
+    def _isop(self, lower: Function, upper: Function, memo: dict, limit: int | None) -> tuple[list[Cube], Function]:
+        bdd = self.bdd
+        if lower == bdd.false:
+            return [], bdd.false
+        if upper == bdd.true:
+            return [{}], bdd.true
+        key = (lower, upper)
+        found = memo.get(key)
+        if found is not None:
+            return found
+        a, b = self._first(lower), self._first(upper)
+        ranks = self._ranks
+        v = a if b is None or (a is not None and ranks[a] <= ranks[b]) else b
+        assert v is not None  # lower is not false, upper not true
+        l0, l1 = self._cofactors(lower, v)
+        u0, u1 = self._cofactors(upper, v)
+        c0, f0 = self._isop(l0 & ~u1, u0, memo, limit)
+        c1, f1 = self._isop(l1 & ~u0, u1, memo, limit)
+        if limit is not None and len(c0) + len(c1) > limit:  # the cover holds them: too large already
+            raise CoverTooLarge(limit)
+        cd, fd = self._isop((l0 & ~f0) | (l1 & ~f1), u0 & u1, memo, limit)
+        if limit is not None and len(c0) + len(c1) + len(cd) > limit:
+            raise CoverTooLarge(limit)
+        cover = [{v: False, **c} for c in c0] + [{v: True, **c} for c in c1] + cd
+        result = (cover, bdd.ite(bdd.var(v), f1, f0) | fd)
+        memo[key] = result
+        return result
