@@ -194,22 +194,7 @@ class PlantEncoding:
         order: what a report shows comes from :meth:`smallest`."""
         if u == self.engine.false:
             return None
-        values = {v: False for v in self.variables}
-        outer = self.engine.name_of
-        f = u
-        true, false = self.engine.true, self.engine.false
-        while f != true:
-            lo, hi = f.low, f.high  # children of the regular node: complement them if f is
-            if f.negated:
-                lo, hi = ~lo, ~hi
-            name = outer(f.var)
-            if lo != false:
-                values[name] = False
-                f = lo
-            else:
-                values[name] = True
-                f = hi
-        return values
+        return {**{v: False for v in self.variables}, **first_path(self.engine, u)}
 
     def smallest(self, u: Function) -> dict[str, bool] | None:
         """The smallest state of ``u``, ``None`` if empty: variables in declaration order,
@@ -301,3 +286,18 @@ def _exact_count(u: Function, levels: Sequence[int], engine: Engine) -> int:
         return r
 
     return models(u) * (1 << below(u))
+
+
+def first_path(engine: Engine, u: Function) -> dict[str, bool]:
+    """The first path to 1 of ``u`` (not false) in the BDD order, low branch first: the
+    variables it sets, by caller names (those it leaves free are absent)."""
+    out: dict[str, bool] = {}
+    f = u
+    true, false = engine.true, engine.false
+    while f != true:
+        lo, hi = f.low, f.high  # children of the regular node: complement them if f is
+        if f.negated:
+            lo, hi = ~lo, ~hi
+        out[engine.name_of(f.var)] = lo == false
+        f = hi if lo == false else lo
+    return out

@@ -26,7 +26,7 @@ from __future__ import annotations
 
 from synth.plant.composition import Plant
 from synth.sup.constraints import CompiledConstraints
-from synth.symbolic.reachability import shortest_trace
+from synth.symbolic.reachability import Path, shortest_trace
 from synth.symbolic.sync import SymbolicSync
 from synth.validation.analysis import Trace
 from synth.validation.sync import Edge, Node, Prohibition, _order_moves
@@ -75,7 +75,10 @@ class ExplicitNodes:
         return self.index[key]
 
     def trace(self, key: Key) -> Trace:
-        path = shortest_trace(self.ssync, *key)
+        return self.trace_of(shortest_trace(self.ssync, *key))
+
+    def trace_of(self, path: Path) -> Trace:
+        """``path`` (symbolic nodes and events) as a trace, its nodes and edges made explicit."""
         ids = [self.node(k) for k in path.nodes]
         for a, e, b in zip(ids, path.events, ids[1:]):
             if (a, e, b) not in self._edges:

@@ -50,11 +50,11 @@ from synth.grafcet.language import CONDITIONAL, CONTINUOUS, Semantics
 from synth.grafcet.machine import GrafcetMachine, Situation
 from synth.grafcet.recorder import InputRecorder
 from synth.grafcet.situation import CompiledFn, sorted_steps
-from synth.logic.bdd import Engine, Function
+from synth.logic.bdd import Function
 from synth.logic.events import Event
-from synth.logic.expr import Var, names
+from synth.logic.expr import names
 from synth.plant.composition import Plant
-from synth.symbolic.encoding import Copy, PlantEncoding
+from synth.symbolic.encoding import Copy, PlantEncoding, first_path
 
 __all__ = ["Unsupported", "unsupported", "anchors", "StepEncoding", "MAX_ROUNDS", "step_name"]
 
@@ -213,7 +213,7 @@ class StepEncoding:
         true = self.engine.false
         rest = self.engine.true
         while rest != self.engine.false:
-            point = _walk(self.engine, rest)
+            point = first_path(self.engine, rest)
             inputs = InputRecorder(partial(_inputs, point, self.inputs))
             steps = _Steps({s: point.get(step_name(s), False) for s in self.steps})
             answer = fn(inputs, cast(frozenset[str], steps), frozenset(), event, {})
@@ -282,23 +282,3 @@ class StepEncoding:
 
 def _inputs(point: Mapping[str, bool], inputs: frozenset[str]) -> dict[str, bool]:
     return {n: point.get(n, False) for n in inputs}
-
-
-def _walk(engine: Engine, u: Function) -> dict[str, bool]:
-    """One point of ``u`` (not false): the first path to 1, by caller names; the
-    variables it leaves free are absent (read as false)."""
-    out: dict[str, bool] = {}
-    f = u
-    true, false = engine.true, engine.false
-    while f != true:
-        lo, hi = f.low, f.high
-        if f.negated:
-            lo, hi = ~lo, ~hi
-        name = engine.name_of(f.var)
-        if lo != false:
-            out[name] = False
-            f = lo
-        else:
-            out[name] = True
-            f = hi
-    return out

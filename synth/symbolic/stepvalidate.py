@@ -41,7 +41,7 @@ from synth.logic.expr import evaluate
 from synth.plant.composition import Plant
 from synth.plant.rules import RuleSet
 from synth.sup.constraints import CompiledConstraints
-from synth.symbolic.encoding import Copy, live_nodes
+from synth.symbolic.encoding import live_nodes
 from synth.symbolic.explicit import ExplicitNodes, Key
 from synth.symbolic.stepreach import StepReach
 from synth.symbolic.stepsync import StepSync
@@ -50,7 +50,7 @@ from synth.symbolic.supervisor import SymbolicSupervisor
 from synth.validation.analysis import Analysis, Trace
 from synth.validation.diagnosis import diagnose_all
 from synth.validation.result import Validation, home_conditions
-from synth.validation.sync import Edge, Sync
+from synth.validation.sync import Sync
 
 __all__ = ["validate_steps", "MAX_HELD_ASKED"]
 
@@ -194,10 +194,4 @@ def _keys(ex: ExplicitNodes) -> dict[int, Key]:
 
 def _trace(r: StepReach, ex: ExplicitNodes, key: Key) -> Trace:
     """The trace to ``key`` (:meth:`StepReach.shortest_trace`), its nodes and edges made explicit."""
-    path = r.shortest_trace(key)
-    ids = [ex.node(k) for k in path.nodes]
-    for a, e, b in zip(ids, path.events, ids[1:]):
-        if (a, e, b) not in ex._edges:
-            ex._edges.add((a, e, b))
-            ex.edges.append(Edge(a, e, b))
-    return Trace(tuple(ids), tuple(path.events))
+    return ex.trace_of(r.shortest_trace(key))

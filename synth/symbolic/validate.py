@@ -39,7 +39,6 @@ from synth.symbolic.reachability import (
     node_held,
     listed,
     prohibited_nodes,
-    shortest_trace,
     stuck_nodes,
     terminal_components,
 )
@@ -52,7 +51,7 @@ from synth.symbolic.sync import SymbolicSync
 from synth.validation.analysis import Analysis, Trace
 from synth.validation.diagnosis import diagnose_all
 from synth.validation.conflicts import Conflict
-from synth.validation.sync import Edge, Node, Prohibition, Sync, _order_moves
+from synth.validation.sync import Sync
 from synth.validation.result import Validation, home_conditions, load_model
 
 __all__ = ["validate_symbolic", "validate_loaded"]
