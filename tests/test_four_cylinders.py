@@ -218,3 +218,27 @@ def test_the_seeds_toggling_controller_turns_1_2_3_pallets(cli, pallets, states,
         f"transparency: {corrected} of {cycles} cycles correct the requests, largest Hamming distance 4",
         "progress ↑i2: holds: GOAL stays reachable from every state and no fair cycle avoids it"]
     assert _lines(out)[0] == f"explored {states} states ({plant_states} plant states), {cycles} cycles"
+
+
+@pytest.mark.parametrize("pallets", [1, 2, 3])
+def test_every_transfer_stays_reachable_under_the_toggle(pallets):
+    """Seed 000 §6, "every transfer stays reachable": with the toggling controller, each of
+    the four transfers (↑i1 … ↑i4) is reachable from every state and no fair cycle avoids it
+    (one exploration of the loop, the four goals checked on it)."""
+    pytest.importorskip("blark")
+    from synth.codegen.interpreter import load_st
+    from synth.filter.closed_loop import goal_of, progress_of
+    from synth.filter.control_st import StSource
+    from synth.filter.cycle import Algorithm, Mode
+    from synth.filter.explorer import Explorer
+    from synth.filter.language_check import load_filter
+    from synth.filter.product import Product
+
+    pr = Product(load_filter(FILTER), str(PLANTS[pallets]), None, Algorithm.ALGEBRAIC, Mode.SUPERVISOR, False,
+                 StSource(str(TOGGLE), load_st))
+    ex = Explorer(pr, 100_000, edges=True)
+    ex.run()
+    assert ex.complete and ex.states == {1: 2304, 2: 1080, 3: 80}[pallets]
+    verdicts = {g: progress_of(ex, goal_of(g, pr)) for g in ("↑i1", "↑i2", "↑i3", "↑i4")}
+    assert {g: (p.holds, p.unreachable, p.avoiding) for g, p in verdicts.items()} == {
+        g: (True, 0, 0) for g in ("↑i1", "↑i2", "↑i3", "↑i4")}
