@@ -24,6 +24,8 @@ Example
 
 from __future__ import annotations
 
+from typing import Callable
+
 from synth.plant.composition import Plant
 from synth.sup.constraints import CompiledConstraints
 from synth.symbolic.reachability import Path, shortest_trace
@@ -31,9 +33,11 @@ from synth.symbolic.sync import SymbolicSync
 from synth.validation.analysis import Trace
 from synth.validation.sync import Edge, Node, Prohibition, _order_moves
 
-__all__ = ["ExplicitNodes", "Key"]
+__all__ = ["ExplicitNodes", "Key", "PathKey", "Blocking"]
 
 Key = tuple[int, tuple[int, ...]]  # a node: situation, plant state
+PathKey = tuple[tuple[int, int, int], ...]  # a shortest path, in the explicit exploration's order
+Blocking = tuple[list[int], dict[int, tuple[int, ...]], dict[int, Trace], dict[int, int]]
 
 
 class ExplicitNodes:
@@ -76,6 +80,25 @@ class ExplicitNodes:
 
     def trace(self, key: Key) -> Trace:
         return self.trace_of(shortest_trace(self.ssync, *key))
+
+    def blocking(self, found: list[tuple[int, PathKey, Key, list[Key]]], trace: Callable[[Key], Trace],
+                 comes_back: Callable[[Key], bool]) -> Blocking:
+        """The blocking findings (distance, then path, then their node), made explicit: the
+        nodes, each one's component, its trace, and the first node of that trace from which
+        home cannot be reached again."""
+        found.sort(key=lambda f: (f[0], f[1]))
+        blocking: list[int] = []
+        components: dict[int, tuple[int, ...]] = {}
+        traces: dict[int, Trace] = {}
+        no_return: dict[int, int] = {}
+        for _, _, key, members in found:
+            b = self.node(key)
+            blocking.append(b)
+            components[b] = tuple(sorted(self.node(k) for k in members))
+            traces[b] = trace(key)
+            keys = {v: k for k, v in self.index.items()}
+            no_return[b] = next((n for n in traces[b].nodes if not comes_back(keys[n])), b)
+        return blocking, components, traces, no_return
 
     def trace_of(self, path: Path) -> Trace:
         """``path`` (symbolic nodes and events) as a trace, its nodes and edges made explicit."""

@@ -42,7 +42,7 @@ from synth.plant.composition import Plant
 from synth.plant.rules import RuleSet
 from synth.sup.constraints import CompiledConstraints
 from synth.symbolic.encoding import live_nodes
-from synth.symbolic.explicit import ExplicitNodes, Key
+from synth.symbolic.explicit import ExplicitNodes, Key, PathKey
 from synth.symbolic.stepreach import StepReach
 from synth.symbolic.stepsync import StepSync
 from synth.symbolic.steps import Unsupported, unsupported
@@ -56,9 +56,6 @@ __all__ = ["validate_steps", "MAX_HELD_ASKED"]
 
 MAX_HELD_ASKED = 1000
 """Above this many listed nodes the held set is computed at once (else node by node)."""
-
-PathKey = tuple[tuple[int, int, int], ...]  # a shortest path, in the explicit exploration's order
-"""Above this many listed nodes the per-situation engine computes the held set at once."""
 
 
 def _homes(s: StepSync, texts: Sequence[str], p: Plant, g: Grafcet) -> Function:
@@ -133,17 +130,8 @@ def validate_steps(
             continue
         key, depth, path = r.first_node(comp)
         found.append((depth, path, key, r.listed(comp)))
-    found.sort(key=lambda f: (f[0], f[1]))
-    blocking: list[int] = []
-    components: dict[int, tuple[int, ...]] = {}
-    traces: dict[int, Trace] = {}
-    no_return: dict[int, int] = {}
-    for _, _, key, members in found:
-        b = ex.node(key)
-        blocking.append(b)
-        components[b] = tuple(sorted(ex.node(k) for k in members))
-        traces[b] = _trace(r, ex, key)
-        no_return[b] = next((n for n in traces[b].nodes if (r.cube(_keys(ex)[n]) & back) == false), b)
+    blocking, components, traces, no_return = ex.blocking(found, lambda key: _trace(r, ex, key),
+                                                          lambda key: (r.cube(key) & back) != false)
     firsts: dict[Key, tuple[int, PathKey]] = {}
     for u in proh_sets.values():
         key, depth, path = r.first_node(u)

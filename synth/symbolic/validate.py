@@ -42,13 +42,13 @@ from synth.symbolic.reachability import (
     stuck_nodes,
     terminal_components,
 )
-from synth.symbolic.explicit import ExplicitNodes, Key
+from synth.symbolic.explicit import ExplicitNodes, Key, PathKey
 from synth.symbolic.steps import anchors, unsupported
 from synth.symbolic.stepvalidate import validate_steps
 from synth.symbolic.supervisor import SymbolicSupervisor
 from synth.symbolic.graph import NodeSet
 from synth.symbolic.sync import SymbolicSync
-from synth.validation.analysis import Analysis, Trace
+from synth.validation.analysis import Analysis
 from synth.validation.diagnosis import diagnose_all
 from synth.validation.conflicts import Conflict
 from synth.validation.sync import Sync
@@ -56,7 +56,6 @@ from synth.validation.result import Validation, home_conditions, load_model
 
 __all__ = ["validate_symbolic", "validate_loaded"]
 
-PathKey = tuple[tuple[int, int, int], ...]  # a shortest path, in the explicit exploration's order
 
 
 def _homes(ssync: SymbolicSync, texts: Sequence[str], p: Plant, g: Grafcet) -> NodeSet:
@@ -192,18 +191,7 @@ def _validate_loaded(
             continue
         s, local, depth, path = first_node(ssync, comp)
         found.append((depth, path, (s, local), listed(ssync, comp, MAX_LISTED)))
-    found.sort(key=lambda f: (f[0], f[1]))
-    blocking: list[int] = []
-    components: dict[int, tuple[int, ...]] = {}
-    traces: dict[int, Trace] = {}
-    no_return: dict[int, int] = {}
-    for _, _, key, members in found:
-        b = ex.node(key)
-        blocking.append(b)
-        components[b] = tuple(sorted(ex.node(k) for k in members))
-        traces[b] = ex.trace(key)
-        keys = {v: k for k, v in ex.index.items()}
-        no_return[b] = next((n for n in traces[b].nodes if not _is_in(ssync, back, keys[n])), b)
+    blocking, components, traces, no_return = ex.blocking(found, ex.trace, lambda key: _is_in(ssync, back, key))
     # prohibited orders: the first node meeting each (steps, event)
     firsts: dict[Key, tuple[int, PathKey]] = {}
     for u in proh_sets.values():
