@@ -149,8 +149,8 @@ def test_help_lists_the_commands(capsys):
 
 
 def test_st_check_without_blark_says_how_to_install_it(capsys, monkeypatch):
-    """blark is a test extra: without it, ``st --check`` stops with exit 2 and the extra to
-    install, never a traceback."""
+    """blark is a dependency; where it is missing all the same, ``st --check`` and ``filter
+    verify --control`` stop with exit 2 and what to install, never a traceback."""
     import importlib.util
 
     real = importlib.util.find_spec
@@ -158,4 +158,8 @@ def test_st_check_without_blark_says_how_to_install_it(capsys, monkeypatch):
     code, out, err = run(capsys, "st", "--check", "grafcets/tri.g7", "--plant", "plants/tri.rules")
     assert (code, out) == (2, "")
     assert err == ("error: synth st --check needs blark, the IEC 61131-3 parser it runs the generated code with: "
-                   "pip install 'synth[test]' (or pip install blark)\n")
+                   "pip install blark (a dependency of synth: install synth again)\n")
+    code, out, err = run(capsys, "filter", "verify", "plants/four_cylinders.filter", "--plant",
+                         "plants/four_cylinders.rules", "--control", "plants/four_cylinders_toggle.st")
+    assert (code, out) == (2, "")
+    assert err.startswith("error: synth filter verify --control needs blark")

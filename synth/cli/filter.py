@@ -258,10 +258,11 @@ def cmd_verify(args: argparse.Namespace) -> int:
     control = None
     if args.control is not None:
         from synth.codegen.check import require_blark
+
+        require_blark("synth filter verify --control")  # before the interpreter, which imports blark
         from synth.codegen.interpreter import load_st
         from synth.filter.control_st import StSource
 
-        require_blark("synth filter verify --control")
         control = StSource(args.control, load_st)
     v = verify(f, args.plant, args.grafcet, any_control=args.any_control, algorithm=Algorithm(args.algorithm),
                mode=Mode(args.mode), atomic=args.atomic_outputs, strict=args.strict, require_sup=args.require_sup,

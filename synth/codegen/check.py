@@ -341,4 +341,4 @@ def require_blark(what: str) -> None:
 
     if importlib.util.find_spec("blark") is None:
         raise SynthError(f"{what} needs blark, the IEC 61131-3 parser it runs the generated code with: "
-                         "pip install 'synth[test]' (or pip install blark)")
+                         "pip install blark (a dependency of synth: install synth again)")
