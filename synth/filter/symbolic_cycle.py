@@ -42,11 +42,11 @@ from synth.filter.language import Filter
 from synth.logic.bdd import Function
 from synth.logic.events import Event
 from synth.logic.past import pre_name
-from synth.plant.composition import LocalTransition, Plant
+from synth.plant.composition import Plant
 from synth.plant.rules import RuleSet
 from synth.sup.constraints import _terms
 from synth.symbolic.encoding import Copy, PlantEncoding
-from synth.symbolic.relation import Move, preimage
+from synth.symbolic.relation import Move, plant_moves, preimage
 
 __all__ = ["SymbolicCycle", "BLOCKED", "FALLBACK", "OUTSIDE", "next_name"]
 
@@ -87,40 +87,13 @@ def check_filter(f: Filter, p: Plant, rules_path: str) -> None:
 
 def _without_reads(p: Plant) -> Plant:
     """``p`` for :class:`PlantEncoding`, which refuses elements reading each other's
-    variables because its own moves ignore the guards: these moves are not used here
-    (:func:`guarded_moves` encodes the guards), only its variables and states."""
+    variables (the symbolic validation does not support them); here its variables and states
+    serve, and :func:`~synth.symbolic.relation.plant_moves` encodes the guards."""
     if not p.reads:
         return p
     q = copy.copy(p)
     q.__dict__["reads"] = False  # the cached property, for this copy only
     return q
-
-
-def guarded_moves(enc: PlantEncoding, p: Plant) -> tuple[Move, ...]:
-    """Every move of the plant (:func:`~synth.symbolic.relation.plant_moves`), with each
-    local transition's guard on the variables its element reads."""
-    e = enc.engine
-    groups: dict[tuple[int, Event], list[tuple[int, LocalTransition]]] = {}
-    for k, t in enumerate(p.transitions):
-        groups.setdefault((t.axis, t.event), []).append((k, t))
-    out = []
-    for (axis, event), ts in groups.items():
-        reads = p.elements[axis].reads
-
-        def source(t: LocalTransition) -> Function:
-            here = enc.local_state(axis, t.src)
-            if t.guard is None:
-                return here
-            return here & e.disjunction(e.cube({r: bool((c >> j) & 1) for j, r in enumerate(reads)})
-                                        for c, ok in enumerate(t.guard) if ok)
-
-        sources = [source(t) for _, t in ts]
-        guard = e.disjunction(sources)
-        rel = e.disjunction(s & enc.local_state(axis, t.dst, Copy.NEXT) for s, (_, t) in zip(sources, ts))
-        var = e.var(event.name)
-        out.append(Move(axis, event, ts[0][1].controllable, ts[0][0], rel, tuple(t for _, t in ts),
-                        guard, var if event.rising else ~var, (e.declare(event.name), ~var)))
-    return tuple(sorted(out, key=lambda m: m.key))
 
 
 class SymbolicCycle:
@@ -151,7 +124,7 @@ class SymbolicCycle:
         for t in terms:
             if t.event is not None:
                 self.forbid[t.event] = self.forbid.get(t.event, e.false) | self._terms([t.factors])
-        self.moves: tuple[Move, ...] = guarded_moves(enc, p)
+        self.moves: tuple[Move, ...] = plant_moves(enc)
         self.uncontrollable = tuple(m for m in self.moves if not m.controllable)
         self.removed = self.backward(self.illegal)
         self._by_constraint = terms

@@ -61,24 +61,34 @@ class Move:
 
 
 def plant_moves(enc: PlantEncoding) -> tuple[Move, ...]:
-    """Every move of the plant, in the order of ``Plant.transitions``."""
+    """Every move of the plant, in the order of ``Plant.transitions``; a local transition of
+    an element that reads others' variables only where its guard allows it."""
+    e = enc.engine
     groups: dict[tuple[int, Event], list[tuple[int, LocalTransition]]] = {}
     for k, t in enumerate(enc.plant.transitions):
         groups.setdefault((t.axis, t.event), []).append((k, t))
     out = []
     for (axis, event), ts in groups.items():
-        rel = enc.engine.disjunction(
-            enc.local_state(axis, t.src) & enc.local_state(axis, t.dst, Copy.NEXT) for _, t in ts
-        )
+        reads = enc.plant.elements[axis].reads
+
+        def source(t: LocalTransition) -> Function:
+            here = enc.local_state(axis, t.src)
+            if t.guard is None:
+                return here
+            return here & e.disjunction(e.cube({r: bool((c >> j) & 1) for j, r in enumerate(reads)})
+                                        for c, ok in enumerate(t.guard) if ok)
+
+        sources = [source(t) for _, t in ts]
+        rel = e.disjunction(s & enc.local_state(axis, t.dst, Copy.NEXT) for s, (_, t) in zip(sources, ts))
         codes = enc.plant.elements[axis].codes
         bit = 1 << enc.element_variables[axis].index(event.name)
         for _, t in ts:  # a move flips its own variable, in its own direction, and nothing else
             if int(codes[t.dst]) != int(codes[t.src]) ^ bit or bool(int(codes[t.dst]) & bit) != event.rising:
                 raise AssertionError(f"local transition {t} does not only flip {event.name}")
-        guard = enc.engine.disjunction(enc.local_state(axis, t.src) for _, t in ts)
-        var = enc.engine.var(event.name)
+        guard = e.disjunction(sources)
+        var = e.var(event.name)
         out.append(Move(axis, event, ts[0][1].controllable, ts[0][0], rel, tuple(t for _, t in ts),
-                        guard, var if event.rising else ~var, (enc.engine.declare(event.name), ~var)))
+                        guard, var if event.rising else ~var, (e.declare(event.name), ~var)))
     return tuple(sorted(out, key=lambda m: m.key))
 
 
