@@ -130,7 +130,7 @@ def verify(f: Filter, rules_path: str, grafcet: str | None = None, *, any_contro
         source, how = ANY_CONTROL, Control(ControlKind.ANY)
     return Verification(
         f.file, rules_path, source, pr.cycle.algorithm, pr.cycle.mode,
-        atomic, strict, ex.states, len({k % pr.size for k in ex.seen_keys if k != ex.prelude or ex.reentered}),
+        atomic, strict, ex.states, ex.plant_states,
         ex.loop_cycles[0], ex.complete,
         time.perf_counter() - started, len(ex.outside_sup), findings, ex.loop_cycles[1], ex.max_distance,
         events_per_cycle, prog, how)

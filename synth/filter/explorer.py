@@ -375,6 +375,12 @@ class Explorer:
         return len(self.seen_keys) - (self.prelude is not None and not self.reentered)
 
     @property
+    def plant_states(self) -> int:
+        """The plant states of :attr:`states`."""
+        hidden = self.prelude if self.prelude is not None and not self.reentered else None
+        return len({k % self.size for k in self.seen_keys if k != hidden})
+
+    @property
     def loop_cycles(self) -> tuple[int, int]:
         """The cycles explored from the states, and those where the filter corrects the
         requests (the power-up cycle is not one of them; its findings are findings)."""
