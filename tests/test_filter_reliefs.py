@@ -18,7 +18,7 @@ def test_the_four_cylinders_keep_reliefs_differ_from_their_force_spelling(capsys
     path = ROOT / "plants/four_cylinders.filter"
     assert err[:4] == [
         f"{path}:45:34: warning: CSc1's relief `keep Q1` written `force Q2=0` gives another algebraic filter "
-        "(the equations of Q1, Q2 differ)",
+        "(it drives Q1, Q2, Q3, Q4 differently)",
         "  45 | safety CSc1: i1 & Q1 & Q2   keep Q1",
         "     |                                  ^~",
         "  = note: the algebraic filter uses `keep Q1`, as written; the loop algorithm reads either spelling as "
@@ -31,7 +31,7 @@ def test_a_force_relief_is_compared_with_its_keep_spelling():
     f = parse_filter(text, "square.filter")
     first = spelling_warnings(f)[0]
     assert first.message == ("CSc1's relief `force Q2=0` written `keep Q1` gives another algebraic filter "
-                             "(the equations of Q1, Q2 differ)")
+                             "(it drives Q1, Q2, Q3, Q4 differently)")
     assert first.render().splitlines()[0].startswith("square.filter:45:35: warning:")  # at Q2=0
 
 
@@ -41,32 +41,37 @@ def test_no_warning_where_the_spellings_agree_or_criteria_are_stated():
 
 
 def _by_definition(f):
-    """The warnings' definition: synthesise the filter with each relief spelt the other way
-    and compare what ``solve`` prints (functional, consistent, the chained equations)."""
+    """The warnings' definition: synthesise the filter with each relief spelt the other way,
+    on one BDD (not the partitioned chain), and compare the care sets and each output's
+    ``∃O.(S∧o)`` and ``∃O.(S∧!o)``, as texts (a function's cover is its own)."""
     import dataclasses
 
     from synth.filter.reliefs import _other
     from synth.filter.solve import synthesis
 
-    def printed(g):
-        s = synthesis(g)
-        return s.functional, s.consistent, dict(s.chained)
+    def relation(g):
+        s = synthesis(g, partitioned=False)
+        e, outs = s.functions.engine, s.functions.outputs
+        one = {o: e.text(e.exists(outs, s.admissible & e.var(o))) for o in g.outputs}
+        zero = {o: e.text(e.exists(outs, s.admissible & ~e.var(o))) for o in g.outputs}
+        return e.text(s.care), one, zero
 
-    base, found = printed(f), []
+    base, found = relation(f), []
     for s in f.combined:
         other = _other(s) if s.has_priority else None
         if other is None:
             continue
         t = dataclasses.replace(s, keep=other.keep, force=other.force)
-        alt = printed(dataclasses.replace(f, safeties=tuple(t if u is s else u for u in f.safeties)))
+        alt = relation(dataclasses.replace(f, safeties=tuple(t if u is s else u for u in f.safeties)))
         if alt != base:
-            found.append((s.id, [o for o in f.outputs if base[2].get(o) != alt[2].get(o)] or list(f.outputs)))
+            found.append((s.id, [o for o in f.outputs if (base[1][o], base[2][o]) != (alt[1][o], alt[2][o])]
+                          or list(f.outputs)))
     return found
 
 
 def test_the_warnings_follow_their_definition_on_the_bench_families():
-    """One chain, each other spelling run from the state before its criterion, texts printed
-    only where the functions differ: the same warnings as a synthesis per relief."""
+    """One chain, each other spelling run from the state before its criterion until it
+    rejoins the chain: the same warnings as a synthesis per relief."""
     import sys
 
     sys.path.insert(0, str(ROOT / "bench"))
@@ -76,7 +81,7 @@ def test_the_warnings_follow_their_definition_on_the_bench_families():
              (ROOT / "plants/four_cylinders.filter").read_text().replace("keep Q1", "force Q2=0")]
     for n, text in enumerate(texts):
         f = parse_filter(text, f"f{n}.filter")
-        got = [(w.message.split("'")[0], w.message.split("equations of ")[1].split(" differ")[0].split(", "))
+        got = [(w.message.split("'")[0], w.message.split("it drives ")[1].split(" differently")[0].split(", "))
                for w in spelling_warnings(f)]
         assert got == _by_definition(f), n
         assert got  # every family has reliefs whose spellings differ

@@ -4,9 +4,11 @@ does not (004 eq. 24 minimises ``!L`` for ``keep L``, the forced outputs being o
 values for ``force``), and the two can give different filters — on the four-cylinder square
 the ``force`` spelling starves the pallets. :func:`spelling_warnings` solves the filter with
 each combined constraint's relief written the other way and warns, located at the relief,
-where the printed equations differ. The criteria differ in one priority only, so one chain of
-narrowings serves them all: each other spelling runs from the state before its criterion,
-without the "no effect" races, and its equations are printed only when its functions differ.
+where the two filters differ: the care set, or an output's ``∃O.(S∧o)`` or ``∃O.(S∧!o)``
+(the outputs it drives differently, on the inputs where it is defined; docs/filter.md).
+The criteria differ in one priority only, so one chain of narrowings serves them all: each
+other spelling runs from the state before its criterion, without the "no effect" races,
+and stops where its state rejoins the chain's.
 
 Example
 -------
@@ -27,7 +29,7 @@ from synth.errors import InputError, Severity
 from synth.filter.language import Criterion, Filter, Forcing, Safety, Sense
 from synth.filter.language_check import output_polarities
 from synth.filter.narrowing import decided, layout
-from synth.logic.bdd import CoverTooLarge, Function
+from synth.logic.bdd import Function
 from synth.logic.expr import And, Expr, Not, Var
 from synth.logic.partition import State
 
@@ -71,9 +73,6 @@ def other_spellings(f: Filter) -> list[Spelling]:
     return []
 
 
-_Printed = tuple[bool, bool, dict[str, str]]  # functional, consistent, the chained equations
-
-
 class _Chain:
     """The chain of narrowings of ``f``'s criteria in one engine and one partition, each
     relief's other spelling run from the state before its criterion (the states before
@@ -97,8 +96,6 @@ class _Chain:
         for g, k in zip(self.goods, self.where):
             self.states.append(self._step(self.states[-1], k, g))
         self.base = self._outcome(self.states[-1])
-        self.printed: _Printed | None = None
-        self._texts: dict[tuple[Function, Function, int | None], str | bool] = {}
 
     def _goods(self, criteria: Sequence[Criterion]) -> list[Function]:
         e = self.m.engine
@@ -110,52 +107,28 @@ class _Chain:
     def _outcome(self, s: State) -> tuple[Function, dict[str, Function], dict[str, Function]]:
         return decided(self.p, s, self.m.outputs)
 
-    def _printed(self, outcome: tuple[Function, dict[str, Function], dict[str, Function]]) -> _Printed:
-        """What ``solve`` prints of an outcome: functional, consistent, the chained equations."""
-        from synth.filter.solve import Synthesis, printed
-
-        e = self.m.engine
-        care, ones, zeros = outcome
-        s = Synthesis(self.m, e.false, care, [])
-        printed(s, ones, zeros, text=self._text)
-        return s.functional, (self.m.assumed & ~care) == e.false, dict(s.chained)
-
-    def _text(self, lower: Function, upper: Function, limit: int | None) -> str:
-        """``Engine.text``, remembered: the two spellings share most equations."""
-        key = (lower, upper, limit)
-        found = self._texts.get(key)
-        if found is None:
-            try:
-                found = self._texts[key] = self.m.engine.text(lower, upper, limit)
-            except CoverTooLarge:
-                found = self._texts[key] = False  # not the exception: its frames hold BDDs
-        if found is False:
-            raise CoverTooLarge(limit or 0)
-        assert isinstance(found, str)
-        return found
-
     def differ(self, n: int) -> list[str] | None:
-        """The outputs whose chained equation differs with alternative ``n`` (every output
-        when they all agree but the filters do not), None when the filters print the same."""
+        """The outputs alternative ``n`` drives differently (another ``∃O.(S∧o)`` or
+        ``∃O.(S∧!o)``; every output when only the care set differs), None when the two
+        spellings give the same filter."""
         alternative = self.alternatives[n]
         if alternative is None:  # the criteria are the file's: the spelling changes none
             return None
         i, g = alternative
         mark = self.p.mark()
         s = self._step(self.states[i], self.p.position(g), g)
-        for j in range(i + 1, len(self.goods)):
-            s = self._step(s, self.where[j], self.goods[j])
-        alt = self._outcome(s)
+        for j in range(i + 1, len(self.goods) + 1):
+            if s.domains == self.states[j].domains:  # the chain rejoined: the same filter from here
+                self.p.forget(mark)
+                return None
+            if j < len(self.goods):
+                s = self._step(s, self.where[j], self.goods[j])
+        care, ones, zeros = self._outcome(s)
         self.p.forget(mark)
-        if alt[0] == self.base[0] and all(alt[1][o] == self.base[1][o] and alt[2][o] == self.base[2][o]
-                                          for o in self.m.outputs):
-            return None  # the same functions: the same equations
-        if self.printed is None:
-            self.printed = self._printed(self.base)
-        mine = self._printed(alt)
-        if mine == self.printed:
+        differ = [o for o in self.m.outputs if ones[o] != self.base[1][o] or zeros[o] != self.base[2][o]]
+        if not differ and care == self.base[0]:
             return None
-        return [o for o in self.m.outputs if self.printed[2].get(o) != mine[2].get(o)] or list(self.m.outputs)
+        return differ or list(self.m.outputs)
 
 
 def spelling_warnings(f: Filter, safeties: Sequence[Safety] | None = None) -> list[InputError]:
@@ -183,7 +156,7 @@ def spelling_warnings(f: Filter, safeties: Sequence[Safety] | None = None) -> li
         loop = Spelling(None, s.forced).text()
         out.append(InputError(
             f"{s.id}'s relief `{written.text()}` written `{other.text()}` gives another algebraic filter "
-            f"(the equations of {', '.join(differ)} differ)",
+            f"(it drives {', '.join(differ)} differently)",
             loc or s.loc, severity=Severity.WARNING,
             notes=(f"the algebraic filter uses `{written.text()}`, as written; the loop algorithm reads either "
                    f"spelling as `{loop}`",)))
