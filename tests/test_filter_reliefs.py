@@ -29,15 +29,15 @@ def test_the_four_cylinders_keep_reliefs_differ_from_their_force_spelling(capsys
 def test_a_force_relief_is_compared_with_its_keep_spelling():
     text = (ROOT / "plants/four_cylinders.filter").read_text().replace("keep Q1", "force Q2=0")
     f = parse_filter(text, "square.filter")
-    first = spelling_warnings(f)[0]
+    first = spelling_warnings(f).warnings[0]
     assert first.message == ("CSc1's relief `force Q2=0` written `keep Q1` gives another algebraic filter "
                              "(it drives Q1, Q2, Q3, Q4 differently)")
     assert first.render().splitlines()[0].startswith("square.filter:45:35: warning:")  # at Q2=0
 
 
 def test_no_warning_where_the_spellings_agree_or_criteria_are_stated():
-    assert spelling_warnings(parse_filter("inputs i\noutputs a, b\nsafety K: i & a & b keep a", "k.filter")) == []
-    assert spelling_warnings(load_filter(ROOT / "plants/tri.filter")) == []  # explicit criteria: no priority criteria
+    assert spelling_warnings(parse_filter("inputs i\noutputs a, b\nsafety K: i & a & b keep a", "k.filter")).reports() == []
+    assert spelling_warnings(load_filter(ROOT / "plants/tri.filter")).reports() == []  # explicit criteria: no priority criteria
 
 
 def _by_definition(f):
@@ -82,6 +82,22 @@ def test_the_warnings_follow_their_definition_on_the_bench_families():
     for n, text in enumerate(texts):
         f = parse_filter(text, f"f{n}.filter")
         got = [(w.message.split("'")[0], w.message.split("it drives ")[1].split(" differently")[0].split(", "))
-               for w in spelling_warnings(f)]
+               for w in spelling_warnings(f).reports()]
         assert got == _by_definition(f), n
         assert got  # every family has reliefs whose spellings differ
+
+
+def test_past_the_work_limit_the_other_reliefs_are_listed_not_compared(capsys):
+    """The first relief is always compared; with no work left the others are named, located
+    at the first of them, and ``--all-spellings`` lifts the limit."""
+    f = load_filter(ROOT / "plants/four_cylinders.filter")
+    found = spelling_warnings(f, limit=0)
+    assert [w.message.split("'")[0] for w in found.warnings] == ["CSc1"]
+    assert [s.id for s in found.skipped] == ["CSc2", "CSc3", "CSc4"]
+    last = found.reports()[-1].render().splitlines()
+    assert last[0].endswith(":46:34: warning: the keep/force spellings of 3 relief(s) from CSc2 on were not compared: "
+                            "over the work limit of the comparison (1e+07 BDD steps)")
+    assert last[-1] == "  = note: `synth filter check --all-spellings` compares them all, whatever it costs"
+    assert spelling_warnings(f, limit=None).skipped == ()
+    assert main(["filter", "check", "--all-spellings", str(ROOT / "plants/four_cylinders.filter")]) in (0, 1)
+    assert sum("warning:" in line for line in capsys.readouterr().err.splitlines()) == 4

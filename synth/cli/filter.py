@@ -30,6 +30,8 @@ def register(sub: "argparse._SubParsersAction") -> None:
     c.add_argument("--json", action="store_true", help="print JSON instead of text")
     c.add_argument("--plant", metavar="P.rules",
                    help="judge on the valuations this plant can reach under any control (printed as assume lines)")
+    c.add_argument("--all-spellings", action="store_true",
+                   help="compare the keep/force spellings of every relief, past the work limit (large filters)")
     ci_options(c)
     c.set_defaults(handler=cmd_check)
 
@@ -97,9 +99,9 @@ def cmd_check(args: argparse.Namespace) -> int:
         inv = invariants(f, args.plant)
         f = assumed(f, inv)
     c = check(f)
-    from synth.filter.reliefs import spelling_warnings
+    from synth.filter.reliefs import SPELLING_WORK, spelling_warnings
 
-    for w in spelling_warnings(f):
+    for w in spelling_warnings(f, limit=None if args.all_spellings else SPELLING_WORK).reports():
         print(w.render(), file=sys.stderr)
     if args.junit or args.sarif:
         from synth.output.ci import filter_check_report, write_ci

@@ -16,7 +16,7 @@ Example
 >>> f = parse_filter("inputs i\\noutputs a, b\\nsafety K: i & a & b keep a", "k.filter")
 >>> [s.text() for s in other_spellings(f)]
 ['keep a', 'force b=0']
->>> spelling_warnings(f)
+>>> spelling_warnings(f).reports()
 []
 """
 
@@ -25,7 +25,7 @@ from __future__ import annotations
 import dataclasses
 from typing import Sequence
 
-from synth.errors import InputError, Severity
+from synth.errors import InputError, Location, Severity
 from synth.filter.language import Criterion, Filter, Forcing, Safety, Sense
 from synth.filter.language_check import output_polarities
 from synth.filter.narrowing import decided, layout
@@ -33,7 +33,7 @@ from synth.logic.bdd import Function
 from synth.logic.expr import And, Expr, Not, Var
 from synth.logic.partition import State
 
-__all__ = ["Spelling", "other_spellings", "spelling_warnings"]
+__all__ = ["SPELLING_WORK", "Spelling", "Spellings", "other_spellings", "spelling_warnings"]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -131,10 +131,42 @@ class _Chain:
         return differ or list(self.m.outputs)
 
 
-def spelling_warnings(f: Filter, safeties: Sequence[Safety] | None = None) -> list[InputError]:
+SPELLING_WORK = 10_000_000
+"""The BDD work (:meth:`Engine.work`) ``filter check`` spends on comparing the spellings of
+the other reliefs once the first is compared: about 4 CPU s on this project's machine; the
+grid of 32 outputs needs half of it for its 52 reliefs, the grid of 64 fifteen times it."""
+
+
+@dataclasses.dataclass(frozen=True)
+class Spellings:
+    """What :func:`spelling_warnings` found: the warnings, and the reliefs not compared
+    because the work limit was reached first (in file order)."""
+
+    warnings: list[InputError]
+    skipped: tuple[Safety, ...] = ()
+
+    def reports(self) -> list[InputError]:
+        """The warnings, then one located at the first relief not compared, if any."""
+        if not self.skipped:
+            return self.warnings
+        first = self.skipped[0]
+        return self.warnings + [InputError(
+            f"the keep/force spellings of {len(self.skipped)} relief(s) from {first.id} on were not compared: "
+            f"over the work limit of the comparison ({SPELLING_WORK:.0e} BDD steps)",
+            _relief_loc(first), severity=Severity.WARNING,
+            notes=("`synth filter check --all-spellings` compares them all, whatever it costs",))]
+
+
+def _relief_loc(s: Safety) -> Location | None:
+    return (s.keep.loc if isinstance(s.keep, Var) and s.keep.loc else (s.force[0].loc if s.force else s.loc)) or s.loc
+
+
+def spelling_warnings(f: Filter, safeties: Sequence[Safety] | None = None,
+                      limit: int | None = SPELLING_WORK) -> Spellings:
     """A located warning for each relief whose other spelling gives a different algebraic
-    filter: another care set, or an output determined in one and not the other or by
-    another function (the same functions print the same equations)."""
+    filter: another care set, or an output that may be on or may be off on other inputs.
+    ``limit``: the BDD work for the reliefs after the first (None: no limit); the reliefs
+    left when it is spent are listed, not compared."""
     swapped: list[tuple[Safety, Filter]] = []
     for s in (safeties if safeties is not None else f.combined):
         other = _other(s) if s.has_priority else None
@@ -142,22 +174,24 @@ def spelling_warnings(f: Filter, safeties: Sequence[Safety] | None = None) -> li
             t = dataclasses.replace(s, keep=other.keep, force=other.force)
             swapped.append((s, dataclasses.replace(f, safeties=tuple(t if u is s else u for u in f.safeties))))
     if not swapped:
-        return []
+        return Spellings([])
     chain = _Chain(f, swapped)
     out: list[InputError] = []
+    start = chain.m.engine.work()
     for n, (s, _) in enumerate(swapped):
+        if n and limit is not None and chain.m.engine.work() - start > limit:
+            return Spellings(out, tuple(s for s, _ in swapped[n:]))
         differ = chain.differ(n)
         if differ is None:
             continue
         other = _other(s)
         assert other is not None
         written = Spelling(s.keep, s.force if s.keep is None else ())
-        loc = s.keep.loc if isinstance(s.keep, Var) and s.keep.loc else (s.force[0].loc if s.force else s.loc)
         loop = Spelling(None, s.forced).text()
         out.append(InputError(
             f"{s.id}'s relief `{written.text()}` written `{other.text()}` gives another algebraic filter "
             f"(it drives {', '.join(differ)} differently)",
-            loc or s.loc, severity=Severity.WARNING,
+            _relief_loc(s), severity=Severity.WARNING,
             notes=(f"the algebraic filter uses `{written.text()}`, as written; the loop algorithm reads either "
                    f"spelling as `{loop}`",)))
-    return out
+    return Spellings(out)

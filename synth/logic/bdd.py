@@ -271,6 +271,18 @@ class Engine:
             warnings.simplefilter("ignore")  # dd's note that the key 'mem' is now in bytes
             return int(self.bdd.statistics()["n_nodes"])
 
+    def work(self) -> int:
+        """The BDD work done so far in this manager, deterministic for a given sequence of
+        operations: CUDD's computed-table lookups (one per recursive step of an operation
+        that is not a terminal case); 0 without CUDD."""
+        if not self.cudd:  # pragma: no cover - dd without its CUDD extension
+            return 0
+        import warnings
+
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # dd's note that the key 'mem' is now in bytes
+            return int(self.bdd.statistics()["cache_lookups"])
+
     def forall(self, names: Iterable[str], u: Function) -> Function:
         vs = [self.declare(n) for n in names]
         return self.bdd.forall(vs, u) if vs else u
