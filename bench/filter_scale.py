@@ -17,8 +17,9 @@
   station ``o<s>_<k> & o<s>_<k+1>`` and between stations ``o<s>_<k> & o<s+1>_<k>`` (keep the
   first); 64 outputs give 200 constraints.
 
-Per N, one fresh process runs the stages (``st``: the algebraic and the loop blocks, from
-the same synthesis) and reports CPU seconds and peak RSS; the sizes stop at the first N
+Per N, one fresh process runs the stages (``check``: P1–P4 and consistency, then the
+keep/force spelling comparison ``synth filter check`` prints; ``st``: the algebraic and the
+loop blocks, from the same synthesis) and reports CPU seconds and peak RSS; the sizes stop at the first N
 whose process exceeds ``--limit`` seconds. Besides, the box-sorting filter of seed 004 end
 to end: ``synth filter check``, ``solve`` and ``st`` as fresh processes (start included).
 """
@@ -47,8 +48,11 @@ from synth.filter.solve import synthesis
 from synth.codegen.filter_st import filter_block
 out = {}
 t = time.perf_counter(); f = load_filter(sys.argv[1]); out["parse"] = time.perf_counter() - t
-t = time.perf_counter(); m = functions(f); c = coherence(m); out["check"] = time.perf_counter() - t
+t = time.perf_counter(); m = functions(f); c = coherence(m)
+from synth.filter.reliefs import spelling_warnings  # what `synth filter check` adds: the keep/force spellings
+w = spelling_warnings(f); out["check"] = time.perf_counter() - t
 out["holds"] = c.holds
+out["spelling_warnings"], out["spellings_not_compared"] = len(w.warnings), len(w.skipped)
 t = time.perf_counter(); s = synthesis(m); out["solve"] = time.perf_counter() - t
 out["functional"], out["consistent"] = s.functional, s.consistent
 out["equation_chars"] = sum(len(x) for x in s.chained.values())
