@@ -36,10 +36,11 @@ Example
 >>> g = load_grafcet(_plants("../tests/data/home/production_loop.g7"), inputs=p.inputs, outputs=p.outputs)
 >>> r = StepReach(step_sync(p, rs.constraints, GrafcetMachine(g)))
 >>> sets = [r.s.nodes & ~r.s.initial, r.s.initial]
->>> first_nodes(r, sets) == [r.first_node(u) for u in sets]
+>>> f = Findings(r, sets)
+>>> f.firsts == [r.first_node(u) for u in sets]
 True
 >>> keys = r.listed(r.s.nodes)
->>> shortest_traces(r, keys) == [r.shortest_trace(k) for k in keys]
+>>> f.traces(keys) == [r.shortest_trace(k) for k in keys]
 True
 """
 
@@ -54,7 +55,7 @@ from synth.symbolic.reachability import Path
 from synth.symbolic.relation import Move
 from synth.symbolic.stepreach import Order, StepReach
 
-__all__ = ["Tags", "first_nodes", "shortest_traces"]
+__all__ = ["Tags", "Findings"]
 
 PathKey = tuple[tuple[int, int, int], ...]
 
@@ -153,8 +154,6 @@ class _Batch:
             target = s._primed(layer)
             options: dict[Order, list[tuple[Event, Function, Function]]] = {}
             for m, e in s.edges:
-                if (layer & m.after) == false:  # an edge of m ends where m's variable is flipped
-                    continue
                 v = s.image(current, m, e) & target
                 if v != false:
                     options.setdefault(order(m), []).append((m.event, v, exists("exists", self._next_cube, v)))
@@ -185,41 +184,64 @@ class _Batch:
         return out
 
 
-def first_nodes(r: StepReach, sets: Sequence[Function]) -> list[tuple[Key, int, PathKey]]:
-    """:meth:`StepReach.first_node` of every set of ``sets``, in one pass."""
-    if not sets:
-        return []
-    b = _Batch(r, sets)
-    chosen, steps = b.greedy(r._key)
-    paths = b.paths(steps)
-    out: list[tuple[Key, int, PathKey]] = []
-    ends: dict[int, dict[int, Function]] = {}
-    for j, d in enumerate(b.depths):
-        if d not in ends:
-            ends[d] = b.tags.split(chosen[d])
-        out.append((r.pick(ends[d][j]), d, tuple(key for key, _ in paths[j])))
-    return out
+class Findings:
+    """The first node of every set of ``sets`` (:attr:`firsts`, as
+    :meth:`StepReach.first_node`), then the traces to nodes (:meth:`traces`, as
+    :meth:`StepReach.shortest_trace`): a node that is the whole target of a set at its
+    depth has that set's layers, which its trace reuses."""
+
+    def __init__(self, r: StepReach, sets: Sequence[Function]) -> None:
+        self.r = r
+        self.firsts: list[tuple[Key, int, PathKey]] = []
+        self._whole: dict[Key, int] = {}  # node -> a set whose target at its depth is that node alone
+        self._batch: _Batch | None = None
+        if not sets:
+            return
+        b = self._batch = _Batch(r, sets)
+        chosen, steps = b.greedy(r._key)
+        paths = b.paths(steps)
+        ends: dict[int, dict[int, Function]] = {}
+        s = r.s
+        for j, d in enumerate(b.depths):
+            if d not in ends:
+                ends[d] = b.tags.split(chosen[d])
+            key = r.pick(ends[d][j])
+            self.firsts.append((key, d, tuple(k for k, _ in paths[j])))
+            if key not in self._whole and s.count(sets[j] & s.rings[d], s._current) == 1:
+                self._whole[key] = j
+
+    def traces(self, keys: Sequence[Key]) -> list[Path]:
+        """The trace to every node of ``keys``."""
+        found: dict[Key, Path] = {}
+        reused = {self._whole[k]: k for k in keys if k in self._whole}
+        if reused:
+            assert self._batch is not None
+            found.update(_traces(self.r, self._batch, reused))
+        rest = [k for k in dict.fromkeys(keys) if k not in found]
+        if rest:
+            found.update(_traces(self.r, _Batch(self.r, [self.r.cube(k) for k in rest]), dict(enumerate(rest))))
+        return [found[k] for k in keys]
 
 
-def shortest_traces(r: StepReach, keys: Sequence[Key]) -> list[Path]:
-    """:meth:`StepReach.shortest_trace` of every node of ``keys``, in one pass: the events
-    by the tagged greedy walk, then the nodes one ring back at a time for every trace."""
-    if not keys:
-        return []
+def _traces(r: StepReach, b: _Batch, wanted: dict[int, Key]) -> dict[Key, Path]:
+    """The traces of the tags ``wanted`` of ``b`` (each the tag of one node, its target):
+    the events by the greedy walk in event order, then the nodes one ring back at a time
+    for every trace at once."""
     s, false = r.s, r.false
-    b = _Batch(r, [r.cube(k) for k in keys])
     chosen, steps = b.greedy(lambda m: m.event)
-    events = [[e for _, e in p] for p in b.paths(steps)]
+    mask = s.engine.disjunction(b.tags.cube(j) for j in wanted)
+    paths = b.paths(steps)
     arcs = {m.event: e for m, e in s.edges}
-    nodes: list[list[Key]] = [[k] for k in keys]
+    nodes: dict[int, list[Key]] = {j: [k] for j, k in wanted.items()}
     memo: dict[Function, Key] = {}
     here = false  # per tag, its node at ring k + 1
     for k in range(len(b.layers) - 2, -1, -1):
-        here |= b.targets.get(k + 1, false)
+        here |= b.targets.get(k + 1, false) & mask
         primed = s._primed(here)
         before = false
         for _, event, sel in steps[k]:
-            before |= s.engine.and_exists(arcs[event], primed & sel, s._next)
+            if (sel & mask) != false:
+                before |= s.engine.and_exists(arcs[event], primed & sel, s._next)
         before &= chosen[k]
         several = picked = false  # tags with several candidate nodes, and the one each picked
         for j, u in b.tags.split(before).items():
@@ -231,4 +253,4 @@ def shortest_traces(r: StepReach, keys: Sequence[Key]) -> list[Path]:
                 several |= b.tags.cube(j)
                 picked |= b.tags.cube(j) & r.cube(key)
         here = (before & ~several) | picked
-    return [Path(tuple(reversed(n)), tuple(ev)) for n, ev in zip(nodes, events)]
+    return {k: Path(tuple(reversed(nodes[j])), tuple(e for _, e in paths[j])) for j, k in wanted.items()}

@@ -43,7 +43,7 @@ from synth.plant.rules import RuleSet
 from synth.sup.constraints import CompiledConstraints
 from synth.symbolic.encoding import live_nodes
 from synth.symbolic.explicit import ExplicitNodes, Key, PathKey
-from synth.symbolic.stepbatch import first_nodes, shortest_traces
+from synth.symbolic.stepbatch import Findings
 from synth.symbolic.stepreach import StepReach
 from synth.symbolic.stepsync import StepSync
 from synth.symbolic.steps import Unsupported, unsupported
@@ -126,14 +126,15 @@ def validate_steps(
              if (r.steps_of(c) & ~covered) != false]  # else every situation of it has a prohibited order
     blocking_sets = list(by_steps.values()) + comps
     # every finding's first node, then every trace, in one pass each (stepbatch)
-    firsts_of = first_nodes(r, blocking_sets + list(proh_sets.values()))
+    search = Findings(r, blocking_sets + list(proh_sets.values()))
+    firsts_of = search.firsts
     found: list[tuple[int, PathKey, Key, list[Key]]] = [
         (depth, path, key, r.listed(u)) for u, (key, depth, path) in zip(blocking_sets, firsts_of)]
     firsts: dict[Key, tuple[int, PathKey]] = {}
     for key, depth, path in firsts_of[len(blocking_sets):]:
         firsts[key] = (depth, path)
     wanted = list(dict.fromkeys([key for _, _, key, _ in found] + list(firsts)))
-    paths = dict(zip(wanted, shortest_traces(r, wanted)))
+    paths = dict(zip(wanted, search.traces(wanted)))
     blocking, components, traces, no_return = ex.blocking(found, lambda key: ex.trace_of(paths[key]),
                                                           lambda key: (r.cube(key) & back) != false)
     ordered = sorted(firsts, key=lambda k: firsts[k])
