@@ -146,6 +146,7 @@ class StepEncoding:
         self._qvars = {c: [self.engine.declare(step_name(s, c)) for s in self.steps] for c in Copy}
         self._equal: dict[tuple[Copy, Copy], Function] = {}
         self._cubes: dict[tuple[tuple[str, ...], Copy], Function] = {}
+        self._exists: dict[Copy, Function] = {}
 
     # ---- variables
     def var(self, step: str, copy: Copy = Copy.CURRENT) -> Function:
@@ -167,7 +168,11 @@ class StepEncoding:
         return self.engine.and_exists(u, self.equal(source, target), self.names(source))
 
     def exists(self, u: Function, copy: Copy) -> Function:
-        return self.engine.bdd.exist(self.names(copy), u)
+        """``∃`` the ``copy`` of every step variable in ``u`` (the cube built once)."""
+        cube = self._exists.get(copy)
+        if cube is None:
+            cube = self._exists[copy] = self.engine.bdd.cube(set(self.names(copy)))
+        return self.engine.bdd.apply("exists", cube, u)
 
     def cube(self, sit: Situation, copy: Copy = Copy.CURRENT) -> Function:
         """The step variables of ``sit`` (its active steps, every other step inactive)."""

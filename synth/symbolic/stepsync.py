@@ -86,6 +86,7 @@ class StepSync:
         self.region_moves: list[Function] = []  # per element, its region moves (X, x, x', x''), x the entry
         self.pairs: Function = self.false  # (X, n, x'): entries and their region's states, without a closure
         self.edge_count = 0
+        self._renames: dict[tuple[Copy, Copy], tuple[Function, list[str]]] = {}
         self._inputs = frozenset(n for n in machine.inputs if n in self.plant.owner)
         self._moves = tuple(m for m in sup.moves if not m.controllable)
         e = self.engine
@@ -180,7 +181,8 @@ class StepSync:
                 r = self.steps.react(entries, m.event if m.variable in self._inputs else None)
                 old = self.reacted.get(m.key)
                 self.reacted[m.key] = (m, r if old is None else old[1] | r)
-                targets |= self.steps.rename(self.steps.exists(r, Copy.CURRENT), Copy.NEXT, Copy.CURRENT)
+                targets |= self.steps.exists(r, Copy.CURRENT)
+            targets = self.steps.rename(targets, Copy.NEXT, Copy.CURRENT)  # once per level: a renaming is a bijection
             new = targets & ~self.entered
             self.entered |= new
             frontier = self._enter(new) & ~self.nodes
@@ -232,7 +234,19 @@ class StepSync:
 
     # ---- fixpoints
     def _primed(self, u: Function) -> Function:
-        return self.enc.rename(self.steps.rename(u, Copy.CURRENT, Copy.NEXT), Copy.CURRENT, Copy.NEXT)
+        """``u`` from the current copies (plant and steps) to the next ones."""
+        return self._rename(u, Copy.CURRENT, Copy.NEXT)
+
+    def _rename(self, u: Function, source: Copy, target: Copy) -> Function:
+        """``u`` with the ``source`` copy of the plant and step variables renamed to
+        ``target``: one relational product with both equalities (cached)."""
+        hit = self._renames.get((source, target))
+        if hit is None:
+            names = [self.engine.declare(v + source.value) for v in self.enc.variables] + self.steps.names(source)
+            equal = self.steps.equal(source, target) & self.engine.conjunction(
+                self.engine.var(v + source.value).equiv(self.engine.var(v + target.value)) for v in self.enc.variables)
+            hit = self._renames[(source, target)] = (equal, names)
+        return self.engine.and_exists(u, hit[0], hit[1])
 
     def pre(self, u: Function, edges: Sequence[tuple[Move, Function]] | None = None,
             within: Function | None = None) -> Function:
@@ -256,7 +270,7 @@ class StepSync:
 
     def unprimed(self, u: Function) -> Function:
         """``u`` from the next copies (plant and steps) to the current ones."""
-        return self.enc.rename(self.steps.rename(u, Copy.NEXT, Copy.CURRENT), Copy.NEXT, Copy.CURRENT)
+        return self._rename(u, Copy.NEXT, Copy.CURRENT)
 
     def post(self, u: Function, edges: Sequence[tuple[Move, Function]] | None = None) -> Function:
         """Nodes an edge (of ``edges``, default all) leads to from ``u``."""
