@@ -90,25 +90,22 @@ class Tags:
         bdd = self.engine.bdd
         false = bdd.false
         levels = sorted((bdd.level_of_var(v), i) for i, v in enumerate(self.inner))
-        bit_at = {lv: i for lv, i in levels}
         out: dict[int, Function] = {}
-
-        def walk(g: Function, depth: int, value: int) -> None:
+        work = [(f, 0, 0)]  # a loop, not a recursive closure: a closure's cycle would hold BDD nodes
+        while work:
+            g, depth, value = work.pop()
             if g == false:
-                return
+                continue
             if depth == len(levels):
                 out[value] = g
-                return
+                continue
             level, bit = levels[depth]
             lo = hi = g
             if g != bdd.true and g.level == level:
                 lo, hi = g.low, g.high
                 if g.negated:
                     lo, hi = ~lo, ~hi
-            walk(lo, depth + 1, value)
-            walk(hi, depth + 1, value | 1 << bit_at[level])
-
-        walk(f, 0, 0)
+            work += [(lo, depth + 1, value), (hi, depth + 1, value | 1 << bit)]
         return dict(sorted(out.items()))
 
 

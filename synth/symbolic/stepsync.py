@@ -138,14 +138,13 @@ class StepSync:
         precomputed closure."""
         reach = frontier = entries & self.helper.equal
         while frontier != self.false:
-            new = self.false
+            new = self.false  # an element's move: its next copy quantified, its auxiliary copy set
             for axis, moves in enumerate(self.region_moves):
                 if moves == self.false:
                     continue
-                names = self.enc.element_variables[axis]
-                step = self.enc.and_exists(frontier, moves, Copy.NEXT, names)
-                new |= self.enc.rename(step, Copy.AUX, Copy.NEXT, names)
-            frontier = new & ~reach
+                new |= self.enc.and_exists(frontier, moves, Copy.NEXT, self.enc.element_variables[axis])
+            # one renaming for every element (a term has the auxiliary copy of its own element only)
+            frontier = self.enc.rename(new, Copy.AUX, Copy.NEXT) & ~reach
             reach |= frontier
         return reach
 
