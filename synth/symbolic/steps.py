@@ -261,6 +261,11 @@ class StepEncoding:
         hit = self._fire[event] = (fired, relation, pairs)
         return hit
 
+    def reads_edge(self, event: Event) -> bool:
+        """Whether a receptivity reads ``event``'s edge (else the reaction after it is the
+        reaction after no event)."""
+        return self._round(event) is not self._round(None)
+
     def react(self, entries: Function, event: Event | None) -> Function:
         """The stable situations the machine reaches from ``entries`` (situation X, plant
         state n right after ``event``): the relation over (X, n, X') — X' in the next

@@ -78,7 +78,8 @@ class StepSync:
         self.members: Function = self.false
         self.entered: Function = self.false
         self.initial_situation: Situation | None = None
-        self.reacted: dict[int, tuple[Move, Function]] = {}
+        self.reacted: dict[int, tuple[Move, Function]] = {}  # per move, its entries (X, n) met
+        self._reactions: dict[Event | None, Function] = {}  # per event, the reaction (X, n, X') of its entries
         self.edges: list[tuple[Move, Function]] = []
         self.links: list[tuple[Function, Function]] = []  # per element, (where its edges end, their union)
         self.rings: list[Function] = []  # the nodes by distance from the initial nodes (the levels)
@@ -173,13 +174,18 @@ class StepSync:
         while frontier != self.false:
             self.rings.append(frontier)
             targets = self.false
+            by_event: dict[Event | None, Function] = {}  # the level's entries, per event the Grafcet tells apart
             for m in self._moves:
                 entries = image(self.enc, frontier, m) & self.sup.kept
                 if entries == self.false:
                     continue
-                r = self.steps.react(entries, m.event if m.variable in self._inputs else None)
+                event = self._event(m)
+                by_event[event] = by_event.get(event, self.false) | entries
                 old = self.reacted.get(m.key)
-                self.reacted[m.key] = (m, r if old is None else old[1] | r)
+                self.reacted[m.key] = (m, entries if old is None else old[1] | entries)
+            for event, entries in by_event.items():  # the reaction is node by node: one per event
+                r = self.steps.react(entries, event)
+                self._reactions[event] = self._reactions.get(event, self.false) | r
                 targets |= self.steps.exists(r, Copy.CURRENT)
             targets = self.steps.rename(targets, Copy.NEXT, Copy.CURRENT)  # once per level: a renaming is a bijection
             new = targets & ~self.entered
@@ -193,9 +199,10 @@ class StepSync:
         settled = (self.pairs if self.closure is None else self.closure) & ~self.enc.rename(self.moving, Copy.CURRENT, Copy.NEXT)
         target = self.steps.rename(settled, Copy.CURRENT, Copy.NEXT)  # (X', n, x')
         for key in sorted(self.reacted):
-            m, r = self.reacted[key]
-            self.edges.append((m, flipped(self.enc, r & target, m)))
+            m, entries = self.reacted[key]  # its reaction: the event's, on its own entries
+            self.edges.append((m, flipped(self.enc, self._reactions[self._event(m)] & entries & target, m)))
         self.reacted = {}
+        self._reactions = {}
         self.pairs = self.false
         self.edge_count = sum(self.count(e, self._current + self._next) for _, e in self.edges)
         by_axis: dict[int, tuple[Function, Function]] = {}  # per element: where its edges end, their union
@@ -204,6 +211,13 @@ class StepSync:
             by_axis[m.axis] = (end | m.after, rel | e)
         self.links = [by_axis[a] for a in sorted(by_axis)]
         return self
+
+    def _event(self, m: Move) -> Event | None:
+        """The event the Grafcet reacts to after ``m``: None when no receptivity reads its
+        edge (the reaction is then the same for every such move)."""
+        if m.variable not in self._inputs or not self.steps.reads_edge(m.event):
+            return None
+        return m.event
 
     # ---- counts
     def count(self, u: Function, inner: Sequence[str]) -> int:
