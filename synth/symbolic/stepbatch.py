@@ -50,14 +50,12 @@ from typing import Callable, Sequence
 
 from synth.logic.bdd import Engine, Function
 from synth.logic.events import Event
-from synth.symbolic.explicit import Key
+from synth.symbolic.explicit import Key, PathKey
 from synth.symbolic.reachability import Path
 from synth.symbolic.relation import Move
 from synth.symbolic.stepreach import Order, StepReach
 
 __all__ = ["Tags", "Findings"]
-
-PathKey = tuple[tuple[int, int, int], ...]
 
 
 class Tags:
