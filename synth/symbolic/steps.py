@@ -52,7 +52,7 @@ from synth.grafcet.recorder import InputRecorder
 from synth.grafcet.situation import CompiledFn, sorted_steps
 from synth.logic.bdd import Function
 from synth.logic.events import Event
-from synth.logic.expr import names
+from synth.logic.expr import Edge, names
 from synth.plant.composition import Plant
 from synth.symbolic.encoding import Copy, PlantEncoding, first_path
 
@@ -147,6 +147,9 @@ class StepEncoding:
         self._equal: dict[tuple[Copy, Copy], Function] = {}
         self._cubes: dict[tuple[tuple[str, ...], Copy], Function] = {}
         self._exists: dict[Copy, Function] = {}
+        # the events some receptivity compares the event with (its compiled code reads E
+        # nowhere else): after any other event every receptivity is its value after none
+        self._edges = frozenset(n.event for t in machine.transitions for n in names(t.receptivity) if isinstance(n, Edge))
 
     # ---- variables
     def var(self, step: str, copy: Copy = Copy.CURRENT) -> Function:
@@ -237,8 +240,9 @@ class StepEncoding:
         hit = self._fire.get(event)
         if hit is not None:
             return hit
-        if event is not None and all(self.receptivity(i, event, Copy.CURRENT) == self.receptivity(i, None, Copy.CURRENT)
-                                     for i in range(len(self.machine.transitions))):
+        if event is not None and (event not in self._edges or all(
+                self.receptivity(i, event, Copy.CURRENT) == self.receptivity(i, None, Copy.CURRENT)
+                for i in range(len(self.machine.transitions)))):
             hit = self._fire[event] = self._round(None)  # no receptivity reads this edge
             return hit
         fireable: list[Function] = []
