@@ -130,11 +130,13 @@ class _Batch:
 
     def _layers(self, by_depth: dict[int, Function], depth: int) -> list[Function]:
         """Per ring k, each tag's ring-k nodes from which its target is reached at its depth."""
-        rings = self.s.rings
+        s = self.s
+        every = s.engine.disjunction(e for _, e in s.links)  # one relation: a pre-image is one product
         layers = [self.false] * (depth + 1)
         layers[depth] = by_depth.get(depth, self.false)
         for k in range(depth - 1, -1, -1):
-            layers[k] = self.s.pre(layers[k + 1], within=rings[k]) | by_depth.get(k, self.false)
+            before = s.engine.and_exists(every, s._primed(layers[k + 1]), s._next)
+            layers[k] = (before & s.rings[k]) | by_depth.get(k, self.false)
         return layers
 
     def greedy(self, order: Callable[[Move], Order]) -> tuple[list[Function], list[list[tuple[Order, Event, Function]]]]:
