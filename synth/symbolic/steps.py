@@ -182,7 +182,8 @@ class StepEncoding:
         hit = self._cubes.get((sit.steps, copy))
         if hit is None:
             active = set(sit.steps)
-            hit = self._cubes[(sit.steps, copy)] = self.engine.cube({step_name(s, copy): s in active for s in self.steps})
+            hit = self._cubes[(sit.steps, copy)] = self.engine.bdd.cube(  # one call, not a conjunction per step
+                {self.engine.declare(step_name(s, copy)): s in active for s in self.steps})
         return hit
 
     def situation(self, active: Mapping[str, bool]) -> Situation:
