@@ -156,13 +156,28 @@ class Engine:
             self._outer[inner] = name
         return inner
 
+    def declare_top(self, name: str) -> str:
+        """As :meth:`declare`, a new name going to the top of the order (level 0; at the
+        bottom without CUDD): tags that select one of many functions stored in one BDD."""
+        inner = self._inner.get(name)
+        if inner is None:
+            inner = f"v{len(self._inner)}"
+            if self.cudd:
+                self.bdd.insert_var(inner, 0)
+            else:  # pragma: no cover - dd without its CUDD extension
+                self.bdd.declare(inner)
+            self._inner[name] = inner
+            self._outer[inner] = name
+        return inner
+
     def name_of(self, inner: str) -> str:
         """The caller's name of the manager's variable ``inner`` (``u.var`` of a node)."""
         return self._outer[inner]
 
     @property
     def names(self) -> tuple[str, ...]:
-        """Every declared name, in the variable order."""
+        """Every declared name, in the variable order (declaration order: :meth:`declare_top` is
+        for tags no caller lists)."""
         return tuple(self._inner)
 
     @property

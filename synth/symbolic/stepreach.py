@@ -41,7 +41,7 @@ from synth.errors import LimitExceeded
 from synth.grafcet.machine import Situation
 from synth.logic.bdd import Function
 from synth.logic.events import Event
-from synth.symbolic.encoding import Copy
+from synth.symbolic.encoding import Copy, first_path
 from synth.symbolic.explicit import Key
 from synth.symbolic.reachability import MAX_LISTED, Path
 from synth.symbolic.relation import Move
@@ -91,6 +91,11 @@ class StepReach:
     def pick(self, u: Function) -> Key:
         """The node of ``u`` (not empty) with the smallest situation, then the smallest state."""
         st = self.s.steps
+        if self.s.count(u, self.s._current) == 1:  # one node: its path to 1 sets every variable
+            values = first_path(self.s.engine, u)
+            key = self.s.helper.situation(st.situation(values)), self.s.enc.local(values)
+            self._cubes.setdefault(key, u)
+            return key
         f = self.steps_of(u)
         active: dict[str, bool] = {}
         for name in st.steps:

@@ -52,7 +52,7 @@ from synth.grafcet.recorder import InputRecorder
 from synth.grafcet.situation import CompiledFn, sorted_steps
 from synth.logic.bdd import Function
 from synth.logic.events import Event
-from synth.logic.expr import names
+from synth.logic.expr import Edge, names
 from synth.plant.composition import Plant
 from synth.symbolic.encoding import Copy, PlantEncoding, first_path
 
@@ -146,6 +146,10 @@ class StepEncoding:
         self._qvars = {c: [self.engine.declare(step_name(s, c)) for s in self.steps] for c in Copy}
         self._equal: dict[tuple[Copy, Copy], Function] = {}
         self._cubes: dict[tuple[tuple[str, ...], Copy], Function] = {}
+        self._exists: dict[Copy, Function] = {}
+        # the events some receptivity compares the event with (its compiled code reads E
+        # nowhere else): after any other event every receptivity is its value after none
+        self._edges = frozenset(n.event for t in machine.transitions for n in names(t.receptivity) if isinstance(n, Edge))
 
     # ---- variables
     def var(self, step: str, copy: Copy = Copy.CURRENT) -> Function:
@@ -167,14 +171,19 @@ class StepEncoding:
         return self.engine.and_exists(u, self.equal(source, target), self.names(source))
 
     def exists(self, u: Function, copy: Copy) -> Function:
-        return self.engine.bdd.exist(self.names(copy), u)
+        """``∃`` the ``copy`` of every step variable in ``u`` (the cube built once)."""
+        cube = self._exists.get(copy)
+        if cube is None:
+            cube = self._exists[copy] = self.engine.bdd.cube(set(self.names(copy)))
+        return self.engine.bdd.apply("exists", cube, u)
 
     def cube(self, sit: Situation, copy: Copy = Copy.CURRENT) -> Function:
         """The step variables of ``sit`` (its active steps, every other step inactive)."""
         hit = self._cubes.get((sit.steps, copy))
         if hit is None:
             active = set(sit.steps)
-            hit = self._cubes[(sit.steps, copy)] = self.engine.cube({step_name(s, copy): s in active for s in self.steps})
+            hit = self._cubes[(sit.steps, copy)] = self.engine.bdd.cube(  # one call, not a conjunction per step
+                {self.engine.declare(step_name(s, copy)): s in active for s in self.steps})
         return hit
 
     def situation(self, active: Mapping[str, bool]) -> Situation:
@@ -232,8 +241,9 @@ class StepEncoding:
         hit = self._fire.get(event)
         if hit is not None:
             return hit
-        if event is not None and all(self.receptivity(i, event, Copy.CURRENT) == self.receptivity(i, None, Copy.CURRENT)
-                                     for i in range(len(self.machine.transitions))):
+        if event is not None and (event not in self._edges or all(
+                self.receptivity(i, event, Copy.CURRENT) == self.receptivity(i, None, Copy.CURRENT)
+                for i in range(len(self.machine.transitions)))):
             hit = self._fire[event] = self._round(None)  # no receptivity reads this edge
             return hit
         fireable: list[Function] = []
@@ -255,6 +265,11 @@ class StepEncoding:
                     pairs.append((fireable[a], fireable[b]))
         hit = self._fire[event] = (fired, relation, pairs)
         return hit
+
+    def reads_edge(self, event: Event) -> bool:
+        """Whether a receptivity reads ``event``'s edge (else the reaction after it is the
+        reaction after no event)."""
+        return self._round(event) is not self._round(None)
 
     def react(self, entries: Function, event: Event | None) -> Function:
         """The stable situations the machine reaches from ``entries`` (situation X, plant

@@ -78,7 +78,8 @@ class StepSync:
         self.members: Function = self.false
         self.entered: Function = self.false
         self.initial_situation: Situation | None = None
-        self.reacted: dict[int, tuple[Move, Function]] = {}
+        self.reacted: dict[int, tuple[Move, Function]] = {}  # per move, its entries (X, n) met
+        self._reactions: dict[Event | None, Function] = {}  # per event, the reaction (X, n, X') of its entries
         self.edges: list[tuple[Move, Function]] = []
         self.links: list[tuple[Function, Function]] = []  # per element, (where its edges end, their union)
         self.rings: list[Function] = []  # the nodes by distance from the initial nodes (the levels)
@@ -86,6 +87,7 @@ class StepSync:
         self.region_moves: list[Function] = []  # per element, its region moves (X, x, x', x''), x the entry
         self.pairs: Function = self.false  # (X, n, x'): entries and their region's states, without a closure
         self.edge_count = 0
+        self._renames: dict[tuple[Copy, Copy], tuple[Function, list[str]]] = {}
         self._inputs = frozenset(n for n in machine.inputs if n in self.plant.owner)
         self._moves = tuple(m for m in sup.moves if not m.controllable)
         e = self.engine
@@ -137,14 +139,13 @@ class StepSync:
         precomputed closure."""
         reach = frontier = entries & self.helper.equal
         while frontier != self.false:
-            new = self.false
+            new = self.false  # an element's move: its next copy quantified, its auxiliary copy set
             for axis, moves in enumerate(self.region_moves):
                 if moves == self.false:
                     continue
-                names = self.enc.element_variables[axis]
-                step = self.enc.and_exists(frontier, moves, Copy.NEXT, names)
-                new |= self.enc.rename(step, Copy.AUX, Copy.NEXT, names)
-            frontier = new & ~reach
+                new |= self.enc.and_exists(frontier, moves, Copy.NEXT, self.enc.element_variables[axis])
+            # one renaming for every element (a term has the auxiliary copy of its own element only)
+            frontier = self.enc.rename(new, Copy.AUX, Copy.NEXT) & ~reach
             reach |= frontier
         return reach
 
@@ -173,14 +174,20 @@ class StepSync:
         while frontier != self.false:
             self.rings.append(frontier)
             targets = self.false
+            by_event: dict[Event | None, Function] = {}  # the level's entries, per event the Grafcet tells apart
             for m in self._moves:
                 entries = image(self.enc, frontier, m) & self.sup.kept
                 if entries == self.false:
                     continue
-                r = self.steps.react(entries, m.event if m.variable in self._inputs else None)
+                event = self._event(m)
+                by_event[event] = by_event.get(event, self.false) | entries
                 old = self.reacted.get(m.key)
-                self.reacted[m.key] = (m, r if old is None else old[1] | r)
-                targets |= self.steps.rename(self.steps.exists(r, Copy.CURRENT), Copy.NEXT, Copy.CURRENT)
+                self.reacted[m.key] = (m, entries if old is None else old[1] | entries)
+            for event, entries in by_event.items():  # the reaction is node by node: one per event
+                r = self.steps.react(entries, event)
+                self._reactions[event] = self._reactions.get(event, self.false) | r
+                targets |= self.steps.exists(r, Copy.CURRENT)
+            targets = self.steps.rename(targets, Copy.NEXT, Copy.CURRENT)  # once per level: a renaming is a bijection
             new = targets & ~self.entered
             self.entered |= new
             frontier = self._enter(new) & ~self.nodes
@@ -192,9 +199,10 @@ class StepSync:
         settled = (self.pairs if self.closure is None else self.closure) & ~self.enc.rename(self.moving, Copy.CURRENT, Copy.NEXT)
         target = self.steps.rename(settled, Copy.CURRENT, Copy.NEXT)  # (X', n, x')
         for key in sorted(self.reacted):
-            m, r = self.reacted[key]
-            self.edges.append((m, flipped(self.enc, r & target, m)))
+            m, entries = self.reacted[key]  # its reaction: the event's, on its own entries
+            self.edges.append((m, flipped(self.enc, self._reactions[self._event(m)] & entries & target, m)))
         self.reacted = {}
+        self._reactions = {}
         self.pairs = self.false
         self.edge_count = sum(self.count(e, self._current + self._next) for _, e in self.edges)
         by_axis: dict[int, tuple[Function, Function]] = {}  # per element: where its edges end, their union
@@ -203,6 +211,13 @@ class StepSync:
             by_axis[m.axis] = (end | m.after, rel | e)
         self.links = [by_axis[a] for a in sorted(by_axis)]
         return self
+
+    def _event(self, m: Move) -> Event | None:
+        """The event the Grafcet reacts to after ``m``: None when no receptivity reads its
+        edge (the reaction is then the same for every such move)."""
+        if m.variable not in self._inputs or not self.steps.reads_edge(m.event):
+            return None
+        return m.event
 
     # ---- counts
     def count(self, u: Function, inner: Sequence[str]) -> int:
@@ -232,7 +247,19 @@ class StepSync:
 
     # ---- fixpoints
     def _primed(self, u: Function) -> Function:
-        return self.enc.rename(self.steps.rename(u, Copy.CURRENT, Copy.NEXT), Copy.CURRENT, Copy.NEXT)
+        """``u`` from the current copies (plant and steps) to the next ones."""
+        return self._rename(u, Copy.CURRENT, Copy.NEXT)
+
+    def _rename(self, u: Function, source: Copy, target: Copy) -> Function:
+        """``u`` with the ``source`` copy of the plant and step variables renamed to
+        ``target``: one relational product with both equalities (cached)."""
+        hit = self._renames.get((source, target))
+        if hit is None:
+            names = [self.engine.declare(v + source.value) for v in self.enc.variables] + self.steps.names(source)
+            equal = self.steps.equal(source, target) & self.engine.conjunction(
+                self.engine.var(v + source.value).equiv(self.engine.var(v + target.value)) for v in self.enc.variables)
+            hit = self._renames[(source, target)] = (equal, names)
+        return self.engine.and_exists(u, hit[0], hit[1])
 
     def pre(self, u: Function, edges: Sequence[tuple[Move, Function]] | None = None,
             within: Function | None = None) -> Function:
@@ -256,7 +283,7 @@ class StepSync:
 
     def unprimed(self, u: Function) -> Function:
         """``u`` from the next copies (plant and steps) to the current ones."""
-        return self.enc.rename(self.steps.rename(u, Copy.NEXT, Copy.CURRENT), Copy.NEXT, Copy.CURRENT)
+        return self._rename(u, Copy.NEXT, Copy.CURRENT)
 
     def post(self, u: Function, edges: Sequence[tuple[Move, Function]] | None = None) -> Function:
         """Nodes an edge (of ``edges``, default all) leads to from ``u``."""

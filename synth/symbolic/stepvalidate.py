@@ -43,6 +43,7 @@ from synth.plant.rules import RuleSet
 from synth.sup.constraints import CompiledConstraints
 from synth.symbolic.encoding import live_nodes
 from synth.symbolic.explicit import ExplicitNodes, Key, PathKey
+from synth.symbolic.stepbatch import Findings
 from synth.symbolic.stepreach import StepReach
 from synth.symbolic.stepsync import StepSync
 from synth.symbolic.steps import Unsupported, unsupported
@@ -114,31 +115,32 @@ def validate_steps(
     proh_sets = r.prohibited()
     held = r.held() if proh_sets else None
 
-    found: list[tuple[int, PathKey, Key, list[Key]]] = []
     by_steps: dict[tuple[str, ...], Function] = {}
     for (steps, _), u in proh_sets.items():
         assert held is not None
         v = u & held
         if v != false:
             by_steps[steps] = by_steps.get(steps, false) | v
-    for u in by_steps.values():
-        key, depth, path = r.first_node(u)
-        found.append((depth, path, key, r.listed(u)))
     covered = s.steps.engine.disjunction(s.steps.cube(Situation(steps)) for steps in by_steps)
-    for comp in r.terminal_components(stuck):
-        if (r.steps_of(comp) & ~covered) == false:  # every situation of it has a prohibited order
-            continue
-        key, depth, path = r.first_node(comp)
-        found.append((depth, path, key, r.listed(comp)))
-    blocking, components, traces, no_return = ex.blocking(found, lambda key: _trace(r, ex, key),
-                                                          lambda key: (r.cube(key) & back) != false)
+    comps = [c for c in r.terminal_components(stuck)
+             if (r.steps_of(c) & ~covered) != false]  # else every situation of it has a prohibited order
+    blocking_sets = list(by_steps.values()) + comps
+    # every finding's first node, then every trace, in one pass each (stepbatch)
+    search = Findings(r, blocking_sets + list(proh_sets.values()))
+    firsts_of = search.firsts
+    found: list[tuple[int, PathKey, Key, list[Key]]] = [
+        (depth, path, key, r.listed(u)) for u, (key, depth, path) in zip(blocking_sets, firsts_of)]
     firsts: dict[Key, tuple[int, PathKey]] = {}
-    for u in proh_sets.values():
-        key, depth, path = r.first_node(u)
+    for key, depth, path in firsts_of[len(blocking_sets):]:
         firsts[key] = (depth, path)
-    prohibited = [ex.node(k) for k in sorted(firsts, key=lambda k: firsts[k])]
-    for i in prohibited:
-        traces.setdefault(i, _trace(r, ex, _keys(ex)[i]))
+    wanted = list(dict.fromkeys([key for _, _, key, _ in found] + list(firsts)))
+    paths = dict(zip(wanted, search.traces(wanted)))
+    blocking, components, traces, no_return = ex.blocking(found, lambda key: ex.trace_of(paths[key]),
+                                                          lambda key: (r.cube(key) & back) != false)
+    ordered = sorted(firsts, key=lambda k: firsts[k])
+    prohibited = [ex.node(k) for k in ordered]
+    for i, k in zip(prohibited, ordered):
+        traces.setdefault(i, ex.trace_of(paths[k]))
     assert s.initial_situation is not None
     never = (r.steps_of(s.nodes) & ~s.steps.cube(s.initial_situation)) == false  # situations are active steps here
     if never:  # the explicit diagnosis reads the situation of every node: one node per situation
@@ -175,11 +177,6 @@ def _engine_stats(sup: SymbolicSupervisor, situations: int) -> dict[str, int | l
             "variable_order": [elements[a].name for a in sup.enc.order]}
 
 
-
 def _keys(ex: ExplicitNodes) -> dict[int, Key]:
     return {v: k for k, v in ex.index.items()}
 
-
-def _trace(r: StepReach, ex: ExplicitNodes, key: Key) -> Trace:
-    """The trace to ``key`` (:meth:`StepReach.shortest_trace`), its nodes and edges made explicit."""
-    return ex.trace_of(r.shortest_trace(key))
