@@ -133,6 +133,32 @@ class Covers:
             return (~low, ~high) if u.negated else (low, high)
         return self.bdd.let({v: False}, u), self.bdd.let({v: True}, u)
 
+    def _eliminated(self, lower: Function, upper: Function) -> tuple[Function, Function]:
+        """``[∃V.lower, ∀V.upper]`` for a prefix V (in the text order) of the interval's
+        support such that ``∃V.lower ≤ ∀V.upper``: the recursion would split on each
+        variable of V in turn and find both halves empty (docs/filter.md, "The covers'
+        eliminations"), so its cover is that of the smaller interval. The prefix is found
+        by galloping (any such prefix gives the same cover; a longer one saves more)."""
+        bdd = self.bdd
+        if lower == bdd.false or upper == bdd.true:
+            return lower, upper
+        names = sorted(bdd.support(lower) | bdd.support(upper), key=self._ranks.__getitem__)
+        done, step = 0, 1
+        while done < len(names):
+            chunk = names[done:done + step]
+            some, every = bdd.exist(chunk, lower), bdd.forall(chunk, upper)
+            if (some & ~every) == bdd.false:
+                lower, upper = some, every
+                done += len(chunk)
+                if lower == bdd.false or upper == bdd.true:
+                    break
+                step *= 2
+            elif step == 1:
+                break
+            else:
+                step //= 2
+        return lower, upper
+
     def _isop(self, lower: Function, upper: Function, memo: dict, limit: int | None) -> tuple[list[Cube], Function]:
         bdd = self.bdd
         if lower == bdd.false:
@@ -149,8 +175,13 @@ class Covers:
         assert v is not None  # lower is not false, upper not true
         l0, l1 = self._cofactors(lower, v)
         u0, u1 = self._cofactors(upper, v)
-        c0, f0 = self._isop(l0 & ~u1, u0, memo, limit)
-        c1, f1 = self._isop(l1 & ~u0, u1, memo, limit)
+        x0, x1 = l0 & ~u1, l1 & ~u0
+        if x0 == bdd.false and x1 == bdd.false:  # v appears in no cube: the cover of [∃v.lower, ∀v.upper]
+            result = self._isop(*self._eliminated(l0 | l1, u0 & u1), memo, limit)
+            memo[key] = result
+            return result
+        c0, f0 = self._isop(x0, u0, memo, limit)
+        c1, f1 = self._isop(x1, u1, memo, limit)
         if limit is not None and len(c0) + len(c1) > limit:  # the cover holds them: too large already
             raise CoverTooLarge(limit)
         cd, fd = self._isop((l0 & ~f0) | (l1 & ~f1), u0 & u1, memo, limit)
