@@ -159,7 +159,10 @@ class Covers:
                 step //= 2
         return lower, upper
 
-    def _isop(self, lower: Function, upper: Function, memo: dict, limit: int | None) -> tuple[list[Cube], Function]:
+    def _isop(self, lower: Function, upper: Function, memo: dict, limit: int | None,
+              after: bool = False) -> tuple[list[Cube], Function]:
+        """The Minato–Morreale cover of ``[lower, upper]`` and its function; ``after``: the
+        caller eliminated a variable (its two halves were empty)."""
         bdd = self.bdd
         if lower == bdd.false:
             return [], bdd.false
@@ -177,14 +180,20 @@ class Covers:
         u0, u1 = self._cofactors(upper, v)
         x0, x1 = l0 & ~u1, l1 & ~u0
         if x0 == bdd.false and x1 == bdd.false:  # v appears in no cube: the cover of [∃v.lower, ∀v.upper]
-            result = self._isop(*self._eliminated(l0 | l1, u0 & u1), memo, limit)
+            lower, upper = l0 | l1, u0 & u1
+            if after:  # the second in a row: look for a longer run at once
+                lower, upper = self._eliminated(lower, upper)
+            result = self._isop(lower, upper, memo, limit, True)
             memo[key] = result
             return result
+        # each part's cover is in this one's: a part gets what its siblings leave of the limit
         c0, f0 = self._isop(x0, u0, memo, limit)
-        c1, f1 = self._isop(x1, u1, memo, limit)
+        if limit is not None and len(c0) > limit:
+            raise CoverTooLarge(limit)
+        c1, f1 = self._isop(x1, u1, memo, None if limit is None else limit - len(c0))
         if limit is not None and len(c0) + len(c1) > limit:  # the cover holds them: too large already
             raise CoverTooLarge(limit)
-        cd, fd = self._isop((l0 & ~f0) | (l1 & ~f1), u0 & u1, memo, limit)
+        cd, fd = self._isop((l0 & ~f0) | (l1 & ~f1), u0 & u1, memo, None if limit is None else limit - len(c0) - len(c1))
         if limit is not None and len(c0) + len(c1) + len(cd) > limit:
             raise CoverTooLarge(limit)
         cover = [{v: False, **c} for c in c0] + [{v: True, **c} for c in c1] + cd
