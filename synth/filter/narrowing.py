@@ -178,12 +178,12 @@ class _Race:
         e, ki, u = p.engine, where[self.i], self.undecided
         swapped = self.z.domains[ki]  # S_i's domain ∧ ¬g_i ∧ U
         n = len(self.z.domains)
+        equal: set[tuple[int, int]] = set()  # (chain's key, frame's key) of messages equal on U
         while self.next < len(goods):
             j = self.next
             g, k, best, s = goods[j], where[j], bests[j], states[j]
             z = State(s.domains[:ki] + (swapped,) + s.domains[ki + 1:], [None] * n, [None] * n)
-            if k < ki and (p.backward(z, k + 1) & u) == (p.backward(s, k + 1) & u) or \
-                    k > ki and (p.forward(z, k - 1) & u) == (p.forward(s, k - 1) & u):
+            if k != ki and self._unchanged(p, z, s, k, ki, equal):
                 self.next += 1  # own = best ∧ U, the same care: nothing decided, Z_{j+1} = U ∧ S'_{j+1}
                 continue
             own = p.project(z, k, g) & u
@@ -197,6 +197,22 @@ class _Race:
             if k == ki:
                 swapped &= g.equiv(best)
         self.effect = True
+
+    def _unchanged(self, p: Partition, z: State, s: State, k: int, ki: int, equal: set[tuple[int, int]]) -> bool:
+        """Whether the message across ``ki`` into bag ``k`` (backward for ``k < ki``, forward
+        after it) is the same for the frame ``z`` and the chain's ``s`` on ``U``. The two
+        share every domain but ``ki``'s, so equal messages at a bag between ``ki`` and ``k``
+        stay equal up to ``k``: they are computed from ``ki`` on, and only until one is."""
+        u, forward = self.undecided, k > ki
+        between = range(ki, k) if forward else range(ki, k, -1)  # the messages F_m, or B_m, from ki towards k
+        if any((p.message_key(s, m, forward), p.message_key(z, m, forward)) in equal for m in between):
+            return True
+        message = p.forward if forward else p.backward
+        for m in between:
+            if (message(z, m) & u) == (message(s, m) & u):
+                equal.add((p.message_key(s, m, forward), p.message_key(z, m, forward)))
+                return True
+        return False
 
     def advance(self, p: Partition, goods: Sequence[Function], where: Sequence[int], bests: Sequence[Function]) -> None:
         """Run the race to its verdict, ``effect``."""
