@@ -166,6 +166,8 @@ class _Race:
     def __init__(self, i: int, z: State, undecided: Function) -> None:
         self.i, self.next, self.z, self.undecided = i, i + 1, z, undecided
         self.effect: bool | None = None
+        self.skipped = 0
+        """Steps :meth:`framed` found unchanged without projecting (for tests and benchmarks)."""
 
     def framed(self, p: Partition, goods: Sequence[Function], where: Sequence[int], bests: Sequence[Function],
                states: Sequence[State]) -> None:
@@ -185,6 +187,7 @@ class _Race:
             z = State(s.domains[:ki] + (swapped,) + s.domains[ki + 1:], [None] * n, [None] * n)
             if k != ki and self._unchanged(p, z, s, k, ki, equal):
                 self.next += 1  # own = best ∧ U, the same care: nothing decided, Z_{j+1} = U ∧ S'_{j+1}
+                self.skipped += 1
                 continue
             own = p.project(z, k, g) & u
             if (own & ~best) != e.false:
