@@ -138,25 +138,21 @@ class Covers:
         support such that ``∃V.lower ≤ ∀V.upper``: the recursion would split on each
         variable of V in turn and find both halves empty (docs/filter.md, "The covers'
         eliminations"), so its cover is that of the smaller interval. The prefix is found
-        by galloping (any such prefix gives the same cover; a longer one saves more)."""
+        by galloping, then bisecting (any such prefix gives the same cover; a longer one
+        saves more)."""
         bdd = self.bdd
         if lower == bdd.false or upper == bdd.true:
             return lower, upper
         names = sorted(bdd.support(lower) | bdd.support(upper), key=self._ranks.__getitem__)
-        done, step = 0, 1
-        while done < len(names):
-            chunk = names[done:done + step]
-            some, every = bdd.exist(chunk, lower), bdd.forall(chunk, upper)
+        done, failed, step = 0, len(names) + 1, 1  # the prefix taken; a longer one known to fail
+        while failed - done > 1 and lower != bdd.false and upper != bdd.true:
+            size = min(done + step, len(names)) if failed > len(names) else (done + failed) // 2
+            some, every = bdd.exist(names[done:size], lower), bdd.forall(names[done:size], upper)
             if (some & ~every) == bdd.false:
-                lower, upper = some, every
-                done += len(chunk)
-                if lower == bdd.false or upper == bdd.true:
-                    break
+                lower, upper, done = some, every, size
                 step *= 2
-            elif step == 1:
-                break
             else:
-                step //= 2
+                failed = size
         return lower, upper
 
     def _isop(self, lower: Function, upper: Function, memo: dict, limit: int | None,
