@@ -31,6 +31,10 @@ __all__ = ["Covers", "CoverTooLarge", "Cube", "expanded"]
 Cube = dict[str, bool]  # a name -> its value
 CACHE = 2 ** 14
 """The covers' manager's first computed-table slots (CUDD's default, 2^18, is 8 MiB more per engine)."""
+LOOSE = 2 ** 18
+"""Unique-table slots up to which the covers' manager grows its table instead of collecting its
+dead nodes (dd's default, 6.7·10^6, let the eliminations' intermediate BDDs pile up: 200 MiB
+and slower covers at 64 outputs)."""
 Function = Any  # a dd Function
 
 
@@ -64,7 +68,7 @@ class Covers:
         # dd.autoref: covers in the engine's manager; CUDD's: a small cache to start with (it grows with its hits)
         self.bdd = type(source)(initial_cache_size=CACHE) if self.native else source
         if self.native:
-            self.bdd.configure(reordering=False)
+            self.bdd.configure(reordering=False, loose_up_to=LOOSE)
         self._declared = 0
         self._firsts: dict[Function, str] = {}  # during one cover: no function outlives it
         self._ranks: dict[str, int] = {}  # variable -> its rank, for every variable declared
