@@ -117,7 +117,9 @@ def partitioned(m: FilterFunctions, goods: Sequence[Function], order: Sequence[s
     for r in races:  # the races no point decided, on every Y at once
         if r.effect is None:
             mark = p.mark()
-            r.advance(p, goods, where, bests)
+            r.framed(p, goods, where, bests, states)
+            if r.effect is None:
+                r.advance(p, goods, where, bests)
             p.forget(mark)
     effects = [False] * len(goods)
     for r in races:
@@ -164,6 +166,56 @@ class _Race:
     def __init__(self, i: int, z: State, undecided: Function) -> None:
         self.i, self.next, self.z, self.undecided = i, i + 1, z, undecided
         self.effect: bool | None = None
+        self.skipped = 0
+        """Steps :meth:`framed` found unchanged without projecting (for tests and benchmarks)."""
+
+    def framed(self, p: Partition, goods: Sequence[Function], where: Sequence[int], bests: Sequence[Function],
+               states: Sequence[State]) -> None:
+        """Run the race in the chain's frame while its undecided part stays ``U``; leave
+        ``z`` and ``next`` for :meth:`advance` where it changes (docs/filter.md, "The race in
+        the chain's frame"). While it stays, ``Z_j = U ∧ S'_j``, ``S'_j`` the chain's
+        ``S_j`` with the domain of criterion i's bag ``k_i`` swapped (``¬g_i`` for
+        ``g_i ↔ b_i``): its messages on the far side of ``k_i`` are the chain's, and where
+        the message on the near side is the chain's on ``U`` too, step j changes nothing."""
+        e, ki, u = p.engine, where[self.i], self.undecided
+        swapped = self.z.domains[ki]  # S_i's domain ∧ ¬g_i ∧ U
+        n = len(self.z.domains)
+        equal: set[tuple[int, int]] = set()  # (chain's key, frame's key) of messages equal on U
+        while self.next < len(goods):
+            j = self.next
+            g, k, best, s = goods[j], where[j], bests[j], states[j]
+            z = State(s.domains[:ki] + (swapped,) + s.domains[ki + 1:], [None] * n, [None] * n)
+            if k != ki and self._unchanged(p, z, s, k, ki, equal):
+                self.next += 1  # own = best ∧ U, the same care: nothing decided, Z_{j+1} = U ∧ S'_{j+1}
+                self.skipped += 1
+                continue
+            own = p.project(z, k, g) & u
+            if (own & ~best) != e.false:
+                self.next, self.effect = j + 1, True
+                return
+            if (own | (p.project(z, k, ~g) & u & ~best)) != u:  # some Y decided: the race goes on alone
+                self.z = z
+                return
+            self.next += 1  # own = best on U
+            if k == ki:
+                swapped &= g.equiv(best)
+        self.effect = True
+
+    def _unchanged(self, p: Partition, z: State, s: State, k: int, ki: int, equal: set[tuple[int, int]]) -> bool:
+        """Whether the message across ``ki`` into bag ``k`` (backward for ``k < ki``, forward
+        after it) is the same for the frame ``z`` and the chain's ``s`` on ``U``. The two
+        share every domain but ``ki``'s, so equal messages at a bag between ``ki`` and ``k``
+        stay equal up to ``k``: they are computed from ``ki`` on, and only until one is."""
+        u, forward = self.undecided, k > ki
+        between = range(ki, k) if forward else range(ki, k, -1)  # the messages F_m, or B_m, from ki towards k
+        if any((p.message_key(s, m, forward), p.message_key(z, m, forward)) in equal for m in between):
+            return True
+        message = p.forward if forward else p.backward
+        for m in between:
+            if (message(z, m) & u) == (message(s, m) & u):
+                equal.add((p.message_key(s, m, forward), p.message_key(z, m, forward)))
+                return True
+        return False
 
     def advance(self, p: Partition, goods: Sequence[Function], where: Sequence[int], bests: Sequence[Function]) -> None:
         """Run the race to its verdict, ``effect``."""

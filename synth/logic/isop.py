@@ -31,6 +31,10 @@ __all__ = ["Covers", "CoverTooLarge", "Cube", "expanded"]
 Cube = dict[str, bool]  # a name -> its value
 CACHE = 2 ** 14
 """The covers' manager's first computed-table slots (CUDD's default, 2^18, is 8 MiB more per engine)."""
+LOOSE = 2 ** 18
+"""Unique-table slots up to which the covers' manager grows its table instead of collecting its
+dead nodes (dd's default, 6.7·10^6, let the eliminations' intermediate BDDs pile up: 200 MiB
+and slower covers at 64 outputs)."""
 Function = Any  # a dd Function
 
 
@@ -64,7 +68,7 @@ class Covers:
         # dd.autoref: covers in the engine's manager; CUDD's: a small cache to start with (it grows with its hits)
         self.bdd = type(source)(initial_cache_size=CACHE) if self.native else source
         if self.native:
-            self.bdd.configure(reordering=False)
+            self.bdd.configure(reordering=False, loose_up_to=LOOSE)
         self._declared = 0
         self._firsts: dict[Function, str] = {}  # during one cover: no function outlives it
         self._ranks: dict[str, int] = {}  # variable -> its rank, for every variable declared
@@ -133,7 +137,32 @@ class Covers:
             return (~low, ~high) if u.negated else (low, high)
         return self.bdd.let({v: False}, u), self.bdd.let({v: True}, u)
 
-    def _isop(self, lower: Function, upper: Function, memo: dict, limit: int | None) -> tuple[list[Cube], Function]:
+    def _eliminated(self, lower: Function, upper: Function) -> tuple[Function, Function]:
+        """``[∃V.lower, ∀V.upper]`` for a prefix V (in the text order) of the interval's
+        support such that ``∃V.lower ≤ ∀V.upper``: the recursion would split on each
+        variable of V in turn and find both halves empty (docs/filter.md, "The covers'
+        eliminations"), so its cover is that of the smaller interval. The prefix is found
+        by galloping, then bisecting (any such prefix gives the same cover; a longer one
+        saves more)."""
+        bdd = self.bdd
+        if lower == bdd.false or upper == bdd.true:
+            return lower, upper
+        names = sorted(bdd.support(lower) | bdd.support(upper), key=self._ranks.__getitem__)
+        done, failed, step = 0, len(names) + 1, 1  # the prefix taken; a longer one known to fail
+        while failed - done > 1 and lower != bdd.false and upper != bdd.true:
+            size = min(done + step, len(names)) if failed > len(names) else (done + failed) // 2
+            some, every = bdd.exist(names[done:size], lower), bdd.forall(names[done:size], upper)
+            if (some & ~every) == bdd.false:
+                lower, upper, done = some, every, size
+                step *= 2
+            else:
+                failed = size
+        return lower, upper
+
+    def _isop(self, lower: Function, upper: Function, memo: dict, limit: int | None,
+              after: bool = False) -> tuple[list[Cube], Function]:
+        """The Minato–Morreale cover of ``[lower, upper]`` and its function; ``after``: the
+        caller eliminated a variable (its two halves were empty)."""
         bdd = self.bdd
         if lower == bdd.false:
             return [], bdd.false
@@ -149,11 +178,22 @@ class Covers:
         assert v is not None  # lower is not false, upper not true
         l0, l1 = self._cofactors(lower, v)
         u0, u1 = self._cofactors(upper, v)
-        c0, f0 = self._isop(l0 & ~u1, u0, memo, limit)
-        c1, f1 = self._isop(l1 & ~u0, u1, memo, limit)
+        x0, x1 = l0 & ~u1, l1 & ~u0
+        if x0 == bdd.false and x1 == bdd.false:  # v appears in no cube: the cover of [∃v.lower, ∀v.upper]
+            lower, upper = l0 | l1, u0 & u1
+            if after:  # the second in a row: look for a longer run at once
+                lower, upper = self._eliminated(lower, upper)
+            result = self._isop(lower, upper, memo, limit, True)
+            memo[key] = result
+            return result
+        # each part's cover is in this one's: a part gets what its siblings leave of the limit
+        c0, f0 = self._isop(x0, u0, memo, limit)
+        if limit is not None and len(c0) > limit:
+            raise CoverTooLarge(limit)
+        c1, f1 = self._isop(x1, u1, memo, None if limit is None else limit - len(c0))
         if limit is not None and len(c0) + len(c1) > limit:  # the cover holds them: too large already
             raise CoverTooLarge(limit)
-        cd, fd = self._isop((l0 & ~f0) | (l1 & ~f1), u0 & u1, memo, limit)
+        cd, fd = self._isop((l0 & ~f0) | (l1 & ~f1), u0 & u1, memo, None if limit is None else limit - len(c0) - len(c1))
         if limit is not None and len(c0) + len(c1) + len(cd) > limit:
             raise CoverTooLarge(limit)
         cover = [{v: False, **c} for c in c0] + [{v: True, **c} for c in c1] + cd

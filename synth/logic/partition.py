@@ -153,6 +153,11 @@ class Partition:
             s.bkeys[i] = key
         return key
 
+    def message_key(self, s: State, k: int, forward: bool) -> int:
+        """The cache key of ``F_k`` (``forward``) or ``B_k`` of ``s``: two states whose keys
+        are equal have the same message, computed or not."""
+        return self._fkey(s, k) if forward else self._bkey(s, k)
+
     def forward(self, s: State, k: int) -> Function:
         """``F_k``: bags 0..k conjoined, anchors 0..k quantified (true for k = -1)."""
         e = self.engine
