@@ -144,6 +144,7 @@ class Spellings:
 
     warnings: list[InputError]
     skipped: tuple[Safety, ...] = ()
+    limit: int | None = None
 
     def reports(self) -> list[InputError]:
         """The warnings, then one located at the first relief not compared, if any."""
@@ -152,7 +153,7 @@ class Spellings:
         first = self.skipped[0]
         return self.warnings + [InputError(
             f"the keep/force spellings of {len(self.skipped)} relief(s) from {first.id} on were not compared: "
-            f"over the work limit of the comparison ({SPELLING_WORK:.0e} BDD steps)",
+            f"over the work limit of the comparison ({self.limit or 0:,} BDD steps)",
             _relief_loc(first), severity=Severity.WARNING,
             notes=("`synth filter check --all-spellings` compares them all, whatever it costs",))]
 
@@ -180,7 +181,7 @@ def spelling_warnings(f: Filter, safeties: Sequence[Safety] | None = None,
     start = chain.m.engine.work()
     for n, (s, _) in enumerate(swapped):
         if n and limit is not None and chain.m.engine.work() - start > limit:
-            return Spellings(out, tuple(s for s, _ in swapped[n:]))
+            return Spellings(out, tuple(s for s, _ in swapped[n:]), limit)
         differ = chain.differ(n)
         if differ is None:
             continue
