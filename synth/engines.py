@@ -116,14 +116,10 @@ def validate(
     engine, ``max_nodes`` the symbolic one; ``progress`` receives progress lines;
     ``semantics`` ``sfc`` (one evolution per PLC scan) runs on the explicit engine."""
     from synth.grafcet.language import Semantics
-    from synth.grafcet.language_check import load_grafcet
-    from synth.plant.composition import plant
-    from synth.plant.rules_check import load_rules
+    from synth.validation.result import load_model
 
     asked = choose(engine, 0, needs_listing=True) if needs_listing else EngineChoice(engine)
-    rs = load_rules(rules_path)
-    p = plant(rs)
-    g = load_grafcet(grafcet_path, inputs=p.inputs, outputs=p.outputs, semantics=semantics)
+    rs, p, g = load_model(grafcet_path, rules_path, semantics)
     estimate = p.size * max(1, len(g.steps))
     if (p.reads or g.semantics is not Semantics.GRAFCET) and asked == EngineChoice.AUTO:  # explicit engine only
         asked = EngineChoice.EXPLICIT

@@ -8,15 +8,13 @@ they are asked for, so the existing diagnosis and output run on a small
 
 Example
 -------
->>> from synth.plant.rules_check import load_rules
->>> from synth.plant.composition import plant, _plants
->>> from synth.grafcet.language_check import load_grafcet
+>>> from synth.plant.composition import _plants
+>>> from synth.validation.result import load_model
 >>> from synth.grafcet.machine import GrafcetMachine
 >>> from synth.sup.constraints import CompiledConstraints
 >>> from synth.symbolic.sync import symbolic_sync
->>> rs = load_rules(_plants("tri.rules"))
->>> p = plant(rs)
->>> s = symbolic_sync(p, rs.constraints, GrafcetMachine(load_grafcet(_plants("../grafcets/tri.g7"), inputs=p.inputs, outputs=p.outputs)))
+>>> rs, p, g = load_model(_plants("../grafcets/tri.g7"), _plants("tri.rules"))
+>>> s = symbolic_sync(p, rs.constraints, GrafcetMachine(g))
 >>> ex = ExplicitNodes(s, CompiledConstraints(p, rs.constraints))
 >>> ex.node((0, p.initial)), ex.node((0, p.initial)), len(ex.nodes)
 (0, 0, 1)

@@ -7,14 +7,11 @@ verdicts need (pre- and post-images, backward and forward fixpoints, onion rings
 
 Example
 -------
->>> from synth.plant.rules_check import load_rules
->>> from synth.plant.composition import plant, _plants
->>> from synth.grafcet.language_check import load_grafcet
+>>> from synth.plant.composition import _plants
+>>> from synth.validation.result import load_model
 >>> from synth.grafcet.machine import GrafcetMachine
 >>> from synth.symbolic.sync import symbolic_sync
->>> rs = load_rules(_plants("tri.rules"))
->>> p = plant(rs)
->>> g = load_grafcet(_plants("../grafcets/tri.g7"), inputs=p.inputs, outputs=p.outputs)
+>>> rs, p, g = load_model(_plants("../grafcets/tri.g7"), _plants("tri.rules"))
 >>> s = symbolic_sync(p, rs.constraints, GrafcetMachine(g))
 >>> s.backward(s.initial) == {k: u for k, u in s.nodes().items()}  # every node comes back home
 True

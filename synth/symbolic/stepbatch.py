@@ -25,15 +25,12 @@ parts; reading one target back (:meth:`Tags.split`) walks that tree, no BDD oper
 
 Example
 -------
->>> from synth.plant.rules_check import load_rules
->>> from synth.plant.composition import plant, _plants
->>> from synth.grafcet.language_check import load_grafcet
+>>> from synth.plant.composition import _plants
+>>> from synth.validation.result import load_model
 >>> from synth.grafcet.machine import GrafcetMachine
 >>> from synth.symbolic.stepsync import step_sync
 >>> from synth.symbolic.stepreach import StepReach
->>> rs = load_rules(_plants("../tests/data/home/cylinder.rules"))
->>> p = plant(rs)
->>> g = load_grafcet(_plants("../tests/data/home/production_loop.g7"), inputs=p.inputs, outputs=p.outputs)
+>>> rs, p, g = load_model(_plants("../tests/data/home/production_loop.g7"), _plants("../tests/data/home/cylinder.rules"))
 >>> r = StepReach(step_sync(p, rs.constraints, GrafcetMachine(g)))
 >>> sets = [r.s.nodes & ~r.s.initial, r.s.initial]
 >>> f = Findings(r, sets)

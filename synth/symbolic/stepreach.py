@@ -19,14 +19,11 @@ per situation (:class:`~synth.symbolic.stepsync.StepSync`):
 
 Example
 -------
->>> from synth.plant.rules_check import load_rules
->>> from synth.plant.composition import plant, _plants
->>> from synth.grafcet.language_check import load_grafcet
+>>> from synth.plant.composition import _plants
+>>> from synth.validation.result import load_model
 >>> from synth.grafcet.machine import GrafcetMachine
 >>> from synth.symbolic.stepsync import step_sync
->>> rs = load_rules(_plants("../tests/data/home/cylinder.rules"))
->>> p = plant(rs)
->>> g = load_grafcet(_plants("../tests/data/home/no_restart.g7"), inputs=p.inputs, outputs=p.outputs)
+>>> rs, p, g = load_model(_plants("../tests/data/home/no_restart.g7"), _plants("../tests/data/home/cylinder.rules"))
 >>> r = StepReach(step_sync(p, rs.constraints, GrafcetMachine(g)))
 >>> stuck = r.s.nodes & ~r.s.backward(r.s.initial)
 >>> [len(r.listed(c)) for c in r.terminal_components(stuck)]

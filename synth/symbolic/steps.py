@@ -28,15 +28,13 @@ transient cycle is an input error the machine reports).
 
 Example
 -------
->>> from synth.plant.rules_check import load_rules
->>> from synth.plant.composition import plant, _plants
->>> from synth.grafcet.language_check import load_grafcet
+>>> from synth.plant.composition import _plants
+>>> from synth.validation.result import load_model
 >>> from synth.grafcet.machine import GrafcetMachine
->>> p = plant(load_rules(_plants("tri.rules")))
->>> unsupported(GrafcetMachine(load_grafcet(_plants("../grafcets/tri.g7"), inputs=p.inputs, outputs=p.outputs)), p)
+>>> _, p, g = load_model(_plants("../grafcets/tri.g7"), _plants("tri.rules"))
+>>> unsupported(GrafcetMachine(g), p)
 'timers'
->>> p = plant(load_rules(_plants("../tests/data/home/cylinder.rules")))
->>> g = load_grafcet(_plants("../tests/data/home/production_loop.g7"), inputs=p.inputs, outputs=p.outputs)
+>>> _, p, g = load_model(_plants("../tests/data/home/production_loop.g7"), _plants("../tests/data/home/cylinder.rules"))
 >>> unsupported(GrafcetMachine(g), p) is None
 True
 """

@@ -22,13 +22,11 @@ handle all the situations of a level at once. Same semantics as :mod:`synth.symb
 
 Example
 -------
->>> from synth.plant.rules_check import load_rules
->>> from synth.plant.composition import plant, _plants
->>> from synth.grafcet.language_check import load_grafcet
+>>> from synth.plant.composition import _plants
+>>> from synth.validation.result import load_model
 >>> from synth.grafcet.machine import GrafcetMachine
->>> rs = load_rules(_plants("../tests/data/home/cylinder.rules"))
->>> p = plant(rs)
->>> m = GrafcetMachine(load_grafcet(_plants("../tests/data/home/production_loop.g7"), inputs=p.inputs, outputs=p.outputs))
+>>> rs, p, g = load_model(_plants("../tests/data/home/production_loop.g7"), _plants("../tests/data/home/cylinder.rules"))
+>>> m = GrafcetMachine(g)
 >>> s = step_sync(p, rs.constraints, m)
 >>> s.sync_states, s.aggregated_states, s.edge_count, s.situations
 (17, 9, 21, 3)

@@ -30,13 +30,10 @@ pair relations over (node, node') for backward fixpoints.
 
 Example
 -------
->>> from synth.plant.rules_check import load_rules
->>> from synth.plant.composition import plant, _plants
->>> from synth.grafcet.language_check import load_grafcet
+>>> from synth.plant.composition import _plants
+>>> from synth.validation.result import load_model
 >>> from synth.grafcet.machine import GrafcetMachine
->>> rs = load_rules(_plants("tri.rules"))
->>> p = plant(rs)
->>> g = load_grafcet(_plants("../grafcets/tri.g7"), inputs=p.inputs, outputs=p.outputs)
+>>> rs, p, g = load_model(_plants("../grafcets/tri.g7"), _plants("tri.rules"))
 >>> s = symbolic_sync(p, rs.constraints, GrafcetMachine(g))
 >>> s.aggregated_states == 0
 False

@@ -30,6 +30,7 @@ from synth.validation.analysis import Analysis
 from synth.validation.sync import Edge, Sync
 
 if TYPE_CHECKING:  # pragma: no cover - imported by the engines when there is something to diagnose
+    from synth.grafcet.language import Semantics
     from synth.validation.diagnosis import Diagnosis
 
 __all__ = ["Validation", "ReducedController", "reduced_controller", "home_conditions", "load_model"]
@@ -119,12 +120,14 @@ def home_conditions(texts: Sequence[str], p: Plant, g: Grafcet) -> tuple[Expr, .
     return tuple(out)
 
 
-def load_model(grafcet_path: str | Path, rules_path: str | Path) -> tuple[RuleSet, Plant, Grafcet]:
+def load_model(grafcet_path: str | Path, rules_path: str | Path,
+               semantics: "Semantics | str" = "grafcet") -> tuple[RuleSet, Plant, Grafcet]:
     """What both engines validate: the rules, their plant, and the Grafcet checked against
-    the plant's inputs and outputs (the rules first: the Grafcet's names are checked by them)."""
+    the plant's inputs and outputs (the rules first: the Grafcet's names are checked by them),
+    read with ``semantics`` (``grafcet`` or ``sfc``)."""
     from synth.grafcet.language_check import load_grafcet
     from synth.plant.rules_check import load_rules
 
     rs = load_rules(rules_path)
     p = plant(rs)
-    return rs, p, load_grafcet(grafcet_path, inputs=p.inputs, outputs=p.outputs)
+    return rs, p, load_grafcet(grafcet_path, inputs=p.inputs, outputs=p.outputs, semantics=semantics)

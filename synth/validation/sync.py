@@ -14,13 +14,10 @@ so the cost follows the reachable part of SYNC, never the size of the plant.
 
 Example
 -------
->>> from synth.plant.rules_check import load_rules
->>> from synth.plant.composition import plant, _plants
->>> from synth.grafcet.language_check import load_grafcet
+>>> from synth.plant.composition import _plants
+>>> from synth.validation.result import load_model
 >>> from synth.grafcet.machine import GrafcetMachine
->>> rs = load_rules(_plants("tri.rules"))
->>> p = plant(rs)
->>> g = load_grafcet(_plants("../grafcets/tri.g7"), inputs=p.inputs, outputs=p.outputs)
+>>> rs, p, g = load_model(_plants("../grafcets/tri.g7"), _plants("tri.rules"))
 >>> s = synchronous_product(p, rs.constraints, GrafcetMachine(g))
 >>> s.nodes[0].situation.text()
 '{X0, X100, X200, X300}'
