@@ -38,7 +38,8 @@ from synth.filter.language import Filter
 from synth.filter.symbolic_cycle import FALLBACK, OUTSIDE, SymbolicCycle, next_name
 from synth.filter.verification import FindingKind
 from synth.logic.bdd import Function
-from synth.symbolic.encoding import Copy, _exact_count
+from synth.logic.counting import count
+from synth.symbolic.encoding import Copy
 from synth.symbolic.relation import image
 
 __all__ = ["SymbolicLoop"]
@@ -93,13 +94,7 @@ class SymbolicLoop:
     # ------------------------------------------------------------------ counting
     def count(self, u: Function, names: list[str]) -> int:
         """The valuations of ``names`` in ``u`` (which depends on them only), exactly."""
-        e = self.engine
-        if u == e.false:
-            return 0
-        fast = e.bdd.count(u, nvars=len(names))
-        if fast < 2**50:
-            return int(fast)
-        return _exact_count(u, sorted(e.level(n) for n in names), e)
+        return count(self.engine, u, (self.engine.level(n) for n in names))
 
     def plant_part(self, u: Function) -> Function:
         """``u`` projected on the plant's current variables."""

@@ -29,6 +29,7 @@ from typing import Iterator, Mapping, Sequence
 
 from synth.errors import LimitExceeded, SynthError
 from synth.logic.bdd import Engine, Function, interleaved_order
+from synth.logic.counting import count
 from synth.logic.expr import names as expr_names
 from synth.plant.composition import Plant
 from synth.plant.rules import Constraint
@@ -242,50 +243,11 @@ class PlantEncoding:
     # ---- exact counting
     def count(self, u: Function, copies: Sequence[Copy] = (Copy.CURRENT,)) -> int:
         """The exact number of valuations of the given copies of the variables in ``u``
-        (``u`` must depend on those copies only). CUDD's count (a double) is used when
-        it is exact (below 2^50), an exact recursion over the BDD otherwise."""
-        if u == self.engine.false:
-            return 0
-        nvars = len(self.variables) * len(copies)
-        fast = self.bdd.count(u, nvars=nvars)
-        if fast < 2**50:
-            return int(fast)
-        levels = sorted(self.engine.level(v + c.value) for v in self.variables for c in copies)
-        return _exact_count(u, levels, self.engine)
+        (``u`` must depend on those copies only; :func:`synth.logic.counting.count`)."""
+        return count(self.engine, u, (self.engine.level(v + c.value) for v in self.variables for c in copies))
 
     def check(self, where: str) -> None:
         self.budget.check(self.engine, where)
-
-
-def _exact_count(u: Function, levels: Sequence[int], engine: Engine) -> int:
-    """Models of ``u`` over the variables at ``levels`` (sorted), as a Python int."""
-    position = {lv: i for i, lv in enumerate(levels)}
-    n = len(levels)
-    memo: dict[Function, int] = {}
-    true, false = engine.true, engine.false
-
-    def below(f: Function) -> int:
-        """Index in ``levels`` of ``f``'s top variable (``n`` for constants)."""
-        return n if f == true or f == false else position[f.level]
-
-    def models(f: Function) -> int:  # over levels[below(f):]
-        if f == true:
-            return 1
-        if f == false:
-            return 0
-        hit = memo.get(f)
-        if hit is not None:
-            return hit
-        if f.negated:
-            r = (1 << (n - below(f))) - models(~f)
-        else:
-            i = below(f)
-            lo, hi = f.low, f.high
-            r = models(lo) * (1 << (below(lo) - i - 1)) + models(hi) * (1 << (below(hi) - i - 1))
-        memo[f] = r
-        return r
-
-    return models(u) * (1 << below(u))
 
 
 def first_path(engine: Engine, u: Function) -> dict[str, bool]:

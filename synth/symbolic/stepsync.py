@@ -40,10 +40,11 @@ from typing import Callable, Sequence
 
 from synth.grafcet.machine import GrafcetMachine, Situation
 from synth.logic.bdd import Function
+from synth.logic.counting import count
 from synth.logic.events import Event
 from synth.plant.composition import Plant
 from synth.plant.rules import Constraint
-from synth.symbolic.encoding import Copy, NodeBudget, _exact_count, live_nodes
+from synth.symbolic.encoding import Copy, NodeBudget, live_nodes
 from synth.symbolic.relation import Move, flipped, image
 from synth.symbolic.steps import StepEncoding, Unsupported, anchors, unsupported
 from synth.symbolic.supervisor import SymbolicSupervisor
@@ -220,12 +221,7 @@ class StepSync:
     # ---- counts
     def count(self, u: Function, inner: Sequence[str]) -> int:
         """Models of ``u`` over the manager's variables ``inner`` (``u`` depends on no other)."""
-        if u == self.false:
-            return 0
-        fast = self.engine.bdd.count(u, nvars=len(inner))
-        if fast < 2**50:
-            return int(fast)
-        return _exact_count(u, sorted(self.engine.bdd.level_of_var(v) for v in inner), self.engine)
+        return count(self.engine, u, (self.engine.bdd.level_of_var(v) for v in inner))
 
     @property
     def sync_states(self) -> int:
