@@ -44,7 +44,7 @@ from synth.logic.events import Event
 from synth.logic.past import pre_name
 from synth.plant.composition import Plant
 from synth.plant.rules import RuleSet
-from synth.sup.constraints import _terms
+from synth.sup.constraints import split_terms
 from synth.symbolic.encoding import Copy, PlantEncoding
 from synth.symbolic.relation import Move, plant_moves, preimage
 
@@ -118,7 +118,7 @@ class SymbolicCycle:
         if self.blocking:
             self.free.append(ACK_VAR)
         self._order_variables()
-        terms = _terms(p, rs.constraints)
+        terms = split_terms(p, rs.constraints)
         self.illegal = self._terms(t.factors for t in terms if t.event is None)
         self.forbid: dict[str, Function] = {}
         for t in terms:

@@ -27,11 +27,11 @@ from synth.logic.expr import disjunctive_normal_form, edge_text
 from synth.plant.composition import LocalTransition, Plant
 from synth.plant.rules import Constraint
 
-__all__ = ["CompiledConstraints", "GRID_LIMIT"]
+__all__ = ["CompiledConstraints", "GRID_LIMIT", "Term", "split_terms"]
 
 
 @dataclass(frozen=True)
-class _Term:
+class Term:
     """One monomial of a constraint, split per element: ``factors[axis]`` is the set of
     local states satisfying its level literals on that element."""
 
@@ -40,8 +40,10 @@ class _Term:
     event: str | None  # the edge literal's event, if any
 
 
-def _terms(p: Plant, constraints: Sequence[Constraint]) -> list[_Term]:
-    out: list[_Term] = []
+def split_terms(p: Plant, constraints: Sequence[Constraint]) -> list[Term]:
+    """Each constraint's forbidden monomials split per element (:class:`Term`), in the
+    constraints' order: what SUP compiles and the symbolic closed loop encodes."""
+    out: list[Term] = []
     for c in constraints:
         for m in disjunctive_normal_form(c.forbidden):
             edges = [l for l in m if l.edge]
@@ -54,7 +56,7 @@ def _terms(p: Plant, constraints: Sequence[Constraint]) -> list[_Term]:
                 sat = v if l.positive else ~v
                 per_axis[axis] = per_axis.get(axis, np.ones_like(sat)) & sat
             event = edge_text(edges[0].positive, edges[0].name) if edges else None
-            out.append(_Term(c.id, tuple(sorted(per_axis.items(), key=lambda kv: kv[0])), event))
+            out.append(Term(c.id, tuple(sorted(per_axis.items(), key=lambda kv: kv[0])), event))
     return out
 
 
@@ -103,7 +105,7 @@ class CompiledConstraints:
     def __init__(self, p: Plant, constraints: Sequence[Constraint]) -> None:
         self.plant = p
         self.constraints = tuple(constraints)
-        self.terms = _terms(p, constraints)
+        self.terms = split_terms(p, constraints)
         self.level_terms = [t for t in self.terms if t.event is None]
         self.level_reach = [_closed(p, t.factors) for t in self.level_terms]
         # elements that read each other: "can reach" is no product of per-element closures
@@ -111,7 +113,7 @@ class CompiledConstraints:
         self.reach_grids: list[np.ndarray] | None = (
             [_backward(p, _product(p, t.factors)) for t in self.level_terms] if p.reads else None
         )
-        self.edge_terms: dict[str, list[_Term]] = {}
+        self.edge_terms: dict[str, list[Term]] = {}
         for t in self.terms:
             if t.event is not None:
                 self.edge_terms.setdefault(t.event, []).append(t)
@@ -119,7 +121,7 @@ class CompiledConstraints:
 
     # ------------------------------------------------------------------ one state at a time
     @staticmethod
-    def _ids(pairs: Iterable[tuple[_Term, Sequence[tuple[int, np.ndarray]]]], local: tuple[int, ...]) -> list[str]:
+    def _ids(pairs: Iterable[tuple[Term, Sequence[tuple[int, np.ndarray]]]], local: tuple[int, ...]) -> list[str]:
         """Constraint ids (first-seen order, no repeats) of the terms whose factors hold at ``local``."""
         ids: list[str] = []
         for term, factors in pairs:
