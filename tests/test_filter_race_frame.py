@@ -55,3 +55,25 @@ def test_framed_races_on_random_filters(monkeypatch: pytest.MonkeyPatch) -> None
                 lines.append(f"safety K{k}: o{k} & o{j}   keep o{rng.choice((k, j))}")
         text = "\n".join(lines) + "\n"
         assert _verdicts(text, monkeypatch, framed=True)[0] == _verdicts(text, monkeypatch, framed=False)[0], text
+
+
+def test_random_points_leave_fewer_symbolic_races_and_change_no_verdict(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The rounds of random points (``POINT_ROUNDS``) only show effects the symbolic race
+    would find: the verdicts are the same without them, and on the grid of 16 outputs they
+    leave 6 races of 19 to the symbolic race (the two without effect among them)."""
+    framed: list[int] = []
+
+    def counted(race: narrowing._Race, *args: object) -> None:
+        framed.append(race.i)
+        FRAMED(race, *args)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(narrowing._Race, "framed", counted)
+    runs = {}
+    for rounds in (0, narrowing.POINT_ROUNDS):
+        monkeypatch.setattr(narrowing, "POINT_ROUNDS", rounds)
+        framed.clear()
+        s = synthesis(parse_filter(grid_filter(16), "grid16.filter"))
+        runs[rounds] = ([a.effect for a in s.applied], len(framed))
+    (without, symbolic_without), (with_points, symbolic_with) = runs[0], runs[narrowing.POINT_ROUNDS]
+    assert with_points == without and without.count(False) == 2
+    assert (symbolic_without, symbolic_with) == (19, 6)
