@@ -261,11 +261,19 @@ def _shown_at_points(p: Partition, goods: Sequence[Function], races: Sequence[_R
     anchors = {e.declare(o) for o in p.anchors}
     others = [e.declare(n) for n in e.names if e.declare(n) not in anchors]
     base = p.relation(p.initial)
-    reads = [[v for v in bdd.support(g) if v not in anchors] for g in goods]
+    reads = [sorted(v for v in bdd.support(g) if v not in anchors) for g in goods]
+    restricted: dict[tuple[int, tuple[bool, ...]], Function] = {}  # (criterion, its reads' values) -> g there
+
+    def at_point(j: int, point: dict[str, bool]) -> Function:
+        values = tuple(point[v] for v in reads[j])
+        found = restricted.get((j, values))
+        if found is None:
+            found = restricted[(j, values)] = bdd.let(dict(zip(reads[j], values)), goods[j]) if values else goods[j]
+        return found
 
     def run(point: dict[str, bool]) -> int:
         """Run the chain and the undecided races at ``point``: how many it shows."""
-        at = [bdd.let({v: point[v] for v in r}, g) if r else g for g, r in zip(goods, reads)]  # outputs only
+        at = [at_point(j, point) for j in range(len(goods))]  # outputs only
         s = bdd.let(point, base)
         states, bests = [], []
         for g in at:
