@@ -28,8 +28,9 @@ Example
 from __future__ import annotations
 
 import random
-from dataclasses import dataclass
-from typing import Any, Sequence
+from dataclasses import dataclass, field
+from functools import cached_property
+from typing import Any, Callable, Sequence
 
 from synth.filter.model import FilterFunctions
 from synth.logic.bdd import Function
@@ -38,18 +39,28 @@ from synth.logic.partition import Partition, State
 __all__ = ["Narrowing", "monolithic", "partitioned", "layout", "decided"]
 
 
-@dataclass
+@dataclass(eq=False)
 class Narrowing:
     """What the chain gives the synthesis: per criterion, whether it narrows and whether it
     has an effect; the care set ``∃O.S``; per output ``∃O.(S ∧ o)`` and ``∃O.(S ∧ !o)``;
-    the final S itself."""
+    the final S itself, built when first asked (:attr:`admissible`)."""
 
     narrows: list[bool]
     effects: list[bool]
     care: Function
     ones: dict[str, Function]
     zeros: dict[str, Function]
-    admissible: Function
+    relation: Callable[[], Function] = field(repr=False)
+
+    @cached_property
+    def admissible(self) -> Function:
+        """The final S as one BDD (0.6 CPU s on the grid of 64 outputs: only the free outputs
+        and the tests need it)."""
+        return self.relation()
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, Narrowing) and all(
+            getattr(self, a) == getattr(other, a) for a in ("narrows", "effects", "care", "ones", "zeros", "admissible"))
 
 
 def monolithic(m: FilterFunctions, goods: Sequence[Function]) -> Narrowing:
@@ -65,7 +76,7 @@ def monolithic(m: FilterFunctions, goods: Sequence[Function]) -> Narrowing:
     final = states[-1]
     ones = {o: e.and_exists(final, e.var(o), inner) for o in outs}
     zeros = {o: e.and_exists(final, ~e.var(o), inner) for o in outs}
-    return Narrowing(narrows, effects, e.exists(outs, final), ones, zeros, final)
+    return Narrowing(narrows, effects, e.exists(outs, final), ones, zeros, lambda: final)
 
 
 def _race_monolithic(i: int, goods: Sequence[Function], states: Sequence[Function], bests: Sequence[Function],
@@ -127,11 +138,13 @@ def partitioned(m: FilterFunctions, goods: Sequence[Function], order: Sequence[s
         effects[r.i] = bool(r.effect)
     final = states[-1]
     care, ones, zeros = decided(p, final, order)
-    if all((ones[o] & zeros[o]) == e.false for o in outs):  # functional: S is care ∧ ⋀ o ↔ one_o
-        admissible = care & e.conjunction(e.var(o).equiv(ones[o]) for o in order)
-    else:
-        admissible = p.relation(final)
-    return Narrowing(narrows, effects, care, {o: ones[o] for o in outs}, {o: zeros[o] for o in outs}, admissible)
+
+    def relation() -> Function:
+        if all((ones[o] & zeros[o]) == e.false for o in outs):  # functional: S is care ∧ ⋀ o ↔ one_o
+            return care & e.conjunction(e.var(o).equiv(ones[o]) for o in order)
+        return p.relation(final)
+
+    return Narrowing(narrows, effects, care, {o: ones[o] for o in outs}, {o: zeros[o] for o in outs}, relation)
 
 
 def layout(m: FilterFunctions, goods: Sequence[Function], order: Sequence[str] | None = None) -> Partition:

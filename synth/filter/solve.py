@@ -147,7 +147,7 @@ class Synthesis:
     """The outcome of ``solve``: equations in filter syntax, and why it may have failed."""
 
     functions: FilterFunctions
-    admissible: Function
+    chain: narrowing.Narrowing
     care: Function
     applied: list[Applied]
     equations: dict[str, str] = field(default_factory=dict)  # flat: Y only (FLAT_PROBE cubes at most unless asked)
@@ -157,6 +157,11 @@ class Synthesis:
     inconsistent: Cube | None = None
     inconsistent_text: str = ""
     notes: list[str] = field(default_factory=list)
+
+    @property
+    def admissible(self) -> Function:
+        """The final admissible set S(O, Y) as one BDD (built when first asked)."""
+        return self.chain.admissible
 
     @property
     def functional(self) -> bool:
@@ -203,7 +208,7 @@ def synthesis(f: Filter | FilterFunctions, order: Sequence[str] | None = None, *
     goods = [u if c.sense is Sense.MAX else ~u for c, u in steps]  # Min(c) is Max(!c)
     chain = (narrowing.partitioned if partitioned else narrowing.monolithic)(m, goods)
     verdicts = [Applied(c, narrows, effect) for (c, _), narrows, effect in zip(steps, chain.narrows, chain.effects)]
-    result = Synthesis(m, chain.admissible, chain.care, verdicts)
+    result = Synthesis(m, chain, chain.care, verdicts)
     stated = any(isinstance(c, Criterion) for c in m.filter.criteria)
     if stated and any(s.has_priority for s in m.filter.combined):
         result.notes.append("the file states its criteria: the priorities of the combined constraints are not "
