@@ -84,12 +84,14 @@ class _Chain:
         from synth.filter.solve import criteria
 
         self.m = m = functions(f)
-        self.goods = self._goods(criteria(f))
+        written = criteria(f)
+        self.goods = [self._good(c) for c in written]
         self.alternatives: list[tuple[int, Function] | None] = []
         for _, alt in swapped:  # at most one priority criterion differs: its position and its good
-            goods = self._goods(criteria(alt))
-            i = next((i for i, (a, b) in enumerate(zip(self.goods, goods)) if a != b), None)
-            self.alternatives.append(None if i is None else (i, goods[i]))
+            other = criteria(alt)
+            i = next((i for i, (a, b) in enumerate(zip(written, other)) if a != b), None)
+            good = None if i is None else self._good(other[i])
+            self.alternatives.append(None if i is None or good == self.goods[i] else (i, good))
         self.p = layout(m, self.goods + [a[1] for a in self.alternatives if a is not None])
         self.where = [self.p.position(g) for g in self.goods]
         self.states = [self.p.initial]
@@ -97,9 +99,9 @@ class _Chain:
             self.states.append(self._step(self.states[-1], k, g))
         self.base = self._outcome(self.states[-1])
 
-    def _goods(self, criteria: Sequence[Criterion]) -> list[Function]:
-        e = self.m.engine
-        return [e.expr(c.expr) if c.sense is Sense.MAX else ~e.expr(c.expr) for c in criteria]
+    def _good(self, c: Criterion) -> Function:
+        u = self.m.engine.expr(c.expr)
+        return u if c.sense is Sense.MAX else ~u
 
     def _step(self, s: State, k: int, g: Function) -> State:
         return self.p.refine(s, k, g.equiv(self.p.project(s, k, g)))
