@@ -60,7 +60,7 @@ t = time.perf_counter()
 fb = filter_block(f, "algebraic", synthesis=s); lp = filter_block(f, "loop", synthesis=s)  # the solve reused
 out["st"] = time.perf_counter() - t
 out["st_lines"] = fb.text.count("\n") + lp.text.count("\n")
-out["bdd_nodes"] = len(m.engine.bdd)
+out["bdd_nodes"] = m.engine.live_nodes()  # live: the table also holds dead nodes until a collection
 out["cpu"] = time.process_time()
 if int(sys.argv[2]):  # the truth-table oracle: global consistency by enumeration
     from synth.logic.expr import Edge, evaluate
