@@ -24,6 +24,7 @@ Example
 
 from __future__ import annotations
 
+import sys
 from typing import Any, Callable, Mapping
 
 __all__ = ["Covers", "CoverTooLarge", "Cube", "expanded"]
@@ -69,6 +70,8 @@ class Covers:
         self.bdd = type(source)(initial_cache_size=CACHE) if self.native else source
         if self.native:
             self.bdd.configure(reordering=False, loose_up_to=LOOSE)
+        # CUDD's conjunction-abstraction ∃V.(u ∧ v) (dd.cudd.and_exists), which stops at the first common point
+        self._and_exists = sys.modules[type(source).__module__].and_exists if self.native else None
         self._declared = 0
         self._firsts: dict[Function, str] = {}  # during one cover: no function outlives it
         self._ranks: dict[str, int] = {}  # variable -> its rank, for every variable declared
@@ -149,15 +152,26 @@ class Covers:
             return lower, upper
         names = sorted(bdd.support(lower) | bdd.support(upper), key=self._ranks.__getitem__)
         done, failed, step = 0, len(names) + 1, 1  # the prefix taken; a longer one known to fail
-        while failed - done > 1 and lower != bdd.false and upper != bdd.true:
+        # ∀V.upper depends on no variable of V, so ∃V.lower ≤ ∀V.upper iff lower ≤ ∀V.upper: each
+        # trial tests the given lower (∃V.lower, often larger, is built once, for the prefix taken)
+        while failed - done > 1 and upper != bdd.true:  # lower is not false, nor is ∃V.lower
             size = min(done + step, len(names)) if failed > len(names) else (done + failed) // 2
-            some, every = bdd.exist(names[done:size], lower), bdd.forall(names[done:size], upper)
-            if (some & ~every) == bdd.false:
-                lower, upper, done = some, every, size
+            every = bdd.forall(names[done:size], upper)
+            if self._below(lower, every, names):
+                upper, done = every, size
                 step *= 2
             else:
                 failed = size
-        return lower, upper
+        if done == 0 or upper == bdd.true:  # the cover of [lower, true] is that of [∃V.lower, true]
+            return lower, upper
+        return bdd.exist(names[:done], lower), upper
+
+    def _below(self, lower: Function, upper: Function, names: list[str]) -> bool:
+        """``lower ≤ upper``, ``names`` their supports: ``∃.lower ∧ ¬upper`` false, which CUDD's
+        conjunction-abstraction finds as soon as it meets a common point (no BDD built)."""
+        if self._and_exists is None:
+            return (lower & ~upper) == self.bdd.false
+        return self._and_exists(lower, ~upper, names) == self.bdd.false
 
     def _isop(self, lower: Function, upper: Function, memo: dict, limit: int | None,
               after: bool = False) -> tuple[list[Cube], Function]:
