@@ -66,43 +66,54 @@ class Covers:
         self.source = source
         self.rank = rank
         self.native = type(source).__module__ == "dd.cudd"  # complemented edges, low and high of the regular node
-        # dd.autoref: covers in the engine's manager; CUDD's: a small cache to start with (it grows with its hits)
-        self.bdd = type(source)(initial_cache_size=CACHE) if self.native else source
-        if self.native:
-            self.bdd.configure(reordering=False, loose_up_to=LOOSE)
-        # CUDD's conjunction-abstraction ∃V.(u ∧ v) (dd.cudd.and_exists), which stops at the first common point
-        self._and_exists = sys.modules[type(source).__module__].and_exists if self.native else None
-        self._declared = 0
+        # dd.cudd's module: its conjunction-abstraction ∃V.(u ∧ v), which stops at the first common point
+        self._backend = sys.modules[type(source).__module__] if self.native else None
+        # the manager of the cover being computed: dd.autoref's, the engine's; CUDD's, one per cover (:meth:`_opened`)
+        self.bdd = source
         self._firsts: dict[Function, str] = {}  # during one cover: no function outlives it
-        self._ranks: dict[str, int] = {}  # variable -> its rank, for every variable declared
+        self._ranks: dict[str, int] = {}  # variable -> its rank, for every variable met
 
-    def _copy(self, u: Function) -> Function:
-        """``u`` in the covers' manager (the same variables, in the same order)."""
-        levels = len(self.source.vars)
-        while self._declared < levels:  # the engine declares variables at the end only
-            v = self.source.var_at_level(self._declared)
-            if self.bdd is not self.source:
-                self.bdd.declare(v)
-            self._ranks[v] = self.rank(v)
-            self._declared += 1
-        return u if self.bdd is self.source else self.source.copy(u, self.bdd)
+    def _opened(self, lower: Function, upper: Function) -> tuple[Function, Function]:
+        """``lower`` and ``upper`` in the manager of this cover: with CUDD, a new one that
+        declares their support only, in the engine's order (a transfer is linear). dd's
+        substitutions, quantifications and supports take time in the number of variables
+        declared, whatever the function (a cube of all of them, in Python): the flat probes'
+        small functions over 336 variables at 64 outputs spent more there than in CUDD."""
+        source = self.source
+        names = source.support(lower) | source.support(upper)
+        for v in names:
+            if v not in self._ranks:
+                self._ranks[v] = self.rank(v)
+        if not self.native:
+            return lower, upper
+        bdd = self.bdd = type(source)(initial_cache_size=CACHE)  # a small cache to start with (it grows with its hits)
+        bdd.configure(reordering=False, loose_up_to=LOOSE)
+        bdd.declare(*sorted(names, key=source.level_of_var))
+        lower_here = source.copy(lower, bdd)
+        return lower_here, lower_here if upper == lower else source.copy(upper, bdd)
 
     def cover(self, lower: Function, upper: Function | None = None, limit: int | None = None) -> list[Cube]:
         """An irredundant cover of prime implicants of some function between ``lower`` and
         ``upper`` (``upper`` defaults to ``lower``; the gap is the don't-care set), each
         cube's names in text order. :class:`CoverTooLarge` when the Minato–Morreale cover
         has more than ``limit`` cubes."""
-        lower = self._copy(lower)
-        upper = lower if upper is None else self._copy(upper)
+        try:
+            kept = self._covered(*self._opened(lower, lower if upper is None else upper), limit)
+        finally:
+            self._firsts.clear()
+            self.bdd = self.source  # the cover's own manager goes with its last function
+        if kept is None:
+            raise CoverTooLarge(limit or 0)  # from a frame without the cover's BDDs
+        return kept
+
+    def _covered(self, lower: Function, upper: Function, limit: int | None) -> list[Cube] | None:
+        """:meth:`cover` in the cover's manager; None past ``limit``."""
         try:
             cubes, _ = self._isop(lower, upper, {}, limit)
         except CoverTooLarge:
-            cubes = None  # raised again below, from a frame without the covers' BDDs
-        finally:
-            self._firsts.clear()
-        if cubes is None or (limit is not None and len(cubes) > limit):
-            del lower, upper  # a caller keeping the exception keeps this frame: no BDD may outlive the manager
-            raise CoverTooLarge(limit or 0)
+            return None
+        if limit is not None and len(cubes) > limit:
+            return None
         primes: list[Cube] = []
         for c in (expanded(self.bdd, self._ordered(c), upper) for c in cubes):
             if c not in primes:
@@ -169,9 +180,9 @@ class Covers:
     def _below(self, lower: Function, upper: Function, names: list[str]) -> bool:
         """``lower ≤ upper``, ``names`` their supports: ``∃.lower ∧ ¬upper`` false, which CUDD's
         conjunction-abstraction finds as soon as it meets a common point (no BDD built)."""
-        if self._and_exists is None:
+        if self._backend is None:
             return (lower & ~upper) == self.bdd.false
-        return self._and_exists(lower, ~upper, names) == self.bdd.false
+        return self._backend.and_exists(lower, ~upper, names) == self.bdd.false
 
     def _isop(self, lower: Function, upper: Function, memo: dict, limit: int | None,
               after: bool = False) -> tuple[list[Cube], Function]:
