@@ -201,9 +201,14 @@ class Covers:
         ranks = self._ranks
         v = a if b is None or (a is not None and ranks[a] <= ranks[b]) else b
         assert v is not None  # lower is not false, upper not true
-        l0, l1 = self._cofactors(lower, v)
-        u0, u1 = self._cofactors(upper, v)
-        x0, x1 = l0 & ~u1, l1 & ~u0
+        # a function whose first variable comes after v does not depend on v: its cofactors are itself
+        l0, l1 = self._cofactors(lower, v) if v == a else (lower, lower)
+        if v == b:
+            u0, u1 = self._cofactors(upper, v)
+            x0, x1 = l0 & ~u1, l1 & ~u0
+        else:  # lower ≤ upper at either value of v: both halves are empty
+            u0 = u1 = upper
+            x0 = x1 = bdd.false
         if x0 == bdd.false and x1 == bdd.false:  # v appears in no cube: the cover of [∃v.lower, ∀v.upper]
             lower, upper = l0 | l1, u0 & u1
             if after:  # the second in a row: look for a longer run at once
