@@ -202,15 +202,15 @@ class Covers:
         v = a if b is None or (a is not None and ranks[a] <= ranks[b]) else b
         assert v is not None  # lower is not false, upper not true
         # a function whose first variable comes after v does not depend on v: its cofactors are itself
-        l0, l1 = self._cofactors(lower, v) if v == a else (lower, lower)
         if v == b:
+            l0, l1 = self._cofactors(lower, v) if v == a else (lower, lower)
             u0, u1 = self._cofactors(upper, v)
             x0, x1 = l0 & ~u1, l1 & ~u0
+            empty = x0 == bdd.false and x1 == bdd.false
         else:  # lower ≤ upper at either value of v: both halves are empty
-            u0 = u1 = upper
-            x0 = x1 = bdd.false
-        if x0 == bdd.false and x1 == bdd.false:  # v appears in no cube: the cover of [∃v.lower, ∀v.upper]
-            lower, upper = l0 | l1, u0 & u1
+            empty = True
+        if empty:  # v appears in no cube: the cover of [∃v.lower, ∀v.upper]
+            lower, upper = (l0 | l1, u0 & u1) if v == b else (bdd.exist([v], lower), upper)
             if after:  # the second in a row: look for a longer run at once
                 lower, upper = self._eliminated(lower, upper)
             result = self._isop(lower, upper, memo, limit, True)
