@@ -4,13 +4,15 @@ cube then expanded to a prime implicant (literals dropped in text order) and the
 irredundant (each cube the others cover dropped, in order). A cover depends on the
 interval and the text order only, never on the manager's variable order.
 
-The covers are computed in a manager of their own (:class:`Covers`), with the same
-variable order as the engine's: a transfer there is linear (the text order would make the
-functions exponentially larger: a request first, each output's constraints last), and the
-cofactors and conjunctions of the recursion run on a small unique table, away from the
-engine's millions of nodes. The recursion splits on the first variable, in the text order,
-that ``lower`` or ``upper`` depends on, and remembers each function's first variable and
-each interval's cover (memoised on the pair of nodes).
+Each cover is computed in a manager of its own (:class:`Covers`) that declares the
+interval's support only, in the engine's variable order: a transfer there is linear (the
+text order would make the functions exponentially larger: a request first, each output's
+constraints last), the cofactors and conjunctions of the recursion run on a small unique
+table, away from the engine's millions of nodes, and dd's substitutions, quantifications
+and supports, whose cost grows with the variables declared, see a few dozen rather than all
+of the engine's. The recursion splits on the first variable, in the text order, that
+``lower`` or ``upper`` depends on, and remembers each function's first variable and each
+interval's cover (memoised on the pair of nodes).
 
 Example
 -------
@@ -31,9 +33,9 @@ __all__ = ["Covers", "CoverTooLarge", "Cube", "expanded"]
 
 Cube = dict[str, bool]  # a name -> its value
 CACHE = 2 ** 14
-"""The covers' manager's first computed-table slots (CUDD's default, 2^18, is 8 MiB more per engine)."""
+"""A cover's manager's first computed-table slots (CUDD's default, 2^18, is 8 MiB more)."""
 LOOSE = 2 ** 18
-"""Unique-table slots up to which the covers' manager grows its table instead of collecting its
+"""Unique-table slots up to which a cover's manager grows its table instead of collecting its
 dead nodes (dd's default, 6.7·10^6, let the eliminations' intermediate BDDs pile up: 200 MiB
 and slower covers at 64 outputs)."""
 Function = Any  # a dd Function
