@@ -161,22 +161,23 @@ class Covers:
         """``[∃V.lower, ∀V.upper]`` for a prefix V (in the text order) of the interval's
         support such that ``∃V.lower ≤ ∀V.upper``: the recursion would split on each
         variable of V in turn and find both halves empty (docs/filter.md, "The covers'
-        eliminations"), so its cover is that of the smaller interval. The prefix is found
-        by galloping, then bisecting (any such prefix gives the same cover; a longer one
-        saves more)."""
+        eliminations"), so its cover is that of the smaller interval. The longest such
+        prefix is found by bisection (any such prefix gives the same cover; a longer one
+        saves more): a trial costs about one pass over ``upper`` whatever its length, and
+        the long runs of the chained covers (about a quarter of 150–260 variables at 64
+        outputs) take fewer trials than galloping from one variable."""
         bdd = self.bdd
         if lower == bdd.false or upper == bdd.true:
             return lower, upper
         names = sorted(bdd.support(lower) | bdd.support(upper), key=self._ranks.__getitem__)
-        done, failed, step = 0, len(names) + 1, 1  # the prefix taken; a longer one known to fail
+        done, failed = 0, len(names) + 1  # the prefix taken; a longer one known to fail
         # ∀V.upper depends on no variable of V, so ∃V.lower ≤ ∀V.upper iff lower ≤ ∀V.upper: each
         # trial tests the given lower (∃V.lower, often larger, is built once, for the prefix taken)
         while failed - done > 1 and upper != bdd.true:  # lower is not false, nor is ∃V.lower
-            size = min(done + step, len(names)) if failed > len(names) else (done + failed) // 2
+            size = (done + failed) // 2
             every = bdd.forall(names[done:size], upper)
             if self._below(lower, every, names):
                 upper, done = every, size
-                step *= 2
             else:
                 failed = size
         if done == 0 or upper == bdd.true:  # the cover of [lower, true] is that of [∃V.lower, true]
