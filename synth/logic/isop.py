@@ -4,13 +4,15 @@ cube then expanded to a prime implicant (literals dropped in text order) and the
 irredundant (each cube the others cover dropped, in order). A cover depends on the
 interval and the text order only, never on the manager's variable order.
 
-The covers are computed in a manager of their own (:class:`Covers`), with the same
-variable order as the engine's: a transfer there is linear (the text order would make the
-functions exponentially larger: a request first, each output's constraints last), and the
-cofactors and conjunctions of the recursion run on a small unique table, away from the
-engine's millions of nodes. The recursion splits on the first variable, in the text order,
-that ``lower`` or ``upper`` depends on, and remembers each function's first variable and
-each interval's cover (memoised on the pair of nodes).
+Each cover is computed in a manager of its own (:class:`Covers`) that declares the
+interval's support only, in the engine's variable order: a transfer there is linear (the
+text order would make the functions exponentially larger: a request first, each output's
+constraints last), the cofactors and conjunctions of the recursion run on a small unique
+table, away from the engine's millions of nodes, and dd's substitutions, quantifications
+and supports, whose cost grows with the variables declared, see a few dozen rather than all
+of the engine's. The recursion splits on the first variable, in the text order, that
+``lower`` or ``upper`` depends on, and remembers each function's first variable and each
+interval's cover (memoised on the pair of nodes).
 
 Example
 -------
@@ -24,15 +26,19 @@ Example
 
 from __future__ import annotations
 
+import sys
 from typing import Any, Callable, Mapping
 
 __all__ = ["Covers", "CoverTooLarge", "Cube", "expanded"]
 
 Cube = dict[str, bool]  # a name -> its value
 CACHE = 2 ** 14
-"""The covers' manager's first computed-table slots (CUDD's default, 2^18, is 8 MiB more per engine)."""
+"""A cover's manager's first computed-table slots (CUDD's default, 2^18, is 8 MiB more)."""
+MEMORY = 2 ** 28
+"""A cover's manager's memory target in bytes (past it, CUDD collects its dead nodes more
+eagerly; no limit): dd's default, 1 GiB, takes 1.3 ms to open a manager, 2^28 0.35 ms."""
 LOOSE = 2 ** 18
-"""Unique-table slots up to which the covers' manager grows its table instead of collecting its
+"""Unique-table slots up to which a cover's manager grows its table instead of collecting its
 dead nodes (dd's default, 6.7·10^6, let the eliminations' intermediate BDDs pile up: 200 MiB
 and slower covers at 64 outputs)."""
 Function = Any  # a dd Function
@@ -65,41 +71,55 @@ class Covers:
         self.source = source
         self.rank = rank
         self.native = type(source).__module__ == "dd.cudd"  # complemented edges, low and high of the regular node
-        # dd.autoref: covers in the engine's manager; CUDD's: a small cache to start with (it grows with its hits)
-        self.bdd = type(source)(initial_cache_size=CACHE) if self.native else source
-        if self.native:
-            self.bdd.configure(reordering=False, loose_up_to=LOOSE)
-        self._declared = 0
+        # dd.cudd's module: its conjunction-abstraction ∃V.(u ∧ v), which stops at the first common point
+        self._backend = sys.modules[type(source).__module__] if self.native else None
+        # the manager of the cover being computed: dd.autoref's, the engine's; CUDD's, one per cover (:meth:`_opened`)
+        self.bdd = source
         self._firsts: dict[Function, str] = {}  # during one cover: no function outlives it
-        self._ranks: dict[str, int] = {}  # variable -> its rank, for every variable declared
+        self._ranks: dict[str, int] = {}  # variable -> its rank, for every variable met
 
-    def _copy(self, u: Function) -> Function:
-        """``u`` in the covers' manager (the same variables, in the same order)."""
-        levels = len(self.source.vars)
-        while self._declared < levels:  # the engine declares variables at the end only
-            v = self.source.var_at_level(self._declared)
-            if self.bdd is not self.source:
-                self.bdd.declare(v)
-            self._ranks[v] = self.rank(v)
-            self._declared += 1
-        return u if self.bdd is self.source else self.source.copy(u, self.bdd)
+    def _opened(self, lower: Function, upper: Function) -> tuple[Function, Function]:
+        """``lower`` and ``upper`` in the manager of this cover: with CUDD, a new one that
+        declares their support only, in the engine's order (a transfer is linear). dd's
+        substitutions, quantifications and supports take time in the number of variables
+        declared, whatever the function (a cube of all of them, in Python): the flat probes'
+        small functions over 336 variables at 64 outputs spent more there than in CUDD."""
+        source = self.source
+        names = source.support(lower) | source.support(upper)
+        for v in names:
+            if v not in self._ranks:
+                self._ranks[v] = self.rank(v)
+        if not self.native:
+            return lower, upper
+        # a small cache to start with (it grows with its hits)
+        bdd = self.bdd = type(source)(memory_estimate=MEMORY, initial_cache_size=CACHE)
+        bdd.configure(reordering=False, loose_up_to=LOOSE)
+        bdd.declare(*sorted(names, key=source.level_of_var))
+        lower_here = source.copy(lower, bdd)
+        return lower_here, lower_here if upper == lower else source.copy(upper, bdd)
 
     def cover(self, lower: Function, upper: Function | None = None, limit: int | None = None) -> list[Cube]:
         """An irredundant cover of prime implicants of some function between ``lower`` and
         ``upper`` (``upper`` defaults to ``lower``; the gap is the don't-care set), each
         cube's names in text order. :class:`CoverTooLarge` when the Minato–Morreale cover
         has more than ``limit`` cubes."""
-        lower = self._copy(lower)
-        upper = lower if upper is None else self._copy(upper)
+        try:
+            kept = self._covered(*self._opened(lower, lower if upper is None else upper), limit)
+        finally:
+            self._firsts.clear()
+            self.bdd = self.source  # the cover's own manager goes with its last function
+        if kept is None:
+            raise CoverTooLarge(limit or 0)  # from a frame without the cover's BDDs
+        return kept
+
+    def _covered(self, lower: Function, upper: Function, limit: int | None) -> list[Cube] | None:
+        """:meth:`cover` in the cover's manager; None past ``limit``."""
         try:
             cubes, _ = self._isop(lower, upper, {}, limit)
         except CoverTooLarge:
-            cubes = None  # raised again below, from a frame without the covers' BDDs
-        finally:
-            self._firsts.clear()
-        if cubes is None or (limit is not None and len(cubes) > limit):
-            del lower, upper  # a caller keeping the exception keeps this frame: no BDD may outlive the manager
-            raise CoverTooLarge(limit or 0)
+            return None
+        if limit is not None and len(cubes) > limit:
+            return None
         primes: list[Cube] = []
         for c in (expanded(self.bdd, self._ordered(c), upper) for c in cubes):
             if c not in primes:
@@ -141,23 +161,35 @@ class Covers:
         """``[∃V.lower, ∀V.upper]`` for a prefix V (in the text order) of the interval's
         support such that ``∃V.lower ≤ ∀V.upper``: the recursion would split on each
         variable of V in turn and find both halves empty (docs/filter.md, "The covers'
-        eliminations"), so its cover is that of the smaller interval. The prefix is found
-        by galloping, then bisecting (any such prefix gives the same cover; a longer one
-        saves more)."""
+        eliminations"), so its cover is that of the smaller interval. The longest such
+        prefix is found by bisection (any such prefix gives the same cover; a longer one
+        saves more): a trial costs about one pass over ``upper`` whatever its length, and
+        the long runs of the chained covers (about a quarter of 150–260 variables at 64
+        outputs) take fewer trials than galloping from one variable."""
         bdd = self.bdd
         if lower == bdd.false or upper == bdd.true:
             return lower, upper
         names = sorted(bdd.support(lower) | bdd.support(upper), key=self._ranks.__getitem__)
-        done, failed, step = 0, len(names) + 1, 1  # the prefix taken; a longer one known to fail
-        while failed - done > 1 and lower != bdd.false and upper != bdd.true:
-            size = min(done + step, len(names)) if failed > len(names) else (done + failed) // 2
-            some, every = bdd.exist(names[done:size], lower), bdd.forall(names[done:size], upper)
-            if (some & ~every) == bdd.false:
-                lower, upper, done = some, every, size
-                step *= 2
+        done, failed = 0, len(names) + 1  # the prefix taken; a longer one known to fail
+        # ∀V.upper depends on no variable of V, so ∃V.lower ≤ ∀V.upper iff lower ≤ ∀V.upper: each
+        # trial tests the given lower (∃V.lower, often larger, is built once, for the prefix taken)
+        while failed - done > 1 and upper != bdd.true:  # lower is not false, nor is ∃V.lower
+            size = (done + failed) // 2
+            every = bdd.forall(names[done:size], upper)
+            if self._below(lower, every, names):
+                upper, done = every, size
             else:
                 failed = size
-        return lower, upper
+        if done == 0 or upper == bdd.true:  # the cover of [lower, true] is that of [∃V.lower, true]
+            return lower, upper
+        return bdd.exist(names[:done], lower), upper
+
+    def _below(self, lower: Function, upper: Function, names: list[str]) -> bool:
+        """``lower ≤ upper``, ``names`` their supports: ``∃.lower ∧ ¬upper`` false, which CUDD's
+        conjunction-abstraction finds as soon as it meets a common point (no BDD built)."""
+        if self._backend is None:
+            return (lower & ~upper) == self.bdd.false
+        return self._backend.and_exists(lower, ~upper, names) == self.bdd.false
 
     def _isop(self, lower: Function, upper: Function, memo: dict, limit: int | None,
               after: bool = False) -> tuple[list[Cube], Function]:
@@ -176,11 +208,16 @@ class Covers:
         ranks = self._ranks
         v = a if b is None or (a is not None and ranks[a] <= ranks[b]) else b
         assert v is not None  # lower is not false, upper not true
-        l0, l1 = self._cofactors(lower, v)
-        u0, u1 = self._cofactors(upper, v)
-        x0, x1 = l0 & ~u1, l1 & ~u0
-        if x0 == bdd.false and x1 == bdd.false:  # v appears in no cube: the cover of [∃v.lower, ∀v.upper]
-            lower, upper = l0 | l1, u0 & u1
+        # a function whose first variable comes after v does not depend on v: its cofactors are itself
+        if v == b:
+            l0, l1 = self._cofactors(lower, v) if v == a else (lower, lower)
+            u0, u1 = self._cofactors(upper, v)
+            x0, x1 = l0 & ~u1, l1 & ~u0
+            empty = x0 == bdd.false and x1 == bdd.false
+        else:  # lower ≤ upper at either value of v: both halves are empty
+            empty = True
+        if empty:  # v appears in no cube: the cover of [∃v.lower, ∀v.upper]
+            lower, upper = (l0 | l1, u0 & u1) if v == b else (bdd.exist([v], lower), upper)
             if after:  # the second in a row: look for a longer run at once
                 lower, upper = self._eliminated(lower, upper)
             result = self._isop(lower, upper, memo, limit, True)
