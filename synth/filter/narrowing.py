@@ -139,10 +139,14 @@ def partitioned(m: FilterFunctions, goods: Sequence[Function], order: Sequence[s
     final = states[-1]
     care, ones, zeros = decided(p, final, order)
 
-    def relation() -> Function:
-        if all((ones[o] & zeros[o]) == e.false for o in outs):  # functional: S is care ∧ ⋀ o ↔ one_o
+    if all((ones[o] & zeros[o]) == e.false for o in outs):  # functional: S is care ∧ ⋀ o ↔ one_o, built if asked
+        def relation() -> Function:  # the partition and its messages are not kept for it
             return care & e.conjunction(e.var(o).equiv(ones[o]) for o in order)
-        return p.relation(final)
+    else:
+        admissible = p.relation(final)
+
+        def relation() -> Function:
+            return admissible
 
     return Narrowing(narrows, effects, care, {o: ones[o] for o in outs}, {o: zeros[o] for o in outs}, relation)
 
