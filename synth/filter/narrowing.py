@@ -138,7 +138,6 @@ def partitioned(m: FilterFunctions, goods: Sequence[Function], order: Sequence[s
         effects[r.i] = bool(r.effect)
     final = states[-1]
     care, ones, zeros = decided(p, final, order)
-
     if all((ones[o] & zeros[o]) == e.false for o in outs):  # functional: S is care ∧ ⋀ o ↔ one_o, built if asked
         def relation() -> Function:  # the partition and its messages are not kept for it
             return care & e.conjunction(e.var(o).equiv(ones[o]) for o in order)
