@@ -77,28 +77,16 @@ def test_the_box_sorting_program_with_its_filter_runs_compiled_as_interpreted(fi
 def test_split_blocks_compiled_run_as_the_whole_filter(tmp_path) -> None:
     """``filter st --split`` on the real compiler: each cluster's block compiled by iec2c
     and gcc, driven on its own inputs, gives the whole filter's outputs cycle after cycle."""
-    import random
-
-    from synth.codegen.filter_st import filter_block, split_blocks
+    from synth.codegen.filter_st import split_blocks
     from synth.filter.language_check import parse_filter
-    from synth.codegen.interpreter import load_st
-    from test_filter_scale import MIXED
+    from test_filter_scale import MIXED, assert_split_runs_as_whole
 
     f = parse_filter(MIXED, "mixed.filter")
     blocks = split_blocks(f)
     assert len(blocks) == 3
     parts = [CompiledProgram(StProgram(b.text, b.name, (), (b.pou,)), tmp_path / b.name, pou=b.name) for b in blocks]
-    whole_block = filter_block(f)
-    whole = load_st(whole_block.text, "whole.st").instance(whole_block.name)
-    rnd = random.Random(5)
     try:
-        for n in range(300):
-            values = {x: rnd.random() < 0.5 for x in whole_block.inputs}
-            whole.cycle(values)
-            for b, plc in zip(blocks, parts):
-                plc.cycle({x: values[x] for x in b.inputs})
-            got = {o: plc[o] for b, plc in zip(blocks, parts) for o in b.outputs}
-            assert got == {o: whole[o] for o in f.outputs}, f"cycle {n}"
+        assert_split_runs_as_whole(f, blocks, parts, 5)
     finally:
         for plc in parts:
             plc.close()

@@ -7,18 +7,19 @@ from __future__ import annotations
 import json
 import random
 import sys
+from typing import Any, Sequence
 
 import pytest
 
 from conftest import ROOT
-from synth.codegen.filter_st import filter_block, split_blocks
+from synth.codegen.filter_st import FilterBlock, filter_block, split_blocks
 from synth.codegen.interpreter import load_st
 from synth.filter.clusters import clusters, solve_clusters
 from synth.filter.language_check import load_filter, parse_filter
 from synth.filter.language_reader import filter_expression
 from synth.filter.model import bdd_order, variable_order
 from synth.filter.solve import criteria, synthesis
-from synth.filter.language import Sense
+from synth.filter.language import Filter, Sense
 
 sys.path.insert(0, str(ROOT / "bench"))
 from filter_scale import chain_filter, grid_filter, ring_filter  # noqa: E402
@@ -115,23 +116,30 @@ def test_clusters_compose_to_the_whole_filter(text: str) -> None:
         assert (~composed[o].equiv(whole.output(o)) & whole.care) == e.false, o
 
 
-def test_mixed_has_three_clusters_and_split_blocks_run_as_the_whole(cli, tmp_path) -> None:
-    f = parse_filter(MIXED, "mixed.filter")
-    assert clusters(f) == (("Q1", "Q2", "Q3"), ("o1", "o2", "o3"), ("L",))
-    blocks = split_blocks(f)
-    assert [b.name for b in blocks] == ["FB_mixed_1_Filter", "FB_mixed_2_Filter", "FB_mixed_3_Filter"]
-    assert blocks[2].inputs == ("R_L", "e")
-    parts = [load_st(b.text, f"{b.name}.st").instance(b.name) for b in blocks]
+def assert_split_runs_as_whole(f: Filter, blocks: Sequence[FilterBlock], parts: Sequence[Any], seed: int) -> None:
+    """Drive each split block (``parts``: a running instance per block, with ``cycle`` and
+    ``[output]``) on its own inputs and the whole filter's block on all of them, 300 random
+    cycles: the outputs agree at every cycle (the ring's assumptions are on past outputs:
+    the runs stay in the care set)."""
     whole_block = filter_block(f)
     whole = load_st(whole_block.text, "whole.st").instance(whole_block.name)
-    rnd = random.Random(3)
-    for n in range(300):  # the ring's assumptions are on past outputs: the runs stay in the care set
+    rnd = random.Random(seed)
+    for n in range(300):
         values = {x: rnd.random() < 0.5 for x in whole_block.inputs}
         whole.cycle(values)
         for b, fb in zip(blocks, parts):
             fb.cycle({x: values[x] for x in b.inputs})
         got = {o: fb[o] for b, fb in zip(blocks, parts) for o in b.outputs}
         assert got == {o: whole[o] for o in f.outputs}, f"cycle {n}"
+
+
+def test_mixed_has_three_clusters_and_split_blocks_run_as_the_whole(cli, tmp_path) -> None:
+    f = parse_filter(MIXED, "mixed.filter")
+    assert clusters(f) == (("Q1", "Q2", "Q3"), ("o1", "o2", "o3"), ("L",))
+    blocks = split_blocks(f)
+    assert [b.name for b in blocks] == ["FB_mixed_1_Filter", "FB_mixed_2_Filter", "FB_mixed_3_Filter"]
+    assert blocks[2].inputs == ("R_L", "e")
+    assert_split_runs_as_whole(f, blocks, [load_st(b.text, f"{b.name}.st").instance(b.name) for b in blocks], 3)
     path = tmp_path / "mixed.filter"
     path.write_text(MIXED)
     code, out, _ = cli("filter", "st", path, "--split")
