@@ -13,7 +13,7 @@ from conftest import ROOT
 
 sys.path.insert(0, str(ROOT / "bench"))
 from filter_scale import chain_filter, grid_filter, ring_filter  # noqa: E402
-from synth.filter import narrowing
+from synth.filter import narrowing, points
 from synth.filter.language_check import parse_filter
 from synth.filter.solve import synthesis
 
@@ -69,11 +69,11 @@ def test_random_points_leave_fewer_symbolic_races_and_change_no_verdict(monkeypa
 
     monkeypatch.setattr(narrowing._Race, "framed", counted)
     runs = {}
-    for rounds in (0, narrowing.POINT_ROUNDS):
-        monkeypatch.setattr(narrowing, "POINT_ROUNDS", rounds)
+    for rounds in (0, points.POINT_ROUNDS):
+        monkeypatch.setattr(points, "POINT_ROUNDS", rounds)
         framed.clear()
         s = synthesis(parse_filter(grid_filter(16), "grid16.filter"))
         runs[rounds] = ([a.effect for a in s.applied], len(framed))
-    (without, symbolic_without), (with_points, symbolic_with) = runs[0], runs[narrowing.POINT_ROUNDS]
+    (without, symbolic_without), (with_points, symbolic_with) = runs[0], runs[points.POINT_ROUNDS]
     assert with_points == without and without.count(False) == 2
     assert (symbolic_without, symbolic_with) == (19, 6)

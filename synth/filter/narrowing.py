@@ -11,7 +11,7 @@ constraints' complements and the assumptions, and each narrowing adds a factor o
 outputs of its criterion (one output for the priorities and the sims), so every ``S_j``
 is a :class:`~synth.logic.partition.Partition` state and each ``∃O`` eliminates the
 outputs one at a time, reusing the messages of the states before it; the races run on
-the same states, each first at a few single valuations of Y (:func:`_shown_at_points`). On
+the same states, each first at a few single valuations of Y (:func:`_shown_at_points`, :mod:`synth.filter.points`). On
 the grid of 64 outputs ``S_j`` reaches 0.86 M nodes as one BDD, the largest message 13 k.
 
 Example
@@ -30,8 +30,9 @@ from __future__ import annotations
 import random
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import Any, Callable, Sequence
+from typing import Callable, Sequence
 
+from synth.filter import points
 from synth.filter.model import FilterFunctions
 from synth.logic.bdd import Function
 from synth.logic.partition import Partition, State
@@ -253,80 +254,38 @@ class _Race:
         self.effect = True
 
 
-POINT_DEFAULTS = (False, True)
-"""The first points tried per race: one of its undecided part, the variables it leaves free
-first all false, then all true (requests and sensors on: where the priorities meet)."""
-POINT_ROUNDS = 4
-"""Then at most this many rounds of one random point per race still undecided, taken in its
-undecided part (a seeded generator: the same points for the same filter), while a round shows
-some effect: on the grid of 64 outputs they leave 10 of 83 races to the symbolic race instead
-of 83, for 0.4 CPU s."""
-POINT_SEED = 60848
-
-
 def _shown_at_points(p: Partition, goods: Sequence[Function], races: Sequence[_Race]) -> None:
     """Set ``effect`` on the races that, run at one valuation Y0 of the variables other
-    than the outputs, show an effect there (the symbolic race would too: it is the same
-    race on every Y at once).
+    than the outputs (:mod:`synth.filter.points`), show an effect there (the symbolic race
+    would too: it is the same race on every Y at once).
 
-    At Y0 each S_j is a small relation on the outputs alone: the chain and every race
-    that drops something at Y0 are run there. Each race not shown yet gives one Y0, taken
-    where it is still undecided: the free variables all false, all true, then random
-    (:data:`POINT_ROUNDS`)."""
-    e, bdd = p.engine, p.engine.bdd
-    anchors = {e.declare(o) for o in p.anchors}
-    others = [e.declare(n) for n in e.names if e.declare(n) not in anchors]
-    base = p.relation(p.initial)
-    reads = [sorted(v for v in bdd.support(g) if v not in anchors) for g in goods]
-    restricted: dict[tuple[int, tuple[bool, ...]], Function] = {}  # (criterion, its reads' values) -> g there
-
-    def at_point(j: int, point: dict[str, bool]) -> Function:
-        values = tuple(point[v] for v in reads[j])
-        found = restricted.get((j, values))
-        if found is None:
-            found = restricted[(j, values)] = bdd.let(dict(zip(reads[j], values)), goods[j]) if values else goods[j]
-        return found
+    At Y0 the chain and every race that drops something there are run. Each race not shown
+    yet gives one Y0, taken where it is still undecided: the free variables all false, all
+    true, then random (:data:`~synth.filter.points.POINT_ROUNDS`)."""
+    at = points.Points(p, goods)
+    false = p.engine.false
 
     def run(point: dict[str, bool]) -> int:
         """Run the chain and the undecided races at ``point``: how many it shows."""
-        at = [at_point(j, point) for j in range(len(goods))]  # outputs only
-        s = bdd.let(point, base)
-        states, bests = [], []
-        for g in at:
-            states.append(s)
-            bests.append((s & g) != e.false)
-            s &= g if bests[-1] else ~g
+        restricted = [at.at(g, point) for g in goods]  # outputs only
+        states, bests = at.chain(point)
         shown = 0
         for r in races:
             i = r.i
-            if r.effect is None and bests[i] and (z := states[i] & ~at[i]) != e.false and \
-                    _race_at_point(z, at[i + 1:], bests[i + 1:], e.false):
+            if r.effect is None and bests[i] and (z := states[i] & ~restricted[i]) != false and \
+                    _race_at_point(z, restricted[i + 1:], bests[i + 1:], false):
                 r.effect = True
                 shown += 1
         return shown
 
-    for first, default in ((r, d) for d in POINT_DEFAULTS for r in races):
+    for first, default in ((r, d) for d in points.POINT_DEFAULTS for r in races):
         if first.effect is None:
-            picked = bdd.pick(first.undecided)
-            run({v: picked.get(v, default) for v in others})
-    rng = random.Random(POINT_SEED)
-    for _ in range(POINT_ROUNDS):
-        shown = sum(run(_random_point(bdd, r.undecided, others, rng)) for r in races if r.effect is None)
+            run(at.point(at.bdd.pick(first.undecided), default))
+    rng = random.Random(points.POINT_SEED)
+    for _ in range(points.POINT_ROUNDS):
+        shown = sum(run(at.random(r.undecided, rng)) for r in races if r.effect is None)
         if not shown:
             break
-
-
-def _random_point(bdd: Any, u: Function, names: Sequence[str], rng: random.Random) -> dict[str, bool]:
-    """A valuation of ``names`` (internal) in ``u`` (not false, on those variables): random
-    values, each of ``u``'s variables in turn changed where the random one leaves ``u``."""
-    point = {v: rng.random() < 0.5 for v in names}
-    for v in sorted(bdd.support(u), key=bdd.level_of_var):
-        rest = bdd.let({v: point[v]}, u)
-        if rest == bdd.false:
-            point[v] = not point[v]
-            rest = bdd.let({v: point[v]}, u)
-        u = rest
-    return point
 
 
 def _race_at_point(z: Function, at: Sequence[Function], bests: Sequence[bool], false: Function) -> bool:
