@@ -12,18 +12,29 @@ from synth.filter.reliefs import spelling_warnings
 ROOT = Path(__file__).resolve().parent.parent
 
 
+WITNESS_NOTE = ("  = note: `synth filter check --all-spellings` compares on every input and names every output it "
+                "drives differently")
+
+
 def test_the_four_cylinders_keep_reliefs_differ_from_their_force_spelling(capsys):
-    assert main(["filter", "check", str(ROOT / "plants/four_cylinders.filter")]) in (0, 1)
-    err = capsys.readouterr().err.splitlines()
+    """A point shows CSc1's spellings different: the warning gives it (the variables at 1)
+    and what the other spelling does there; ``--all-spellings`` names every output."""
     path = ROOT / "plants/four_cylinders.filter"
-    assert err[:4] == [
+    assert main(["filter", "check", str(path)]) in (0, 1)
+    err = capsys.readouterr().err.splitlines()
+    assert err[:5] == [
         f"{path}:45:34: warning: CSc1's relief `keep Q1` written `force Q2=0` gives another algebraic filter "
-        "(it drives Q1, Q2, Q3, Q4 differently)",
+        "(it drives Q2 differently when only R_Q1, i1, R_Q2, h2, Q2^-1 are 1)",
         "  45 | safety CSc1: i1 & Q1 & Q2   keep Q1",
         "     |                                  ^~",
         "  = note: the algebraic filter uses `keep Q1`, as written; the loop algorithm reads either spelling as "
-        "`force Q2=0`"]
+        "`force Q2=0`",
+        WITNESS_NOTE]
     assert sum("warning:" in line for line in err) == 4
+    assert main(["filter", "check", "--all-spellings", str(path)]) in (0, 1)
+    err = capsys.readouterr().err.splitlines()
+    assert err[0].endswith("gives another algebraic filter (it drives Q1, Q2, Q3, Q4 differently)")
+    assert WITNESS_NOTE not in err and sum("warning:" in line for line in err) == 4
 
 
 def test_a_force_relief_is_compared_with_its_keep_spelling():
@@ -31,8 +42,9 @@ def test_a_force_relief_is_compared_with_its_keep_spelling():
     f = parse_filter(text, "square.filter")
     first = spelling_warnings(f).warnings[0]
     assert first.message == ("CSc1's relief `force Q2=0` written `keep Q1` gives another algebraic filter "
-                             "(it drives Q1, Q2, Q3, Q4 differently)")
+                             "(it drives Q2 differently when only R_Q1, i1, R_Q2, h2, Q2^-1 are 1)")
     assert first.render().splitlines()[0].startswith("square.filter:45:35: warning:")  # at Q2=0
+    assert spelling_warnings(f, limit=None).warnings[0].message.endswith("(it drives Q1, Q2, Q3, Q4 differently)")
 
 
 def test_no_warning_where_the_spellings_agree_or_criteria_are_stated():
@@ -40,64 +52,122 @@ def test_no_warning_where_the_spellings_agree_or_criteria_are_stated():
     assert spelling_warnings(load_filter(ROOT / "plants/tri.filter")).reports() == []  # explicit criteria: no priority criteria
 
 
-def _by_definition(f):
-    """The warnings' definition: synthesise the filter with each relief spelt the other way,
-    on one BDD (not the partitioned chain), and compare the care sets and each output's
-    ``∃O.(S∧o)`` and ``∃O.(S∧!o)``, as texts (a function's cover is its own)."""
+def _syntheses(f):
+    """The filter of ``f`` and, per relief with another spelling, the filter with that
+    relief spelt the other way: each as one BDD (not the partitioned chain)."""
     import dataclasses
 
     from synth.filter.reliefs import _other
     from synth.filter.solve import synthesis
 
-    def relation(g):
-        s = synthesis(g, partitioned=False)
-        e, outs = s.functions.engine, s.functions.outputs
-        one = {o: e.text(e.exists(outs, s.admissible & e.var(o))) for o in g.outputs}
-        zero = {o: e.text(e.exists(outs, s.admissible & ~e.var(o))) for o in g.outputs}
-        return e.text(s.care), one, zero
-
-    base, found = relation(f), []
+    base, others = synthesis(f, partitioned=False), {}
     for s in f.combined:
         other = _other(s) if s.has_priority else None
-        if other is None:
-            continue
-        t = dataclasses.replace(s, keep=other.keep, force=other.force)
-        alt = relation(dataclasses.replace(f, safeties=tuple(t if u is s else u for u in f.safeties)))
+        if other is not None:
+            t = dataclasses.replace(s, keep=other.keep, force=other.force)
+            others[s.id] = synthesis(dataclasses.replace(f, safeties=tuple(t if u is s else u for u in f.safeties)),
+                                     partitioned=False)
+    return base, others
+
+
+def _by_definition(f):
+    """The warnings' definition: synthesise the filter with each relief spelt the other way
+    and compare the care sets and each output's ``∃O.(S∧o)`` and ``∃O.(S∧!o)``, as texts (a
+    function's cover is its own)."""
+    def relation(s):
+        e, outs = s.functions.engine, s.functions.outputs
+        one = {o: e.text(e.exists(outs, s.admissible & e.var(o))) for o in f.outputs}
+        zero = {o: e.text(e.exists(outs, s.admissible & ~e.var(o))) for o in f.outputs}
+        return e.text(s.care), one, zero
+
+    synthesised, others = _syntheses(f)
+    base, found = relation(synthesised), []
+    for name, other in others.items():
+        alt = relation(other)
         if alt != base:
-            found.append((s.id, [o for o in f.outputs if (base[1][o], base[2][o]) != (alt[1][o], alt[2][o])]
+            found.append((name, [o for o in f.outputs if (base[1][o], base[2][o]) != (alt[1][o], alt[2][o])]
                           or list(f.outputs)))
     return found
 
 
-def test_the_warnings_follow_their_definition_on_the_bench_families():
-    """One chain, each other spelling run from the state before its criterion until it
-    rejoins the chain: the same warnings as a synthesis per relief."""
+def _at(s, ones):
+    """Each output's (may be 1, may be 0) in synthesis ``s`` where exactly ``ones`` of what
+    the filter reads are 1."""
+    e = s.functions.engine
+    point = {e.declare(n): n in ones for n in e.names if n not in s.functions.outputs}
+    there = e.bdd.let(point, s.admissible)
+    return {o: ((there & e.var(o)) != e.false, (there & ~e.var(o)) != e.false) for o in s.functions.outputs}
+
+
+def _families():
     import sys
 
     sys.path.insert(0, str(ROOT / "bench"))
     from filter_scale import chain_filter, grid_filter, ring_filter
 
-    texts = [ring_filter(4), chain_filter(6), grid_filter(8),
-             (ROOT / "plants/four_cylinders.filter").read_text().replace("keep Q1", "force Q2=0")]
-    for n, text in enumerate(texts):
+    return [ring_filter(4), chain_filter(6), grid_filter(8),
+            (ROOT / "plants/four_cylinders.filter").read_text().replace("keep Q1", "force Q2=0")]
+
+
+def test_the_warnings_follow_their_definition_on_the_bench_families():
+    """``--all-spellings``: one chain, each other spelling run from the state before its
+    criterion until it rejoins the chain; the same warnings as a synthesis per relief."""
+    for n, text in enumerate(_families()):
         f = parse_filter(text, f"f{n}.filter")
         got = [(w.message.split("'")[0], w.message.split("it drives ")[1].split(" differently")[0].split(", "))
-               for w in spelling_warnings(f).reports()]
+               for w in spelling_warnings(f, limit=None).reports()]
         assert got == _by_definition(f), n
         assert got  # every family has reliefs whose spellings differ
 
 
-def test_past_the_work_limit_the_other_reliefs_are_listed_not_compared(capsys):
-    """The first relief is always compared; with no work left the others are named, located
-    at the first of them, and ``--all-spellings`` lifts the limit."""
+def test_the_points_witnesses_hold_on_the_syntheses():
+    """Points first: the same reliefs warned as by definition; where a point shows the
+    difference, the two syntheses evaluated there differ on exactly the outputs named."""
+    witnessed = 0
+    for n, text in enumerate(_families()):
+        f = parse_filter(text, f"f{n}.filter")
+        base, others = _syntheses(f)
+        definition = dict(_by_definition(f))
+        found = spelling_warnings(f)
+        assert [w.message.split("'")[0] for w in found.warnings] == list(definition), n
+        for w in found.warnings:
+            outputs = w.message.split("it drives ")[1].split(" differently")[0].split(", ")
+            if " when " not in w.message:
+                assert outputs == definition[w.message.split("'")[0]]
+                continue
+            witnessed += 1
+            ones = w.message.split(" when only ")[1].split(" are 1)")[0].split(" is 1)")[0].split(", ") \
+                if " when only " in w.message else []
+            mine, theirs = _at(base, ones), _at(others[w.message.split("'")[0]], ones)
+            assert [o for o in f.outputs if mine[o] != theirs[o]] == outputs, w.message
+            assert set(outputs) <= set(definition[w.message.split("'")[0]])
+    assert witnessed >= 10
+
+
+def test_past_the_work_limit_the_other_reliefs_are_listed_not_compared(capsys, monkeypatch):
+    """Without points, the first relief is always compared; with no work left the others
+    are named, located at the first of them, and ``--all-spellings`` lifts the limit."""
+    from synth.filter import points
+
+    monkeypatch.setattr(points, "POINT_DEFAULTS", ())
+    monkeypatch.setattr(points, "POINT_ROUNDS", 0)
     f = load_filter(ROOT / "plants/four_cylinders.filter")
     found = spelling_warnings(f, limit=1)
     assert [w.message.split("'")[0] for w in found.warnings] == ["CSc1"]
     assert [s.id for s in found.skipped] == ["CSc2", "CSc3", "CSc4"]
     last = found.reports()[-1].render().splitlines()
-    assert last[0].endswith(":46:34: warning: the keep/force spellings of 3 relief(s) from CSc2 on were not compared: "
-                            "over the work limit of the comparison (1 BDD steps)")
+    assert last[0].endswith(":46:34: warning: the keep/force spellings of 3 relief(s) (CSc2, CSc3, CSc4) were not "
+                            "compared: over the work limit of the comparison (1 BDD steps)")
     assert last[-1] == "  = note: `synth filter check --all-spellings` compares them all, whatever it costs"
     assert spelling_warnings(f, limit=None).skipped == ()
     assert main(["filter", "check", "--all-spellings", str(ROOT / "plants/four_cylinders.filter")]) in (0, 1)
     assert sum("warning:" in line for line in capsys.readouterr().err.splitlines()) == 4
+
+
+def test_a_relief_a_point_shows_is_warned_past_the_limit():
+    """Points come before the work limit: on the four cylinders, two reliefs are shown at
+    points and the other two compared on every input, one past a limit of 1."""
+    found = spelling_warnings(load_filter(ROOT / "plants/four_cylinders.filter"), limit=1)
+    assert [(w.message.split("'")[0], " when only " in w.message) for w in found.warnings] == [
+        ("CSc1", True), ("CSc2", True), ("CSc3", False)]
+    assert [s.id for s in found.skipped] == ["CSc4"]

@@ -31,7 +31,8 @@ def register(sub: "argparse._SubParsersAction") -> None:
     c.add_argument("--plant", metavar="P.rules",
                    help="judge on the valuations this plant can reach under any control (printed as assume lines)")
     c.add_argument("--all-spellings", action="store_true",
-                   help="compare the keep/force spellings of every relief, past the work limit (large filters)")
+                   help="compare the keep/force spellings of every relief on every input, past the work "
+                        "limit, naming every output each drives differently (no witness points)")
     ci_options(c)
     c.set_defaults(handler=cmd_check)
 

@@ -6,9 +6,13 @@ the ``force`` spelling starves the pallets. :func:`spelling_warnings` solves the
 each combined constraint's relief written the other way and warns, located at the relief,
 where the two filters differ: the care set, or an output's ``∃O.(S∧o)`` or ``∃O.(S∧!o)``
 (the outputs it drives differently, on the inputs where it is defined; docs/filter.md).
-The criteria differ in one priority only, so one chain of narrowings serves them all: each
-other spelling runs from the state before its criterion, without the "no effect" races,
-and stops where its state rejoins the chain's.
+
+Points come first (:mod:`synth.filter.points`): at one valuation of what the filter reads,
+both chains are small, and a point where they differ is a witness, given in the warning
+(made sparse: the variables at 1, the others 0). The reliefs no point shows different are
+compared on every input, within a work limit: one chain of narrowings serves them all, as
+the criteria differ in one priority only; each other spelling runs from the state before
+its criterion, without the "no effect" races, and stops where its state rejoins the chain's.
 
 Example
 -------
@@ -23,9 +27,12 @@ Example
 from __future__ import annotations
 
 import dataclasses
+import functools
+import random
 from typing import Sequence
 
 from synth.errors import InputError, Location, Severity
+from synth.filter import points
 from synth.filter.language import Criterion, Filter, Forcing, Safety, Sense
 from synth.filter.language_check import output_polarities
 from synth.filter.narrowing import decided, layout
@@ -33,7 +40,7 @@ from synth.logic.bdd import Function
 from synth.logic.expr import And, Expr, Not, Var
 from synth.logic.partition import State
 
-__all__ = ["SPELLING_WORK", "Spelling", "Spellings", "other_spellings", "spelling_warnings"]
+__all__ = ["SPELLING_WORK", "Spelling", "Spellings", "Witness", "other_spellings", "spelling_warnings"]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -94,10 +101,22 @@ class _Chain:
             self.alternatives.append(None if i is None or good == self.goods[i] else (i, good))
         self.p = layout(m, self.goods + [a[1] for a in self.alternatives if a is not None])
         self.where = [self.p.position(g) for g in self.goods]
-        self.states = [self.p.initial]
-        for g, k in zip(self.goods, self.where):
-            self.states.append(self._step(self.states[-1], k, g))
-        self.base = self._outcome(self.states[-1])
+        self.states: list[State] = [self.p.initial]
+        self.bests: list[Function] = []
+
+    def _upto(self, j: int) -> State:
+        """The chain's ``S_j``, the chain run that far if it is not yet (the points need it
+        only up to the last relief's criterion)."""
+        while len(self.states) <= j:
+            g, k = self.goods[len(self.bests)], self.where[len(self.bests)]
+            self.bests.append(self.p.project(self.states[-1], k, g))
+            self.states.append(self.p.refine(self.states[-1], k, g.equiv(self.bests[-1])))
+        return self.states[j]
+
+    @functools.cached_property
+    def base(self) -> tuple[Function, dict[str, Function], dict[str, Function]]:
+        """The file's filter: what :meth:`_outcome` gives at the end of the chain."""
+        return self._outcome(self._upto(len(self.goods)))
 
     def _good(self, c: Criterion) -> Function:
         u = self.m.engine.expr(c.expr)
@@ -109,6 +128,87 @@ class _Chain:
     def _outcome(self, s: State) -> tuple[Function, dict[str, Function], dict[str, Function]]:
         return decided(self.p, s, self.m.outputs)
 
+    def _region(self, n: int) -> Function:
+        """Where alternative ``n`` may differ from the chain: the Y where its criterion or
+        the file's narrows ``S_i`` (elsewhere both leave it as it is, and so the rest)."""
+        alternative = self.alternatives[n]
+        assert alternative is not None
+        i, g = alternative
+        self._upto(i + 1)  # S_i and b_i
+        p, s = self.p, self.states[i]
+        k = p.position(g)
+        return (self.bests[i] & p.project(s, self.where[i], ~self.goods[i])) | \
+            (p.project(s, k, g) & p.project(s, k, ~g))
+
+    def at_points(self) -> dict[int, Witness]:
+        """The alternatives some point shows different (:mod:`synth.filter.points`), each
+        with its witness: the first point tried in the regions (:meth:`_region`) the
+        alternatives may differ in, then made sparse (fewer variables at 1)."""
+        e = self.m.engine
+        at = points.Points(self.p, self.goods)
+        regions = {n: self._region(n) for n, a in enumerate(self.alternatives) if a is not None}
+        todo = [n for n, r in regions.items() if r != e.false]
+        shown: dict[int, dict[str, bool]] = {}
+
+        def run(point: dict[str, bool]) -> int:
+            states, _ = at.chain(point)
+            found = [n for n in todo if n not in shown and self._differ_at(at, states, n, point)]
+            shown.update((n, point) for n in found)
+            return len(found)
+
+        for default in points.POINT_DEFAULTS:
+            for n in todo:
+                if n not in shown:
+                    run(at.point(e.bdd.pick(regions[n]), default))
+        rng = random.Random(points.POINT_SEED)
+        for _ in range(points.POINT_ROUNDS):
+            if not sum(run(at.random(regions[n], rng)) for n in todo if n not in shown):
+                break
+        return {n: self._witness(at, n, shown[n]) for n in sorted(shown)}
+
+    def _differ_at(self, at: points.Points, states: Sequence[Function], n: int,
+                   point: dict[str, bool]) -> list[str]:
+        """The outputs alternative ``n`` drives differently at ``point`` (``states``: the
+        chain there), none where it rejoins the chain."""
+        alternative = self.alternatives[n]
+        assert alternative is not None
+        i, g = alternative
+        false = self.m.engine.false
+        z, _ = points.narrow(states[i], at.at(g, point), false)
+        for j in range(i + 1, len(self.goods)):
+            if z == states[j]:
+                return []
+            z, _ = points.narrow(z, at.at(self.goods[j], point), false)
+        if z == states[-1]:
+            return []
+        e = self.m.engine
+        return [o for o in self.m.outputs
+                if ((z & e.var(o)) != false, (z & ~e.var(o)) != false) !=
+                ((states[-1] & e.var(o)) != false, (states[-1] & ~e.var(o)) != false)]
+
+    def _witness(self, at: points.Points, n: int, point: dict[str, bool]) -> Witness:
+        """``point`` made sparse: its variables at 1 set to 0, all of a group at once (the
+        whole set, then halves, and so on), wherever alternative ``n`` still differs; the
+        outputs it drives differently at the point left."""
+        point = dict(point)
+
+        def differs() -> list[str]:
+            return self._differ_at(at, at.chain(point)[0], n, point)
+
+        groups = [[v for v in at.others if point[v]]]  # a stack, not a recursive closure (no cycle to collect)
+        while groups:
+            group = groups.pop()
+            for v in group:
+                point[v] = False
+            if differs():
+                continue
+            for v in group:
+                point[v] = True
+            if len(group) > 1:
+                groups += [group[len(group) // 2:], group[:len(group) // 2]]
+        names = {self.m.engine.declare(x): x for x in self.m.engine.names}
+        return Witness(tuple(differs()), tuple(names[v] for v in at.others if point[v]))
+
     def differ(self, n: int) -> list[str] | None:
         """The outputs alternative ``n`` drives differently (another ``∃O.(S∧o)`` or
         ``∃O.(S∧!o)``; every output when only the care set differs), None when the two
@@ -117,6 +217,7 @@ class _Chain:
         if alternative is None:  # the criteria are the file's: the spelling changes none
             return None
         i, g = alternative
+        base = self.base  # before the mark: the chain's messages are kept
         mark = self.p.mark()
         s = self._step(self.states[i], self.p.position(g), g)
         for j in range(i + 1, len(self.goods) + 1):
@@ -127,10 +228,24 @@ class _Chain:
                 s = self._step(s, self.where[j], self.goods[j])
         care, ones, zeros = self._outcome(s)
         self.p.forget(mark)
-        differ = [o for o in self.m.outputs if ones[o] != self.base[1][o] or zeros[o] != self.base[2][o]]
-        if not differ and care == self.base[0]:
+        differ = [o for o in self.m.outputs if ones[o] != base[1][o] or zeros[o] != base[2][o]]
+        if not differ and care == base[0]:
             return None
         return differ or list(self.m.outputs)
+
+
+@dataclasses.dataclass(frozen=True)
+class Witness:
+    """Where a point shows two spellings different: the outputs they drive differently
+    there, and the variables read that are 1 at the point (the others are 0)."""
+
+    outputs: tuple[str, ...]
+    ones: tuple[str, ...]
+
+    def text(self) -> str:
+        where = f"only {', '.join(self.ones)} {'is' if len(self.ones) == 1 else 'are'} 1" if self.ones \
+            else "all it reads is 0"
+        return f"it drives {', '.join(self.outputs)} differently when {where}"
 
 
 SPELLING_WORK = 10_000_000
@@ -142,7 +257,8 @@ grid of 32 outputs needs half of it for its 52 reliefs, the grid of 64 fifteen t
 @dataclasses.dataclass(frozen=True)
 class Spellings:
     """What :func:`spelling_warnings` found: the warnings, and the reliefs not compared
-    because the work limit was reached first (in file order)."""
+    because the work limit was reached first (in file order), no point showing them
+    different."""
 
     warnings: list[InputError]
     skipped: tuple[Safety, ...] = ()
@@ -153,8 +269,9 @@ class Spellings:
         if not self.skipped:
             return self.warnings
         first = self.skipped[0]
+        ids = ", ".join(s.id for s in self.skipped[:3]) + (", …" if len(self.skipped) > 3 else "")
         return self.warnings + [InputError(
-            f"the keep/force spellings of {len(self.skipped)} relief(s) from {first.id} on were not compared: "
+            f"the keep/force spellings of {len(self.skipped)} relief(s) ({ids}) were not compared: "
             f"over the work limit of the comparison ({self.limit or 0:,} BDD steps)",
             _relief_loc(first), severity=Severity.WARNING,
             notes=("`synth filter check --all-spellings` compares them all, whatever it costs",))]
@@ -167,9 +284,13 @@ def _relief_loc(s: Safety) -> Location | None:
 def spelling_warnings(f: Filter, safeties: Sequence[Safety] | None = None,
                       limit: int | None = SPELLING_WORK) -> Spellings:
     """A located warning for each relief whose other spelling gives a different algebraic
-    filter: another care set, or an output that may be on or may be off on other inputs.
-    ``limit``: the BDD work for the reliefs after the first (None: no limit); the reliefs
-    left when it is spent are listed, not compared."""
+    filter: another care set, or an output that may be on or may be off on some input.
+
+    With a ``limit``, points come first (:meth:`_Chain.at_points`): a relief a point shows
+    different is warned with the point; the others are compared on every input while the
+    BDD work spent on them stays under ``limit`` (the first always), and those left are
+    listed, not compared. ``limit`` None: every relief compared on every input, each
+    warning naming every output it drives differently."""
     swapped: list[tuple[Safety, Filter]] = []
     for s in (safeties if safeties is not None else f.combined):
         other = _other(s) if s.has_priority else None
@@ -179,22 +300,32 @@ def spelling_warnings(f: Filter, safeties: Sequence[Safety] | None = None,
     if not swapped:
         return Spellings([])
     chain = _Chain(f, swapped)
+    shown = {} if limit is None else chain.at_points()
     out: list[InputError] = []
-    start = chain.m.engine.work()
+    skipped: list[Safety] = []
+    start, compared = chain.m.engine.work(), False
     for n, (s, _) in enumerate(swapped):
-        if n and limit is not None and chain.m.engine.work() - start > limit:
-            return Spellings(out, tuple(s for s, _ in swapped[n:]), limit)
-        differ = chain.differ(n)
-        if differ is None:
+        if n in shown:
+            differ = shown[n].text()
+        elif compared and limit is not None and chain.m.engine.work() - start > limit:
+            skipped.append(s)
             continue
+        else:
+            compared = True
+            outputs = chain.differ(n)
+            if outputs is None:
+                continue
+            differ = f"it drives {', '.join(outputs)} differently"
         other = _other(s)
         assert other is not None
         written = Spelling(s.keep, s.force if s.keep is None else ())
         loop = Spelling(None, s.forced).text()
+        notes = [f"the algebraic filter uses `{written.text()}`, as written; the loop algorithm reads either "
+                 f"spelling as `{loop}`"]
+        if n in shown:
+            notes.append("`synth filter check --all-spellings` compares on every input and names every output "
+                         "it drives differently")
         out.append(InputError(
-            f"{s.id}'s relief `{written.text()}` written `{other.text()}` gives another algebraic filter "
-            f"(it drives {', '.join(differ)} differently)",
-            _relief_loc(s), severity=Severity.WARNING,
-            notes=(f"the algebraic filter uses `{written.text()}`, as written; the loop algorithm reads either "
-                   f"spelling as `{loop}`",)))
-    return Spellings(out)
+            f"{s.id}'s relief `{written.text()}` written `{other.text()}` gives another algebraic filter ({differ})",
+            _relief_loc(s), severity=Severity.WARNING, notes=tuple(notes)))
+    return Spellings(out, tuple(skipped), limit if skipped else None)
