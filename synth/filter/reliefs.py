@@ -103,6 +103,7 @@ class _Chain:
         self.where = [self.p.position(g) for g in self.goods]
         self.states: list[State] = [self.p.initial]
         self.bests: list[Function] = []
+        self._regions: dict[int, Function] = {}
 
     def _upto(self, j: int) -> State:
         """The chain's ``S_j``, the chain run that far if it is not yet (the points need it
@@ -131,6 +132,12 @@ class _Chain:
     def _region(self, n: int) -> Function:
         """Where alternative ``n`` may differ from the chain: the Y where its criterion or
         the file's narrows ``S_i`` (elsewhere both leave it as it is, and so the rest)."""
+        found = self._regions.get(n)
+        if found is None:
+            found = self._regions[n] = self._narrowed(n)
+        return found
+
+    def _narrowed(self, n: int) -> Function:
         alternative = self.alternatives[n]
         assert alternative is not None
         i, g = alternative
@@ -140,14 +147,15 @@ class _Chain:
         return (self.bests[i] & p.project(s, self.where[i], ~self.goods[i])) | \
             (p.project(s, k, g) & p.project(s, k, ~g))
 
-    def at_points(self) -> dict[int, Witness]:
-        """The alternatives some point shows different (:mod:`synth.filter.points`), each
-        with its witness: the first point tried in the regions (:meth:`_region`) the
-        alternatives may differ in, then made sparse (fewer variables at 1)."""
-        e = self.m.engine
-        at = points.Points(self.p, self.goods)
-        regions = {n: self._region(n) for n, a in enumerate(self.alternatives) if a is not None}
-        todo = [n for n, r in regions.items() if r != e.false]
+    def at_points(self, candidates: Sequence[int], defaults: Sequence[bool], rounds: int) -> dict[int, Witness]:
+        """Those of the alternatives ``candidates`` some point shows different
+        (:mod:`synth.filter.points`), each with its witness. The points are taken in the
+        regions the alternatives may differ in (:meth:`_region`): one per alternative not
+        shown yet, its free variables set to each of ``defaults`` in turn, then ``rounds``
+        rounds of random ones; a point showing several alternatives serves them all. Each
+        witness is the first point that showed it, made sparse (fewer variables at 1)."""
+        e, at = self.m.engine, self._at
+        todo = [n for n in candidates if self.alternatives[n] is not None and self._region(n) != e.false]
         shown: dict[int, dict[str, bool]] = {}
 
         def run(point: dict[str, bool]) -> int:
@@ -156,15 +164,19 @@ class _Chain:
             shown.update((n, point) for n in found)
             return len(found)
 
-        for default in points.POINT_DEFAULTS:
+        for default in defaults:
             for n in todo:
                 if n not in shown:
-                    run(at.point(e.bdd.pick(regions[n]), default))
+                    run(at.point(e.bdd.pick(self._region(n)), default))
         rng = random.Random(points.POINT_SEED)
-        for _ in range(points.POINT_ROUNDS):
-            if not sum(run(at.random(regions[n], rng)) for n in todo if n not in shown):
+        for _ in range(rounds):
+            if not sum(run(at.random(self._region(n), rng)) for n in todo if n not in shown):
                 break
         return {n: self._witness(at, n, shown[n]) for n in sorted(shown)}
+
+    @functools.cached_property
+    def _at(self) -> points.Points:
+        return points.Points(self.p, self.goods)
 
     def _differ_at(self, at: points.Points, states: Sequence[Function], n: int,
                    point: dict[str, bool]) -> list[str]:
@@ -286,11 +298,12 @@ def spelling_warnings(f: Filter, safeties: Sequence[Safety] | None = None,
     """A located warning for each relief whose other spelling gives a different algebraic
     filter: another care set, or an output that may be on or may be off on some input.
 
-    With a ``limit``, points come first (:meth:`_Chain.at_points`): a relief a point shows
-    different is warned with the point; the others are compared on every input while the
-    BDD work spent on them stays under ``limit`` (the first always), and those left are
-    listed, not compared. ``limit`` None: every relief compared on every input, each
-    warning naming every output it drives differently."""
+    With a ``limit``: first the sparse points (:meth:`_Chain.at_points`; the free
+    variables 0), a relief one shows different warned with it; the others compared on
+    every input while the BDD work spent on them stays under ``limit`` (the first always);
+    those left tried at the other points (free variables 1, random), and the rest listed,
+    not compared. ``limit`` None: every relief compared on every input, each warning
+    naming every output it drives differently."""
     swapped: list[tuple[Safety, Filter]] = []
     for s in (safeties if safeties is not None else f.combined):
         other = _other(s) if s.has_priority else None
@@ -300,22 +313,29 @@ def spelling_warnings(f: Filter, safeties: Sequence[Safety] | None = None,
     if not swapped:
         return Spellings([])
     chain = _Chain(f, swapped)
-    shown = {} if limit is None else chain.at_points()
+    every = range(len(swapped))
+    sparse = {} if limit is None else chain.at_points(every, points.POINT_DEFAULTS[:1], 0)
+    compared: dict[int, list[str] | None] = {}
+    left: list[int] = []
+    start = chain.m.engine.work()
+    for n in every:
+        if n in sparse:
+            continue
+        if compared and limit is not None and chain.m.engine.work() - start > limit:
+            left.append(n)
+        else:
+            compared[n] = chain.differ(n)
+    dense = chain.at_points(left, points.POINT_DEFAULTS[1:], points.POINT_ROUNDS) if left else {}
+    shown = sparse | dense
     out: list[InputError] = []
-    skipped: list[Safety] = []
-    start, compared = chain.m.engine.work(), False
     for n, (s, _) in enumerate(swapped):
+        outputs = compared.get(n)
         if n in shown:
             differ = shown[n].text()
-        elif compared and limit is not None and chain.m.engine.work() - start > limit:
-            skipped.append(s)
-            continue
-        else:
-            compared = True
-            outputs = chain.differ(n)
-            if outputs is None:
-                continue
+        elif outputs is not None:
             differ = f"it drives {', '.join(outputs)} differently"
+        else:
+            continue
         other = _other(s)
         assert other is not None
         written = Spelling(s.keep, s.force if s.keep is None else ())
@@ -328,4 +348,5 @@ def spelling_warnings(f: Filter, safeties: Sequence[Safety] | None = None,
         out.append(InputError(
             f"{s.id}'s relief `{written.text()}` written `{other.text()}` gives another algebraic filter ({differ})",
             _relief_loc(s), severity=Severity.WARNING, notes=tuple(notes)))
-    return Spellings(out, tuple(skipped), limit if skipped else None)
+    skipped = tuple(swapped[n][0] for n in left if n not in dense)
+    return Spellings(out, skipped, limit if skipped else None)
