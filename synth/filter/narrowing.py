@@ -11,8 +11,9 @@ constraints' complements and the assumptions, and each narrowing adds a factor o
 outputs of its criterion (one output for the priorities and the sims), so every ``S_j``
 is a :class:`~synth.logic.partition.Partition` state and each ``∃O`` eliminates the
 outputs one at a time, reusing the messages of the states before it; the races run on
-the same states, each first at a few single valuations of Y (:func:`_shown_at_points`, :mod:`synth.filter.points`). On
-the grid of 64 outputs ``S_j`` reaches 0.86 M nodes as one BDD, the largest message 13 k.
+the same states, each first at a few single valuations of Y (:func:`_shown_at_points`,
+:mod:`synth.filter.points`). On the grid of 64 outputs ``S_j`` reaches 0.86 M nodes as one
+BDD, the largest message 13 k.
 
 Example
 -------
@@ -267,8 +268,7 @@ def _shown_at_points(p: Partition, goods: Sequence[Function], races: Sequence[_R
 
     def run(point: dict[str, bool]) -> int:
         """Run the chain and the undecided races at ``point``: how many it shows."""
-        restricted = [at.at(g, point) for g in goods]  # outputs only
-        states, bests = at.chain(point)
+        states, bests, restricted = at.chain(point)  # the criteria restricted: outputs only
         shown = 0
         for r in races:
             i = r.i

@@ -14,7 +14,7 @@ Example
 >>> a, b, i = (e.var(n) for n in "abi")
 >>> goods = [a & i, b]
 >>> at = Points(Partition(e, ["a", "b"], [~(a & b)]), goods)
->>> states, bests = at.chain(at.point({e.declare("i"): True}, default=False))
+>>> states, bests, _ = at.chain(at.point({e.declare("i"): True}, default=False))
 >>> bests, e.text(states[-1])
 ([True, False], 'a & !b')
 """
@@ -71,16 +71,16 @@ class Points:
             found = self._restricted[(g, values)] = self.bdd.let(dict(zip(reads, values)), g) if values else g
         return found
 
-    def chain(self, point: Mapping[str, bool]) -> tuple[list[Function], list[bool]]:
-        """The chain at ``point``: ``S_0 … S_n`` on the outputs, and whether each criterion
-        finds a solution there (its ``b_j`` at Y0)."""
+    def chain(self, point: Mapping[str, bool]) -> tuple[list[Function], list[bool], list[Function]]:
+        """The chain at ``point``: ``S_0 … S_n`` on the outputs, whether each criterion
+        finds a solution there (its ``b_j`` at Y0), and the criteria there (:meth:`at`)."""
         s = self.bdd.let(dict(point), self._base)
-        states, bests = [s], []
-        for g in self.goods:
-            s, best = narrow(s, self.at(g, point), self.engine.false)
+        states, bests, there = [s], [], [self.at(g, point) for g in self.goods]
+        for g in there:
+            s, best = narrow(s, g, self.engine.false)
             states.append(s)
             bests.append(best)
-        return states, bests
+        return states, bests, there
 
     def random(self, region: Function, rng: random.Random) -> dict[str, bool]:
         """A random point in ``region`` (not false, a function of :attr:`others`)."""

@@ -159,7 +159,7 @@ class _Chain:
         shown: dict[int, dict[str, bool]] = {}
 
         def run(point: dict[str, bool]) -> int:
-            states, _ = at.chain(point)
+            states = at.chain(point)[0]
             found = [n for n in todo if n not in shown and self._differ_at(at, states, n, point)]
             shown.update((n, point) for n in found)
             return len(found)
