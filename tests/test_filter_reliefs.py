@@ -194,3 +194,16 @@ def test_a_relief_a_point_shows_is_warned_past_the_limit():
     assert [(w.message.split("'")[0], " when only " in w.message) for w in found.warnings] == [
         ("CSc1", True), ("CSc2", True), ("CSc3", False)]
     assert [s.id for s in found.skipped] == ["CSc4"]
+
+
+def test_a_witness_gives_the_integer_observers_as_integers():
+    """The palletizer's counter ``cpt : 0..3`` is two Boolean bits in the BDDs; the witness
+    gives it (and ``cpt^-1``) as a value: with no layer on the pallet ``keep lift`` cannot
+    lift and leaves the push requested, ``force push=0`` drops it all the same."""
+    f = load_filter(ROOT / "tests/data/filter/palletizer.filter")
+    (w,) = spelling_warnings(f).warnings
+    assert w.message == ("BOTH's relief `keep lift` written `force push=0` gives another algebraic filter "
+                         "(it drives push differently when only R_push, ready, R_lift are 1, cpt = 0, cpt^-1 = 0)")
+    base, others = _syntheses(f)
+    ones = ["R_push", "ready", "R_lift"]  # the bits of cpt and cpt^-1 at 0
+    assert (_at(base, ones)["push"], _at(others["BOTH"], ones)["push"]) == ((True, False), (False, True))

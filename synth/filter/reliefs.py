@@ -39,6 +39,7 @@ from synth.filter.narrowing import decided, layout
 from synth.logic.bdd import Function
 from synth.logic.expr import And, Expr, Not, Var
 from synth.logic.partition import State
+from synth.logic.past import pre_name
 
 __all__ = ["SPELLING_WORK", "Spelling", "Spellings", "Witness", "other_spellings", "spelling_warnings"]
 
@@ -218,8 +219,14 @@ class _Chain:
                 point[v] = True
             if len(group) > 1:
                 groups += [group[len(group) // 2:], group[:len(group) // 2]]
-        names = {self.m.engine.declare(x): x for x in self.m.engine.names}
-        return Witness(tuple(differs()), tuple(names[v] for v in at.others if point[v]))
+        e = self.m.engine
+        value = {x: point[e.declare(x)] for x in e.names if e.declare(x) in point}
+        integers: list[tuple[str, int]] = []
+        for i in self.m.filter.integer_observers:  # their bits read as the integer (and its ^-1)
+            for name, bits in ((i.name, i.bits), (pre_name(i.name), [pre_name(b) for b in i.bits])):
+                if all(b in value for b in bits):
+                    integers.append((name, i.low + sum(value.pop(b) << k for k, b in enumerate(bits))))
+        return Witness(tuple(differs()), tuple(x for x, v in value.items() if v), tuple(integers))
 
     def differ(self, n: int) -> list[str] | None:
         """The outputs alternative ``n`` drives differently (another ``∃O.(S∧o)`` or
@@ -249,14 +256,23 @@ class _Chain:
 @dataclasses.dataclass(frozen=True)
 class Witness:
     """Where a point shows two spellings different: the outputs they drive differently
-    there, and the variables read that are 1 at the point (the others are 0)."""
+    there, the Boolean variables read that are 1 at the point (the others are 0), and the
+    integer observers' values there.
+
+    >>> Witness(("push",), ("R_push", "ready"), (("cpt", 3), ("cpt^-1", 0))).text()
+    'it drives push differently when only R_push, ready are 1, cpt = 3, cpt^-1 = 0'
+    """
 
     outputs: tuple[str, ...]
     ones: tuple[str, ...]
+    integers: tuple[tuple[str, int], ...] = ()
+    """The integer observers (and their previous values) at the point: every one, by name."""
 
     def text(self) -> str:
+        """``it drives o differently when only a, b are 1`` (``…, cpt = 2`` with integers)."""
         where = f"only {', '.join(self.ones)} {'is' if len(self.ones) == 1 else 'are'} 1" if self.ones \
-            else "all it reads is 0"
+            else ("no Boolean it reads is 1" if self.integers else "all it reads is 0")
+        where += "".join(f", {n} = {v}" for n, v in self.integers)
         return f"it drives {', '.join(self.outputs)} differently when {where}"
 
 
