@@ -19,7 +19,7 @@ from synth.grafcet.language_check import parse_grafcet
 from synth.grafcet.machine import GrafcetMachine
 from synth.logic.events import Event
 from synth.output.result import validation_json, validation_text
-from synth.symbolic import validate as symbolic_validate
+from synth.symbolic import ties, validate as symbolic_validate
 from synth.symbolic.encoding import Copy
 from synth.symbolic.steps import StepEncoding, Unsupported, anchors, step_name, unsupported
 from synth.symbolic.stepsync import step_sync
@@ -192,3 +192,8 @@ def test_ties_as_the_explicit_engine(variant, tmp_path, monkeypatch):
         return sorted(re.sub(r"^(\w+) \d+:", r"\1:", line) for line in text.splitlines())
 
     assert unnumbered(per_situation) == unnumbered(validation_text(explicit))
+    # past the region limit a tie is broken by the smallest node again: the same findings
+    monkeypatch.setattr(symbolic_validate, "unsupported", unsupported)
+    monkeypatch.setattr(ties, "REGION_LIMIT", 1)
+    limited = validation_text(validate_symbolic(grafcet, rules))
+    assert limited != validation_text(explicit) and unnumbered(limited) == unnumbered(validation_text(explicit))

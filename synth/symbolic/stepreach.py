@@ -220,11 +220,14 @@ class StepReach:
         """The node of ``u`` the explicit engine numbers first, ``u`` being nodes the
         region entered from node ``via[0]`` by move ``via[1]`` (edges ``via[2]``) settles
         in (None: the initial region), and its rank among that region's settled states
-        (0 where it settles in one: no region is run explicitly)."""
+        (0 where it settles in one: no region is run explicitly; 0 and the smallest
+        node past :data:`~synth.symbolic.ties.REGION_LIMIT` states)."""
         entered = self.s.initial if via is None else self.s.unprimed(self.s.image(self.cube(via[0]), via[1], via[2]))
         if self.s.count(entered, self.s._current) == 1:
             return u, 0
         sit, order = settled.order(None, None) if via is None else settled.order(via[0], via[1])
+        if order is None:  # a region too large to run explicitly: the smallest node
+            return self.cube(self.pick(u)), 0
         for rank, q in enumerate(order):
             node = self.cube((sit, q))
             if (node & u) != self.false:

@@ -16,7 +16,8 @@ Example
 >>> from synth.plant.composition import _plants
 >>> from synth.validation.result import load_model
 >>> from synth.grafcet.machine import GrafcetMachine
->>> from synth.sup.constraints import CompiledConstraints
+>>> from synth.errors import LimitExceeded
+from synth.sup.constraints import CompiledConstraints
 >>> from synth.symbolic.stepsync import step_sync
 >>> rs, p, g = load_model(_plants("../tests/data/home/production_loop.g7"), _plants("../tests/data/home/cylinder.rules"))
 >>> s = step_sync(p, rs.constraints, GrafcetMachine(g))
@@ -28,15 +29,20 @@ Example
 
 from __future__ import annotations
 
+from synth.errors import LimitExceeded
 from synth.sup.constraints import CompiledConstraints
 from synth.symbolic.explicit import Key
 from synth.symbolic.relation import Move
 from synth.symbolic.stepsync import StepSync
 from synth.validation.sync import _grafcet_inputs, _order_moves, region
 
-__all__ = ["Settled"]
+__all__ = ["Settled", "REGION_LIMIT"]
 
 Local = tuple[int, ...]
+
+REGION_LIMIT = 100_000
+"""A region of more states is not run explicitly (the symbolic engine is there for them):
+its tie is broken by the smallest situation, then state, and the rank is 0."""
 
 
 class Settled:
@@ -48,19 +54,19 @@ class Settled:
         self.p = s.plant
         self.oracle = oracle
         self.moves = _order_moves(self.p)
-        self._found: dict[tuple[Key | None, int | None], tuple[int, list[Local]]] = {}
+        self._found: dict[tuple[Key | None, int | None], tuple[int, list[Local] | None]] = {}
 
-    def order(self, parent: Key | None, move: Move | None) -> tuple[int, list[Local]]:
+    def order(self, parent: Key | None, move: Move | None) -> tuple[int, list[Local] | None]:
         """The situation (its index in the nodes' numbering) of the region ``parent``
         enters by ``move`` (None, None: the initial region) and its settled plant states
-        in the explicit engine's order."""
+        in the explicit engine's order (None past :data:`REGION_LIMIT` states)."""
         key = (parent, None if move is None else move.key)
         found = self._found.get(key)
         if found is None:
             found = self._found[key] = self._order(parent, move)
         return found
 
-    def _order(self, parent: Key | None, move: Move | None) -> tuple[int, list[Local]]:
+    def _order(self, parent: Key | None, move: Move | None) -> tuple[int, list[Local] | None]:
         p, machine = self.p, self.s.machine
         if parent is None or move is None:
             entry = p.initial
@@ -72,5 +78,8 @@ class Settled:
             sit, _ = machine.react_with_trace(before, _grafcet_inputs(p, machine, local),
                                               _grafcet_inputs(p, machine, entry))
         wanted = machine.orders(sit, _grafcet_inputs(p, machine, entry))
-        _, settled = region(p, self.oracle, entry, wanted, self.moves)
+        try:
+            _, settled = region(p, self.oracle, entry, wanted, self.moves, REGION_LIMIT)
+        except LimitExceeded:
+            return self.s.helper.situation(sit), None
         return self.s.helper.situation(sit), [q for q, _ in settled]
