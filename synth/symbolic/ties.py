@@ -16,8 +16,7 @@ Example
 >>> from synth.plant.composition import _plants
 >>> from synth.validation.result import load_model
 >>> from synth.grafcet.machine import GrafcetMachine
->>> from synth.errors import LimitExceeded
-from synth.sup.constraints import CompiledConstraints
+>>> from synth.sup.constraints import CompiledConstraints
 >>> from synth.symbolic.stepsync import step_sync
 >>> rs, p, g = load_model(_plants("../tests/data/home/production_loop.g7"), _plants("../tests/data/home/cylinder.rules"))
 >>> s = step_sync(p, rs.constraints, GrafcetMachine(g))
