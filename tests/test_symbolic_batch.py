@@ -16,6 +16,8 @@ from synth.logic.bdd import Engine
 from synth.symbolic.stepbatch import Findings, Tags
 from synth.symbolic.stepreach import StepReach
 from synth.symbolic.stepsync import step_sync
+from synth.symbolic.ties import Settled
+from synth.sup.constraints import CompiledConstraints
 from synth.validation.result import load_model
 
 from conftest import ROOT
@@ -26,9 +28,14 @@ from gen_branches import write_branches  # noqa: E402
 H = ROOT / "tests" / "data" / "home"
 
 
-def _reach(grafcet, rules) -> StepReach:
+def _reach(grafcet, rules, ties: bool = False) -> StepReach:
+    """The step path's searches; ``ties``: first nodes as the explicit engine numbers them
+    (synth/symbolic/ties.py, as ``validate`` runs them)."""
     rs, p, g = load_model(grafcet, rules)
-    return StepReach(step_sync(p, rs.constraints, GrafcetMachine(g)))
+    r = StepReach(step_sync(p, rs.constraints, GrafcetMachine(g)))
+    if ties:
+        r.settled = Settled(r.s, CompiledConstraints(p, rs.constraints))
+    return r
 
 
 def _sets(r: StepReach) -> list:
@@ -50,12 +57,19 @@ def _check(r: StepReach) -> tuple[int, int]:
     return len(sets), len(keys)
 
 
+@pytest.mark.parametrize("ties", [False, True], ids=["smallest", "explicit_order"])
 @pytest.mark.parametrize("variant", [0, pytest.param(1, marks=pytest.mark.nightly)], ids=["branches_3x2", "branches_3x2_missing"])
-def test_batch_is_the_per_target_search_on_branches(variant, tmp_path):
+def test_batch_is_the_per_target_search_on_branches(variant, ties, tmp_path):
     rules, passing, missing = write_branches(3, 2, tmp_path)
-    r = _reach((passing, missing)[variant], rules)
+    r = _reach((passing, missing)[variant], rules, ties)
     n_sets, n_keys = _check(r)
     assert len(r.prohibited()) > 20 and n_sets > 60 and n_keys > 50  # the batch is not trivial
+    paths = [path for _, _, path in Findings(r, _sets(r)).firsts]
+    if ties:  # each ring's rank: some first node is not the first state its region settles in
+        assert all(len(path[0]) == 1 and all(len(k) == 4 for k in path[1:]) for path in paths)
+        assert any(k[-1] for path in paths for k in path)
+    else:  # the events' keys alone
+        assert all(len(k) == 3 for path in paths for k in path)
 
 
 @pytest.mark.parametrize("grafcet", ["production_loop.g7", "no_restart.g7", "prohibited_initial.g7", "never_leaves.g7"])

@@ -34,7 +34,7 @@ from synth.validation.sync import Edge, Node, Prohibition, _order_moves
 __all__ = ["ExplicitNodes", "Key", "PathKey", "Blocking"]
 
 Key = tuple[int, tuple[int, ...]]  # a node: situation, plant state
-PathKey = tuple[tuple[int, int, int], ...]  # a shortest path, in the explicit exploration's order
+PathKey = tuple[tuple[int, ...], ...]  # a shortest path, in the explicit exploration's order (with ranks: synth.symbolic.ties)
 Blocking = tuple[list[int], dict[int, tuple[int, ...]], dict[int, Trace], dict[int, int]]
 
 

@@ -43,14 +43,17 @@ True
 
 from __future__ import annotations
 
-from typing import Callable, Sequence
+from typing import TYPE_CHECKING, Callable, Sequence
 
 from synth.logic.bdd import Engine, Function
 from synth.logic.events import Event
 from synth.symbolic.explicit import Key, PathKey
 from synth.symbolic.reachability import Path
 from synth.symbolic.relation import Move
-from synth.symbolic.stepreach import Order, StepReach
+from synth.symbolic.stepreach import Order, StepReach, path_key
+
+if TYPE_CHECKING:  # pragma: no cover
+    from synth.symbolic.ties import Settled
 
 __all__ = ["Tags", "Findings"]
 
@@ -136,11 +139,17 @@ class _Batch:
             layers[k] = (before & s.rings[k]) | by_depth.get(k, self.false)
         return layers
 
-    def greedy(self, order: Callable[[Move], Order]) -> tuple[list[Function], list[list[tuple[Order, Event, Function]]]]:
+    def greedy(self, order: Callable[[Move], Order], settled: "Settled | None" = None,
+               ) -> tuple[list[Function], list[list[tuple[Order, Event, Function]]], list[dict[int, int]]]:
         """Forward through the layers, each tag taking its smallest move (by ``order``):
-        the tagged current sets per ring, and per step the (order, event, tags) chosen."""
+        the tagged current sets per ring, per step the (order, event, tags) chosen, and
+        with ``settled`` each tag's set narrowed at each ring to the node the explicit
+        engine enters first, with its rank (:meth:`StepReach.first_of`)."""
         s, false, exists = self.s, self.false, self.s.engine.bdd.apply
         current = self.layers[0]
+        ranks: list[dict[int, int]] = []
+        if settled is not None:
+            current = self._first(current, None, settled, ranks)
         chosen = [current]
         steps: list[list[tuple[Order, Event, Function]]] = []
         for k in range(1, len(self.layers)):
@@ -164,9 +173,40 @@ class _Batch:
                         record.append((key, event, sel))
                 taken |= later
             current = s.unprimed(nxt)
+            if settled is not None:
+                current = self._first(current, (chosen[-1], record), settled, ranks)
             chosen.append(current)
             steps.append(record)
-        return chosen, steps
+        return chosen, steps, ranks
+
+    def _first(self, current: Function, via: "tuple[Function, list[tuple[Order, Event, Function]]] | None",
+               settled: "Settled", ranks: list[dict[int, int]]) -> Function:
+        """Each tag's part of ``current`` narrowed to its first node (as
+        :meth:`StepReach.first_of`; ``via``: the previous ring's tagged nodes and the moves
+        the tags took), each tag's rank appended to ``ranks``."""
+        r, tags = self.r, self.tags
+        arcs = {m.event: (m, e) for m, e in self.s.edges}
+        before: dict[int, Function] = {}
+        moved: dict[int, Event] = {}
+        if via is not None:
+            before = tags.split(via[0])
+            for _, event, sel in via[1]:
+                moved.update((j, event) for j in tags.split(sel))
+        memo: dict[tuple[Function | None, Event | None, Function], tuple[Function, int]] = {}
+        out, rank = self.false, {}
+        for j, u in tags.split(current).items():
+            key = (before.get(j), moved.get(j), u)
+            hit = memo.get(key)
+            if hit is None:
+                parent: tuple[Key, Move, Function] | None = None
+                if via is not None:
+                    m, e = arcs[moved[j]]
+                    parent = (r.pick(before[j]), m, e)
+                hit = memo[key] = r.first_of(u, parent, settled)
+            out |= tags.cube(j) & hit[0]
+            rank[j] = hit[1]
+        ranks.append(rank)
+        return out
 
     def paths(self, steps: list[list[tuple[Order, Event, Function]]]) -> list[list[tuple[Order, Event]]]:
         """Each tag's (order, event) per step, read from the chosen tag sets."""
@@ -192,7 +232,7 @@ class Findings:
         if not sets:
             return
         b = self._batch = _Batch(r, sets)
-        chosen, steps = b.greedy(r._key)
+        chosen, steps, ranks = b.greedy(r._key, r.settled)
         paths = b.paths(steps)
         ends: dict[int, dict[int, Function]] = {}
         s = r.s
@@ -200,7 +240,7 @@ class Findings:
             if d not in ends:
                 ends[d] = b.tags.split(chosen[d])
             key = r.pick(ends[d][j])
-            self.firsts.append((key, d, tuple(k for k, _ in paths[j])))
+            self.firsts.append((key, d, path_key([k for k, _ in paths[j]], [rk[j] for rk in ranks[:d + 1]])))
             if key not in self._whole and s.count(sets[j] & s.rings[d], s._current) == 1:
                 self._whole[key] = j
 
@@ -222,7 +262,7 @@ def _traces(r: StepReach, b: _Batch, wanted: dict[int, Key]) -> dict[Key, Path]:
     the events by the greedy walk in event order, then the nodes one ring back at a time
     for every trace at once."""
     s, false = r.s, r.false
-    chosen, steps = b.greedy(lambda m: m.event)
+    chosen, steps, _ = b.greedy(lambda m: m.event)
     mask = s.engine.disjunction(b.tags.cube(j) for j in wanted)
     paths = b.paths(steps)
     arcs = {m.event: e for m, e in s.edges}

@@ -32,22 +32,37 @@ Example
 
 from __future__ import annotations
 
-from typing import Callable, TypeVar
+from typing import TYPE_CHECKING, Callable, Sequence, TypeVar
 
 from synth.errors import LimitExceeded
 from synth.grafcet.machine import Situation
 from synth.logic.bdd import Function
 from synth.logic.events import Event
 from synth.symbolic.encoding import Copy, first_path
-from synth.symbolic.explicit import Key
+from synth.symbolic.explicit import Key, PathKey
 from synth.symbolic.reachability import MAX_LISTED, Path
 from synth.symbolic.relation import Move
 from synth.symbolic.steps import step_name
 from synth.symbolic.stepsync import StepSync
 
-__all__ = ["StepReach"]
+if TYPE_CHECKING:  # pragma: no cover - the explicit order needs the explicit engine's region search
+    from synth.symbolic.ties import Settled
+
+__all__ = ["StepReach", "path_key"]
 
 Order = TypeVar("Order", tuple[int, int, int], Event)  # how events are ordered: by plant transition, or by name
+
+
+def path_key(keys: Sequence[tuple[int, int, int]], ranks: Sequence[int]) -> PathKey:
+    """A first node's path in the explicit engine's order: the events' keys, each with the
+    rank of the node it enters when ranks are known (the initial node's rank first).
+
+    >>> path_key([(0, 1, 0)], []), path_key([(0, 1, 0)], [1, 0])
+    (((0, 1, 0),), ((1,), (0, 1, 0, 0)))
+    """
+    if not ranks:
+        return tuple(keys)
+    return ((ranks[0],),) + tuple(k + (r,) for k, r in zip(keys, ranks[1:]))
 
 
 class StepReach:
@@ -58,6 +73,9 @@ class StepReach:
         self.false = s.false
         self.situations: list[Situation] = s.helper.situations  # the explicit nodes' numbering
         self._cubes: dict[Key, Function] = {}
+        self.settled: Settled | None = None
+        """When set, first nodes are the explicit engine's where a region settles in
+        several states (:mod:`synth.symbolic.ties`); else the smallest (:meth:`pick`)."""
         assert s.initial_situation is not None
         s.helper.situation(s.initial_situation)  # situation 0
 
@@ -169,23 +187,52 @@ class StepReach:
             layers[k] = self.s.pre(layers[k + 1], within=rings[k])
         return layers
 
-    def _greedy(self, layers: list[Function], order: Callable[[Move], Order]) -> tuple[list[Function], list[Event], list[Order]]:
+    def _greedy(self, layers: list[Function], order: Callable[[Move], Order], settled: "Settled | None" = None,
+                ) -> tuple[list[Function], list[Event], list[Order], list[int]]:
+        """Forward through ``layers``, the smallest move (by ``order``) at each ring; with
+        ``settled``, each ring's set narrowed to the node the explicit engine enters first
+        (:meth:`first_of`), and its rank there."""
         current = layers[0]
+        ranks: list[int] = []
+        if settled is not None:
+            current, rank = self.first_of(current, None, settled)
+            ranks.append(rank)
         chosen, events, keys = [current], [], []
         for k in range(1, len(layers)):
-            options: dict[Order, tuple[Event, Function]] = {}
+            options: dict[Order, tuple[Move, Function, Function]] = {}
             target = self.s._primed(layers[k])
             for m, e in self.s.edges:
                 v = self.s.image(current, m, e) & target
                 if v != self.false:
-                    options[order(m)] = (m.event, v)
+                    options[order(m)] = (m, e, v)
             best = min(options)
-            event, current = options[best]
+            m, e, current = options[best]
             current = self.s.unprimed(current)
-            events.append(event)
+            if settled is not None:
+                current, rank = self.first_of(current, (self.pick(chosen[-1]), m, e), settled)
+                ranks.append(rank)
+            events.append(m.event)
             keys.append(best)
             chosen.append(current)
-        return chosen, events, keys
+        return chosen, events, keys, ranks
+
+    def first_of(self, u: Function, via: "tuple[Key, Move, Function] | None", settled: "Settled") -> tuple[Function, int]:
+        """The node of ``u`` the explicit engine numbers first, ``u`` being nodes the
+        region entered from node ``via[0]`` by move ``via[1]`` (edges ``via[2]``) settles
+        in (None: the initial region), and its rank among that region's settled states
+        (0 where it settles in one: no region is run explicitly; 0 and the smallest
+        node past :data:`~synth.symbolic.ties.REGION_LIMIT` states)."""
+        entered = self.s.initial if via is None else self.s.unprimed(self.s.image(self.cube(via[0]), via[1], via[2]))
+        if self.s.count(entered, self.s._current) == 1:
+            return u, 0
+        sit, order = settled.order(None, None) if via is None else settled.order(via[0], via[1])
+        if order is None:  # a region too large to run explicitly: the smallest node
+            return self.cube(self.pick(u)), 0
+        for rank, q in enumerate(order):
+            node = self.cube((sit, q))
+            if (node & u) != self.false:
+                return node, rank
+        raise AssertionError("the explicit region settles elsewhere than the symbolic one")
 
     def _key(self, m: Move) -> tuple[int, int, int]:
         return (0, m.axis, self.s.plant.elements[m.axis].variables.index(m.variable))
@@ -196,13 +243,15 @@ class StepReach:
                 return k
         return None
 
-    def first_node(self, candidates: Function) -> tuple[Key, int, tuple[tuple[int, int, int], ...]]:
-        """The candidate the explicit engine numbers first: (node, distance, path key)."""
+    def first_node(self, candidates: Function) -> tuple[Key, int, PathKey]:
+        """The candidate the explicit engine numbers first: (node, distance, path key).
+        With :attr:`settled` the path key holds each ring's rank (:mod:`synth.symbolic.ties`),
+        without it the smallest node of the last ring is taken (:meth:`pick`)."""
         depth = self.depth(candidates)
         if depth is None:
             raise ValueError("no candidate is reachable")
-        chosen, _, keys = self._greedy(self._layers(candidates, depth), self._key)
-        return self.pick(chosen[-1]), depth, tuple(keys)
+        chosen, _, keys, ranks = self._greedy(self._layers(candidates, depth), self._key, self.settled)
+        return self.pick(chosen[-1]), depth, path_key(keys, ranks)
 
     def shortest_trace(self, key: Key) -> Path:
         """The shortest path from an initial node to ``key`` whose events are smallest by name."""
@@ -210,7 +259,7 @@ class StepReach:
         depth = self.depth(node)
         if depth is None:
             raise ValueError("node not reachable")
-        chosen, events, _ = self._greedy(self._layers(node, depth), lambda m: m.event)
+        chosen, events, _, _ = self._greedy(self._layers(node, depth), lambda m: m.event)
         nodes = [key]
         for k in range(depth - 1, -1, -1):
             arcs = [(m, e) for m, e in self.s.edges if m.event == events[k]]

@@ -43,6 +43,7 @@ from synth.plant.rules import RuleSet
 from synth.sup.constraints import CompiledConstraints
 from synth.symbolic.encoding import live_nodes
 from synth.symbolic.explicit import ExplicitNodes, Key, PathKey
+from synth.symbolic.ties import Settled
 from synth.symbolic.stepbatch import Findings
 from synth.symbolic.stepreach import StepReach
 from synth.symbolic.stepsync import StepSync
@@ -106,6 +107,7 @@ def validate_steps(
         return None
     false = s.false
     r = StepReach(s)
+    r.settled = Settled(s, oracle)  # first nodes as the explicit engine numbers them, ties included
     ex = ExplicitNodes(s.helper, oracle)
     initial_keys = r.listed(s.initial)
     initial = tuple(ex.node(k) for k in initial_keys)

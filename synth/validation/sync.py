@@ -135,11 +135,13 @@ def region(
     entry: Local,
     wanted: frozenset[str],
     order_moves: dict[str, list[LocalTransition]] | None = None,
+    limit: int | None = None,
 ) -> tuple[list[Local], list[tuple[Local, tuple[Prohibition, ...]]]]:
     """The region entered at ``entry`` when the controller emits ``wanted``.
 
     Returns its members (entry first) and its settled states, each with the order
-    changes SUP refuses there.
+    changes SUP refuses there. ``limit``: raise :class:`~synth.errors.LimitExceeded`
+    past this many members.
     """
     moves = order_moves if order_moves is not None else _order_moves(p)
     members = [entry]
@@ -170,6 +172,8 @@ def region(
                     seen.add(n)
                     members.append(n)
                     queue.append(n)
+                    if limit is not None and len(members) > limit:
+                        raise LimitExceeded(f"a region of more than {limit} states")
         if not progressed:
             settled.append((cur, tuple(sorted(refused))))
     return members, settled
