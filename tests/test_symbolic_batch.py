@@ -34,7 +34,7 @@ def _reach(grafcet, rules, ties: bool = False) -> StepReach:
     rs, p, g = load_model(grafcet, rules)
     r = StepReach(step_sync(p, rs.constraints, GrafcetMachine(g)))
     if ties:
-        r.settled = Settled(r.s, CompiledConstraints(p, rs.constraints))
+        r.settled = Settled(r.s.helper, CompiledConstraints(p, rs.constraints))
     return r
 
 

@@ -22,7 +22,7 @@ Example
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable, TypeVar
+from typing import TYPE_CHECKING, Callable, Sequence, TypeVar
 
 from synth.errors import LimitExceeded
 from synth.logic.bdd import Function
@@ -30,8 +30,11 @@ from synth.logic.events import Event
 from synth.symbolic.graph import Bundle, NodeSet
 from synth.symbolic.sync import SymbolicSync
 
+if TYPE_CHECKING:  # pragma: no cover - the explicit order needs the explicit engine's region search
+    from synth.symbolic.ties import Settled
+
 __all__ = ["Path", "coreachable", "stuck_nodes", "held_nodes", "terminal_components", "first_node", "shortest_trace",
-           "prohibited_nodes", "listed", "MAX_LISTED", "node_held"]
+           "prohibited_nodes", "listed", "MAX_LISTED", "node_held", "path_key"]
 
 MAX_LISTED = 100_000
 """At most this many nodes of one component are listed for the diagnosis."""
@@ -184,16 +187,22 @@ def _layers(sync: SymbolicSync, target: NodeSet, depth: int) -> list[NodeSet]:
 Key = TypeVar("Key", tuple[int, int, int], Event)  # how events are ordered: by plant transition, or by name
 
 
-def _greedy(sync: SymbolicSync, layers: list[NodeSet], order: Callable[[Bundle], Key]
-            ) -> tuple[list[NodeSet], list[Event], list[Key]]:
+def _greedy(sync: SymbolicSync, layers: list[NodeSet], order: Callable[[Bundle], Key], settled: "Settled | None" = None,
+            ) -> tuple[list[NodeSet], list[Event], list[Key], list[int]]:
     """Forward through ``layers``, taking at each step the smallest event (by ``order``):
-    the nodes chosen per layer, the events and their keys."""
+    the nodes chosen per layer, the events and their keys; with ``settled``, each layer's
+    nodes narrowed to the one the explicit engine enters first, and its rank
+    (:func:`_first_of`)."""
     current = layers[0]
+    ranks: list[int] = []
+    if settled is not None:
+        current, rank = _first_of(sync, current, None, settled)
+        ranks.append(rank)
     chosen = [current]
     events: list[Event] = []
     keys: list[Key] = []
     for k in range(1, len(layers)):
-        options: dict[Key, tuple[Event, NodeSet]] = {}
+        options: dict[Key, tuple[Event, NodeSet, list[Bundle]]] = {}
         for s, u in current.items():
             for b in sync.out_bundles(s):
                 if b.target not in layers[k]:
@@ -202,15 +211,62 @@ def _greedy(sync: SymbolicSync, layers: list[NodeSet], order: Callable[[Bundle],
                 if v == sync.false:
                     continue
                 key = order(b)
-                ev, nxt = options.get(key, (b.event, {}))
+                ev, nxt, taken = options.get(key, (b.event, {}, []))
                 nxt[b.target] = nxt.get(b.target, sync.false) | v
-                options[key] = (ev, nxt)
+                taken.append(b)
+                options[key] = (ev, nxt, taken)
         best = min(options)
-        ev, current = options[best]
+        ev, current, taken = options[best]
+        if settled is not None:
+            current, rank = _first_of(sync, current, (_pick(sync, chosen[-1]), taken), settled)
+            ranks.append(rank)
         events.append(ev)
         keys.append(best)
         chosen.append(current)
-    return chosen, events, keys
+    return chosen, events, keys, ranks
+
+
+def _first_of(sync: SymbolicSync, u: NodeSet, via: "tuple[tuple[int, tuple[int, ...]], list[Bundle]] | None",
+              settled: "Settled") -> tuple[NodeSet, int]:
+    """The node of ``u`` the explicit engine numbers first, ``u`` being nodes the region
+    entered from node ``via[0]`` by the event of bundles ``via[1]`` settles in (None: the
+    initial region), and its rank among that region's settled states (0 where it settles
+    in one; 0 and the smallest node past :data:`~synth.symbolic.ties.REGION_LIMIT`)."""
+    false = sync.false
+    if via is None:
+        entered, event, move, parent = sync.initial, None, None, None
+    else:
+        parent, bundles = via
+        source = {parent[0]: sync.enc.state(parent[1])}
+        entered = {}
+        for b in bundles:
+            if b.source == parent[0] and (v := sync.post(source, b)) != false:
+                entered[b.target] = entered.get(b.target, false) | v
+        event, move = bundles[0].event, bundles[0].move
+    if sum(sync.enc.count(v) for v in entered.values()) == 1:
+        return u, 0
+    sit, order = settled.order(parent, event, move)
+    if order is None:  # a region too large to run explicitly: the smallest node
+        s, local = _pick(sync, u)
+        return {s: sync.enc.state(local)}, 0
+    inside = u.get(sit, false)
+    for rank, q in enumerate(order):
+        node = sync.enc.state(q)
+        if (node & inside) != false:
+            return {sit: node}, rank
+    raise AssertionError("the explicit region settles elsewhere than the symbolic one")
+
+
+def path_key(keys: Sequence[tuple[int, int, int]], ranks: Sequence[int]) -> tuple[tuple[int, ...], ...]:
+    """A first node's path in the explicit engine's order: the events' keys, each with the
+    rank of the node it enters when ranks are known (the initial node's rank first).
+
+    >>> path_key([(0, 1, 0)], []), path_key([(0, 1, 0)], [1, 0])
+    (((0, 1, 0),), ((1,), (0, 1, 0, 0)))
+    """
+    if not ranks:
+        return tuple(keys)
+    return ((ranks[0],),) + tuple(k + (r,) for k, r in zip(keys, ranks[1:]))
 
 
 def _pick(sync: SymbolicSync, u: NodeSet) -> tuple[int, tuple[int, ...]]:
@@ -218,9 +274,12 @@ def _pick(sync: SymbolicSync, u: NodeSet) -> tuple[int, tuple[int, ...]]:
     return s, sync.enc.one(u[s])
 
 
-def first_node(sync: SymbolicSync, candidates: NodeSet) -> tuple[int, tuple[int, ...], int, tuple[tuple[int, int, int], ...]]:
+def first_node(sync: SymbolicSync, candidates: NodeSet, settled: "Settled | None" = None,
+               ) -> tuple[int, tuple[int, ...], int, tuple[tuple[int, ...], ...]]:
     """The candidate the explicit engine numbers first: smallest distance, then smallest
-    path in exploration order. Returns (situation, plant state, distance, path key)."""
+    path in exploration order (with ``settled``, ties broken as the explicit engine
+    breaks them: :mod:`synth.symbolic.ties`). Returns (situation, plant state, distance,
+    path key)."""
     rings = sync.onion_rings()
     for depth, ring in enumerate(rings):
         hit = {s: u & ring[s] for s, u in candidates.items() if s in ring and (u & ring[s]) != sync.false}
@@ -229,9 +288,9 @@ def first_node(sync: SymbolicSync, candidates: NodeSet) -> tuple[int, tuple[int,
     else:
         raise ValueError("no candidate is reachable")
     layers = _layers(sync, hit, depth)
-    chosen, _, keys = _greedy(sync, layers, lambda b: _key(sync, b))  # keys: to sort first nodes at one distance
+    chosen, _, keys, ranks = _greedy(sync, layers, lambda b: _key(sync, b), settled)  # keys: to sort first nodes
     s, local = _pick(sync, chosen[-1])
-    return s, local, depth, tuple(keys)
+    return s, local, depth, path_key(keys, ranks)
 
 
 def shortest_trace(sync: SymbolicSync, s: int, local: tuple[int, ...]) -> Path:
@@ -242,7 +301,7 @@ def shortest_trace(sync: SymbolicSync, s: int, local: tuple[int, ...]) -> Path:
     if depth is None:
         raise ValueError("node not reachable")
     layers = _layers(sync, {s: node}, depth)
-    chosen, events, _ = _greedy(sync, layers, lambda b: b.event)
+    chosen, events, _, _ = _greedy(sync, layers, lambda b: b.event)
     # one concrete node per layer, backwards from the target
     nodes = [(s, local)]
     for k in range(depth - 1, -1, -1):

@@ -48,9 +48,9 @@ from typing import TYPE_CHECKING, Callable, Sequence
 from synth.logic.bdd import Engine, Function
 from synth.logic.events import Event
 from synth.symbolic.explicit import Key, PathKey
-from synth.symbolic.reachability import Path
+from synth.symbolic.reachability import Path, path_key
 from synth.symbolic.relation import Move
-from synth.symbolic.stepreach import Order, StepReach, path_key
+from synth.symbolic.stepreach import Order, StepReach
 
 if TYPE_CHECKING:  # pragma: no cover
     from synth.symbolic.ties import Settled

@@ -32,7 +32,7 @@ Example
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Callable, Sequence, TypeVar
+from typing import TYPE_CHECKING, Callable, TypeVar
 
 from synth.errors import LimitExceeded
 from synth.grafcet.machine import Situation
@@ -40,7 +40,7 @@ from synth.logic.bdd import Function
 from synth.logic.events import Event
 from synth.symbolic.encoding import Copy, first_path
 from synth.symbolic.explicit import Key, PathKey
-from synth.symbolic.reachability import MAX_LISTED, Path
+from synth.symbolic.reachability import MAX_LISTED, Path, path_key
 from synth.symbolic.relation import Move
 from synth.symbolic.steps import step_name
 from synth.symbolic.stepsync import StepSync
@@ -48,21 +48,9 @@ from synth.symbolic.stepsync import StepSync
 if TYPE_CHECKING:  # pragma: no cover - the explicit order needs the explicit engine's region search
     from synth.symbolic.ties import Settled
 
-__all__ = ["StepReach", "path_key"]
+__all__ = ["StepReach"]
 
 Order = TypeVar("Order", tuple[int, int, int], Event)  # how events are ordered: by plant transition, or by name
-
-
-def path_key(keys: Sequence[tuple[int, int, int]], ranks: Sequence[int]) -> PathKey:
-    """A first node's path in the explicit engine's order: the events' keys, each with the
-    rank of the node it enters when ranks are known (the initial node's rank first).
-
-    >>> path_key([(0, 1, 0)], []), path_key([(0, 1, 0)], [1, 0])
-    (((0, 1, 0),), ((1,), (0, 1, 0, 0)))
-    """
-    if not ranks:
-        return tuple(keys)
-    return ((ranks[0],),) + tuple(k + (r,) for k, r in zip(keys, ranks[1:]))
 
 
 class StepReach:
@@ -225,7 +213,7 @@ class StepReach:
         entered = self.s.initial if via is None else self.s.unprimed(self.s.image(self.cube(via[0]), via[1], via[2]))
         if self.s.count(entered, self.s._current) == 1:
             return u, 0
-        sit, order = settled.order(None, None) if via is None else settled.order(via[0], via[1])
+        sit, order = settled.order(None, None, None) if via is None else settled.order(via[0], via[1].event, via[1])
         if order is None:  # a region too large to run explicitly: the smallest node
             return self.cube(self.pick(u)), 0
         for rank, q in enumerate(order):

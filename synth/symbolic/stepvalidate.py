@@ -107,7 +107,7 @@ def validate_steps(
         return None
     false = s.false
     r = StepReach(s)
-    r.settled = Settled(s, oracle)  # first nodes as the explicit engine numbers them, ties included
+    r.settled = Settled(s.helper, oracle)  # first nodes as the explicit engine numbers them, ties included
     ex = ExplicitNodes(s.helper, oracle)
     initial_keys = r.listed(s.initial)
     initial = tuple(ex.node(k) for k in initial_keys)

@@ -1,8 +1,9 @@
-"""The explicit engine's order among the nodes one edge enters, for the step path's first
-nodes (:mod:`synth.symbolic.stepreach`, :mod:`synth.symbolic.stepbatch`).
+"""The explicit engine's order among the nodes one edge enters, for the first nodes of both
+symbolic paths (:mod:`synth.symbolic.stepreach` and :mod:`synth.symbolic.stepbatch` on the
+step path, :mod:`synth.symbolic.reachability` per situation).
 
 The explicit engine numbers SYNC's nodes breadth-first: it expands the nodes in the
-order it numbered them, each node's events in the plant's order, and an event's target
+order it numbered them, each node's events in the plant's order (then its timers), and an event's target
 region gives its settled states in the order its own breadth-first search over the
 controllable moves (orders sorted by name) settled them. So the node it numbers first in
 a set at depth d is reached by a chain of single nodes, each the first the previous one
@@ -20,8 +21,8 @@ Example
 >>> from synth.symbolic.stepsync import step_sync
 >>> rs, p, g = load_model(_plants("../tests/data/home/production_loop.g7"), _plants("../tests/data/home/cylinder.rules"))
 >>> s = step_sync(p, rs.constraints, GrafcetMachine(g))
->>> settled = Settled(s, CompiledConstraints(p, rs.constraints))
->>> sit, order = settled.order(None, None)
+>>> settled = Settled(s.helper, CompiledConstraints(p, rs.constraints))
+>>> sit, order = settled.order(None, None, None)
 >>> sit, order == [p.initial]
 (0, True)
 """
@@ -29,15 +30,16 @@ Example
 from __future__ import annotations
 
 from synth.errors import LimitExceeded
+from synth.logic.events import Event
 from synth.sup.constraints import CompiledConstraints
-from synth.symbolic.explicit import Key
 from synth.symbolic.relation import Move
-from synth.symbolic.stepsync import StepSync
+from synth.symbolic.sync import SymbolicSync
 from synth.validation.sync import _grafcet_inputs, _order_moves, region
 
 __all__ = ["Settled", "REGION_LIMIT"]
 
 Local = tuple[int, ...]
+Key = tuple[int, Local]  # a node: situation, plant state (as synth.symbolic.explicit.Key)
 
 REGION_LIMIT = 100_000
 """A region of more states is not run explicitly (the symbolic engine is there for them):
@@ -45,40 +47,49 @@ its tie is broken by the smallest situation, then state, and the rank is 0."""
 
 
 class Settled:
-    """The settled states of the region a node enters by a move (or of the initial
-    region), in the explicit engine's order, computed once per (node, move)."""
+    """The settled states of the region a node enters by an event (or of the initial
+    region), in the explicit engine's order, computed once per (node, event). ``sync``
+    numbers the situations (the step path's helper, or the per-situation path itself)."""
 
-    def __init__(self, s: StepSync, oracle: CompiledConstraints) -> None:
-        self.s = s
-        self.p = s.plant
+    def __init__(self, sync: SymbolicSync, oracle: CompiledConstraints) -> None:
+        self.sync = sync
+        self.p = sync.plant
         self.oracle = oracle
         self.moves = _order_moves(self.p)
-        self._found: dict[tuple[Key | None, int | None], tuple[int, list[Local] | None]] = {}
+        self._found: dict[tuple[Key | None, Event | None], tuple[int, list[Local] | None]] = {}
 
-    def order(self, parent: Key | None, move: Move | None) -> tuple[int, list[Local] | None]:
+    def order(self, parent: Key | None, event: Event | None, move: Move | None) -> tuple[int, list[Local] | None]:
         """The situation (its index in the nodes' numbering) of the region ``parent``
-        enters by ``move`` (None, None: the initial region) and its settled plant states
-        in the explicit engine's order (None past :data:`REGION_LIMIT` states)."""
-        key = (parent, None if move is None else move.key)
+        enters by ``event``, the plant ``move`` or a timer (``move`` None; ``parent`` None:
+        the initial region), and its settled plant states in the explicit engine's order
+        (None past :data:`REGION_LIMIT` states)."""
+        key = (parent, event)
         found = self._found.get(key)
         if found is None:
-            found = self._found[key] = self._order(parent, move)
+            found = self._found[key] = self._order(parent, event, move)
         return found
 
-    def _order(self, parent: Key | None, move: Move | None) -> tuple[int, list[Local] | None]:
-        p, machine = self.p, self.s.machine
-        if parent is None or move is None:
+    def _order(self, parent: Key | None, event: Event | None, move: Move | None) -> tuple[int, list[Local] | None]:
+        p, machine = self.p, self.sync.machine
+
+        def inputs(local: Local) -> dict[str, bool]:
+            return _grafcet_inputs(p, machine, local)
+
+        if parent is None or event is None:
             entry = p.initial
-            sit = machine.initial(_grafcet_inputs(p, machine, entry))
+            sit = machine.initial(inputs(entry))
         else:
-            before, local = self.s.helper.situations[parent[0]], parent[1]
-            t = next(t for t in move.transitions if t.src == local[t.axis] and p.enabled(t, local))
-            entry = local[:t.axis] + (t.dst,) + local[t.axis + 1:]
-            sit, _ = machine.react_with_trace(before, _grafcet_inputs(p, machine, local),
-                                              _grafcet_inputs(p, machine, entry))
-        wanted = machine.orders(sit, _grafcet_inputs(p, machine, entry))
+            before, local = self.sync.situations[parent[0]], parent[1]
+            if move is None:  # a timer: the plant stays
+                entry = local
+                sit, _ = machine.fire_timer_with_trace(before, event, inputs(local))
+            else:
+                t = next(t for t in move.transitions if t.src == local[t.axis] and p.enabled(t, local))
+                entry = local[:t.axis] + (t.dst,) + local[t.axis + 1:]
+                sit, _ = machine.react_with_trace(before, inputs(local), inputs(entry))
+        wanted = machine.orders(sit, inputs(entry))
         try:
             _, settled = region(p, self.oracle, entry, wanted, self.moves, REGION_LIMIT)
         except LimitExceeded:
-            return self.s.helper.situation(sit), None
-        return self.s.helper.situation(sit), [q for q, _ in settled]
+            return self.sync.situation(sit), None
+        return self.sync.situation(sit), [q for q, _ in settled]

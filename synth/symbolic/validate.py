@@ -43,6 +43,7 @@ from synth.symbolic.reachability import (
     terminal_components,
 )
 from synth.symbolic.explicit import ExplicitNodes, Key, PathKey
+from synth.symbolic.ties import Settled
 from synth.symbolic.steps import anchors, unsupported
 from synth.symbolic.stepvalidate import validate_steps
 from synth.symbolic.supervisor import SymbolicSupervisor
@@ -167,6 +168,7 @@ def _validate_loaded(
                           counts=stats, reached_steps=frozenset(), engine_stats=_stats(ssync))
     initial_keys = listed(ssync, ssync.initial)
     initial = tuple(ex.node(k) for k in initial_keys)
+    settled = Settled(ssync, oracle)  # first nodes as the explicit engine numbers them, ties included
     home = _homes(ssync, homes, p, g)
     back = coreachable(ssync, home)
     stuck = stuck_nodes(ssync, back)
@@ -184,18 +186,18 @@ def _validate_loaded(
                 d = by_steps.setdefault(steps, {})
                 d[s] = d.get(s, false) | v
     for steps, u in by_steps.items():
-        s, local, depth, path = first_node(ssync, u)
+        s, local, depth, path = first_node(ssync, u, settled)
         found.append((depth, path, (s, local), listed(ssync, u, MAX_LISTED)))
     for comp in terminal_components(ssync, stuck):
         if all(ssync.situations[s].steps in by_steps for s in comp):
             continue
-        s, local, depth, path = first_node(ssync, comp)
+        s, local, depth, path = first_node(ssync, comp, settled)
         found.append((depth, path, (s, local), listed(ssync, comp, MAX_LISTED)))
     blocking, components, traces, no_return = ex.blocking(found, ex.trace, lambda key: _is_in(ssync, back, key))
     # prohibited orders: the first node meeting each (steps, event)
     firsts: dict[Key, tuple[int, PathKey]] = {}
     for u in proh_sets.values():
-        s, local, depth, path = first_node(ssync, u)
+        s, local, depth, path = first_node(ssync, u, settled)
         firsts[(s, local)] = (depth, path)
     prohibited = [ex.node(k) for k in sorted(firsts, key=lambda k: firsts[k])]
     for i in prohibited:
@@ -203,7 +205,7 @@ def _validate_loaded(
         traces.setdefault(i, ex.trace(keys[i]))
     conflicts: list[Conflict] = []
     for s, sources, event, step, names in ssync.conflicts:
-        cs, local, _, _ = first_node(ssync, {s: sources})
+        cs, local, _, _ = first_node(ssync, {s: sources}, settled)
         i = ex.node((cs, local))
         traces.setdefault(i, ex.trace((cs, local)))
         conflicts.append(Conflict(i, event, step, names))
