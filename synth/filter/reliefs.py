@@ -110,9 +110,10 @@ class _Chain:
         """The chain's ``S_j``, the chain run that far if it is not yet (the points need it
         only up to the last relief's criterion)."""
         while len(self.states) <= j:
-            g, k = self.goods[len(self.bests)], self.where[len(self.bests)]
-            self.bests.append(self.p.project(self.states[-1], k, g))
-            self.states.append(self.p.refine(self.states[-1], k, g.equiv(self.bests[-1])))
+            n = len(self.bests)
+            state, best = self._step(self.states[-1], self.where[n], self.goods[n])
+            self.states.append(state)
+            self.bests.append(best)
         return self.states[j]
 
     @functools.cached_property
@@ -124,8 +125,10 @@ class _Chain:
         u = self.m.engine.expr(c.expr)
         return u if c.sense is Sense.MAX else ~u
 
-    def _step(self, s: State, k: int, g: Function) -> State:
-        return self.p.refine(s, k, g.equiv(self.p.project(s, k, g)))
+    def _step(self, s: State, k: int, g: Function) -> tuple[State, Function]:
+        """``Max(g)`` on ``s`` (``g`` in bag ``k``): the state after it, and ``b = ∃O.(s ∧ g)``."""
+        best = self.p.project(s, k, g)
+        return self.p.refine(s, k, g.equiv(best)), best
 
     def _outcome(self, s: State) -> tuple[Function, dict[str, Function], dict[str, Function]]:
         return decided(self.p, s, self.m.outputs)
@@ -238,13 +241,13 @@ class _Chain:
         i, g = alternative
         base = self.base  # before the mark: the chain's messages are kept
         mark = self.p.mark()
-        s = self._step(self.states[i], self.p.position(g), g)
+        s, _ = self._step(self.states[i], self.p.position(g), g)
         for j in range(i + 1, len(self.goods) + 1):
             if s.domains == self.states[j].domains:  # the chain rejoined: the same filter from here
                 self.p.forget(mark)
                 return None
             if j < len(self.goods):
-                s = self._step(s, self.where[j], self.goods[j])
+                s, _ = self._step(s, self.where[j], self.goods[j])
         care, ones, zeros = self._outcome(s)
         self.p.forget(mark)
         differ = [o for o in self.m.outputs if ones[o] != base[1][o] or zeros[o] != base[2][o]]

@@ -245,16 +245,10 @@ def _first_of(sync: SymbolicSync, u: NodeSet, via: "tuple[tuple[int, tuple[int, 
         event, move = bundles[0].event, bundles[0].move
     if sum(sync.enc.count(v) for v in entered.values()) == 1:
         return u, 0
-    sit, order = settled.order(parent, event, move)
-    if order is None:  # a region too large to run explicitly: the smallest node
-        s, local = _pick(sync, u)
-        return {s: sync.enc.state(local)}, 0
-    inside = u.get(sit, false)
-    for rank, q in enumerate(order):
-        node = sync.enc.state(q)
-        if (node & inside) != false:
-            return {sit: node}, rank
-    raise AssertionError("the explicit region settles elsewhere than the symbolic one")
+    found = settled.first(parent, event, move,
+                          lambda key: (sync.enc.state(key[1]) & u.get(key[0], false)) != false)
+    (s, local), rank = (_pick(sync, u), 0) if found is None else found  # too large to run: the smallest node
+    return {s: sync.enc.state(local)}, rank
 
 
 def path_key(keys: Sequence[tuple[int, int, int]], ranks: Sequence[int]) -> tuple[tuple[int, ...], ...]:

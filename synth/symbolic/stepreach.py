@@ -213,14 +213,12 @@ class StepReach:
         entered = self.s.initial if via is None else self.s.unprimed(self.s.image(self.cube(via[0]), via[1], via[2]))
         if self.s.count(entered, self.s._current) == 1:
             return u, 0
-        sit, order = settled.order(None, None, None) if via is None else settled.order(via[0], via[1].event, via[1])
-        if order is None:  # a region too large to run explicitly: the smallest node
+        parent, move = (None, None) if via is None else via[:2]
+        found = settled.first(parent, None if move is None else move.event, move,
+                              lambda key: (self.cube(key) & u) != self.false)
+        if found is None:  # a region too large to run explicitly: the smallest node
             return self.cube(self.pick(u)), 0
-        for rank, q in enumerate(order):
-            node = self.cube((sit, q))
-            if (node & u) != self.false:
-                return node, rank
-        raise AssertionError("the explicit region settles elsewhere than the symbolic one")
+        return self.cube(found[0]), found[1]
 
     def _key(self, m: Move) -> tuple[int, int, int]:
         return (0, m.axis, self.s.plant.elements[m.axis].variables.index(m.variable))

@@ -29,6 +29,8 @@ Example
 
 from __future__ import annotations
 
+from typing import Callable
+
 from synth.errors import LimitExceeded
 from synth.logic.events import Event
 from synth.sup.constraints import CompiledConstraints
@@ -68,6 +70,18 @@ class Settled:
         if found is None:
             found = self._found[key] = self._order(parent, event, move)
         return found
+
+    def first(self, parent: Key | None, event: Event | None, move: Move | None,
+              among: Callable[[Key], bool]) -> tuple[Key, int] | None:
+        """The first node of that region (see :meth:`order`) for which ``among`` holds,
+        and its rank among the region's settled states; None past :data:`REGION_LIMIT`."""
+        sit, order = self.order(parent, event, move)
+        if order is None:
+            return None
+        for rank, q in enumerate(order):
+            if among((sit, q)):
+                return (sit, q), rank
+        raise AssertionError("the explicit region settles elsewhere than the symbolic one")
 
     def _order(self, parent: Key | None, event: Event | None, move: Move | None) -> tuple[int, list[Local] | None]:
         p, machine = self.p, self.sync.machine
