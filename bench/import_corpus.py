@@ -20,7 +20,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from synth.codegen.plcopen_import import import_sfc  # noqa: E402
+from synth.codegen.plcopen.importer import import_sfc  # noqa: E402
 from synth.errors import SynthError  # noqa: E402
 from synth.grafcet.language_check import parse_grafcet  # noqa: E402
 

@@ -7,7 +7,7 @@ from functools import lru_cache
 from pathlib import Path
 
 from synth.codegen.filter_st import FilterBlock, filter_block
-from synth.codegen.interpreter import Module, load_st
+from synth.codegen.interpreter.machine import Module, load_st
 from synth.filter.language_check import load_filter
 
 ROOT = Path(__file__).resolve().parent.parent

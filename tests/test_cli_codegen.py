@@ -10,7 +10,7 @@ import pytest
 
 from synth.cli.main import main
 from synth.codegen.grafcet_st import synth_version
-from synth.codegen.plcopen_xml import validation_errors
+from synth.codegen.plcopen.tc6 import validation_errors
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -39,7 +39,7 @@ def test_st_to_a_file_same_bytes_twice(capsys, tmp_path):
 
 
 def test_st_with_the_filter_gives_one_program_in_which_the_filter_runs_last(capsys, tmp_path):
-    from synth.codegen.interpreter import load_st
+    from synth.codegen.interpreter.machine import load_st
 
     out = tmp_path / "tri.st"
     code, _, err = run(capsys, "st", "grafcets/tri.g7", "--plant", "plants/tri.rules",

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from synth.codegen.interp_runtime import Array
-from synth.codegen.interpreter import load_st
+from synth.codegen.interpreter.runtime import Array
+from synth.codegen.interpreter.machine import load_st
 from synth.errors import InputError
 
 PROGRAM = """
@@ -145,7 +145,7 @@ def test_node_types_outside_the_subset_are_located(text: str, where: str, messag
 def test_var_temp_is_initialised_again_at_every_call() -> None:
     """IEC 61131-3: a VAR_TEMP keeps nothing between calls (MATIEC's iec2c sets it at the
     start of every call); a VAR keeps its value."""
-    from synth.codegen.interpreter import load_st
+    from synth.codegen.interpreter.machine import load_st
 
     m = load_st("PROGRAM P\nVAR_INPUT a : BOOL; END_VAR\nVAR n : INT; END_VAR\nVAR_TEMP r : INT := 2; "
                 "f : ARRAY[1..2] OF BOOL; END_VAR\nr := r + 1;\nIF a THEN f[1] := TRUE; END_IF;\n"

@@ -44,7 +44,7 @@ def test_the_box_sorting_program_with_its_filter_runs_compiled_as_interpreted(fi
 
     from synth.codegen.filter_st import filter_block
     from synth.codegen.grafcet_st import generate_program
-    from synth.codegen.interpreter import load_st
+    from synth.codegen.interpreter.machine import load_st
     from synth.codegen.program import filter_call
     from synth.grafcet.language_check import load_grafcet
     from synth.plant.rules_check import load_rules

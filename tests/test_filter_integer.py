@@ -17,7 +17,7 @@ import pytest
 from conftest import ROOT
 from iec2c import CompiledProgram, find_iec2c
 from synth.codegen.filter_st import FilterBlock, filter_block
-from synth.codegen.interpreter import load_st
+from synth.codegen.interpreter.machine import load_st
 from synth.codegen.program import StProgram
 from synth.errors import InputError
 from synth.filter.cycle import Algorithm, FilterCycle, Mode

@@ -12,9 +12,9 @@ from synth.filter.coherence import check
 from synth.filter.cycle import Algorithm, Mode
 from synth.filter.from_rules import Classification, skeleton
 from synth.filter.language_check import load_filter
-from synth.filter.product import Product
+from synth.filter.loop.product import Product
 from synth.filter.run import run_trace
-from synth.filter.verification import FindingKind
+from synth.filter.loop.verification import FindingKind
 from synth.logic.events import Event
 from synth.output.filter_text import FINDINGS, check_text, run_json, skeleton_text, verification_json
 from synth.plant.composition import plant
@@ -58,7 +58,7 @@ def test_finding_kinds_print_as_before():
 
 
 def test_verification_json_keys_are_plain_strings(tmp_path):
-    from synth.filter.closed_loop import verify
+    from synth.filter.loop.verify import verify
 
     out = tmp_path / "F.filter"
     sk = skeleton(DATA / "two.rules", out)

@@ -13,7 +13,7 @@ import pytest
 
 from conftest import ROOT
 from synth.codegen.filter_st import FilterBlock, filter_block, split_blocks
-from synth.codegen.interpreter import load_st
+from synth.codegen.interpreter.machine import load_st
 from synth.filter.clusters import clusters, solve_clusters
 from synth.filter.language_check import load_filter, parse_filter
 from synth.filter.language_reader import filter_expression

@@ -11,7 +11,7 @@ import pytest
 
 from synth.cli.main import main
 from synth.codegen.filter_st import filter_block
-from synth.codegen.interpreter import load_st
+from synth.codegen.interpreter.machine import load_st
 from synth.errors import InputError, ModelError
 from synth.logic.past import pre_name
 from synth.filter.language_check import load_filter, parse_filter
@@ -182,7 +182,7 @@ def test_cli_bad_filter_is_exit_2(tmp_path: Path, capsys: pytest.CaptureFixture[
 def test_cli_xml_is_valid_tc6(tmp_path: Path) -> None:
     from lxml import etree
 
-    from synth.codegen.plcopen_xml import validation_errors
+    from synth.codegen.plcopen.tc6 import validation_errors
 
     out = tmp_path / "fb.xml"
     assert main(["filter", "st", str(ROOT / "plants" / "loop_b.filter"), "--algorithm", "loop", "--xml",

@@ -16,7 +16,7 @@ import pytest
 from conftest import ROOT
 from schemas import assert_valid
 from synth.errors import InputError
-from synth.filter.closed_loop import verify
+from synth.filter.loop.verify import verify
 from synth.filter.cycle import Algorithm, FilterCycle, Mode
 from synth.filter.from_rules import skeleton
 from synth.filter.language_check import load_filter, parse_filter

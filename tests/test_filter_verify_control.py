@@ -15,15 +15,15 @@ import pytest
 from conftest import ROOT
 from schemas import assert_valid
 from test_filter_verify_cycle import SINGLE_ACTING
-from synth.codegen.interpreter import load_st
+from synth.codegen.interpreter.machine import load_st
 from synth.errors import InputError
-from synth.filter.closed_loop import verify
-from synth.filter.control_st import StSource, split_control
+from synth.filter.loop.verify import verify
+from synth.filter.loop.control_st import StSource, split_control
 from synth.filter.cycle import Algorithm, Mode
-from synth.filter.explorer import Explorer
+from synth.filter.loop.explorer import Explorer
 from synth.filter.from_rules import skeleton
 from synth.filter.language_check import load_filter
-from synth.filter.product import Product
+from synth.filter.loop.product import Product
 from synth.output.filter_text import trace_text
 
 DATA = ROOT / "tests" / "data" / "filter"

@@ -13,7 +13,7 @@ import pytest
 from conftest import ROOT
 from schemas import assert_valid
 from synth.errors import InputError
-from synth.filter.closed_loop import verify
+from synth.filter.loop.verify import verify
 from synth.filter.cycle import FilterCycle
 from synth.filter.language_check import load_filter, parse_filter
 from synth.filter.run import run_trace

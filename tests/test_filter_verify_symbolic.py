@@ -16,12 +16,12 @@ from conftest import ROOT
 from schemas import assert_valid
 from synth.engines import EngineChoice
 from synth.errors import LimitExceeded
-from synth.filter.closed_loop import verify
+from synth.filter.loop.verify import verify
 from synth.filter.cycle import Algorithm, Mode
 from synth.filter.from_rules import skeleton
 from synth.filter.language_check import load_filter, parse_filter
-from synth.filter.symbolic_verify import verify_symbolic
-from synth.filter.verification import FindingKind
+from synth.filter.loop.symbolic.verify import verify_symbolic
+from synth.filter.loop.verification import FindingKind
 
 DATA = ROOT / "tests" / "data" / "filter"
 FOUR = ROOT / "plants" / "four_cylinders.filter"

@@ -226,13 +226,13 @@ def test_every_transfer_stays_reachable_under_the_toggle(pallets):
     the four transfers (↑i1 … ↑i4) is reachable from every state and no fair cycle avoids it
     (one exploration of the loop, the four goals checked on it)."""
     pytest.importorskip("blark")
-    from synth.codegen.interpreter import load_st
-    from synth.filter.closed_loop import goal_of, progress_of
-    from synth.filter.control_st import StSource
+    from synth.codegen.interpreter.machine import load_st
+    from synth.filter.loop.verify import goal_of, progress_of
+    from synth.filter.loop.control_st import StSource
     from synth.filter.cycle import Algorithm, Mode
-    from synth.filter.explorer import Explorer
+    from synth.filter.loop.explorer import Explorer
     from synth.filter.language_check import load_filter
-    from synth.filter.product import Product
+    from synth.filter.loop.product import Product
 
     pr = Product(load_filter(FILTER), str(PLANTS[pallets]), None, Algorithm.ALGEBRAIC, Mode.SUPERVISOR, False,
                  StSource(str(TOGGLE), load_st))

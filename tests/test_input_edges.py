@@ -113,7 +113,7 @@ def test_an_unclosed_parenthesis_is_reported_where_it_opens(tmp_path, capsys):
 @pytest.mark.parametrize("bad", ['refLocalId="x1"', 'refLocalId="²"', 'refLocalId=""'])
 def test_a_non_numeric_reference_in_plcopen_xml_is_located(bad, tmp_path, capsys):
     """A connection's refLocalId that is no number (it was a ValueError traceback)."""
-    from synth.codegen.plcopen_export import sfc_project_xml
+    from synth.codegen.plcopen.export import sfc_project_xml
     from synth.grafcet.language_check import parse_grafcet
 
     g = parse_grafcet("grafcet G { initial step 0 step 1: A transition 0 -> 1 when a transition 1 -> 0 when !a }", "g.g7")
@@ -130,7 +130,7 @@ def test_a_non_numeric_reference_in_plcopen_xml_is_located(bad, tmp_path, capsys
 def test_running_out_of_memory_stops_with_exit_2(tmp_path, capsys, monkeypatch):
     """A closed loop larger than the machine (it ended in a traceback with exit 1, the
     'unsafe' code): exit 2 and a message naming the budget options."""
-    import synth.filter.closed_loop as closed_loop
+    import synth.filter.loop.verify as closed_loop
 
     def exhausted(*args: object, **kwargs: object) -> None:
         raise MemoryError

@@ -213,7 +213,7 @@ def test_a_boolean_takes_an_expression_of_boolean_internal_variables(cli, tmp_pa
 
 
 def test_import_reads_a_boolean_expression_and_refuses_a_sequential_read():
-    from synth.codegen.plcopen_import import import_sfc
+    from synth.codegen.plcopen.importer import import_sfc
 
     xml = (ROOT / "tests/data/plcopen/beremiz_counter.xml").read_text()
     xml = xml.replace('<variable name="Cnt"><type><INT/></type></variable>',

@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 from synth.cli.main import main
-from synth.codegen.plcopen_import import import_sfc, list_pous
+from synth.codegen.plcopen.importer import import_sfc, list_pous
 from synth.errors import InputError
 from synth.grafcet.ass import stable_situation_automaton
 from synth.grafcet.language_check import load_grafcet, parse_grafcet
@@ -310,7 +310,7 @@ def test_what_an_internal_variable_cannot_be_is_located(old, new, first):
 
 def test_sfc_round_trip_of_internal_variables():
     """synth sfc writes INT locals documented 'internal 0..3' and P1/P0 bodies; import reads them back."""
-    from synth.codegen.plcopen_export import sfc_project_xml
+    from synth.codegen.plcopen.export import sfc_project_xml
 
     g = load_grafcet(Path(__file__).resolve().parent.parent / "grafcets/tri_counting.g7")
     warnings: list[InputError] = []

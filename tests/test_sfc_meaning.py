@@ -15,8 +15,8 @@ from beremiz import beremiz_program, find_beremiz
 from conftest import ROOT
 from iec2c import CompiledProgram, compile_st, find_iec2c
 from synth.codegen.grafcet_st import generate_program
-from synth.codegen.plcopen_export import sfc_project_xml
-from synth.codegen.plcopen_import import import_sfc
+from synth.codegen.plcopen.export import sfc_project_xml
+from synth.codegen.plcopen.importer import import_sfc
 from synth.codegen.program import StProgram
 from synth.codegen.st import Declaration, Pou, PouKind, SectionKind, VarSection
 from synth.grafcet.language_check import load_grafcet, parse_grafcet
@@ -28,7 +28,7 @@ MATIEC_FORWARD_STEP_FLAGS = {"tri.g7", "tri_missing_order.g7", "tri_counting.g7"
 
 
 def interpreted(program: StProgram):
-    from synth.codegen.interpreter import load_st
+    from synth.codegen.interpreter.machine import load_st
 
     return load_st(program.text, "p.st").instance(program.program)
 
@@ -98,7 +98,7 @@ def test_on_the_plc_the_pump_stops_when_its_step_is_left(tmp_path):
 
 def test_st_xml_with_a_task_carries_the_configuration(tmp_path):
     from synth.cli.main import main
-    from synth.codegen.plcopen_xml import validation_errors
+    from synth.codegen.plcopen.tc6 import validation_errors
 
     out = tmp_path / "plc.xml"
     assert main(["st", str(ROOT / "grafcets/tri.g7"), "--xml", "--task", "10ms", "-o", str(out)]) == 0

@@ -287,8 +287,8 @@ def test_node_held_agrees_with_held_nodes(grafcet):
     whole set's, on every node of the symbolic SYNC; and the explicit engine's held set."""
     from synth.grafcet.language_check import load_grafcet
     from synth.grafcet.machine import GrafcetMachine
-    from synth.symbolic.reachability import held_nodes, listed, node_held
-    from synth.symbolic.sync import symbolic_sync
+    from synth.symbolic.situations.reach import held_nodes, listed, node_held
+    from synth.symbolic.situations.sync import symbolic_sync
 
     rs = load_rules(P / "tri.rules")
     p = plant(rs)

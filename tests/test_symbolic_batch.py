@@ -1,7 +1,7 @@
-"""Findings in one pass (synth/symbolic/stepbatch.py, issue 25).
+"""Findings in one pass (synth/symbolic/steps/batch.py, issue 25).
 
 The tagged search must give, target by target, what the one-target search of
-:class:`~synth.symbolic.stepreach.StepReach` gives: the same first node, distance and
+:class:`~synth.symbolic.steps.reach.StepReach` gives: the same first node, distance and
 path key, the same trace (nodes and events), ties included (``branches_3x2`` meets them).
 """
 
@@ -13,9 +13,9 @@ import pytest
 
 from synth.grafcet.machine import GrafcetMachine
 from synth.logic.bdd import Engine
-from synth.symbolic.stepbatch import Findings, Tags
-from synth.symbolic.stepreach import StepReach
-from synth.symbolic.stepsync import step_sync
+from synth.symbolic.steps.batch import Findings, Tags
+from synth.symbolic.steps.reach import StepReach
+from synth.symbolic.steps.sync import step_sync
 from synth.symbolic.ties import Settled
 from synth.sup.constraints import CompiledConstraints
 from synth.validation.result import load_model

@@ -1,4 +1,4 @@
-"""The steps in the BDD (synth/symbolic/steps.py, stepsync.py, stepreach.py, stepvalidate.py).
+"""The steps in the BDD (synth/symbolic/steps/encoding.py, steps/sync.py, steps/reach.py, steps/validate.py).
 
 The exploration over (steps, plant state) must give the per-situation engine's counts;
 a model it covers is decided on it (verdicts, components, first nodes, traces) and its
@@ -21,10 +21,10 @@ from synth.logic.events import Event
 from synth.output.result import validation_json, validation_text
 from synth.symbolic import ties, validate as symbolic_validate
 from synth.symbolic.encoding import Copy
-from synth.symbolic.steps import StepEncoding, Unsupported, anchors, step_name, unsupported
-from synth.symbolic.stepsync import step_sync
+from synth.symbolic.steps.encoding import StepEncoding, Unsupported, anchors, step_name, unsupported
+from synth.symbolic.steps.sync import step_sync
 from synth.symbolic.supervisor import SymbolicSupervisor
-from synth.symbolic.sync import symbolic_sync
+from synth.symbolic.situations.sync import symbolic_sync
 from synth.symbolic.validate import validate_symbolic
 from synth.validation.result import load_model
 from synth.validation.validate import validate

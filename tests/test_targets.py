@@ -16,7 +16,7 @@ from synth.cli.main import main
 from synth.codegen.check import differential_check
 from synth.codegen.filter_st import filter_block
 from synth.codegen.grafcet_st import generate_program
-from synth.codegen.plcopen_xml import validation_errors
+from synth.codegen.plcopen.tc6 import validation_errors
 from synth.codegen.targets import Target, render, st_of
 from synth.codegen.twincat import object_id
 from synth.filter.cycle import FilterCycle
@@ -90,7 +90,7 @@ def test_xml_is_plcopen_and_refuses_another_target(tmp_path, capsys):
 
 @pytest.mark.parametrize("target", [Target.PLCOPEN, Target.CODESYS, Target.TWINCAT])
 def test_each_target_of_a_filter_block_runs_as_the_st_text(target):
-    from synth.codegen.interpreter import load_st
+    from synth.codegen.interpreter.machine import load_st
 
     f = load_filter(ROOT / "plants/tri.filter")
     block = filter_block(f)

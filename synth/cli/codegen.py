@@ -124,7 +124,7 @@ def cmd_st(args: argparse.Namespace) -> int:
 
 
 def cmd_sfc(args: argparse.Namespace) -> int:
-    from synth.codegen.plcopen_export import sfc_project_xml
+    from synth.codegen.plcopen.export import sfc_project_xml
     from synth.codegen.program import program_name
     from synth.codegen.provenance import provenance_lines
 
@@ -135,7 +135,7 @@ def cmd_sfc(args: argparse.Namespace) -> int:
 
 
 def cmd_import(args: argparse.Namespace) -> int:
-    from synth.codegen.plcopen_import import import_sfc, list_pous
+    from synth.codegen.plcopen.importer import import_sfc, list_pous
     from synth.grafcet.language_check import parse_grafcet
 
     with open(args.file, "rb") as fh:

@@ -15,7 +15,7 @@ TYPE_CHECKING = False  # typing.TYPE_CHECKING, without importing typing (fast --
 
 if TYPE_CHECKING:
     from synth.filter.language import Filter
-    from synth.filter.verification import Verification
+    from synth.filter.loop.verification import Verification
 
 __all__ = ["register", "register_run", "register_verify", "register_from_rules"]
 
@@ -253,7 +253,7 @@ def register_verify(commands: "argparse._SubParsersAction") -> None:
 def cmd_verify(args: argparse.Namespace) -> int:
     from synth.output.summary import print_json
     from synth.engines import EngineChoice
-    from synth.filter.closed_loop import DEFAULT_MAX_STATES, verify
+    from synth.filter.loop.verify import DEFAULT_MAX_STATES, verify
     from synth.filter.cycle import Algorithm, Mode
     from synth.output.filter_text import verification_json, verification_text
 
@@ -263,8 +263,8 @@ def cmd_verify(args: argparse.Namespace) -> int:
         from synth.codegen.check import require_blark
 
         require_blark("synth filter verify --control")  # before the interpreter, which imports blark
-        from synth.codegen.interpreter import load_st
-        from synth.filter.control_st import StSource
+        from synth.codegen.interpreter.machine import load_st
+        from synth.filter.loop.control_st import StSource
 
         control = StSource(args.control, load_st)
     v = verify(f, args.plant, args.grafcet, any_control=args.any_control, algorithm=Algorithm(args.algorithm),
@@ -301,7 +301,7 @@ def cmd_verify(args: argparse.Namespace) -> int:
 
 def _progress_text(v: "Verification", goal: str) -> str:
     """The lines of ``--progress GOAL``, after the verification's text."""
-    from synth.filter.verification import ProgressFailure
+    from synth.filter.loop.verification import ProgressFailure
     from synth.output.filter_text import trace_text
 
     p = v.progress

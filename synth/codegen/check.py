@@ -6,7 +6,7 @@ situation and plays each one on both sides:
 * synth's :class:`~synth.grafcet.machine.GrafcetMachine` (what ``synth run`` steps), one input
   event (``↑x``/``↓x``) or timer event (``2s/X101``) at a time;
 * the generated program (:func:`~synth.codegen.grafcet_st.generate_program`) parsed by blark and
-  run by :mod:`synth.codegen.interpreter`, one PLC cycle per event; a timer event is the clock
+  run by :mod:`synth.codegen.interpreter.machine`, one PLC cycle per event; a timer event is the clock
   advanced until the timer reaches its preset, then one cycle with unchanged inputs.
 
 After every cycle the active steps (``X<step>``) and the outputs must be equal; a transient
@@ -135,10 +135,10 @@ class ProgramRunner(Protocol):
 
 
 class InterpretedProgram:
-    """The generated program parsed by blark and run by :mod:`synth.codegen.interpreter`."""
+    """The generated program parsed by blark and run by :mod:`synth.codegen.interpreter.machine`."""
 
     def __init__(self, program: StProgram, file: str) -> None:
-        from synth.codegen.interpreter import load_st
+        from synth.codegen.interpreter.machine import load_st
 
         self.module = load_st(program.text, file)
         self.inst = self.module.instance(program.program)

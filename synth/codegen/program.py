@@ -157,7 +157,7 @@ def compact(lines: list[str]) -> list[str]:
 class Configuration:
     """``--task 10ms``: one resource, one periodic task, one instance of the program, so the
     file builds as it is in Beremiz and OpenPLC. Written as ST (:meth:`lines`) or as TC6 XML
-    (:func:`synth.codegen.plcopen_export.st_project_xml`)."""
+    (:func:`synth.codegen.plcopen.export.st_project_xml`)."""
 
     program: str
     interval: str  # the TIME literal, T#10ms

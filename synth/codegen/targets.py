@@ -68,7 +68,7 @@ def render(target: Target, pous: Sequence[Pou], *, text: str, name: str, header:
                              "not in a POU file", Location("--task", 1, 1, "", 1),
                              notes=("drop --task, or write --target iec, plcopen or codesys",))
         return [(f"{p.name}.TcPOU", tcpou(p, header)) for p in pous]
-    from synth.codegen.plcopen_export import st_project_xml
+    from synth.codegen.plcopen.export import st_project_xml
 
     xml = st_project_xml(pous, name=name, version=version, comment="\n".join(header), config=config,
                          codesys=target is Target.CODESYS)

@@ -29,7 +29,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from synth.errors import Location
     from synth.filter.coherence import Check
     from synth.filter.language import Filter
-    from synth.filter.verification import Verification
+    from synth.filter.loop.verification import Verification
     from synth.codegen.check import DifferentialReport
     from synth.grafcet.language import Grafcet
     from synth.validation.result import Validation
@@ -175,7 +175,7 @@ def filter_check_report(f: Filter, c: Check) -> CiReport:
 def filter_verify_report(f: Filter, v: Verification) -> CiReport:
     """``synth filter verify``: one finding per kind found (its shortest trace, at the first
     constraint involved); the kinds that do not fail the loop are warnings."""
-    from synth.filter.verification import INCOHERENT, UNSAFE, FindingKind
+    from synth.filter.loop.verification import INCOHERENT, UNSAFE, FindingKind
     from synth.output.filter_text import FINDINGS
 
     failing = set(UNSAFE) | set(INCOHERENT) | ({FindingKind.TRANSIENT} if v.strict else set())

@@ -26,7 +26,7 @@ from synth.filter.cycle import Algorithm
 from synth.filter.from_rules import Classification, Skeleton
 from synth.filter.run import Run
 from synth.filter.solve import Synthesis
-from synth.filter.verification import ANY_CONTROL, INCOHERENT, UNSAFE, FindingKind, TraceRow, Verification
+from synth.filter.loop.verification import ANY_CONTROL, INCOHERENT, UNSAFE, FindingKind, TraceRow, Verification
 from synth.logic.bdd import cube_text
 
 __all__ = ["FINDINGS", "check_text", "check_json", "synthesis_text", "synthesis_json", "run_text", "run_json",

@@ -115,7 +115,7 @@ class PlantEncoding:
         self.budget = budget or NodeBudget()
         self.variables: tuple[str, ...] = tuple(v for e in p.elements for v in e.variables)
         self.order: tuple[int, ...] = element_order(p, constraints)
-        # ``anchored``: other variables (the Grafcet's steps, :mod:`synth.symbolic.steps`), in
+        # ``anchored``: other variables (the Grafcet's steps, :mod:`synth.symbolic.steps.encoding`), in
         # three copies too, declared just before the element they are anchored to (None: first)
         extra = anchored or {}
         order = [v + c.value for v in extra.get(None, ()) for c in Copy]

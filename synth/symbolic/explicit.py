@@ -1,6 +1,6 @@
 """The explicit nodes and edges a symbolic report shows.
 
-Both symbolic paths (:mod:`synth.symbolic.validate`, :mod:`synth.symbolic.stepvalidate`)
+Both symbolic paths (:mod:`synth.symbolic.validate`, :mod:`synth.symbolic.steps.validate`)
 decide on BDDs, then make explicit :class:`~synth.validation.sync.Node` objects of the
 few nodes a report shows (initial nodes, trace nodes, component members), numbered as
 they are asked for, so the existing diagnosis and output run on a small
@@ -12,7 +12,7 @@ Example
 >>> from synth.validation.result import load_model
 >>> from synth.grafcet.machine import GrafcetMachine
 >>> from synth.sup.constraints import CompiledConstraints
->>> from synth.symbolic.sync import symbolic_sync
+>>> from synth.symbolic.situations.sync import symbolic_sync
 >>> rs, p, g = load_model(_plants("../grafcets/tri.g7"), _plants("tri.rules"))
 >>> s = symbolic_sync(p, rs.constraints, GrafcetMachine(g))
 >>> ex = ExplicitNodes(s, CompiledConstraints(p, rs.constraints))
@@ -26,8 +26,8 @@ from typing import Callable
 
 from synth.plant.composition import Plant
 from synth.sup.constraints import CompiledConstraints
-from synth.symbolic.reachability import Path, shortest_trace
-from synth.symbolic.sync import SymbolicSync
+from synth.symbolic.situations.reach import Path, shortest_trace
+from synth.symbolic.situations.sync import SymbolicSync
 from synth.validation.analysis import Trace
 from synth.validation.sync import Edge, Node, Prohibition, _order_moves
 

@@ -1,6 +1,6 @@
 """The explicit engine's order among the nodes one edge enters, for the first nodes of both
-symbolic paths (:mod:`synth.symbolic.stepreach` and :mod:`synth.symbolic.stepbatch` on the
-step path, :mod:`synth.symbolic.reachability` per situation).
+symbolic paths (:mod:`synth.symbolic.steps.reach` and :mod:`synth.symbolic.steps.batch` on the
+step path, :mod:`synth.symbolic.situations.reach` per situation).
 
 The explicit engine numbers SYNC's nodes breadth-first: it expands the nodes in the
 order it numbered them, each node's events in the plant's order (then its timers), and an event's target
@@ -18,7 +18,7 @@ Example
 >>> from synth.validation.result import load_model
 >>> from synth.grafcet.machine import GrafcetMachine
 >>> from synth.sup.constraints import CompiledConstraints
->>> from synth.symbolic.stepsync import step_sync
+>>> from synth.symbolic.steps.sync import step_sync
 >>> rs, p, g = load_model(_plants("../tests/data/home/production_loop.g7"), _plants("../tests/data/home/cylinder.rules"))
 >>> s = step_sync(p, rs.constraints, GrafcetMachine(g))
 >>> settled = Settled(s.helper, CompiledConstraints(p, rs.constraints))
@@ -35,7 +35,7 @@ from synth.errors import LimitExceeded
 from synth.logic.events import Event
 from synth.sup.constraints import CompiledConstraints
 from synth.symbolic.relation import Move
-from synth.symbolic.sync import SymbolicSync
+from synth.symbolic.situations.sync import SymbolicSync
 from synth.validation.sync import _grafcet_inputs, _order_moves, region
 
 __all__ = ["Settled", "REGION_LIMIT"]

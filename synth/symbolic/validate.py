@@ -31,7 +31,7 @@ from synth.plant.composition import Plant
 from synth.plant.rules import RuleSet
 from synth.sup.constraints import CompiledConstraints
 from synth.symbolic.encoding import NodeBudget, live_nodes
-from synth.symbolic.reachability import (
+from synth.symbolic.situations.reach import (
     MAX_LISTED,
     coreachable,
     first_node,
@@ -44,11 +44,11 @@ from synth.symbolic.reachability import (
 )
 from synth.symbolic.explicit import ExplicitNodes, Key, PathKey
 from synth.symbolic.ties import Settled
-from synth.symbolic.steps import anchors, unsupported
-from synth.symbolic.stepvalidate import validate_steps
+from synth.symbolic.steps.encoding import anchors, unsupported
+from synth.symbolic.steps.validate import validate_steps
 from synth.symbolic.supervisor import SymbolicSupervisor
-from synth.symbolic.graph import NodeSet
-from synth.symbolic.sync import SymbolicSync
+from synth.symbolic.situations.graph import NodeSet
+from synth.symbolic.situations.sync import SymbolicSync
 from synth.validation.analysis import Analysis
 from synth.validation.diagnosis import diagnose_all
 from synth.validation.conflicts import Conflict

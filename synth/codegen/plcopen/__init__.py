@@ -1,0 +1,1 @@
+"""PLCopen TC6 XML: the exporter (ST POUs, the Grafcet as an SFC, CODESYS's ``addData``) and the importer of SFC charts as IDEs write them (Beremiz, OpenPLC, CODESYS, TwinCAT), over the shared TC6 document model of :mod:`synth.codegen.plcopen.tc6`."""

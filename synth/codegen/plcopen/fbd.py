@@ -1,0 +1,177 @@
+"""A transition condition wired as FBD or LD (``synth import``): the TC6 specification's own
+SFC example and every CODESYS V3.5 export connect the condition of a transition to an
+``<inVariable>`` (an ST expression), or to a small network of ``AND``/``OR``/``NOT`` blocks
+over such variables; Beremiz draws LD contacts from a power rail (in series: AND, in
+parallel: OR). :func:`fbd_condition` reads that network back into one ``.g7``
+receptivity; any other construct (an LD contact, another block, a loop) is an
+:class:`~synth.errors.InputError` at its element.
+
+Example
+-------
+>>> sorted(FBD_ELEMENTS)
+['block', 'contact', 'inVariable', 'leftPowerRail']
+"""
+
+from __future__ import annotations
+
+from typing import Any, Callable
+
+from synth.codegen.plcopen.blocks import FBD_FUNCTION_BLOCKS, sel, ton_output, trigger
+from synth.codegen.plcopen.latch import LATCH_BLOCKS, latch_chart, latch_step
+from synth.codegen.plcopen.st_condition import ExprReader
+from synth.errors import InputError
+
+__all__ = ["FBD_ELEMENTS", "fbd_condition", "fbd_transition"]
+
+FBD_ELEMENTS = frozenset({"inVariable", "block", "contact", "leftPowerRail"})
+"""The FBD elements an SFC body may hold as the sources of transition conditions."""
+
+_BLOCKS = {"AND": " & ", "OR": " | ", "NOT": ""}
+
+
+def _negated(el: Any) -> bool:
+    return el is not None and el.get("negated", "false") in ("true", "1")
+
+
+def fbd_condition(cond: Any, elements: dict[int, Any], q: Callable[[str], str], src: Any,
+                  steps: dict[str, str], sources: tuple[str, ...] = ()) -> str:
+    """The receptivity of ``<condition><connectionPointIn>`` wired to an FBD network."""
+    from lxml import etree
+
+    latches: dict[int, str] = {}  # an SR/RS block being read -> its output (its state: no loop)
+
+    def one_source(cp: Any, owner: Any) -> str:
+        conns = cp.findall(q("connection"))
+        if len(conns) != 1:
+            raise InputError(f"a condition input with {len(conns)} connections (one is expected)", src.at(owner))
+        text = conns[0].get("refLocalId", "")
+        if not text.strip().isdigit() or int(text) not in elements:
+            raise InputError(f"connection to unknown localId {text}", src.at(conns[0]))
+        return node(int(text), frozenset())
+
+    def node(lid: int, seen: frozenset[int]) -> str:
+        el = elements[lid]
+        kind = etree.QName(el).localname
+        if lid in latches:
+            return latches[lid]
+        if lid in seen:
+            raise InputError("an FBD condition that loops back on itself", src.at(el))
+        if kind == "inVariable":
+            ex = el.find(q("expression"))
+            text = (ex.text or "") if ex is not None else ""
+            if not text.strip():
+                raise InputError("an <inVariable> without an expression", src.at(el))
+            reader = ExprReader(text, lambda off, w, h=ex, t=text: src.text_at(h, t, off, w), steps)
+            expr = reader.whole()
+            return f"!({expr})" if _negated(el) else expr
+        if kind == "block":
+            name = (el.get("typeName") or "").upper()
+            if name not in _BLOCKS and name not in FBD_FUNCTION_BLOCKS and name not in LATCH_BLOCKS:
+                raise InputError(f"an FBD block {el.get('typeName')} in a transition condition: only AND, OR, NOT, "
+                                 "SEL, R_TRIG, F_TRIG, TON, SR and RS have a Boolean or step-timer meaning in .g7",
+                                 src.at(el), expected=(*_BLOCKS, *FBD_FUNCTION_BLOCKS, *LATCH_BLOCKS))
+            outs = el.find(f"{q('outputVariables')}/{q('variable')}")
+            inner = seen | {lid}
+            if name in LATCH_BLOCKS:  # its inputs may read its output back
+                latches[lid] = latch_step(str(el.get("instanceName") or name))
+                latches[lid] = f"!({latches[lid]})" if _negated(outs) else latches[lid]
+                inner = frozenset({lid})
+            args: list[str] = []
+            params: dict[str, tuple[str, Any]] = {}
+            for var in el.iterfind(f"{q('inputVariables')}/{q('variable')}"):
+                cp = var.find(q("connectionPointIn"))
+                if cp is None:
+                    raise InputError("an unconnected block input", src.at(var))
+                conns = cp.findall(q("connection"))
+                if len(conns) != 1 or not conns[0].get("refLocalId", "").strip().isdigit():
+                    raise InputError("a block input must be connected to one element", src.at(var))
+                ref = int(conns[0].get("refLocalId"))
+                if ref not in elements:
+                    raise InputError(f"connection to unknown localId {ref}", src.at(conns[0]))
+                if name == "TON" and str(var.get("formalParameter", "")).upper() == "PT":
+                    ex = elements[ref].find(q("expression"))
+                    params["PT"] = ((ex.text or "") if ex is not None else "", elements[ref])
+                    continue
+                arg = node(ref, inner)
+                args.append(f"!({arg})" if _negated(var) else f"({arg})")
+                params[str(var.get("formalParameter", "")).upper()] = (args[-1], var)
+            out = _function_block(name, el, args, params)
+            if name in LATCH_BLOCKS:
+                return latches[lid]
+            return f"!({out})" if _negated(outs) else out
+        if kind == "leftPowerRail":
+            return "1"
+        if kind == "contact":  # LD: this contact in series after what feeds it (several feeds: in parallel)
+            var = el.find(q("variable"))
+            name = (var.text or "").strip() if var is not None else ""
+            if not name:
+                raise InputError("an LD contact without a variable", src.at(el))
+            reader = ExprReader(name, lambda off, w, h=var, t=name: src.text_at(h, t, off, w), steps)
+            literal = reader.whole()
+            edge = el.get("edge", "none")
+            if edge in ("rising", "falling"):
+                literal = ("↑" if edge == "rising" else "↓") + literal
+            if _negated(el):
+                literal = f"!{literal}" if edge == "none" else f"!({literal})"
+            cp = el.find(q("connectionPointIn"))
+            feeds = [] if cp is None else cp.findall(q("connection"))
+            before = []
+            for c in feeds:
+                ref = c.get("refLocalId", "")
+                if not ref.strip().isdigit() or int(ref) not in elements:
+                    raise InputError(f"connection to unknown localId {ref}", src.at(c))
+                before.append(node(int(ref), seen | {lid}))
+            before = [b for b in before if b != "1"]
+            if not feeds:
+                raise InputError("an LD contact not fed by the power rail or another contact", src.at(el))
+            if not before or len(before) < len(feeds):  # fed by the rail (alone or in parallel): just this contact
+                return literal
+            fed = before[0] if len(before) == 1 else "(" + " | ".join(f"({b})" for b in before) + ")"
+            return f"({fed}) & {literal}"
+        raise InputError(f"<{kind}> in a transition condition: .g7 reads inVariables, AND/OR/NOT blocks and LD "
+                         "contacts", src.at(el))
+
+    def _function_block(name: str, el: Any, args: list[str], params: dict[str, tuple[str, Any]]) -> str:
+        if name in _BLOCKS:
+            if not args or (name == "NOT" and len(args) != 1):
+                raise InputError(f"an FBD {name} block with {len(args)} inputs", src.at(el))
+            return f"!{args[0]}" if name == "NOT" else _BLOCKS[name].join(args)
+        wanted = {"SEL": ("G", "IN0", "IN1"), "R_TRIG": ("CLK",), "F_TRIG": ("CLK",), "TON": ("IN", "PT"),
+                  **LATCH_BLOCKS}[name]
+        missing = [p for p in wanted if p not in params]
+        if missing:
+            raise InputError(f"an FBD {name} block without its input {missing[0]}", src.at(el))
+        instance = str(el.get("instanceName") or name)
+        if name == "SEL":
+            return sel(*(params[p][0] for p in wanted))
+        if name in LATCH_BLOCKS:
+            latch_chart(name, instance, params[wanted[0]][0], params[wanted[1]][0], list(sources), src.at(el))
+            return ""
+        if name == "TON":
+            return ton_output(instance, params["IN"][0], params["PT"][0], list(sources), src.at(el), elements,
+                              steps, src.at(params["PT"][1]))
+        return trigger(name, instance, params["CLK"][0], src.at(el))
+
+    cp = cond.find(q("connectionPointIn"))
+    return one_source(cp, cond)
+
+
+def fbd_transition(transition: Any, fbd: Any, q: Callable[[str], str], src: Any, steps: dict[str, str],
+                   sources: tuple[str, ...] = ()) -> str:
+    """The receptivity of a named transition whose body is FBD: the network wired to the
+    ``<outVariable>`` that carries the transition's name."""
+    from lxml import etree
+
+    name = str(transition.get("name", ""))
+    elements: dict[int, Any] = {}
+    target = None
+    for el in fbd:
+        if not isinstance(el.tag, str) or el.get("localId") is None or not el.get("localId").isdigit():
+            continue
+        elements[int(el.get("localId"))] = el
+        ex = el.find(q("expression"))
+        if etree.QName(el).localname == "outVariable" and ex is not None and (ex.text or "").strip().upper() == name.upper():
+            target = el
+    if target is None:
+        raise InputError(f"the FBD body of transition {name} has no <outVariable> {name}", src.at(transition))
+    return fbd_condition(target, elements, q, src, steps, sources)

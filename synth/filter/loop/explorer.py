@@ -1,0 +1,425 @@
+"""The breadth-first search of ``synth filter verify`` over the closed loop's product
+(:class:`~synth.filter.loop.product.Product`), one level at a time, with the first
+(shortest) occurrence of every kind of finding and its trace.
+
+Example
+-------
+>>> from synth.plant.composition import _plants
+>>> from synth.filter.from_rules import skeleton
+>>> from synth.filter.cycle import Algorithm
+>>> from synth.filter.loop.product import Product
+>>> sk = skeleton(_plants("tri.rules"), _plants("F.filter"))  # the text only: nothing is written
+>>> ex = Explorer(Product(sk.filter, _plants("tri.rules"), None, Algorithm.ALGEBRAIC, Mode.SUPERVISOR, False), 100)
+>>> ex.run()
+>>> ex.complete, len(ex.seen_keys)
+(False, 100)
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any
+
+import numpy as np
+
+from synth.filter.loop.control_st import TIMER_PREFIX
+from synth.filter.cycle import ACK, Memory, Mode
+from synth.errors import LimitExceeded
+from synth.filter.loop.outcomes import Outcome, OutcomeArrays, lane_bits, react, situation_text, trace_row, unpack
+from synth.filter.loop.product import Product
+from synth.filter.loop.writes import merge_events, write
+from synth.filter.loop.verification import Finding, FindingKind, TraceRow
+
+__all__ = ["POWER_UP", "Explorer"]
+
+POWER_UP = "power-up"
+"""The event of a program's first cycle: its first scan, on the plant's initial state."""
+
+
+_NOTES = {FindingKind.VIOLATION: "", FindingKind.EDGE: "output event forbidden",
+          FindingKind.REFUSED: "output change refused", FindingKind.FALLBACK: "fallback",
+          FindingKind.OUTSIDE_CARE: "outside the care set",
+          FindingKind.TRANSIENT: "an intermediate state of the write violates a constraint"}
+
+
+class Explorer:
+    """The breadth-first search over the product, one level at a time.
+
+    A node is the integer ``aux * plant.size + code``: ``code`` the plant state, ``aux``
+    an interned (memory of the names whose past value the filter reads, Blocked,
+    situation). The cycle's outcomes depend on the node only through a *class* (Y read,
+    aux before, situation after the Grafcet's reaction), computed once for every request
+    vector at once; the writes are then applied to whole arrays of (state, outcome) pairs.
+    """
+
+    def __init__(self, pr: Product, max_states: int, events_per_cycle: int = 1, edges: bool = False) -> None:
+        self.pr, self.max_states, self.k, self.track = pr, max_states, events_per_cycle, edges
+        self.size = pr.size
+        self.aux_of: dict[tuple, int] = {}
+        self.aux_list: list[tuple] = []
+        self.classes: dict[tuple, int] = {}
+        self.outcomes: list[Outcome] = []
+        self.outcome_of: dict[Outcome, int] = {}
+        self.flat: list[int] = []  # the outcomes of every class, class after class
+        self.n_out: list[int] = []
+        self.arrays = OutcomeArrays(len(pr.orders))
+        # the events of a cycle: its label ("-", "↑a", "↑a, ↓b", a timer) and sequence, interned
+        self.events: list[str] = []
+        self.seqs: list[tuple[str, ...]] = []
+        self.seq_of: dict[tuple[str, ...], int] = {}
+        for seq in [(), *((e,) for e, _ in pr.uncontrollable)]:  # ids in the plant's event order
+            self.intern_seq(seq)
+        # the events the plant (and the Grafcet's timers) may not postpone forever: one bit each
+        self.fair: dict[str, int] = {e: i for i, (e, _) in enumerate(pr.uncontrollable)}
+        self.order: list[int] = []  # the nodes in the order they were found (breadth-first)
+        # (source, target, fairness bits of the events taken, events id, outcome): with --progress
+        self.edge_parts: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
+        self.parent: dict[int, tuple[int, str, int]] = {}  # node -> (parent node, event, outcome)
+        self.seen_keys: set[int] = set()
+        self.seen_arrays: dict[int, np.ndarray] = {}
+        # kind -> (node, event, outcome, code, ids)
+        self.first: dict[FindingKind, tuple[int, str, int, int, tuple[str, ...]]] = {}
+        self.counts: dict[FindingKind, set[int]] = {k: set() for k in FindingKind}
+        self.outside_sup: set[int] = set()
+        self.first_outside_sup: int | None = None
+        self.cycles = self.corrected = self.max_distance = 0
+        self.complete = True
+        p = pr.plant
+        init = {v.name: v.initial for v in pr.rules.variables if v.is_input}
+        sit0 = pr.initial_situation(init)
+        memory = pr.cycle.initial()
+        self.key0 = self.intern((tuple(memory.previous[i] for i in pr.used_index), False, sit0)) * self.size \
+            + p.initial_index
+        self.admit_one(self.key0)
+        # a program's fresh instance: the PLC before its power-up scan (see run)
+        self.prelude: int | None = self.key0 if pr.control is not None else None
+        self.prelude_cycles = self.prelude_corrected = 0
+        self.powered: set[int] = set()  # the states the power-up scan leads to
+        self.reentered = False
+        if pr.illegal[p.initial_index]:
+            self.counts[FindingKind.VIOLATION].add(p.initial_index)
+
+    # ------------------------------------------------------------------ bookkeeping
+    def intern(self, a: tuple) -> int:
+        k = self.aux_of.get(a)
+        if k is None:
+            k = self.aux_of[a] = len(self.aux_list)
+            self.aux_list.append(a)
+        return k
+
+    def intern_seq(self, seq: tuple[str, ...]) -> int:
+        k = self.seq_of.get(seq)
+        if k is None:
+            k = self.seq_of[seq] = len(self.seqs)
+            self.seqs.append(seq)
+            self.events.append(", ".join(seq) if seq else "-")
+        return k
+
+    def bit(self, event: str) -> int:
+        """The fairness bit of a plant event or timer (at most 64 of them, for --progress)."""
+        b = self.fair.setdefault(event, len(self.fair))
+        if b >= 64 and self.track:
+            raise LimitExceeded("--progress tracks at most 64 plant events and Grafcet timers in this closed loop")
+        return 1 << b if b < 64 else 0
+
+    def seen_array(self, aux: int) -> np.ndarray:
+        arr = self.seen_arrays.get(aux)
+        if arr is None:
+            arr = self.seen_arrays[aux] = np.zeros(self.size, dtype=bool)
+        return arr
+
+    def admit_one(self, key: int) -> None:
+        code = key % self.size
+        self.seen_keys.add(key)
+        self.order.append(key)
+        self.seen_array(key // self.size)[code] = True
+        if self.pr.outside_sup[code]:
+            self.outside_sup.add(code)
+            self.first_outside_sup = key if self.first_outside_sup is None else self.first_outside_sup
+
+    def record(self, kind: FindingKind, mask: np.ndarray, where: np.ndarray, node: np.ndarray, event: np.ndarray,
+               oid: np.ndarray | None, shown: np.ndarray, ids: Any = ()) -> None:
+        """Count the plant states ``where[mask]``; keep the first occurrence (its node, event,
+        outcome, the state to show and the constraints, ``ids(i)`` when callable)."""
+        if not mask.any():
+            return
+        self.counts[kind].update(np.unique(where[mask]).tolist())
+        if kind not in self.first:
+            i = int(np.argmax(mask))
+            self.first[kind] = (int(node[i]), self.events[int(event[i])], -1 if oid is None else int(oid[i]),
+                                int(shown[i]), ids(i) if callable(ids) else ids)
+
+    # ------------------------------------------------------------------ one cycle's outcomes
+    def outcomes_for(self, ybits: int, aux: int, sit: Any) -> int:
+        """The class of (Y, aux before, situation after): its distinct outcomes over every
+        request vector (and Ack), each with the first request vector giving it."""
+        key = (ybits, aux, sit)
+        k = self.classes.get(key)
+        if k is not None:
+            return k
+        pr, cyc = self.pr, self.pr.cycle
+        mem_used, blocked, _ = self.aux_list[aux]
+        values = {n: bool((ybits >> i) & 1) for i, n in enumerate(pr.ynames)}
+        fixed = {n: values[n] for n in pr.filter.inputs}
+        free: list[str] = []
+        passed: dict[str, bool] = {}
+        requested = pr.requested(sit, values)
+        if requested is not None:
+            fixed.update(requested[0])
+            fixed.update({r: requested[1][o] for o, r in zip(cyc.outputs, cyc.requests)})
+            passed = {o: requested[1][o] for o in pr.passthrough}
+        else:
+            fixed.update({r: pr.held[o] for o, r in zip(cyc.outputs, cyc.requests) if o in pr.held})
+            passed = {o: pr.held[o] for o in pr.passthrough if o in pr.held}
+            free = [r for o, r in zip(cyc.outputs, cyc.requests) if o not in pr.held]
+            free += [o for o in pr.passthrough if o not in pr.held]
+        if cyc.mode is Mode.BLOCKING:
+            free.append(ACK)
+        previous = [False] * len(cyc.remembered)
+        for i, v in zip(pr.used_index, mem_used):
+            previous[i] = v
+        lanes = cyc.lanes(Memory(tuple(previous), blocked), fixed, free)
+        n = lanes.count
+        out = {o: unpack(m, n) for o, m in zip(cyc.outputs, lanes.outputs)}
+        for o in pr.passthrough:
+            out[o] = np.full(n, passed[o]) if o in passed else unpack(lane_bits(free.index(o), n), n)
+        columns = [out[o] for o in pr.orders] + [unpack(lanes.previous[i], n) for i in pr.used_index]
+        columns += [unpack(m, n) for m in (lanes.blocked, lanes.fallback, lanes.outside_care)]
+        _, firsts = np.unique(np.stack(columns, axis=1), axis=0, return_index=True)
+        found: list[int] = []
+        for j in sorted(firsts.tolist()):  # one witness lane per distinct outcome, the first
+            result, memory = lanes.lane(j)
+            targets = dict(zip(cyc.outputs, result.outputs))
+            req = dict(zip(cyc.outputs, result.requests))
+            for o in pr.passthrough:
+                targets[o] = req[o] = bool(out[o][j])
+            mem = tuple(memory.previous[i] for i in pr.used_index)
+            oc = Outcome(tuple(targets[o] for o in pr.orders), self.intern((mem, memory.blocked, sit)),
+                          result.fallback, result.outside_care, tuple(req[o] for o in pr.orders), result.violated)
+            g = self.outcome_of.get(oc)
+            if g is None:
+                g = self.outcome_of[oc] = len(self.outcomes)
+                self.outcomes.append(oc)
+            found.append(g)
+        k = self.classes[key] = len(self.n_out)
+        self.flat.extend(found)
+        self.n_out.append(len(found))
+        return k
+
+    # ------------------------------------------------------------------ one level
+    def events_from(self, frontier: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Step 1 of a cycle for every node: (state after the plant's events, node, events id,
+        fairness bits of the events taken). The events are none, up to ``events_per_cycle``
+        uncontrollable events of the plant in sequence (one entry per state reached, with the
+        union of the events of every sequence reaching it, the shortest shown), or a Grafcet
+        timer. A plant event into a violating state is a transient finding."""
+        pr, size = self.pr, self.size
+        codes0 = frontier % size
+        fi = np.arange(frontier.size, dtype=np.int64)
+        post, seq, mask = codes0, np.zeros(frontier.size, dtype=np.int64), np.zeros(frontier.size, dtype=np.uint64)
+        parts = [(fi, post, seq, mask)]
+        by_events = pr.machine is not None  # a Grafcet reacts to each event; a program scans once
+        for _ in range(self.k):
+            found = []
+            for ev, nxt in pr.uncontrollable:
+                dst = nxt[post]
+                ok = dst >= 0
+                if not ok.any():
+                    continue
+                uniq, inv = np.unique(seq[ok], return_inverse=True)
+                ids = np.array([self.intern_seq(self.seqs[u] + (ev,)) for u in uniq.tolist()], dtype=np.int64)
+                found.append((fi[ok], dst[ok], ids[inv.ravel()], mask[ok] | np.uint64(self.bit(ev))))
+            if not found:
+                break
+            fi, post, seq, mask = merge_events([np.concatenate(c) for c in zip(*found)], size, frontier, by_events)
+            bad = pr.illegal[post] & ~pr.illegal[codes0[fi]]
+            self.record(FindingKind.TRANSIENT, bad, post, frontier[fi], seq, None, post,
+                        lambda i: pr.violated(int(post[i])))
+            parts.append((fi, post, seq, mask))
+        fi, post, seq, mask = merge_events([np.concatenate(c) for c in zip(*parts)], size, frontier, by_events)
+        if pr.controlled:
+            timed = [(fi, post, seq, mask)]
+            auxes = frontier // size
+            for aux in np.unique(auxes).tolist():
+                where = np.nonzero(auxes == aux)[0]
+                for tev in pr.timers(self.aux_list[aux][2]):
+                    timed.append((where, codes0[where], np.full(where.size, self.intern_seq((tev,)), dtype=np.int64),
+                                  np.full(where.size, self.bit(tev), dtype=np.uint64)))
+            fi, post, seq, mask = (np.concatenate(c) for c in zip(*timed))
+            by_aux = np.argsort(auxes[fi], kind="stable")  # a node's timers after its plant events
+            fi, post, seq, mask = fi[by_aux], post[by_aux], seq[by_aux], mask[by_aux]
+        return post, frontier[fi], seq, mask
+
+    def classify(self, post: np.ndarray, node: np.ndarray, event: np.ndarray) -> np.ndarray:
+        """Steps 2-3: the class of each (state after the event, node, event)."""
+        pr, width = self.pr, len(self.pr.ynames)
+        ybits = np.zeros(post.size, dtype=np.int64)
+        for i, n in enumerate(pr.ynames):
+            ybits |= pr.val[n][post].astype(np.int64) << i
+        if not pr.controlled:  # the events matter only to a controller
+            event = np.zeros_like(event)
+        elif pr.control is not None:  # a program scans once after the plant's events: only a timer matters
+            timer = np.array([bool(q) and q[0].startswith(TIMER_PREFIX) for q in self.seqs], dtype=bool)
+            event = np.where(timer[event], event, 0)
+        combo = ((node // self.size) * len(self.events) + event) * (1 << width) + ybits
+        uniq, inverse = np.unique(combo, return_inverse=True)
+        class_ids = np.empty(uniq.size, dtype=np.int64)
+        for u, c in enumerate(uniq.tolist()):
+            yb, rest = c % (1 << width), c >> width
+            ei, aux = rest % len(self.events), rest // len(self.events)
+            sit = self.aux_list[aux][2]
+            if pr.controlled:
+                sit = react(pr, sit, self.seqs[ei], yb)
+            class_ids[u] = self.outcomes_for(yb, aux, sit)
+        return class_ids[inverse]
+
+    def level(self, frontier: np.ndarray) -> np.ndarray:
+        """Every cycle from the nodes of ``frontier``; returns the new nodes."""
+        pr, size = self.pr, self.size
+        post, node, event, taken = self.events_from(frontier)
+        cls = self.classify(post, node, event)
+        n_out = np.array(self.n_out, dtype=np.int64)
+        self.cycles += int(n_out[cls].sum())
+        # one expansion per distinct (state, class); the first occurrence is the parent
+        _, keep, rep = np.unique(post * len(self.n_out) + cls, return_index=True, return_inverse=True)
+        by_position = np.argsort(keep)
+        keep = keep[by_position]
+        position = np.empty_like(by_position)
+        position[by_position] = np.arange(by_position.size)
+        rep = position[rep.ravel()]  # the kept entry that stands for each (state, class)
+        sources, taken_all, events_all = node, taken, event
+        post, node, event, cls = post[keep], node[keep], event[keep], cls[keep]
+        # one entry per (state, outcome of its class)
+        reps = n_out[cls]
+        entry = np.repeat(np.arange(post.size), reps)
+        within = np.arange(entry.size) - np.repeat(np.cumsum(reps) - reps, reps)
+        offsets = np.concatenate(([0], np.cumsum(n_out)))
+        oid = np.array(self.flat, dtype=np.int64)[offsets[cls][entry] + within]
+        targets, fallback, outside, aux_after, requests = self.arrays.update(self.outcomes)
+        post, node, event, targets = post[entry], node[entry], event[entry], targets[oid]
+        cur, refused, edge_bad, edge_events, middle_bad = write(pr, post, targets)
+        ok = cur >= 0
+        final = np.where(ok, cur, 0)
+        violation = ok & pr.illegal[final]
+        middle_bad &= ~violation & ~pr.illegal[post]  # reported as a violation / before the write
+        shown = np.where(ok, final, post)
+
+        def edge_ids(i: int) -> tuple[str, ...]:
+            return tuple(dict.fromkeys(c for ev in edge_events for c in pr.sup.forbidding(ev, pr.plant.local(int(post[i])))))
+
+        self.record(FindingKind.VIOLATION, violation, final, node, event, oid, shown,
+                    lambda i: pr.violated(int(final[i])))
+        self.record(FindingKind.EDGE, edge_bad, post, node, event, oid, shown, edge_ids)
+        for kind, mask in ((FindingKind.REFUSED, refused), (FindingKind.FALLBACK, fallback[oid]),
+                           (FindingKind.OUTSIDE_CARE, outside[oid]), (FindingKind.TRANSIENT, middle_bad)):
+            self.record(kind, mask, post, node, event, oid, shown)
+        if pr.controlled and oid.size:
+            dist = (requests[oid] != targets).sum(axis=1)
+            self.corrected += int((dist > 0).sum())
+            self.max_distance = max(self.max_distance, int(dist.max()))
+        if self.track:
+            self.edges((sources, taken_all, events_all), rep, entry[ok], aux_after[oid][ok] * size + final[ok],
+                       oid[ok], keep.size)
+        return self.admit(aux_after[oid][ok] * size + final[ok], node[ok], event[ok], oid[ok])
+
+    def edges(self, entries: tuple[np.ndarray, np.ndarray, np.ndarray], rep: np.ndarray, succ_rep: np.ndarray,
+              succ_key: np.ndarray, succ_oid: np.ndarray, reps: int) -> None:
+        """Every edge of the product (for --progress): each (node, events) entry gets the
+        successors (and outcomes) of the entry that stands for its (state, class)."""
+        sources, taken, events = entries
+        counts = np.bincount(succ_rep, minlength=reps)
+        starts = np.cumsum(counts) - counts
+        by_rep = np.argsort(succ_rep, kind="stable")
+        n = counts[rep]
+        pick = np.repeat(starts[rep], n) + np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)
+        self.edge_parts.append((np.repeat(sources, n), succ_key[by_rep][pick], np.repeat(taken, n),
+                                np.repeat(events, n), succ_oid[by_rep][pick]))
+
+    def admit(self, keys: np.ndarray, node: np.ndarray, event: np.ndarray, oid: np.ndarray) -> np.ndarray:
+        """The nodes of ``keys`` not seen before (their first occurrence is the parent)."""
+        size = self.size
+        uk, first = np.unique(keys, return_index=True)
+        fresh = np.ones(uk.size, dtype=bool)
+        uk_aux = uk // size
+        for a in np.unique(uk_aux).tolist():
+            sel = uk_aux == a
+            fresh[sel] = ~self.seen_array(a)[uk[sel] % size]
+        new: list[int] = []
+        if self.prelude is not None and not self.reentered and self.prelude in uk:
+            self.reentered = True  # a scan gives the fresh instance back: a state like any other
+            new.append(self.prelude)
+        for k, i in zip(uk[fresh].tolist(), first[fresh].tolist()):
+            if self.states >= self.max_states:
+                self.complete = False
+                break
+            self.admit_one(k)
+            self.parent[k] = (int(node[i]), self.events[int(event[i])], int(oid[i]))
+            new.append(k)
+        return np.array(new, dtype=np.int64)
+
+    def run(self) -> None:
+        frontier = np.array([self.key0], dtype=np.int64)
+        if self.prelude is not None:  # the power-up scan reads the plant's initial state: no event before it
+            k, self.k = self.k, 0
+            frontier = self.level(frontier)
+            self.powered = set(frontier.tolist())
+            self.k, self.prelude_cycles, self.prelude_corrected = k, self.cycles, self.corrected
+        while frontier.size and self.complete:
+            frontier = self.level(frontier)
+
+    @property
+    def states(self) -> int:
+        """The nodes found: the closed loop after a PLC cycle (a program's fresh instance, the
+        PLC before its power-up scan, is the traces' first row, not a state unless a scan gives
+        it back)."""
+        return len(self.seen_keys) - (self.prelude is not None and not self.reentered)
+
+    @property
+    def plant_states(self) -> int:
+        """The plant states of :attr:`states`."""
+        hidden = self.prelude if self.prelude is not None and not self.reentered else None
+        return len({k % self.size for k in self.seen_keys if k != hidden})
+
+    @property
+    def loop_cycles(self) -> tuple[int, int]:
+        """The cycles explored from the states, and those where the filter corrects the
+        requests (the power-up cycle is not one of them; its findings are findings)."""
+        return self.cycles - self.prelude_cycles, self.corrected - self.prelude_corrected
+
+    # ------------------------------------------------------------------ traces
+    def trace(self, key: int) -> list[TraceRow]:
+        """The shortest path of cycles from the initial node to ``key``."""
+        rows = []
+        while key in self.parent:
+            pk, ev, g = self.parent[key]
+            ev = POWER_UP if key in self.powered else ev
+            rows.append(trace_row(self.pr, self.outcomes[g], ev, key % self.size, self.aux_list[key // self.size][2]))
+            key = pk
+        rows.append(TraceRow("initial", self.pr.label(key % self.size),
+                             situation_text(self.aux_list[key // self.size][2]), (), ()))
+        return rows[::-1]
+
+    def findings(self) -> dict[FindingKind, Finding]:
+        out: dict[FindingKind, Finding] = {}
+        if self.pr.illegal[self.key0 % self.size]:
+            out[FindingKind.VIOLATION] = Finding(FindingKind.VIOLATION, self.pr.violated(self.key0 % self.size),
+                                       tuple(self.trace(self.key0)), len(self.counts[FindingKind.VIOLATION]))
+        for kind, (node, ev, g, code, ids) in self.first.items():
+            if kind in out:
+                continue
+            rows = self.trace(node)
+            if g < 0:  # the plant's event alone
+                rows.append(TraceRow(ev, self.pr.label(code), rows[-1].situation, (), (), "before the PLC writes",
+                                     False))
+            else:
+                oc = self.outcomes[g]
+                rows.append(trace_row(self.pr, oc, ev, code, self.aux_list[oc.aux][2], _NOTES[kind]))
+            out[kind] = Finding(kind, ids, tuple(rows), len(self.counts[kind]))
+        if self.first_outside_sup is not None:
+            key = self.first_outside_sup
+            rows = self.trace(key)
+            ids = tuple(self.pr.sup.threatened(self.pr.plant.local(key % self.size)))
+            rows[-1] = dataclasses.replace(rows[-1], note="; ".join(
+                n for n in (rows[-1].note, "outside SUP: uncontrollable events can lead to " + ", ".join(ids)) if n))
+            out[FindingKind.OUTSIDE_SUP] = Finding(FindingKind.OUTSIDE_SUP, ids, tuple(rows), len(self.outside_sup))
+        return {k: out[k] for k in FindingKind if k in out}

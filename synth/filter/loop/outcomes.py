@@ -1,0 +1,119 @@
+"""The outcomes of one PLC cycle in ``synth filter verify``'s exploration: an outcome
+(the orders written, the memory after the cycle, the flags), the arrays over every
+outcome found so far, the lane masks of :meth:`~synth.filter.cycle.FilterCycle.lanes`
+as numpy arrays, the Grafcet's reaction to a cycle's events and a trace row.
+
+Example
+-------
+>>> unpack(0b0110, 4).tolist(), lane_bits(1, 4)
+([False, True, True, False], 12)
+>>> arrays = OutcomeArrays(2)
+>>> oc = Outcome((True, False), 0, False, False, (True, True), ("K",))
+>>> targets, fallback, outside, aux, requests = arrays.update([oc])
+>>> targets.tolist(), requests.tolist()
+([[True, False]], [[True, True]])
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Sequence
+
+import numpy as np
+
+from synth.filter.loop.verification import TraceRow
+from synth.logic.events import Event, EventKind
+
+TYPE_CHECKING = False
+if TYPE_CHECKING:
+    from synth.filter.loop.product import Product
+
+__all__ = ["Outcome", "OutcomeArrays", "unpack", "lane_bits", "react", "situation_text", "trace_row"]
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """What one cycle does to the product; the requests are one witness (not compared:
+    request vectors that give the same outputs, memory and flags are one outcome)."""
+
+    targets: tuple[bool, ...]  # every plant order, in plant output order
+    aux: int
+    fallback: bool
+    outside_care: bool
+    requests: tuple[bool, ...] = field(compare=False)  # every plant order's request
+    violated: tuple[str, ...] = field(compare=False)  # filter constraints the requests violate
+
+
+def unpack(mask: int, count: int) -> np.ndarray:
+    """A lane mask as a bool array (lane j at index j)."""
+    raw = np.frombuffer(mask.to_bytes((count + 7) // 8, "little"), dtype=np.uint8)
+    return np.unpackbits(raw, bitorder="little")[:count].astype(bool)
+
+
+def lane_bits(i: int, count: int) -> int:
+    """The lanes where free name ``i`` is true (bit i of the lane number)."""
+    return sum(1 << j for j in range(count) if (j >> i) & 1)
+
+
+class OutcomeArrays:
+    """Arrays over the outcomes found so far, extended with the new ones only."""
+
+    def __init__(self, width: int) -> None:
+        self.targets = np.zeros((0, width), dtype=bool)
+        self.fallback = np.zeros(0, dtype=bool)
+        self.outside = np.zeros(0, dtype=bool)
+        self.aux = np.zeros(0, dtype=np.int64)
+        self.requests = np.zeros((0, width), dtype=bool)
+
+    def update(self, outcomes: Sequence[Outcome]
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        new = outcomes[self.aux.size:]
+        if new:
+            self.requests = np.concatenate((self.requests, np.array([o.requests for o in new], dtype=bool)
+                                            .reshape(len(new), self.requests.shape[1])))
+            self.targets = np.concatenate((self.targets, np.array([o.targets for o in new], dtype=bool)
+                                           .reshape(len(new), self.targets.shape[1])))
+            self.fallback = np.concatenate((self.fallback, np.array([o.fallback for o in new], dtype=bool)))
+            self.outside = np.concatenate((self.outside, np.array([o.outside_care for o in new], dtype=bool)))
+            self.aux = np.concatenate((self.aux, np.array([o.aux for o in new], dtype=np.int64)))
+        return self.targets, self.fallback, self.outside, self.aux, self.requests
+
+
+def react(pr: "Product", sit: Any, events: tuple[str, ...], ybits: int) -> Any:
+    """The Grafcet's stable situation after a cycle's ``events``: a timer, or plant events
+    (none, one, or up to ``--events-per-cycle``); the Grafcet reacts to each event on one
+    of its inputs in turn, with the inputs as they were just after it. An ST program
+    (``--control``) runs one scan on the inputs after the events."""
+    values = {n: bool((ybits >> i) & 1) for i, n in enumerate(pr.ynames)}
+    inputs = {n: values[n] for n in pr.grafcet_inputs}
+    if pr.control is not None:  # one scan on the inputs after every event (or a timer)
+        return pr.control.react(sit, events, inputs)
+    assert pr.machine is not None
+    if len(events) == 1 and Event(events[0]).kind is EventKind.TIMER:
+        return pr.machine.fire_timer(sit, events[0], inputs)
+    after: list[dict[str, bool]] = []
+    for e in reversed(events):  # the inputs after each event, from the last one back
+        after.append(dict(inputs))
+        ev = Event(e)
+        if ev.name in inputs:
+            inputs[ev.name] = not ev.rising
+    for e, seen in zip(events, reversed(after)):
+        if Event(e).name in seen:
+            sit = pr.machine.react_event(sit, Event(e), seen)[0]
+    return sit
+
+
+def situation_text(sit: Any) -> str:
+    return "" if sit is None else sit.text()
+
+
+def trace_row(pr: "Product", oc: Outcome, event: str, code: int, sit: Any, note: str = "") -> TraceRow:
+    """One cycle of a trace: its events, the plant state after the write, the requests and orders."""
+    req = tuple(o for o, v in zip(pr.orders, oc.requests) if v)
+    out = tuple(o for o, v in zip(pr.orders, oc.targets) if v)
+    extra = []
+    if oc.violated:
+        extra.append("requests violate " + ", ".join(oc.violated))
+    if note:
+        extra.append(note)
+    return TraceRow(event, pr.label(code), situation_text(sit), req, out, "; ".join(extra))

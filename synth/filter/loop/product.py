@@ -1,0 +1,155 @@
+"""The closed loop's parts for ``synth filter verify``: the plant of a rules file as flat
+arrays over its state codes (variables, controllable and uncontrollable moves), the
+filter cycle, the controller that makes the requests (a Grafcet, an ST program of
+:mod:`~synth.filter.loop.control_st`, or none: any control), and the constraints' grids
+from :class:`~synth.sup.supervisor.Supervisor` (illegal states, states outside SUP,
+edge events forbidden).
+
+Example
+-------
+>>> from synth.plant.composition import _plants
+>>> from synth.filter.from_rules import skeleton
+>>> sk = skeleton(_plants("tri.rules"), _plants("F.filter"))  # the text only: nothing is written
+>>> pr = Product(sk.filter, _plants("tri.rules"), None, Algorithm.ALGEBRAIC, Mode.SUPERVISOR, False)
+>>> pr.size == pr.plant.size, bool(pr.illegal[pr.plant.initial_index])
+(True, False)
+"""
+
+from __future__ import annotations
+
+from typing import Any, Mapping
+
+import numpy as np
+
+from synth.errors import InputError, LimitExceeded
+from synth.filter.cycle import Algorithm, FilterCycle, Mode
+from synth.filter.language import Filter
+from synth.logic.events import Event
+
+TYPE_CHECKING = False  # typing.TYPE_CHECKING: the Grafcet modules load only with --grafcet
+if TYPE_CHECKING:
+    from synth.grafcet.language import Grafcet
+    from synth.grafcet.machine import GrafcetMachine
+    from synth.filter.loop.control_st import StControl, StSource
+    from synth.filter.loop.control_st import StControl
+
+__all__ = ["PLANT_LIMIT", "Product"]
+
+PLANT_LIMIT = 20_000_000
+"""verify keeps flat arrays over the plant's states; above this many it stops."""
+
+
+class Product:
+    """The filter, the plant of ``rules_path`` and the Grafcet of ``grafcet_path`` (or
+    none: any control), checked against each other and laid out as arrays."""
+
+    def __init__(self, f: Filter, rules_path: str, grafcet_path: str | None, algorithm: Algorithm,
+                 mode: Mode, atomic: bool, control: StSource | None = None) -> None:
+        from synth.plant.composition import plant
+        from synth.plant.rules_check import load_rules
+        from synth.sup.supervisor import Supervisor
+
+        rs = load_rules(rules_path)
+        p = plant(rs)
+        if p.size > PLANT_LIMIT:
+            raise LimitExceeded(f"the plant of {rules_path} has {p.size} states; verify keeps arrays over the "
+                                f"plant's states and stops above {PLANT_LIMIT}")
+        self.plant, self.rules = p, rs
+        self.cycle = FilterCycle(f, algorithm, mode)
+        self.filter, self.atomic = f, atomic
+        for kind, names, have in (("input", f.inputs, p.inputs), ("output", f.outputs, p.outputs)):
+            missing = [n for n in names if n not in have]
+            if missing:
+                raise InputError(f"{f.file}: the filter's {kind} {', '.join(missing)} is not an "
+                                 f"{kind} of the plant {rules_path}", None)
+        self.machine: GrafcetMachine | None = None
+        self.grafcet: Grafcet | None = None
+        if grafcet_path is not None:
+            from synth.grafcet.language_check import load_grafcet
+            from synth.grafcet.machine import GrafcetMachine
+
+            self.grafcet = load_grafcet(grafcet_path, inputs=rs.inputs, outputs=rs.outputs)
+            self.machine = GrafcetMachine(self.grafcet)
+        self.control: StControl | None = None
+        if control is not None:
+            from synth.filter.loop.control_st import StControl
+
+            self.control = StControl(control, rs.inputs, p.outputs, f.outputs, f.file)
+        # the inputs the controller reads: the Grafcet's, or the program's VAR_INPUTs (plant names)
+        self.grafcet_inputs: tuple[str, ...] = () if self.grafcet is None else tuple(self.grafcet.inputs)
+        if self.control is not None:
+            self.grafcet_inputs = tuple(self.control.inputs)
+        self.steps: tuple[str, ...] = () if self.grafcet is None else tuple(s.name for s in self.grafcet.steps)
+        observable = {f"X{s}" for s in self.steps}
+        self.program_observers = tuple(d.name for d in f.observers if d.definition is None)
+        for d in f.observers:
+            if self.control is not None and d.definition is None and d.name.upper() not in self.control.observable:
+                raise InputError(f"observer {d.name} has no value in verify: define it (`observer {d.name} := "
+                                 f"EXPR`) or make it a BOOL variable of PROGRAM {self.control.program}", d.loc)
+            if self.control is None and d.name not in observable and d.definition is None:
+                raise InputError(f"observer {d.name} has no value in verify: define it (`observer {d.name} := "
+                                 "EXPR`) or make it a step variable of the --grafcet Grafcet", d.loc)
+        size, shape = p.size, p.shape
+        self.size = size
+        self.val = {v: np.broadcast_to(p.values(v), shape).ravel().copy() for v in p.variables}
+        self.orders = p.outputs
+        self.passthrough = tuple(o for o in p.outputs if o not in f.outputs)
+        self.held = {v.name: v.initial for v in rs.variables if v.held}  # requested at their held value
+        self.ynames = tuple(dict.fromkeys([*f.inputs, *self.grafcet_inputs]))
+        if len(self.ynames) > 40:
+            raise LimitExceeded(f"{len(self.ynames)} inputs are read; verify codes an input vector in 40 bits")
+        self.toggle: dict[str, np.ndarray] = {}
+        self.uncontrollable: list[tuple[str, np.ndarray]] = []
+        moves: dict[str, np.ndarray] = {}  # uncontrollable event -> its successor array, in first-seen order
+        for t, src, dst in p.transition_arrays():
+            table = self.toggle if t.controllable else moves
+            arr = table.get(t.event)
+            if arr is None:  # one array per event (not one per local transition)
+                arr = table[t.event] = np.full(size, -1, dtype=np.int64)
+            arr[src] = dst
+        self.uncontrollable.extend(moves.items())
+        for z in self.orders:
+            for edge in (Event.rise(z), Event.fall(z)):
+                self.toggle.setdefault(edge, np.full(size, -1, dtype=np.int64))
+        self.sup = Supervisor(p, rs.constraints)  # its grids: no SUP exploration
+        self.illegal: np.ndarray = self.sup.illegal.ravel()
+        self.outside_sup: np.ndarray = self.sup.removed.ravel()
+        self.forbid: dict[str, np.ndarray] = {ev: g.ravel() for ev, g in self.sup.forbid.items()}
+        self.used_index = [self.cycle.remembered.index(n) for n in self.cycle.used]
+
+    @property
+    def controlled(self) -> bool:
+        """A controller (a Grafcet or an ST program) makes the requests: it has a state."""
+        return self.machine is not None or self.control is not None
+
+    def initial_situation(self, inputs: Mapping[str, bool]) -> Any:
+        """The controller's state at start (``inputs``: the plant's initial inputs)."""
+        if self.control is not None:
+            return self.control.initial()
+        if self.machine is not None:
+            return self.machine.initial({n: inputs[n] for n in self.grafcet_inputs})
+        return None
+
+    def timers(self, sit: Any) -> tuple[str, ...]:
+        """The controller's timers that may elapse in the cycle (instead of plant events)."""
+        if self.control is not None:
+            return self.control.timers(sit)
+        return self.machine.timers(sit) if self.machine is not None else ()
+
+    def requested(self, sit: Any, values: Mapping[str, bool]) -> tuple[dict[str, bool], dict[str, bool]] | None:
+        """The controller's observers (step variables, program variables) and its requests
+        for every plant order, in ``sit`` after its reaction to ``values`` (None: any control)."""
+        if self.control is not None:
+            req = self.control.orders(sit)
+            return (self.control.observe(sit, self.program_observers),
+                    {o: self.held.get(o, req.get(o, False)) for o in self.orders})
+        if self.machine is None:
+            return None
+        orders = self.machine.orders(sit, {n: values[n] for n in self.grafcet_inputs})
+        return {f"X{s}": s in sit.steps for s in self.steps}, {o: self.held.get(o, o in orders) for o in self.orders}
+
+    def label(self, code: int) -> str:
+        return self.plant.label(self.plant.local(code))
+
+    def violated(self, code: int) -> tuple[str, ...]:
+        return tuple(self.sup.violated(self.plant.local(code)))

@@ -1,0 +1,290 @@
+"""Findings in one pass: the first node and the trace of every finding at once (issue 25).
+
+:meth:`StepReach.first_node <synth.symbolic.steps.reach.StepReach.first_node>` and
+:meth:`~synth.symbolic.steps.reach.StepReach.shortest_trace` answer for one target: a
+backward layering through the onion rings, then a greedy walk forward. A failing model
+has hundreds of findings (``branches_3x6``: 300 prohibited situations), and one
+layering each made the findings 80 % of the run. Here the targets are numbered and the
+number is written in a few *tag* variables at the top of the BDD order, so one BDD
+``L(t, X, x)`` holds every target's layer at once (a tag selects its own), and:
+
+- **one backward layering** from every target at its own depth: a pre-image per ring for
+  all the targets (``pre`` does not touch the tags);
+- **one forward greedy pass**: per ring and move, one image of the tagged current sets;
+  the tags that reach their layer by a move are read from that image, and each tag
+  takes its smallest move (the per-target order, ties as :meth:`StepReach._greedy`:
+  the last move of an order key); the tags' paths are read from the chosen tag sets;
+- **traces** (event order): the same two passes from the single target nodes, then the
+  concrete nodes one ring back at a time for every trace at once (a pre-image per
+  event used at that step), the smallest node per tag when a tag has several.
+
+Each tag's result is the per-target search's: layers, choices and picks are the same
+sets, only computed together. Tags sit above every other variable, so a tagged BDD is
+the targets' BDDs under a small decision tree on the tag bits, sharing their common
+parts; reading one target back (:meth:`Tags.split`) walks that tree, no BDD operation.
+
+Example
+-------
+>>> from synth.plant.composition import _plants
+>>> from synth.validation.result import load_model
+>>> from synth.grafcet.machine import GrafcetMachine
+>>> from synth.symbolic.steps.sync import step_sync
+>>> from synth.symbolic.steps.reach import StepReach
+>>> rs, p, g = load_model(_plants("../tests/data/home/production_loop.g7"), _plants("../tests/data/home/cylinder.rules"))
+>>> r = StepReach(step_sync(p, rs.constraints, GrafcetMachine(g)))
+>>> sets = [r.s.nodes & ~r.s.initial, r.s.initial]
+>>> f = Findings(r, sets)
+>>> f.firsts == [r.first_node(u) for u in sets]
+True
+>>> keys = r.listed(r.s.nodes)
+>>> f.traces(keys) == [r.shortest_trace(k) for k in keys]
+True
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Callable, Sequence
+
+from synth.logic.bdd import Engine, Function
+from synth.logic.events import Event
+from synth.symbolic.explicit import Key, PathKey
+from synth.symbolic.situations.reach import Path, path_key
+from synth.symbolic.relation import Move
+from synth.symbolic.steps.reach import Order, StepReach
+
+if TYPE_CHECKING:  # pragma: no cover
+    from synth.symbolic.ties import Settled
+
+__all__ = ["Tags", "Findings"]
+
+
+class Tags:
+    """``n`` targets numbered in ``bits`` variables ``#T0``, ``#T1``, … at the top of the
+    order (declared once per manager, reused by later batches).
+
+    >>> e = Engine(["x"])
+    >>> t = Tags(e, 3)
+    >>> f = (t.cube(0) & e.var("x")) | (t.cube(2) & ~e.var("x"))
+    >>> t.split(f) == {0: e.var("x"), 2: ~e.var("x")}
+    True
+    """
+
+    def __init__(self, engine: Engine, n: int) -> None:
+        self.engine = engine
+        self.bits = max(1, (n - 1).bit_length())
+        self.inner = [engine.declare_top(f"#T{i}") for i in range(self.bits)]
+        self._cubes: dict[int, Function] = {}
+
+    def cube(self, j: int) -> Function:
+        """The tag of target ``j``."""
+        hit = self._cubes.get(j)
+        if hit is None:
+            bdd = self.engine.bdd
+            hit = self._cubes[j] = bdd.cube({v: bool(j >> i & 1) for i, v in enumerate(self.inner)})
+        return hit
+
+    def split(self, f: Function) -> dict[int, Function]:
+        """Per tag present in ``f`` (tags on top of every variable of ``f``), its function."""
+        bdd = self.engine.bdd
+        false = bdd.false
+        levels = sorted((bdd.level_of_var(v), i) for i, v in enumerate(self.inner))
+        out: dict[int, Function] = {}
+        work = [(f, 0, 0)]  # a loop, not a recursive closure: a closure's cycle would hold BDD nodes
+        while work:
+            g, depth, value = work.pop()
+            if g == false:
+                continue
+            if depth == len(levels):
+                out[value] = g
+                continue
+            level, bit = levels[depth]
+            lo = hi = g
+            if g != bdd.true and g.level == level:
+                lo, hi = g.low, g.high
+                if g.negated:
+                    lo, hi = ~lo, ~hi
+            work += [(lo, depth + 1, value), (hi, depth + 1, value | 1 << bit)]
+        return dict(sorted(out.items()))
+
+
+class _Batch:
+    """The tagged layers and greedy walk of :class:`StepReach`, for many targets."""
+
+    def __init__(self, r: StepReach, targets: Sequence[Function]) -> None:
+        self.r = r
+        self.s = r.s
+        self.false = r.false
+        self.tags = Tags(self.s.engine, len(targets))
+        bdd = self.s.engine.bdd
+        self._next_cube = bdd.cube(set(self.s._next))
+        self.depths: list[int] = []
+        by_depth: dict[int, Function] = {}
+        for j, u in enumerate(targets):
+            d = r.depth(u)
+            if d is None:
+                raise ValueError("no candidate is reachable")
+            self.depths.append(d)
+            by_depth[d] = by_depth.get(d, self.false) | (self.tags.cube(j) & u & self.s.rings[d])
+        self.targets = by_depth
+        self.layers = self._layers(by_depth, max(self.depths, default=0))
+
+    def _layers(self, by_depth: dict[int, Function], depth: int) -> list[Function]:
+        """Per ring k, each tag's ring-k nodes from which its target is reached at its depth."""
+        s = self.s
+        every = s.engine.disjunction(e for _, e in s.links)  # one relation: a pre-image is one product
+        layers = [self.false] * (depth + 1)
+        layers[depth] = by_depth.get(depth, self.false)
+        for k in range(depth - 1, -1, -1):
+            before = s.engine.and_exists(every, s._primed(layers[k + 1]), s._next)
+            layers[k] = (before & s.rings[k]) | by_depth.get(k, self.false)
+        return layers
+
+    def greedy(self, order: Callable[[Move], Order], settled: "Settled | None" = None,
+               ) -> tuple[list[Function], list[list[tuple[Order, Event, Function]]], list[dict[int, int]]]:
+        """Forward through the layers, each tag taking its smallest move (by ``order``):
+        the tagged current sets per ring, per step the (order, event, tags) chosen, and
+        with ``settled`` each tag's set narrowed at each ring to the node the explicit
+        engine enters first, with its rank (:meth:`StepReach.first_of`)."""
+        s, false, exists = self.s, self.false, self.s.engine.bdd.apply
+        current = self.layers[0]
+        ranks: list[dict[int, int]] = []
+        if settled is not None:
+            current = self._first(current, None, settled, ranks)
+        chosen = [current]
+        steps: list[list[tuple[Order, Event, Function]]] = []
+        for k in range(1, len(self.layers)):
+            layer = self.layers[k]
+            target = s._primed(layer)
+            options: dict[Order, list[tuple[Event, Function, Function]]] = {}
+            for m, e in s.edges:
+                v = s.image(current, m, e) & target
+                if v != false:
+                    options.setdefault(order(m), []).append((m.event, v, exists("exists", self._next_cube, v)))
+            taken = nxt = false
+            record: list[tuple[Order, Event, Function]] = []
+            for key in sorted(options):
+                # per tag, the last move of this key that reaches its layer (as StepReach._greedy)
+                later = false
+                for event, v, tags in reversed(options[key]):
+                    sel = tags & ~later & ~taken
+                    later |= tags
+                    if sel != false:
+                        nxt |= v & sel
+                        record.append((key, event, sel))
+                taken |= later
+            current = s.unprimed(nxt)
+            if settled is not None:
+                current = self._first(current, (chosen[-1], record), settled, ranks)
+            chosen.append(current)
+            steps.append(record)
+        return chosen, steps, ranks
+
+    def _first(self, current: Function, via: "tuple[Function, list[tuple[Order, Event, Function]]] | None",
+               settled: "Settled", ranks: list[dict[int, int]]) -> Function:
+        """Each tag's part of ``current`` narrowed to its first node (as
+        :meth:`StepReach.first_of`; ``via``: the previous ring's tagged nodes and the moves
+        the tags took), each tag's rank appended to ``ranks``."""
+        r, tags = self.r, self.tags
+        arcs = {m.event: (m, e) for m, e in self.s.edges}
+        before: dict[int, Function] = {}
+        moved: dict[int, Event] = {}
+        if via is not None:
+            before = tags.split(via[0])
+            for _, event, sel in via[1]:
+                moved.update((j, event) for j in tags.split(sel))
+        memo: dict[tuple[Function | None, Event | None, Function], tuple[Function, int]] = {}
+        out, rank = self.false, {}
+        for j, u in tags.split(current).items():
+            key = (before.get(j), moved.get(j), u)
+            hit = memo.get(key)
+            if hit is None:
+                parent: tuple[Key, Move, Function] | None = None
+                if via is not None:
+                    m, e = arcs[moved[j]]
+                    parent = (r.pick(before[j]), m, e)
+                hit = memo[key] = r.first_of(u, parent, settled)
+            out |= tags.cube(j) & hit[0]
+            rank[j] = hit[1]
+        ranks.append(rank)
+        return out
+
+    def paths(self, steps: list[list[tuple[Order, Event, Function]]]) -> list[list[tuple[Order, Event]]]:
+        """Each tag's (order, event) per step, read from the chosen tag sets."""
+        out: list[list[tuple[Order, Event]]] = [[] for _ in self.depths]
+        for record in steps:
+            for key, event, sel in record:
+                for j in self.tags.split(sel):
+                    out[j].append((key, event))
+        return out
+
+
+class Findings:
+    """The first node of every set of ``sets`` (:attr:`firsts`, as
+    :meth:`StepReach.first_node`), then the traces to nodes (:meth:`traces`, as
+    :meth:`StepReach.shortest_trace`): a node that is the whole target of a set at its
+    depth has that set's layers, which its trace reuses."""
+
+    def __init__(self, r: StepReach, sets: Sequence[Function]) -> None:
+        self.r = r
+        self.firsts: list[tuple[Key, int, PathKey]] = []
+        self._whole: dict[Key, int] = {}  # node -> a set whose target at its depth is that node alone
+        self._batch: _Batch | None = None
+        if not sets:
+            return
+        b = self._batch = _Batch(r, sets)
+        chosen, steps, ranks = b.greedy(r._key, r.settled)
+        paths = b.paths(steps)
+        ends: dict[int, dict[int, Function]] = {}
+        s = r.s
+        for j, d in enumerate(b.depths):
+            if d not in ends:
+                ends[d] = b.tags.split(chosen[d])
+            key = r.pick(ends[d][j])
+            self.firsts.append((key, d, path_key([k for k, _ in paths[j]], [rk[j] for rk in ranks[:d + 1]])))
+            if key not in self._whole and s.count(sets[j] & s.rings[d], s._current) == 1:
+                self._whole[key] = j
+
+    def traces(self, keys: Sequence[Key]) -> list[Path]:
+        """The trace to every node of ``keys``."""
+        found: dict[Key, Path] = {}
+        reused = {self._whole[k]: k for k in keys if k in self._whole}
+        if reused:
+            assert self._batch is not None
+            found.update(_traces(self.r, self._batch, reused))
+        rest = [k for k in dict.fromkeys(keys) if k not in found]
+        if rest:
+            found.update(_traces(self.r, _Batch(self.r, [self.r.cube(k) for k in rest]), dict(enumerate(rest))))
+        return [found[k] for k in keys]
+
+
+def _traces(r: StepReach, b: _Batch, wanted: dict[int, Key]) -> dict[Key, Path]:
+    """The traces of the tags ``wanted`` of ``b`` (each the tag of one node, its target):
+    the events by the greedy walk in event order, then the nodes one ring back at a time
+    for every trace at once."""
+    s, false = r.s, r.false
+    chosen, steps, _ = b.greedy(lambda m: m.event)
+    mask = s.engine.disjunction(b.tags.cube(j) for j in wanted)
+    paths = b.paths(steps)
+    arcs = {m.event: e for m, e in s.edges}
+    nodes: dict[int, list[Key]] = {j: [k] for j, k in wanted.items()}
+    memo: dict[Function, Key] = {}
+    here = false  # per tag, its node at ring k + 1
+    for k in range(len(b.layers) - 2, -1, -1):
+        here |= b.targets.get(k + 1, false) & mask
+        primed = s._primed(here)
+        before = false
+        for _, event, sel in steps[k]:
+            if (sel & mask) != false:
+                before |= s.engine.and_exists(arcs[event], primed & sel, s._next)
+        before &= chosen[k]
+        several = picked = false  # tags with several candidate nodes, and the one each picked
+        for j, u in b.tags.split(before).items():
+            key = memo.get(u)
+            if key is None:
+                key = memo[u] = r.pick(u)
+            nodes[j].append(key)
+            if r.cube(key) != u:
+                several |= b.tags.cube(j)
+                picked |= b.tags.cube(j) & r.cube(key)
+        here = (before & ~several) | picked
+    return {k: Path(tuple(reversed(nodes[j])), tuple(e for _, e in paths[j])) for j, k in wanted.items()}
