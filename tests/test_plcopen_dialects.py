@@ -650,3 +650,36 @@ def test_what_is_not_a_latch_or_a_blinker_is_located(old, new, first):
     with pytest.raises(InputError) as info:
         import_sfc(xml.replace(old, new).encode(), "l.xml")
     assert info.value.render().splitlines()[0] == first
+
+
+def _ide_sfc_with_priorities(first: str, second: str) -> bytes:
+    root = Path(__file__).resolve().parent / "data" / "codegen"
+    text = (root / "ide_sfc.xml").read_text()
+    assert text.count('<transition localId="17">') == 1 and text.count('<transition localId="18">') == 1
+    return (text.replace('<transition localId="17">', f'<transition localId="17" priority="{first}">')
+            .replace('<transition localId="18">', f'<transition localId="18" priority="{second}">').encode())
+
+
+def test_a_selection_divergence_honours_the_transitions_priorities():
+    # the right branch (guard) has priority 1, the left one (2s/XWait) priority 2: the PLC tests guard first
+    warnings: list[InputError] = []
+    text = import_sfc(_ide_sfc_with_priorities("2", "1"), "prio.xml", warnings=warnings)
+    assert "  transition Wait -> Up when (2s/XWait) & !(guard)\n  transition Wait -> Up when guard\n" in text
+    assert [w.render().splitlines()[0] for w in warnings] == [
+        "prio.xml:154:13: warning: a selection divergence: IEC 61131-3 SFC fires the true branch of highest priority "
+        "(smallest `priority`, then left to right), .g7 every true branch; the later branches' receptivities are "
+        "made exclusive"]
+    assert warnings[0].render().splitlines()[-1] == "  = note: Wait -> Up when (2s/XWait) & !(guard)"
+
+
+def test_equal_priorities_fall_back_to_the_branch_order():
+    text = import_sfc(_ide_sfc_with_priorities("1", "1"), "prio.xml", warnings=[])
+    assert "  transition Wait -> Up when 2s/XWait\n  transition Wait -> Up when (guard) & !(2s/XWait)\n" in text
+
+
+@pytest.mark.parametrize("bad", ["-1", "high", "1" * 30])
+def test_a_priority_that_is_not_a_number_is_located(bad):
+    with pytest.raises(InputError) as info:
+        import_sfc(_ide_sfc_with_priorities(bad, "1"), "prio.xml", warnings=[])
+    assert info.value.render().splitlines()[0] == (
+        f"prio.xml:160:13: error: transition priority '{bad[:40]}' is not a non-negative integer")

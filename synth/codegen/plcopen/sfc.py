@@ -162,6 +162,22 @@ def _x(el: Any) -> int:
         return 0
 
 
+NO_PRIORITY = 2 ** 63
+"""The rank of a transition without a ``priority`` attribute: after every written one."""
+
+
+def _priority(el: Any, src: Source) -> int:
+    """The ``priority`` attribute of an SFC ``<transition>`` (TC6: the smaller, the earlier a
+    selection divergence tests it), :data:`NO_PRIORITY` when absent; anything else than a
+    non-negative integer is a located error."""
+    text = el.get("priority")
+    if text is None:
+        return NO_PRIORITY
+    if not text.strip().isdigit() or len(text.strip()) > 18:
+        raise InputError(f"transition priority '{text[:40]}' is not a non-negative integer", src.at(el))
+    return int(text)
+
+
 def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
                read_action: Callable[..., list[str]], prefix: str = "") -> Chart:
     """The chart of ``pou`` (its SFC body ``sfc``); step names get ``prefix`` (several POUs
@@ -290,7 +306,7 @@ def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
 
     # transitions
     transitions: list[tuple[str, list[str], list[str], str, object]] = []
-    branches: dict[int, list[tuple[tuple[int, int], int]]] = {}  # selection divergence -> (order, transition)
+    branches: dict[int, list[tuple[tuple[int, int, int], int]]] = {}  # selection divergence -> (order, transition)
     warnings: list[InputError] = []
     for lid, el in elements.items():
         if kind(el) != "transition":
@@ -341,7 +357,7 @@ def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
         div = [(ref, c) for ref, c in producers(el) if kind(elements[ref]) == "selectionDivergence"]
         if len(div) == 1:
             branch = div[0][1].get("formalParameter", "")
-            key = (int(branch) if branch.strip().isdigit() else 10 ** 6, _x(el))
+            key = (_priority(el, src), int(branch) if branch.strip().isdigit() else 10 ** 6, _x(el))
             branches.setdefault(div[0][0], []).append((key, len(transitions) - 1))
         if sources and sources == targets and "↑" not in expr and "↓" not in expr:
             warnings.append(InputError(
@@ -362,14 +378,17 @@ def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
         if len(members) < 2 or written_by_synth:
             continue
         ranked = [i for _, i in sorted(members)]
+        prioritised = any(key[0] < NO_PRIORITY for key, _ in members)
         rewritten = []
         for k, i in enumerate(ranked[1:], 1):
             label, sources, targets, expr, el = transitions[i]
             before = " & ".join(f"!({transitions[j][3]})" for j in ranked[:k])
             transitions[i] = (label, sources, targets, f"({expr}) & {before}", el)
             rewritten.append(f"{' -> '.join([', '.join(sources), ', '.join(targets)])} when {transitions[i][3]}")
+        order = ("the true branch of highest priority (smallest `priority`, then left to right)" if prioritised
+                 else "the first true branch (left to right)")
         warnings.append(InputError(
-            "a selection divergence: IEC 61131-3 SFC fires the first true branch (left to right), .g7 every true "
+            f"a selection divergence: IEC 61131-3 SFC fires {order}, .g7 every true "
             "branch; the later branches' receptivities are made exclusive", src.at(elements[d]),
             severity=Severity.WARNING, notes=tuple(rewritten)))
 
