@@ -108,6 +108,15 @@ def test_list_pous_of_a_file_without_sfc():
     assert [p.imported for p in list_pous(xml.encode())] == [False, False, False]
 
 
+LAMP_HELD = [
+    "ide_sfc.xml:132:15: warning: an N action assigning LAMP in step Lamp is read as the continuous action "
+    "'LAMP if !bottom': LAMP falls when the step is left, while the PLC keeps its last value",
+    '  132 |               <action localId="12" qualifier="N">',
+    "      |               ^~~~~~~",
+    "  = note: to keep the continuous meaning on the PLC, add a P0 action 'LAMP := FALSE;' to step Lamp; for a stored "
+    "order, write S/R actions (set LAMP / reset LAMP)"]
+
+
 def test_a_selection_divergence_keeps_its_sfc_priority_with_a_warning():
     warnings: list[InputError] = []
     root = Path(__file__).resolve().parent / "data" / "codegen"
@@ -118,7 +127,7 @@ def test_a_selection_divergence_keeps_its_sfc_priority_with_a_warning():
         "right), .g7 every true branch; the later branches' receptivities are made exclusive",
         '  154 |             <selectionDivergence localId="16">',
         "      |             ^~~~~~~~~~~~~~~~~~~~",
-        "  = note: Wait -> Up when (guard) & !(2s/XWait)"]]
+        "  = note: Wait -> Up when (guard) & !(2s/XWait)"], LAMP_HELD]
 
 
 def test_a_level_self_loop_jump_is_imported_with_a_warning():
@@ -668,7 +677,7 @@ def test_a_selection_divergence_honours_the_transitions_priorities():
     assert [w.render().splitlines()[0] for w in warnings] == [
         "prio.xml:154:13: warning: a selection divergence: IEC 61131-3 SFC fires the true branch of highest priority "
         "(smallest `priority`, then left to right), .g7 every true branch; the later branches' receptivities are "
-        "made exclusive"]
+        "made exclusive", LAMP_HELD[0].replace("ide_sfc.xml", "prio.xml")]
     assert warnings[0].render().splitlines()[-1] == "  = note: Wait -> Up when (2s/XWait) & !(guard)"
 
 
@@ -683,3 +692,18 @@ def test_a_priority_that_is_not_a_number_is_located(bad):
         import_sfc(_ide_sfc_with_priorities(bad, "1"), "prio.xml", warnings=[])
     assert info.value.render().splitlines()[0] == (
         f"prio.xml:160:13: error: transition priority '{bad[:40]}' is not a non-negative integer")
+
+
+def test_an_n_assignment_with_its_p0_reset_is_continuous_without_a_warning():
+    """synth sfc writes `A if c` as N `A := c;` and P0 `A := FALSE;`: the pair is the continuous
+    action on the PLC too, so no warning; without the P0 body the PLC keeps A (warning above)."""
+    root = Path(__file__).resolve().parent / "data" / "codegen"
+    text = (root / "ide_sfc.xml").read_text()
+    p0 = ('<action localId="12" qualifier="N">',
+          '<action localId="90" qualifier="P0"><inline><ST><xhtml:p><![CDATA[LAMP := FALSE;]]></xhtml:p></ST>'
+          '</inline></action><action localId="12" qualifier="N">')
+    assert text.count(p0[0]) == 1
+    warnings: list[InputError] = []
+    g7 = import_sfc(text.replace(*p0).encode(), "ide_sfc.xml", warnings=warnings)
+    assert "LAMP if !bottom" in g7 and "reset LAMP on deactivation" not in g7
+    assert [w.render().splitlines()[0].split(": warning: ")[1][:24] for w in warnings] == ["a selection divergence: "]

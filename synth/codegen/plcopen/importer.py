@@ -32,6 +32,8 @@ grafcet G {
 
 from __future__ import annotations
 
+import contextvars
+
 import re
 from dataclasses import dataclass
 from typing import Any
@@ -44,7 +46,7 @@ from synth.codegen.plcopen.timers import prepare_scope
 from synth.codegen.plcopen.vendor import IecQualifier
 from synth.codegen.plcopen.tc6 import Qualifier
 from synth.codegen.plcopen.st_condition import PREDICATES, ExprReader, st_text
-from synth.errors import InputError, Location
+from synth.errors import InputError, Location, Severity
 from synth.version import version as synth_version
 
 __all__ = ["import_sfc", "list_pous", "PouSummary", "NAMESPACES"]
@@ -164,6 +166,8 @@ def import_sfc(data: bytes | str, file: str = "<xml>", pou: str | None = None,
         token = PREDICATES.set({})  # comparisons become declared predicates while a chart is read
         action_warnings: list[InputError] = []
         token2 = ACTION_WARNINGS.set(action_warnings)
+        held: list[tuple[str, str, Location]] = []
+        token4 = HELD.set(held)
         prefix = f"{p.get('name')}_" if several else ""
         scope = prepare_scope(p, s, q, src.at, prefix, src.text_at)
         token3 = DATA.set(scope)
@@ -173,7 +177,8 @@ def import_sfc(data: bytes | str, file: str = "<xml>", pou: str | None = None,
             PREDICATES.reset(token)
             ACTION_WARNINGS.reset(token2)
             DATA.reset(token3)
-        charts[-1].warnings.extend(action_warnings + scope.warnings)
+            HELD.reset(token4)
+        charts[-1].warnings.extend(action_warnings + scope.warnings + _held_warnings(charts[-1], held))
         charts[-1].internals = scope.declarations()
         charts[-1].outputs[:] = [o for o in charts[-1].outputs if o.upper() not in scope.used]
         charts[-1].outputs.extend(n for n in [*scope.action_refs, *scope.globals_out.values(), *scope.inputs_out.values()]
@@ -263,6 +268,30 @@ def _g7_text(charts: list[Chart], file: str, several: bool) -> str:
     return "\n".join(lines) + "\n"
 
 
+HELD: contextvars.ContextVar[list[tuple[str, str, Location]] | None] = contextvars.ContextVar("HELD", default=None)
+"""While a chart is read: the ``N`` actions ``X := c;`` read as ``X if c`` (step, action, where)."""
+
+
+def _held_warnings(chart: Chart, held: list[tuple[str, str, Location]]) -> list[InputError]:
+    """``X := c;`` in an ``N`` action: the PLC assigns X while the step is active and keeps its
+    last value once the step is left; ``X if c`` (continuous) lets X fall. The two agree when the
+    step also resets X on deactivation (a ``P0`` action, as ``synth sfc`` writes it); otherwise a
+    located warning says what changed."""
+    actions = {s.name: s.actions for s in chart.steps}
+    out = []
+    for step, action, where in held:
+        target, cond = action.split(" if ", 1)
+        if f"reset {target} on deactivation" in actions.get(step, ()):
+            continue
+        out.append(InputError(
+            f"an N action assigning {target} in step {step} is read as the continuous action '{action}': "
+            f"{target} falls when the step is left, while the PLC keeps its last value",
+            where, severity=Severity.WARNING,
+            notes=(f"to keep the continuous meaning on the PLC, add a P0 action '{target} := FALSE;' to step {step}; "
+                   f"for a stored order, write S/R actions (set {target} / reset {target})",)))
+    return out
+
+
 def _paired(actions: list[str]) -> list[str]:
     """``A if c`` is exported as an ``N`` body and a ``P0`` body ``A := FALSE;`` (its IEC
     meaning: reset when the step is left); read back, the pair is ``A if c`` alone."""
@@ -311,7 +340,10 @@ def _read_action(a: Any, src: Source, steps: dict[str, str], q: Any, pou_actions
                              src.at(a))
         timer = f"{d}/X{step}"
         return [f"{name} if {timer}" if qualifier == IecQualifier.D else f"{name} if !{timer}"]
-    return [_one_action(a, src, steps, q, qualifier)]
+    action = _one_action(a, src, steps, q, qualifier)
+    if qualifier == IecQualifier.N and " if " in action and (held := HELD.get()) is not None:
+        held.append((step, action, src.at(a)))  # X := c; the PLC keeps X once the step is left
+    return [action]
 
 
 def _pou_action(a: Any, name: str, action: Any, qualifier: IecQualifier, src: Source, q: Any,
