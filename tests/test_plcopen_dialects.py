@@ -707,3 +707,17 @@ def test_an_n_assignment_with_its_p0_reset_is_continuous_without_a_warning():
     g7 = import_sfc(text.replace(*p0).encode(), "ide_sfc.xml", warnings=warnings)
     assert "LAMP if !bottom" in g7 and "reset LAMP on deactivation" not in g7
     assert [w.render().splitlines()[0].split(": warning: ")[1][:24] for w in warnings] == ["a selection divergence: "]
+
+
+@pytest.mark.parametrize("value, action", [("TRUE", "set LAMP on activation"), ("0", "reset LAMP on activation")])
+def test_an_n_assignment_of_a_constant_is_a_stored_action(value, action):
+    """`pump := 1;` in an N action: the PLC sets it while the step is active and keeps it after;
+    not the continuous `pump if 1` (which ends with the step), nor `pump if 0` (a no-op)."""
+    root = Path(__file__).resolve().parent / "data" / "codegen"
+    text = (root / "ide_sfc.xml").read_text()
+    assert text.count("LAMP := NOT bottom;") == 1
+    warnings: list[InputError] = []
+    g7 = import_sfc(text.replace("LAMP := NOT bottom;", f"LAMP := {value};").encode(), "ide_sfc.xml",
+                    warnings=warnings)
+    assert f"step Lamp: {action}" in g7 and "LAMP if" not in g7
+    assert len(warnings) == 1  # the selection divergence's alone

@@ -423,6 +423,8 @@ def _one_action(a: Any, src: Source, steps: dict[str, str], q: Any, qualifier: s
             if re.search(r"[A-Za-z]", value):
                 scope.every_scan(body.strip(), "an N action", where(0, len(cm[1])))
             return f"{target.name} := {value}"
+        if m:  # X := TRUE; at every scan while the step is active, kept once it is left: stored
+            return f"{'set' if m[2].upper() in ('TRUE', '1') else 'reset'} {m[1]} on activation"
         if cm:
             raw = st_text(st)
             off = raw.find(cm[2])
