@@ -721,3 +721,25 @@ def test_an_n_assignment_of_a_constant_is_a_stored_action(value, action):
                     warnings=warnings)
     assert f"step Lamp: {action}" in g7 and "LAMP if" not in g7
     assert len(warnings) == 1  # the selection divergence's alone
+
+
+def test_codesys_implicit_chart_flags_are_named_not_silently_dropped():
+    """CODESYS's SFCReset/SFCInit/SFCPause (declared in the POU, set by the caller on an emergency
+    stop) force the chart on the PLC; the .g7 has no such forcing: a located warning each."""
+    text = (DATA / "codesys_v35.xml").read_text()
+    old = '            <variable name="xGripOk"><type><BOOL /></type></variable>\n          </inputVars>\n'
+    assert text.count(old) == 1
+    flags = ('            <variable name="SFCReset"><type><BOOL /></type></variable>\n'
+             '            <variable name="SFCError"><type><BOOL /></type></variable>\n')
+    warnings: list[InputError] = []
+    import_sfc(text.replace(old, old.replace("          </inputVars>\n", flags + "          </inputVars>\n")).encode(),
+               "flags.xml", pou="Crane", warnings=warnings)
+    found = [w.render().splitlines() for w in warnings if "implicit SFC flag" in w.render()]
+    assert found == [[
+        "flags.xml:25:13: warning: 'SFCReset' is CODESYS's implicit SFC flag: on the PLC it puts the chart back to its "
+        "initial step while it is TRUE; the .g7 has no such forcing, so the import reads it as a plain variable and "
+        "the chart ignores it",
+        '  25 |             <variable name="SFCReset"><type><BOOL /></type></variable>',
+        "     |             ^~~~~~~~~",
+        "  = note: validate the emergency stop separately, or model it as transitions back to the initial steps "
+        "guarded by the flag"]]

@@ -22,7 +22,7 @@ from synth.codegen.plcopen.data import DATA
 from synth.codegen.plcopen.ids import number_ids
 from synth.codegen.plcopen.scan import one_scan_steps
 from synth.codegen.plcopen.timers import ton_chart
-from synth.codegen.plcopen.vendor import step_actions
+from synth.codegen.plcopen.vendor import chart_flag_warnings, step_actions
 from synth.codegen.plcopen.fbd import FBD_ELEMENTS, fbd_condition, fbd_transition
 from synth.codegen.plcopen.tc6 import SYNTH_DATA
 from synth.codegen.plcopen.st_condition import PREDICATES, ExprReader, st_text
@@ -373,6 +373,7 @@ def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
         transitions += [("", a, b, expr, pou) for a, b, expr in htrans]
     _declare_predicates(inputs, warnings)
     _check_names(pou, q, src, transitions, {st.name for st in [*steps.values(), *helpers]}, inputs, outputs, warnings)
+    warnings += chart_flag_warnings(pou, q, src.at)
     written_by_synth = any(st.grafcet for st in steps.values())  # its .g7 is the meaning: no rewriting
     for d, members in branches.items():  # IEC 61131-3: the first true branch, left to right; .g7: every one
         if len(members) < 2 or written_by_synth:
