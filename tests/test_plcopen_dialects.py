@@ -743,3 +743,24 @@ def test_codesys_implicit_chart_flags_are_named_not_silently_dropped():
         "     |             ^~~~~~~~~",
         "  = note: validate the emergency stop separately, or model it as transitions back to the initial steps "
         "guarded by the flag"]]
+
+
+def test_several_pous_keep_their_own_variables():
+    """Two POUs declaring the same names (two cranes) imported whole: each keeps its own
+    variables on the PLC, so each chart's are prefixed, with a warning at each declaration."""
+    lines = (DATA / "codesys_v35.xml").read_text().splitlines(keepends=True)
+    assert lines[18].strip() == '<pou name="Crane" pouType="program">' and lines[102].strip() == "</pou>"
+    crane2 = "".join(lines[18:103]).replace('<pou name="Crane"', '<pou name="Crane2"')
+    xml = "".join(lines[:103]) + crane2 + "".join(lines[103:])
+    warnings: list[InputError] = []
+    g7 = import_sfc(xml.encode(), "cranes.xml", warnings=warnings)
+    assert g7.splitlines()[1:3] == [
+        "inputs Crane_xStart, Crane_xDown, Crane_xGripOk, Crane2_xStart, Crane2_xDown, Crane2_xGripOk, xPart",
+        "outputs Crane_LOWER, Crane2_LOWER, MOTOR"]
+    assert "  transition Crane2_Init -> Crane2_Lower when Crane2_xStart & !Crane2_xDown\n" in g7
+    assert "  step Crane2_Lower: Crane2_LOWER\n" in g7 and "  step Belt_Run: MOTOR\n" in g7
+    own = [w.render().splitlines()[0] for w in warnings if "each has its own" in w.render()]
+    assert len(own) == 8 and own[0] == (
+        "cranes.xml:22:13: warning: 'xStart' is declared by POU Crane and by Crane2: each has its own on the PLC, "
+        "so this chart's is named Crane_xStart in the .g7")
+    parse_grafcet(g7, "cranes.g7")  # a valid .g7

@@ -41,6 +41,7 @@ from typing import Any
 from synth.codegen.plcopen.actions import ACTION_WARNINGS, action_body
 from synth.codegen.plcopen.assign import sum_text
 from synth.codegen.plcopen.data import DATA, duration
+from synth.codegen.plcopen.instances import separate_instances
 from synth.codegen.plcopen.sfc import Chart, Source, read_chart
 from synth.codegen.plcopen.timers import prepare_scope
 from synth.codegen.plcopen.vendor import IecQualifier
@@ -183,6 +184,8 @@ def import_sfc(data: bytes | str, file: str = "<xml>", pou: str | None = None,
         charts[-1].outputs[:] = [o for o in charts[-1].outputs if o.upper() not in scope.used]
         charts[-1].outputs.extend(n for n in [*scope.action_refs, *scope.globals_out.values(), *scope.inputs_out.values()]
                                   if n not in charts[-1].outputs and n.upper() not in scope.used)
+    if several:
+        separate_instances(charts, [p for p, _ in sfc_pous], q, src.at)
     _feedback(charts, src)
     if warnings is not None:
         warnings += [w for c in charts for w in c.warnings]
