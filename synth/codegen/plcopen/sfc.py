@@ -386,10 +386,10 @@ def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
             before = " & ".join(f"!({transitions[j][3]})" for j in ranked[:k])
             transitions[i] = (label, sources, targets, f"({expr}) & {before}", el)
             rewritten.append(f"{' -> '.join([', '.join(sources), ', '.join(targets)])} when {transitions[i][3]}")
-        order = ("the true branch of highest priority (smallest `priority`, then left to right)" if prioritised
+        rule = ("the true branch of highest priority (smallest `priority`, then left to right)" if prioritised
                  else "the first true branch (left to right)")
         warnings.append(InputError(
-            f"a selection divergence: IEC 61131-3 SFC fires {order}, .g7 every true "
+            f"a selection divergence: IEC 61131-3 SFC fires {rule}, .g7 every true "
             "branch; the later branches' receptivities are made exclusive", src.at(elements[d]),
             severity=Severity.WARNING, notes=tuple(rewritten)))
 
