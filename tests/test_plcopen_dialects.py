@@ -764,3 +764,57 @@ def test_several_pous_keep_their_own_variables():
         "cranes.xml:22:13: warning: 'xStart' is declared by POU Crane and by Crane2: each has its own on the PLC, "
         "so this chart's is named Crane_xStart in the .g7")
     parse_grafcet(g7, "cranes.g7")  # a valid .g7
+
+
+LD_OFF = """<LD>
+                <leftPowerRail localId="40"><connectionPointOut formalParameter=""/></leftPowerRail>
+                <contact localId="41" negated="{negated}">
+                  <connectionPointIn><connection refLocalId="40"/></connectionPointIn>
+                  <connectionPointOut/>
+                  <variable>c</variable>
+                </contact>
+                <coil localId="44" negated="false">
+                  <connectionPointIn><connection refLocalId="41"/></connectionPointIn>
+                  <connectionPointOut/>
+                  <variable>OFF</variable>
+                </coil>
+              </LD>"""
+
+
+@pytest.mark.parametrize("negated, expr", [("true", "!c"), ("false", "c")])
+def test_a_named_transition_written_in_ld_is_read(negated, expr):
+    """OpenPLC writes a named transition's body in LD: a coil named after the transition."""
+    text = (DATA / "beremiz_ld_fbd.xml").read_text()
+    start, end = text.index("<FBD>"), text.index("</FBD>") + len("</FBD>")
+    g7 = import_sfc((text[:start] + LD_OFF.format(negated=negated) + text[end:]).encode(), "ld.xml")
+    assert f"  transition On -> Idle when {expr}\n" in g7
+
+
+def test_a_named_transition_body_without_its_name_is_read():
+    """`:= c;` (the transition's name left out) as well as `OFF := c;`."""
+    text = (DATA / "beremiz_ld_fbd.xml").read_text()
+    start, end = text.index("<FBD>"), text.index("</FBD>") + len("</FBD>")
+    st = '<ST><xhtml:p xmlns:xhtml="http://www.w3.org/1999/xhtml"><![CDATA[:= NOT c;]]></xhtml:p></ST>'
+    g7 = import_sfc((text[:start] + st + text[end:]).encode(), "st.xml")
+    assert "  transition On -> Idle when !c\n" in g7
+
+
+def test_tc6_1_0_condition_connected_without_connection_point():
+    """TC6 1.0 files wire a condition as <condition><connection refLocalId=…/></condition>."""
+    text = (DATA / "beremiz_tc6_1_0.xml").read_text()
+    old = '<connectionPointIn><connection refLocalId="22"><position x="559" y="109"/><position x="401" y="109"/></connection></connectionPointIn>'
+    assert text.count(old) == 1
+    g7 = import_sfc(text.replace(old, '<connection refLocalId="22"/>').encode(), "tc6.xml")
+    assert "  transition Idle -> On when (a) & !b\n" in g7
+
+
+def test_two_statements_in_an_inline_n_action_are_stored_actions():
+    root = Path(__file__).resolve().parent / "data" / "codegen"
+    text = (root / "ide_sfc.xml").read_text()
+    assert text.count("LAMP := NOT bottom;") == 1
+    g7 = import_sfc(text.replace("LAMP := NOT bottom;", "LAMP := TRUE; BUSY := FALSE;").encode(), "x.xml")
+    assert "  step Lamp: set LAMP, reset BUSY\n" in g7
+    with pytest.raises(InputError) as info:
+        import_sfc(text.replace("LAMP := NOT bottom;", "LAMP := NOT bottom; BUSY := TRUE;").encode(), "x.xml")
+    assert info.value.render().splitlines()[0].startswith(
+        "x.xml:134:90: error: a statement of action N (inline) that .g7 cannot hold (LAMP := NOT bottom)")

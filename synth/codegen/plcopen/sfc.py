@@ -194,12 +194,14 @@ def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
         body = t.find(q("body"))
         st = body.find(q("ST")) if body is not None else None
         fbd = body.find(q("FBD")) if body is not None else None
+        if fbd is None and body is not None:
+            fbd = body.find(q("LD"))  # OpenPLC writes a named transition in LD: a coil named after it
         if st is not None:
             named_conditions[t.get("name")] = (st, st_text(st))
         elif fbd is not None:
             named_fbd[t.get("name")] = (t, fbd)
         else:
-            raise InputError("a named transition whose body is neither ST nor FBD", src.at(t))
+            raise InputError("a named transition whose body is neither ST, FBD nor LD", src.at(t))
 
     number_ids(sfc, q, src.at)
     elements: dict[int, Any] = {}  # localId -> lxml element
@@ -335,10 +337,10 @@ def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
                 raise InputError(f"condition '{ref.get('name')}' is not defined in the POU's <transitions>",
                                  src.at(ref), suggestions=close_names(ref.get("name", ""), named_conditions))
             holder, ctext = named_conditions[ref.get("name")]
-            m = re.fullmatch(r"\s*\w+\s*:=\s*(.*?);?\s*", ctext, re.S)
+            m = re.fullmatch(r"\s*(?:\w+\s*)?:=\s*(.*?);?\s*", ctext, re.S)  # NAME := c; or := c;
             if m:
                 ctext = m[1]
-        elif cond.find(q("connectionPointIn")) is not None:
+        elif cond.find(q("connectionPointIn")) is not None or cond.find(q("connection")) is not None:  # TC6 1.0
             holder = None
         else:
             raise InputError("a transition condition with neither ST nor a connection", src.at(cond))
