@@ -394,7 +394,9 @@ def _one_action(a: Any, src: Source, steps: dict[str, str], q: Any, qualifier: s
     scope = DATA.get()
     data = re.fullmatch(r"(\w+)\s*:=\s*([^;]*?)\s*;?", body, re.S)
     target = scope.find(data[1]) if scope is not None and data is not None else None
-    if qualifier in (Qualifier.N, Qualifier.P0, Qualifier.P1) and len([x for x in body.split(";") if x.strip()]) > 1:
+    several = len([x for x in body.split(";") if x.strip()]) > 1
+    if_body = qualifier == Qualifier.N and re.match(r"IF\b", body, re.I)  # IF c THEN X := TRUE; END_IF;
+    if several and qualifier in (Qualifier.N, Qualifier.P0, Qualifier.P1) and not if_body:
         return ", ".join(action_body(f"{qualifier} (inline)", st_text(st), IecQualifier(qualifier), where, steps))
     if qualifier in (Qualifier.P0, Qualifier.P1) and target is not None and data is not None and scope is not None:
         raw = st_text(st)
