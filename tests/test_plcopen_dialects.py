@@ -154,6 +154,23 @@ def test_a_chart_inside_an_action_of_a_function_block_is_named_not_dropped(cli, 
     assert code == 0 and "SFC in its action ACT_Extend: not imported" in err
 
 
+def test_a_chart_inside_an_action_is_named_when_its_pou_alone_is_imported(cli, tmp_path):
+    """`--pou Stack` of an SFC function block whose action holds another chart: the chart
+    imported is the body's, and the one inside the action is named as not imported."""
+    text = (DATA / "codesys_v35.xml").read_text()
+    action = ('<actions><action name="ACT_Auto"><body><SFC><step localId="1" name="A0" initialStep="true">'
+              '<position x="0" y="0"/></step></SFC></body></action></actions>\n        <body>\n          <SFC>')
+    assert text.count("<body>\n          <SFC>") >= 1
+    (tmp_path / "fb.xml").write_text(text.replace("<body>\n          <SFC>", action, 1))
+    code, _, err = cli("import", tmp_path / "fb.xml", "--pou", "Crane", "-o", tmp_path / "fb.g7")
+    last = err.splitlines()[-1]
+    assert code == 0 and ": note: POU Crane: " in last and last.endswith(
+        "; SFC in its action ACT_Auto: not imported (.g7 reads the SFC body of a POU, not a chart "
+        "inside an action of a function block)")
+    code, _, err = cli("import", tmp_path / "fb.xml", "--pou", "Belt", "-o", tmp_path / "belt.g7")
+    assert code == 0 and "ACT_Auto" not in err
+
+
 def _with_pou_action(body: str, qualifier: str = "N") -> bytes:
     text = (DATA / "codesys_v35.xml").read_text()
     text = text.replace('<variable name="LOWER"><type><BOOL /></type></variable>',

@@ -158,9 +158,10 @@ def import_sfc(data: bytes | str, file: str = "<xml>", pou: str | None = None,
     if not sfc_pous:
         raise InputError("no POU with an SFC body in this file", src.at(root),
                          notes=(("POUs: " + ", ".join(names)) if names else "the file has no POU",))
-    if notes is not None and pou is None:
+    if notes is not None:  # the whole file: every POU left out; one POU (--pou): the charts inside it left out
         notes += [f"POU {s.name} not imported: {s.note}" if not s.imported else f"POU {s.name}: {s.note}"
-                  for s in list_pous(data, file) if not s.imported or "SFC in its action" in s.note]
+                  for s in list_pous(data, file) if (pou is None and not s.imported or "SFC in its action" in s.note)
+                  and (pou is None or s.name == pou)]
     several = len(sfc_pous) > 1
     charts = []
     for p, s in sfc_pous:
