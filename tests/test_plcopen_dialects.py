@@ -835,3 +835,30 @@ def test_two_statements_in_an_inline_n_action_are_stored_actions():
         import_sfc(text.replace("LAMP := NOT bottom;", "LAMP := NOT bottom; BUSY := TRUE;").encode(), "x.xml")
     assert info.value.render().splitlines()[0].startswith(
         "x.xml:134:90: error: a statement of action N (inline) that .g7 cannot hold (LAMP := NOT bottom)")
+
+
+def test_the_scan_note_says_when_it_is_not_computed(cli, tmp_path):
+    """The import's note on steps a PLC keeps for a scan explores both readings within a small
+    budget; past it, the note says it was not checked instead of disappearing."""
+    lines = ["inputs " + ", ".join(f"a{i}" for i in range(12)), "outputs " + ", ".join(f"Q{i}" for i in range(12))]
+    lines += [f"grafcet G{i} {{ initial step {i}0 step {i}1: Q{i} transition {i}0 -> {i}1 when a{i} "
+              f"transition {i}1 -> {i}0 when !a{i} }}" for i in range(12)]  # 4 096 situations
+    (tmp_path / "wide.g7").write_text("\n".join(lines) + "\n")
+    assert cli("sfc", tmp_path / "wide.g7", "-o", tmp_path / "wide.xml")[0] == 0
+    code, _, err = cli("import", tmp_path / "wide.xml", "-o", tmp_path / "back.g7")
+    assert code == 0 and err == (
+        f"{tmp_path / 'wide.xml'}: note: not checked whether some steps stay active for a PLC scan where IEC 60848 "
+        "passes through them (more than 2000 situations to explore): validate with --semantics sfc for the meaning "
+        "the program has on the PLC\n")
+
+
+def test_import_list_says_refused_for_a_pou_the_import_refuses(cli, tmp_path):
+    text = (DATA / "codesys_v35.xml").read_text()
+    assert text.count("<expression>xStart AND NOT xDown</expression>") == 1
+    (tmp_path / "p.xml").write_text(text.replace("xStart AND NOT xDown", "xStart AND NOT xNowhere"))
+    code, out, _ = cli("import", "--list", tmp_path / "p.xml")
+    assert code == 0 and out.splitlines() == [
+        "Crane\tprogram\tSFC\tnot imported: refused: a transition reads 'xNowhere', which the POU Crane does not "
+        "declare",
+        "Belt\tprogram\tSFC\timported",
+        "PLC_PRG\tprogram\tST\tnot imported: an ST body: .g7 holds SFC charts only"]

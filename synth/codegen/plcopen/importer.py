@@ -33,15 +33,14 @@ grafcet G {
 from __future__ import annotations
 
 import contextvars
-
 import re
-from dataclasses import dataclass
 from typing import Any
 
 from synth.codegen.plcopen.actions import ACTION_WARNINGS, action_body
 from synth.codegen.plcopen.assign import sum_text
 from synth.codegen.plcopen.data import DATA, duration
 from synth.codegen.plcopen.instances import separate_instances
+from synth.codegen.plcopen.project import NAMESPACES, PouSummary, body_language, list_pous, pous_of, read_project
 from synth.codegen.plcopen.sfc import Chart, Source, read_chart
 from synth.codegen.plcopen.timers import prepare_scope
 from synth.codegen.plcopen.vendor import IecQualifier
@@ -50,86 +49,7 @@ from synth.codegen.plcopen.st_condition import PREDICATES, ExprReader, st_text
 from synth.errors import InputError, Location, Severity
 from synth.version import version as synth_version
 
-__all__ = ["import_sfc", "list_pous", "PouSummary", "NAMESPACES"]
-
-NAMESPACES = {
-    "http://www.plcopen.org/xml/tc6_0201": "TC6 2.01",
-    "http://www.plcopen.org/xml/tc6_0200": "TC6 2.00",
-    "http://www.plcopen.org/xml/tc6.xsd": "TC6 1.0",
-}
-"""The PLCopen namespaces read, with the version they name."""
-
-_LANGUAGES = ("SFC", "ST", "IL", "FBD", "LD")
-
-
-@dataclass(frozen=True)
-class PouSummary:
-    """What ``synth import --list`` prints for one POU."""
-
-    name: str
-    kind: str  # program, functionBlock, function
-    language: str
-    imported: bool
-    note: str
-
-    def text(self) -> str:
-        return f"{self.name}\t{self.kind}\t{self.language}\t{'imported' if self.imported else 'not imported'}" + \
-            (f": {self.note}" if self.note else "")
-
-
-def _project(data: bytes | str, file: str) -> tuple[Any, Source, Any]:
-    """The root element, the located source and the namespace function ``q``."""
-    from lxml import etree
-
-    raw = data if isinstance(data, bytes) else data.encode("utf-8")
-    src = Source(file, raw.decode("utf-8", errors="replace"))
-    try:
-        root = etree.fromstring(raw, etree.XMLParser(remove_blank_text=False, resolve_entities=False))
-    except etree.XMLSyntaxError as err:
-        line, col = err.position if hasattr(err, "position") else (err.lineno, 1)
-        raw_line = src.lines[line - 1] if 0 < line <= len(src.lines) else ""
-        message = re.sub(r", line \d+, column \d+$", "", str(err.msg))
-        raise InputError(f"not well-formed XML: {message}", Location(file, line, max(1, col), raw_line)) from None
-    ns = etree.QName(root).namespace
-    if ns not in NAMESPACES or etree.QName(root).localname != "project":
-        raise InputError(f"not a PLCopen TC6 XML project (root element {root.tag})", src.at(root),
-                         expected=tuple(f'<project xmlns="{n}">' for n in NAMESPACES))
-    return root, src, lambda tag: f"{{{ns}}}{tag}"
-
-
-def _language(pou: Any, q: Any) -> str:
-    body = pou.find(q("body"))
-    if body is None:
-        return "none"
-    for lang in _LANGUAGES:
-        if body.find(q(lang)) is not None:
-            return lang
-    return "other"
-
-
-def _pous(root: Any, q: Any) -> list[Any]:
-    # CODESYS exports with a device put POUs in the resource's addData as well as in types/pous
-    return list(root.iter(q("pou")))
-
-
-def list_pous(data: bytes | str, file: str = "<xml>") -> list[PouSummary]:
-    """Every POU of the project: its kind, body language and whether ``import`` reads it."""
-    root, src, q = _project(data, file)
-    out = []
-    for pou in _pous(root, q):
-        lang = _language(pou, q)
-        note = "" if lang == "SFC" else f"an {lang} body: .g7 holds SFC charts only"
-        if pou.find(q("actions")) is not None and lang == "SFC":
-            note = "POU actions are read where an action block references them"
-        charts = [str(a.get("name", "")) for a in pou.findall(f"{q('actions')}/{q('action')}")
-                  if a.find(f"{q('body')}/{q('SFC')}") is not None]
-        if charts:
-            note += ("; " if note else "") + (f"SFC in its action{'s' if len(charts) > 1 else ''} {', '.join(charts)}: "
-                                              "not imported (.g7 reads the SFC body of a POU, not a chart inside "
-                                              "an action of a function block)")
-        out.append(PouSummary(str(pou.get("name", "")), str(pou.get("pouType", "")), lang, lang == "SFC", note))
-    return out
-
+__all__ = ["import_sfc", "checked_pous", "list_pous", "PouSummary", "NAMESPACES"]
 
 def import_sfc(data: bytes | str, file: str = "<xml>", pou: str | None = None,
                notes: list[str] | None = None, warnings: list[InputError] | None = None) -> str:
@@ -141,8 +61,8 @@ def import_sfc(data: bytes | str, file: str = "<xml>", pou: str | None = None,
     at their line. ``notes`` receives what was left out (POUs that are not SFC), ``warnings``
     where IEC 61131-3 SFC and IEC 60848 read the chart differently (located).
     """
-    root, src, q = _project(data, file)
-    all_pous = _pous(root, q)
+    root, src, q = read_project(data, file)
+    all_pous = pous_of(root, q)
     sfc_pous = [(p, p.find(f"{q('body')}/{q('SFC')}")) for p in all_pous]
     sfc_pous = [(p, s) for p, s in sfc_pous if s is not None]
     names = [str(p.get("name", "")) for p in all_pous]
@@ -442,3 +362,18 @@ def _one_action(a: Any, src: Source, steps: dict[str, str], q: Any, qualifier: s
             return f"{cm[1]} if {cond}"
     raise InputError(f"a {qualifier} action body that .g7 cannot represent (expected 'NAME := condition;')",
                      where(0, 1))
+
+
+def checked_pous(data: bytes | str, file: str = "<xml>") -> list[PouSummary]:
+    """:func:`list_pous` with each SFC POU imported on its own: a POU the import refuses is
+    listed as not imported, with the first line of the reason (``synth import --list``)."""
+    out = []
+    for s in list_pous(data, file):
+        if s.imported:
+            try:
+                import_sfc(data, file, pou=s.name)
+            except InputError as err:
+                reason = err.render().splitlines()[0].split(": error: ", 1)[-1]
+                s = PouSummary(s.name, s.kind, s.language, False, "refused: " + reason)
+        out.append(s)
+    return out
