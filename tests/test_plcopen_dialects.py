@@ -127,7 +127,9 @@ def test_a_selection_divergence_keeps_its_sfc_priority_with_a_warning():
         "right), .g7 every true branch; the later branches' receptivities are made exclusive",
         '  154 |             <selectionDivergence localId="16">',
         "      |             ^~~~~~~~~~~~~~~~~~~~",
-        "  = note: Wait -> Up when (guard) & !(2s/XWait)"], LAMP_HELD]
+        "  = note: Wait -> Up when (guard) & !(2s/XWait)",
+        "  = note: on MATIEC (the compiler of Beremiz and OpenPLC) every true branch fires, priorities ignored: for a "
+        "program that runs there, validate the receptivities as written, without this rewrite"], LAMP_HELD]
 
 
 def test_a_level_self_loop_jump_is_imported_with_a_warning():
@@ -695,7 +697,7 @@ def test_a_selection_divergence_honours_the_transitions_priorities():
         "prio.xml:154:13: warning: a selection divergence: IEC 61131-3 SFC fires the true branch of highest priority "
         "(smallest `priority`, then left to right), .g7 every true branch; the later branches' receptivities are "
         "made exclusive", LAMP_HELD[0].replace("ide_sfc.xml", "prio.xml")]
-    assert warnings[0].render().splitlines()[-1] == "  = note: Wait -> Up when (2s/XWait) & !(guard)"
+    assert warnings[0].render().splitlines()[-2] == "  = note: Wait -> Up when (2s/XWait) & !(guard)"
 
 
 def test_equal_priorities_fall_back_to_the_branch_order():

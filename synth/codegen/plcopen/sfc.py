@@ -162,6 +162,11 @@ def _x(el: Any) -> int:
         return 0
 
 
+MATIEC_DIVERGENCE = ("on MATIEC (the compiler of Beremiz and OpenPLC) every true branch fires, priorities ignored: "
+                     "for a program that runs there, validate the receptivities as written, without this rewrite")
+"""The runtime that reads a selection divergence otherwise than IEC 61131-3 (measured: two
+tokens after a divergence whose branches were both true)."""
+
 NO_PRIORITY = 2 ** 63
 """The rank of a transition without a ``priority`` attribute: after every written one."""
 
@@ -393,7 +398,7 @@ def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
         warnings.append(InputError(
             f"a selection divergence: IEC 61131-3 SFC fires {rule}, .g7 every true "
             "branch; the later branches' receptivities are made exclusive", src.at(elements[d]),
-            severity=Severity.WARNING, notes=tuple(rewritten)))
+            severity=Severity.WARNING, notes=(*rewritten, MATIEC_DIVERGENCE)))
 
     # actions: CODESYS/TwinCAT step actions (vendor addData), then the action blocks
     if scope is not None:
