@@ -175,15 +175,6 @@ class SupRun:
     def labels(self) -> dict[str, str]:
         return {c.id: c.label for c in self.rules.constraints}
 
-    def summary(self) -> dict[str, Any]:
-        """The JSON of ``synth sup`` (the key ``symbolic`` when the symbolic engine ran)."""
-        from synth.output.summary import sup_summary
-
-        data = sup_summary(self.rules, self.sup, self.path)
-        if self.bdd_nodes is not None:
-            data["symbolic"] = {"bdd_nodes": self.bdd_nodes}
-        return data
-
     def why(self, state: str | None = None) -> Explanation:
         """Why ``state`` (its true variables; default the initial state) is in SUP or not."""
         from synth.sup.explain import explain
@@ -191,13 +182,6 @@ class SupRun:
 
         sup = self.sup if isinstance(self.sup, Supervisor) else Supervisor(self.plant, self.rules.constraints)
         return explain(sup, self.plant.initial if state is None else self.plant.parse_state(state))
-
-    def text(self) -> str:
-        """The terminal listing of :meth:`summary`, with why SUP is empty when it is."""
-        from synth.output.summary import sup_text
-
-        labels = self.labels
-        return sup_text(self.summary(), labels, self.why().text(labels) if self.sup.empty else "")
 
 
 def supervisor(

@@ -63,7 +63,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from synth.engines import EngineChoice
+from synth.choices import EngineChoice
 from synth.errors import InputError, close_names
 from synth.filter.loop.control_st import StSource
 from synth.filter.cycle import Algorithm, Mode

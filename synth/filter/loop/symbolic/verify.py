@@ -27,7 +27,7 @@ import time
 
 import numpy as np
 
-from synth.engines import EngineChoice
+from synth.choices import EngineChoice
 from synth.errors import InputError
 from synth.filter.cycle import Algorithm, Mode
 from synth.filter.language import Filter
