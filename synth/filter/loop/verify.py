@@ -60,6 +60,7 @@ from __future__ import annotations
 import dataclasses
 import time
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -76,14 +77,14 @@ from synth.filter.loop.verification import (ANY_CONTROL, Control, ControlKind, F
                                        TraceRow, Verification)
 from synth.logic.events import Event
 from synth.logic.expr import Edge, Expr, evaluate, names
-from synth.plant.composition import load_plant
+from synth.plant.composition import load_plant, plant
 
 TYPE_CHECKING = False  # typing.TYPE_CHECKING: the Grafcet modules load only with --grafcet
 if TYPE_CHECKING:
     from synth.grafcet.language import Grafcet
     from synth.plant.composition import Plant
 
-__all__ = ["verify", "verify_explicit", "Goal", "goal_of", "DEFAULT_MAX_STATES"]
+__all__ = ["verify", "verify_explicit", "plant_of", "Goal", "goal_of", "DEFAULT_MAX_STATES"]
 
 DEFAULT_MAX_STATES = 1_000_000
 """The explicit engine's default ``--max-states``."""
@@ -112,7 +113,7 @@ def verify(f: Filter, rules_path: str, grafcet: str | None = None, *, any_contro
         raise InputError(f"--max-states is a number of states, 1 or more, not {max_states}", None)
     options = ({Need.CONTROLLER} if not any_control else set()) | ({Need.PROGRESS} if progress is not None else set())
     refuse(Command.FILTER_VERIFY, engine, options)  # before any input is read
-    p = load_plant(rules_path)
+    p = plant_of(f, rules_path)
     chosen = decide(Command.FILTER_VERIFY, engine, options, estimate=p.size, readers=p.readers)
     if chosen.engine is EngineChoice.SYMBOLIC:
         from synth.filter.loop.symbolic.verify import verify_symbolic
@@ -127,6 +128,14 @@ def verify(f: Filter, rules_path: str, grafcet: str | None = None, *, any_contro
     return verify_explicit(f, p, g, algorithm=algorithm, mode=mode, atomic=atomic, strict=strict,
                            require_sup=require_sup, max_states=max_states, events_per_cycle=events_per_cycle,
                            progress=progress, control=control)
+
+
+def plant_of(f: Filter, rules_path: str) -> Plant:
+    """The plant of ``rules_path``, read once: from the rule set the filter read for its
+    ``use`` when that is the same file (named as ``rules_path`` names it), else from the file."""
+    if f.rules is not None and f.plant is not None and Path(f.plant).resolve() == Path(rules_path).resolve():
+        return plant(dataclasses.replace(f.rules, path=str(rules_path)))
+    return load_plant(rules_path)
 
 
 def verify_explicit(f: Filter, p: Plant, g: Grafcet | None = None, *, algorithm: Algorithm = Algorithm.ALGEBRAIC,
