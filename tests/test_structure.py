@@ -217,3 +217,10 @@ def test_no_module_reads_another_objects_private_members() -> None:
     outside = [r for r in found if not r.startswith("synth.symbolic.")]
     assert outside == []
     assert Counter(r for r in found if r.startswith("synth.symbolic.")) == SYMBOLIC_PRIVATES
+
+
+def test_the_tests_share_one_root() -> None:
+    """Every test module takes ``ROOT`` from conftest.py instead of computing its own."""
+    own = [p.name for p in sorted((ROOT / "tests").glob("*.py"))
+           if p.name != "conftest.py" and any(line.startswith("ROOT = ") for line in p.read_text("utf-8").splitlines())]
+    assert own == []
