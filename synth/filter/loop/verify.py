@@ -77,12 +77,11 @@ from synth.filter.loop.verification import (ANY_CONTROL, Control, ControlKind, F
                                        TraceRow, Verification)
 from synth.logic.events import Event
 from synth.logic.expr import Edge, Expr, evaluate, names
-from synth.plant.composition import load_plant, plant
+from synth.plant.composition import Plant, load_plant, plant
 
 TYPE_CHECKING = False  # typing.TYPE_CHECKING: the Grafcet modules load only with --grafcet
 if TYPE_CHECKING:
     from synth.grafcet.language import Grafcet
-    from synth.plant.composition import Plant
 
 __all__ = ["verify", "verify_explicit", "plant_of", "Goal", "goal_of", "DEFAULT_MAX_STATES"]
 
