@@ -97,8 +97,10 @@ def station_jobs(s: Station) -> list[Job]:
         elif check is Check.ST_CHECK:
             jobs += [Job(s.name, JobKind.ST_CHECK, f"st --check {g.name}", plant, str(g), None,
                          (("semantics", s.semantics), ("depth", str(s.depth))), s.expect) for g in s.grafcets]
-    jobs += [Job(s.name, JobKind.VALIDATE, f"variant {v.name}", str(v.plant), str(v.grafcet), None, options, v.expect)
-             for v in s.variants]
+    for v in s.variants:
+        homes = s.homes if v.homes is None else v.homes
+        jobs.append(Job(s.name, JobKind.VALIDATE, f"variant {v.name}", str(v.plant), str(v.grafcet), None,
+                        tuple((k, "\n".join(homes) if k == "homes" else x) for k, x in options), v.expect))
     return jobs
 
 

@@ -19,6 +19,7 @@ Example
 
 from __future__ import annotations
 
+import os
 import re
 from dataclasses import dataclass
 from enum import StrEnum
@@ -48,12 +49,14 @@ class Expect(StrEnum):
 
 @dataclass(frozen=True)
 class Variant:
-    """``[[station.variant]]``: the station with another Grafcet and/or plant, its own expectation."""
+    """``[[station.variant]]``: the station with another Grafcet and/or plant, its own
+    expectation and, when it says so, its own home states."""
 
     name: str
     grafcet: Path
     plant: Path
     expect: Expect
+    homes: tuple[str, ...] | None
     loc: Location
 
 
@@ -92,7 +95,7 @@ class Line:
 
 STATION_KEYS = ("name", "plant", "grafcets", "filter", "checks", "semantics", "engine", "homes", "expert", "depth",
                 "expect", "variant", "allow_survivors")
-VARIANT_KEYS = ("name", "grafcet", "plant", "expect")
+VARIANT_KEYS = ("name", "grafcet", "plant", "expect", "homes")
 LINE_KEYS = ("name",)
 TOP_KEYS = ("line", "station")
 _HEADER = re.compile(r"^\s*(\[\[?)\s*([A-Za-z0-9_.\- ]+?)\s*\]\]?\s*(?:#.*)?$")
@@ -223,7 +226,7 @@ class _Reader:
         return tuple(value)
 
     def file(self, text: str, key: str, table: tuple[Any, ...]) -> Path:
-        path = self.folder / text
+        path = Path(os.path.normpath(self.folder / text))
         if not path.is_file():
             raise InputError(f"{key}: no file {text!r} (paths are relative to {self.loc.file})",
                              self.loc.at(table, key, value=True))
@@ -270,7 +273,7 @@ class _Reader:
                 self.file(v["grafcet"], "grafcet", vt) if "grafcet" in v else grafcets[0],
                 self.file(v["plant"], "plant", vt) if "plant" in v else plant,
                 Expect(self.string(v, "expect", vt, default=str(expect), choices=tuple(Expect))),
-                self.loc.at(vt)))
+                self.strings(v, "homes", vt) if "homes" in v else None, self.loc.at(vt)))
         if not grafcets and Check.VALIDATE in checks and not variants:
             raise InputError("a station needs grafcets = [\"G.g7\", ...] to validate", self.loc.at(table, "grafcets"))
         return Station(name, plant, grafcets, filter_, tuple(Check(c) for c in checks),

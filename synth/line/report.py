@@ -62,7 +62,7 @@ def line_reports(run: LineRun) -> list[CiReport]:
         if r["expect"] == "fail" and r["verdict"] == "fail":
             report = dataclasses.replace(report, findings=tuple(dataclasses.replace(f, level=Level.NOTE)
                                                                 for f in report.findings))
-        out.append(dataclasses.replace(report, target=f"{r['station']}: {report.target}"))
+        out.append(dataclasses.replace(report, command=f"{report.command} [{r['station']}]"))
     for name, v in verdicts.items():
         s = stations[name]
         mutants = [r for r in run.results if r["station"] == name and r["mutant"] is not None]
