@@ -264,8 +264,8 @@ class _Reader:
         for j, v in enumerate(variants_data):
             vt = ("station", i, "variant", j)
             self.keys(v, VARIANT_KEYS, vt)
-            if "grafcet" not in v and "plant" not in v:
-                raise InputError("a variant changes the grafcet, the plant or both", self.loc.at(vt))
+            if not {"grafcet", "plant", "homes"} & set(v):
+                raise InputError("a variant changes the grafcet, the plant or the homes", self.loc.at(vt))
             if not grafcets and "grafcet" not in v:
                 raise InputError("a variant of a station without grafcets needs its grafcet", self.loc.at(vt))
             variants.append(Variant(
