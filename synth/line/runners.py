@@ -16,7 +16,7 @@ from typing import Any, Callable, Sequence
 
 from synth.errors import SynthError
 from synth.line.jobs import Job
-from synth.line.work import error_result, run_counted
+from synth.line.work import error_result, fresh_worker, run_counted
 
 __all__ = ["RunStats", "run_serial", "run_local", "run_dask", "default_workers"]
 
@@ -76,7 +76,7 @@ def run_local(jobs: Sequence[Job], workers: int | None = None, progress: Progres
     for attempt in range(2):
         lost: list[int] = []
         with ProcessPoolExecutor(max_workers=min(workers or default_workers(), max(1, len(todo))),
-                                 mp_context=multiprocessing.get_context("fork")) as pool:
+                                 mp_context=multiprocessing.get_context("fork"), initializer=fresh_worker) as pool:
             futures = {pool.submit(run_counted, jobs[i]): i for i in todo}
             for fut in as_completed(futures):
                 i = futures[fut]

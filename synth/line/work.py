@@ -25,13 +25,20 @@ if TYPE_CHECKING:  # pragma: no cover
     from synth.plant.composition import Plant
     from synth.plant.rules import RuleSet
 
-__all__ = ["COMPILED", "compiled_plant", "run_job", "run_counted", "error_result", "ci_report_of"]
+__all__ = ["COMPILED", "fresh_worker", "compiled_plant", "run_job", "run_counted", "error_result", "ci_report_of"]
 
 COMPILED: list[str] = []
 """The plants this process compiled (path and digest), in order: one entry per compilation."""
 
 _PLANTS: dict[tuple[str, str], tuple[RuleSet, Plant]] = {}
 _ASS: dict[tuple[str, str, str, str], Any] = {}
+
+
+def fresh_worker() -> None:
+    """A worker process's start: nothing compiled yet (a forked worker forgets its parent's plants)."""
+    COMPILED.clear()
+    _PLANTS.clear()
+    _ASS.clear()
 
 
 def compiled_plant(path: str, digest: str) -> tuple[RuleSet, Plant]:
