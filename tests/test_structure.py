@@ -88,12 +88,13 @@ def test_no_import_cycle_among_synth_modules() -> None:
 
 # room → rooms it may not import (its own or any of their modules)
 FORBIDDEN = {
-    "synth.validation": ("synth.symbolic", "synth.filter", "synth.codegen", "synth.output", "synth.cli"),
-    "synth.symbolic": ("synth.filter", "synth.codegen", "synth.output", "synth.cli"),
+    "synth.validation": ("synth.symbolic", "synth.filter", "synth.codegen", "synth.output", "synth.cli", "synth.line"),
+    "synth.symbolic": ("synth.filter", "synth.codegen", "synth.output", "synth.cli", "synth.line"),
     "synth.logic": ("synth.plant", "synth.sup", "synth.grafcet", "synth.validation", "synth.symbolic",
-                    "synth.filter", "synth.codegen", "synth.output", "synth.cli"),
-    "synth.filter": ("synth.codegen", "synth.output", "synth.cli", "synth.symbolic"),
-    "synth.output": ("synth.cli",),
+                    "synth.filter", "synth.codegen", "synth.output", "synth.cli", "synth.line"),
+    "synth.filter": ("synth.codegen", "synth.output", "synth.cli", "synth.symbolic", "synth.line"),
+    "synth.output": ("synth.cli", "synth.line"),
+    "synth.line": ("synth.cli",),
 }
 
 # (room, module) exceptions: the symbolic closed loop of ``filter verify`` (synth.filter.symbolic_*)

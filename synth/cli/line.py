@@ -12,6 +12,13 @@ from __future__ import annotations
 import argparse
 import sys
 
+TYPE_CHECKING = False  # typing.TYPE_CHECKING, without importing typing (fast --help)
+if TYPE_CHECKING:  # pragma: no cover
+    from collections.abc import Callable
+    from typing import Any
+
+    from synth.line.jobs import Job
+
 __all__ = ["register", "cmd_check", "cmd_mutate"]
 
 
@@ -51,16 +58,15 @@ def register(sub: "argparse._SubParsersAction") -> None:
     m.set_defaults(handler=cmd_mutate)
 
 
-def _progress(quiet: bool, total: list[int]):  # type: ignore[no-untyped-def]
-    """A progress function for stderr: a counted line per finished job."""
+def _progress(quiet: bool) -> Callable[[Job, dict[str, Any], bool], None] | None:
+    """A progress function for stderr: one counted line per finished job (cached or run)."""
     if quiet:
         return None
     done = [0]
 
-    def show(job, result, cached: bool) -> None:  # type: ignore[no-untyped-def]
+    def show(job: Job, result: dict[str, Any], cached: bool) -> None:
         done[0] += 1
-        where = "cache" if cached else "run"
-        sys.stderr.write(f"[{done[0]}] {job.id}: {result['verdict']} ({where})\n")
+        sys.stderr.write(f"[{done[0]}] {job.id}: {result['verdict']} ({'cache' if cached else 'run'})\n")
         sys.stderr.flush()
 
     return show
@@ -77,7 +83,7 @@ def cmd_check(args: argparse.Namespace) -> int:
     line = load_line(args.project)
     cache = None if args.no_cache else Cache(args.cache)
     run = check_line(line, cache, mutate=args.mutate, workers=args.workers, cluster=args.cluster,
-                     progress=_progress(args.quiet, []))
+                     progress=_progress(args.quiet))
     folder = args.report or str(Path("reports") / (line.folder.resolve().name or "line"))
     written = write_line_reports(run, folder, args.junit, args.sarif)
     sys.stdout.write(summary_table(run))

@@ -164,12 +164,12 @@ def grafcet_mutants(g: Grafcet) -> list[tuple[Mutant, Grafcet]]:
             out.append((Mutant(f"level:{name}:{gone}", Operator.EDGE_TO_LEVEL, f"transition {name} when {new.text()}", t.loc),
                         _with_transition(g, t, dataclasses.replace(t, receptivity=new))))
     for p in g.grafcets:
-        for a, b in zip(p.steps, p.steps[1:]):
-            if a.actions != b.actions:
-                out.append((Mutant(f"swap-orders:{a.name}:{b.name}", Operator.SWAP_ORDERS,
-                                   f"steps {a.name} and {b.name} with each other's actions", a.loc),
-                            _with_steps(g, {id(a): dataclasses.replace(a, actions=b.actions),
-                                            id(b): dataclasses.replace(b, actions=a.actions)})))
+        for first, then in zip(p.steps, p.steps[1:]):
+            if first.actions != then.actions:
+                out.append((Mutant(f"swap-orders:{first.name}:{then.name}", Operator.SWAP_ORDERS,
+                                   f"steps {first.name} and {then.name} with each other's actions", first.loc),
+                            _with_steps(g, {id(first): dataclasses.replace(first, actions=then.actions),
+                                            id(then): dataclasses.replace(then, actions=first.actions)})))
     for name, t in labelled:
         for timer in dict.fromkeys(n.name for n in names(t.receptivity) if TIMER_RE.match(n.name)):
             def pick(x: Expr, timer: str = timer) -> Expr | None:

@@ -185,9 +185,9 @@ def _mutant(job: Job, f: Any) -> dict[str, Any]:
         from synth.filter.coherence import check
 
         found = dict((m.id, (m, model)) for m, model in filter_mutants(f))
-        m, model = found[job.mutant] if job.mutant in found else (None, None)
-        if m is None:
+        if job.mutant not in found:
             return error_result(job, f"no mutant {job.mutant!r} of {job.filter}")
+        m, model = found[job.mutant]
         before, after = check(f), check(model)
         caught = (after.holds, after.differences) != (before.holds, before.differences)
         status, why = ("caught", "filter check finds it") if caught else ("survived", "filter check sees no difference")
