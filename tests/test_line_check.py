@@ -152,3 +152,16 @@ def test_an_unmet_expectation_exits_1_and_bad_input_exits_2(line_dir: Path, caps
     out = capsys.readouterr().out
     assert "press       1       0       1  pass    NOT MET: validate clamp.g7: " in out
     assert "gate        1       1       0  fail    ok" in out
+
+
+def test_a_job_over_its_budget_is_reported_with_its_station_and_the_rest_goes_on(line_dir: Path) -> None:
+    toml = line_dir / "synth.toml"
+    toml.write_text(TOML.replace('grafcets = ["m/clamp.g7"]\n', 'grafcets = ["m/clamp.g7"]\nmax_states = 3\n'),
+                    encoding="utf-8")
+    result, ran = run(line_dir)
+    assert len(ran) == 4 and result.exit_code == 2
+    (press,) = [r for r in result.results if r["station"] == "press"]
+    assert (press["id"], press["verdict"]) == ("press/validate clamp.g7", "error")
+    assert press["summary"].startswith("stopped: ") and "3" in press["summary"]
+    assert [v.met for v in result.verdicts()] == [True, False, True]
+    assert run(line_dir)[1] == ["press/validate clamp.g7"]  # an error is not cached: it runs again

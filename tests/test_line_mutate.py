@@ -89,3 +89,24 @@ def test_the_local_pool_compiles_the_plant_once_per_worker_and_matches_the_seria
     assert pooled == serial
     assert list(serial_stats.compiled.values()) == [1]
     assert len(pool_stats.compiled) == 2 and set(pool_stats.compiled.values()) == {1}  # 2 workers, once each
+
+
+def test_a_job_that_kills_its_worker_is_an_error_and_the_others_finish(monkeypatch: pytest.MonkeyPatch) -> None:
+    import os
+
+    from synth.line import work
+
+    jobs = [with_digests(j) for j in grafcet_mutant_jobs("press", CLAMP[2], CLAMP[0], (("semantics", "grafcet"),))][:4]
+    real = work._mutant
+
+    def deadly(job, f):  # type: ignore[no-untyped-def]
+        if job.mutant == jobs[1].mutant:
+            os._exit(9)  # the worker process dies (the pool's workers are forked: they inherit this)
+        return real(job, f)
+
+    monkeypatch.setattr(work, "_mutant", deadly)
+    results = run_local(jobs, workers=2)
+    assert [r["verdict"] for r in results] == ["fail", "error", "fail", "fail"]
+    assert results[1]["summary"] == f"press/mutant clamp.g7 {jobs[1].mutant}: its worker process died"
+    monkeypatch.setattr(work, "_mutant", real)
+    assert [r for i, r in enumerate(results) if i != 1] == [r for i, r in enumerate(run_serial(jobs)) if i != 1]

@@ -76,7 +76,7 @@ class Job:
 def station_options(s: Station) -> tuple[tuple[str, str], ...]:
     """The validation options of a station's jobs."""
     return (("semantics", s.semantics), ("engine", s.engine), ("homes", "\n".join(s.homes)),
-            ("expert", str(s.expert).lower()))
+            ("expert", str(s.expert).lower())) + ((("max_states", str(s.max_states)),) if s.max_states else ())
 
 
 def station_jobs(s: Station) -> list[Job]:

@@ -78,6 +78,7 @@ class Station:
     variants: tuple[Variant, ...]
     allow_survivors: tuple[str, ...]
     loc: Location
+    max_states: int | None = None  # a validation's budget: more aggregated states is an error result
 
 
 @dataclass(frozen=True)
@@ -94,7 +95,7 @@ class Line:
 
 
 STATION_KEYS = ("name", "plant", "grafcets", "filter", "checks", "semantics", "engine", "homes", "expert", "depth",
-                "expect", "variant", "allow_survivors")
+                "expect", "variant", "allow_survivors", "max_states")
 VARIANT_KEYS = ("name", "grafcet", "plant", "expect", "homes")
 LINE_KEYS = ("name",)
 TOP_KEYS = ("line", "station")
@@ -253,6 +254,9 @@ class _Reader:
         depth = s.get("depth", 2)
         if not isinstance(depth, int) or isinstance(depth, bool) or not 1 <= depth <= 6:
             raise InputError("depth must be an integer from 1 to 6", self.loc.at(table, "depth", value=True))
+        max_states = s.get("max_states")
+        if max_states is not None and (not isinstance(max_states, int) or isinstance(max_states, bool) or max_states < 1):
+            raise InputError("max_states must be a positive integer", self.loc.at(table, "max_states", value=True))
         expert = s.get("expert", False)
         if not isinstance(expert, bool):
             raise InputError("expert must be true or false", self.loc.at(table, "expert", value=True))
@@ -280,4 +284,4 @@ class _Reader:
                        self.string(s, "semantics", table, default="grafcet", choices=("grafcet", "sfc")),
                        self.string(s, "engine", table, default="auto", choices=("auto", "explicit", "symbolic")),
                        self.strings(s, "homes", table), expert, depth, expect, tuple(variants),
-                       self.strings(s, "allow_survivors", table), self.loc.at(table))
+                       self.strings(s, "allow_survivors", table), self.loc.at(table), max_states)

@@ -63,40 +63,51 @@ def run_serial(jobs: Sequence[Job], progress: Progress | None = None,
     return out
 
 
-def run_local(jobs: Sequence[Job], workers: int | None = None, progress: Progress | None = None,
-              stats: RunStats | None = None) -> list[dict[str, Any]]:
-    """The jobs on a pool of ``workers`` processes (default one per core). Jobs lost with a
-    dead worker run once more in a fresh pool; lost again, they are ``error`` results."""
+def _pool_round(jobs: Sequence[Job], todo: list[int], workers: int, results: dict[int, dict[str, Any]],
+                progress: Progress | None, stats: RunStats | None) -> list[int]:
+    """Run ``todo`` on one pool; the indices lost when a worker died (the pool breaks: every
+    job not finished yet is lost with it)."""
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor, as_completed
     from concurrent.futures.process import BrokenProcessPool
 
+    lost: list[int] = []
+    with ProcessPoolExecutor(max_workers=min(workers, len(todo)), mp_context=multiprocessing.get_context("fork"),
+                             initializer=fresh_worker) as pool:
+        futures = {pool.submit(run_counted, jobs[i]): i for i in todo}
+        for fut in as_completed(futures):
+            i = futures[fut]
+            try:
+                result, worker = fut.result()
+            except BrokenProcessPool:
+                lost.append(i)
+                continue
+            if stats is not None:
+                stats.note(worker)
+            results[i] = result
+            if progress is not None:
+                progress(i, result)
+    return sorted(lost)
+
+
+def run_local(jobs: Sequence[Job], workers: int | None = None, progress: Progress | None = None,
+              stats: RunStats | None = None) -> list[dict[str, Any]]:
+    """The jobs on a pool of ``workers`` processes (default one per core). A worker that dies
+    breaks the pool: the jobs lost with it run again in a fresh pool, as long as each round
+    finishes some; then each remaining job alone in a pool of its own, so a job that kills its
+    worker is an ``error`` result and no other job is lost with it."""
     results: dict[int, dict[str, Any]] = {}
     todo = list(range(len(jobs)))
-    for attempt in range(2):
-        lost: list[int] = []
-        with ProcessPoolExecutor(max_workers=min(workers or default_workers(), max(1, len(todo))),
-                                 mp_context=multiprocessing.get_context("fork"), initializer=fresh_worker) as pool:
-            futures = {pool.submit(run_counted, jobs[i]): i for i in todo}
-            for fut in as_completed(futures):
-                i = futures[fut]
-                try:
-                    result, worker = fut.result()
-                except BrokenProcessPool:
-                    lost.append(i)
-                    continue
-                if stats is not None:
-                    stats.note(worker)
-                results[i] = result
-                if progress is not None:
-                    progress(i, result)
-        todo = sorted(lost)
-        if not todo:
+    while todo:
+        lost = _pool_round(jobs, todo, workers or default_workers(), results, progress, stats)
+        if len(lost) == len(todo):
             break
-    for i in todo:
-        results[i] = error_result(jobs[i], f"{jobs[i].id}: its worker process died twice")
-        if progress is not None:
-            progress(i, results[i])
+        todo = lost
+    for i in [i for i in todo if i not in results]:
+        if _pool_round(jobs, [i], 1, results, progress, stats):
+            results[i] = error_result(jobs[i], f"{jobs[i].id}: its worker process died")
+            if progress is not None:
+                progress(i, results[i])
     return [results[i] for i in range(len(jobs))]
 
 

@@ -66,7 +66,9 @@ def _validate(job: Job, rs: RuleSet, p: Plant, g: Grafcet) -> Any:
     from synth.line.engine import validate_model
 
     homes = tuple(h for h in job.option("homes").split("\n") if h)
-    return validate_model(rs, p, g, engine=job.option("engine", "auto"), expert=job.option("expert") == "true", homes=homes)
+    budget = int(job.option("max_states")) if job.option("max_states") else None
+    return validate_model(rs, p, g, engine=job.option("engine", "auto"), expert=job.option("expert") == "true", homes=homes,
+                          max_states=budget)
 
 
 def _result(job: Job, verdict: str, summary: str, text: str, report: CiReport | None,
