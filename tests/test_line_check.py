@@ -165,3 +165,16 @@ def test_a_job_over_its_budget_is_reported_with_its_station_and_the_rest_goes_on
     assert press["summary"].startswith("stopped: ") and "3" in press["summary"]
     assert [v.met for v in result.verdicts()] == [True, False, True]
     assert run(line_dir)[1] == ["press/validate clamp.g7"]  # an error is not cached: it runs again
+
+
+def test_a_worker_that_sees_other_files_refuses_the_job(line_dir: Path) -> None:
+    from synth.line.cache import with_digests
+    from synth.line.jobs import line_jobs
+    from synth.line.work import run_job
+
+    job = with_digests(line_jobs(load_line(line_dir / "synth.toml"))[2])
+    assert run_job(job)["verdict"] == "pass"
+    (line_dir / "m" / "clamp.g7").write_text("# another version\n", encoding="utf-8")
+    result = run_job(job)
+    assert (result["verdict"], result["summary"]) == (
+        "error", f"press/validate clamp.g7: {line_dir / 'm' / 'clamp.g7'} differs where the job runs from where it was planned")

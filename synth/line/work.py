@@ -210,7 +210,13 @@ def _mutant(job: Job, f: Any) -> dict[str, Any]:
 
 
 def run_job(job: Job) -> dict[str, Any]:
-    """Run ``job``; bad input or a limit is an ``error`` result, never an exception."""
+    """Run ``job``; bad input, a limit, or files that are not those the job was planned on
+    (a worker on another machine) are an ``error`` result, never an exception."""
+    from synth.line.cache import digest
+
+    changed = [f for f, d in job.digests if digest(f) != d]
+    if changed:  # a cluster's worker that sees other files than the command did
+        return error_result(job, f"{job.id}: {', '.join(changed)} differs where the job runs from where it was planned")
     try:
         if job.kind is JobKind.MUTANT and job.filter is None:
             return _mutant(job, None)
