@@ -40,6 +40,8 @@ plant = "m/clamp.rules"
 grafcets = ["m/clamp.g7"]
 checks = ["validate"]
 
+"""
+GATE = """
 [[station]]
 name = "gate"
 plant = "m/gate.rules"
@@ -47,6 +49,7 @@ grafcets = ["m/gate.g7"]
 checks = ["validate"]
 expect = "fail"
 """
+TOML += GATE
 
 
 @pytest.fixture

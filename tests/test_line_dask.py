@@ -15,24 +15,16 @@ from synth.line.project import load_line
 from synth.line.report import write_line_reports
 from synth.line.run import check_line
 
-distributed = pytest.importorskip("distributed")
+from test_line_check import EXAMPLE, GATE
 
-ROOT = Path(__file__).parent.parent
-EXAMPLE = ROOT / "lines" / "example"
+distributed = pytest.importorskip("distributed")
 TOML = """[[station]]
 name = "press"
 plant = "m/clamp.rules"
 grafcets = ["m/clamp.g7"]
 filter = "m/clamp.filter"
 checks = ["validate", "filter-check"]
-
-[[station]]
-name = "gate"
-plant = "m/gate.rules"
-grafcets = ["m/gate.g7"]
-checks = ["validate"]
-expect = "fail"
-"""
+""" + GATE
 
 
 @pytest.fixture(scope="module")
@@ -59,6 +51,8 @@ def line(tmp_path: Path):  # type: ignore[no-untyped-def]
 def test_the_cluster_gives_the_local_run_byte_for_byte_and_survives_a_killed_worker(cluster, line, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
     local = check_line(line, None, mutate=True, workers=2)
     assert (len(local.results), local.computed, local.exit_code) == (22, 22, 1)  # 3 checks, 19 mutants, 4 survivors
+    # the checks then the mutants on the same two processes, each compiling a plant at most once
+    assert len(local.stats.compiled) == 2 and max(local.stats.compiled.values()) <= 2
     write_line_reports(local, tmp_path / "local")
 
     remote = check_line(line, None, mutate=True, cluster=cluster.scheduler_address)

@@ -9,6 +9,7 @@ from pathlib import Path
 
 import pytest
 
+from schemas import assert_valid
 from synth.cli.main import main
 from synth.grafcet.language_check import load_grafcet
 from synth.line.jobs import JobKind
@@ -42,6 +43,7 @@ def test_every_operator_with_ids_in_file_order() -> None:
 def test_the_press_pins_its_score_and_survivors(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["mutate", *CLAMP, "--filter", str(PRESS / "plants/clamp.filter"), "--workers", "1", "--json"]) == 1
     data = json.loads(capsys.readouterr().out)
+    assert_valid("mutate", data)
     assert (len(data["mutants"]), data["caught"], data["changing"], data["equivalent"], data["score"]) == \
         (19, 15, 19, 0, round(15 / 19, 4))
     assert data["survivors"] == data["unexpected"] == SURVIVORS

@@ -16,7 +16,7 @@ from typing import Any, Callable
 from synth.line.cache import Cache, with_digests
 from synth.line.jobs import Job, JobKind, line_jobs, station_options
 from synth.line.project import Expect, Line, Station
-from synth.line.runners import RunStats, run_dask, run_local, run_serial
+from synth.line.runners import LocalPool, RunStats, run_dask, run_local, run_serial
 
 __all__ = ["LineRun", "StationVerdict", "check_line", "mutant_jobs", "grafcet_mutant_jobs", "filter_mutant_jobs", "run_jobs"]
 
@@ -91,7 +91,7 @@ class LineRun:
 
 def run_jobs(jobs: list[Job], cache: Cache | None, *, workers: int | None = None, cluster: str | None = None,
              progress: Callable[[Job, dict[str, Any], bool], None] | None = None,
-             stats: RunStats | None = None) -> tuple[list[dict[str, Any]], int]:
+             stats: RunStats | None = None, pool: LocalPool | None = None) -> tuple[list[dict[str, Any]], int]:
     """The results of ``jobs`` (in order): cached ones read, the others run and stored (errors
     are not stored: a dead worker or a limit may not happen again); and how many were run."""
     jobs = [with_digests(j) for j in jobs]
@@ -114,7 +114,7 @@ def run_jobs(jobs: list[Job], cache: Cache | None, *, workers: int | None = None
     elif workers == 1 or len(pending) == 1:
         fresh = run_serial(pending, done, stats)
     else:
-        fresh = run_local(pending, workers, done, stats)
+        fresh = run_local(pending, workers, done, stats, pool)
     for i, r in zip(todo, fresh):
         results[i] = r
         if cache is not None and r["verdict"] != "error":
@@ -165,12 +165,18 @@ def check_line(line: Line, cache: Cache | None, *, mutate: bool = False, workers
                cluster: str | None = None, progress: Callable[[Job, dict[str, Any], bool], None] | None = None) -> LineRun:
     """Run the line (see the module docstring)."""
     stats = RunStats()
-    results, computed = run_jobs(line_jobs(line), cache, workers=workers, cluster=cluster, progress=progress, stats=stats)
-    total = len(results)
-    if mutate:
-        more, ran = run_jobs(mutant_jobs(line, results), cache, workers=workers, cluster=cluster, progress=progress,
-                             stats=stats)
-        results += more
-        computed += ran
-        total += len(more)
+    local = None if cluster or workers == 1 else LocalPool(workers)
+    try:
+        results, computed = run_jobs(line_jobs(line), cache, workers=workers, cluster=cluster, progress=progress,
+                                     stats=stats, pool=local)
+        total = len(results)
+        if mutate:
+            more, ran = run_jobs(mutant_jobs(line, results), cache, workers=workers, cluster=cluster,
+                                 progress=progress, stats=stats, pool=local)
+            results += more
+            computed += ran
+            total += len(more)
+    finally:
+        if local is not None:
+            local.close()
     return LineRun(line, results, computed, total - computed, stats, mutate)

@@ -18,7 +18,7 @@ from synth.errors import SynthError
 from synth.line.jobs import Job
 from synth.line.work import error_result, fresh_worker, run_counted
 
-__all__ = ["RunStats", "run_serial", "run_local", "run_dask", "default_workers"]
+__all__ = ["RunStats", "LocalPool", "run_serial", "run_local", "run_dask", "default_workers"]
 
 Progress = Callable[[int, dict[str, Any]], None]
 
@@ -63,18 +63,39 @@ def run_serial(jobs: Sequence[Job], progress: Progress | None = None,
     return out
 
 
-def _pool_round(jobs: Sequence[Job], todo: list[int], workers: int, results: dict[int, dict[str, Any]],
-                progress: Progress | None, stats: RunStats | None) -> list[int]:
-    """Run ``todo`` on one pool; the indices lost when a worker died (the pool breaks: every
-    job not finished yet is lost with it)."""
-    import multiprocessing
-    from concurrent.futures import ProcessPoolExecutor, as_completed
-    from concurrent.futures.process import BrokenProcessPool
+class LocalPool:
+    """Worker processes kept for a whole run (``synth check --mutate`` runs the checks, then the
+    mutants, on the same workers: each compiles a plant once for both); a new set of processes
+    after a worker died. Use as a context manager."""
 
-    lost: list[int] = []
-    with ProcessPoolExecutor(max_workers=min(workers, len(todo)), mp_context=multiprocessing.get_context("fork"),
-                             initializer=fresh_worker) as pool:
-        futures = {pool.submit(run_counted, jobs[i]): i for i in todo}
+    def __init__(self, workers: int | None = None) -> None:
+        self.workers = workers or default_workers()
+        self._pool: Any = None
+
+    def __enter__(self) -> LocalPool:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def close(self) -> None:
+        if self._pool is not None:
+            self._pool.shutdown(wait=True, cancel_futures=True)
+            self._pool = None
+
+    def round(self, jobs: Sequence[Job], todo: list[int], results: dict[int, dict[str, Any]],
+              progress: Progress | None, stats: RunStats | None) -> list[int]:
+        """Run ``todo``; the indices lost when a worker died (the pool breaks: every job not
+        finished yet is lost with it, and the next round starts new processes)."""
+        import multiprocessing
+        from concurrent.futures import ProcessPoolExecutor, as_completed
+        from concurrent.futures.process import BrokenProcessPool
+
+        if self._pool is None:
+            self._pool = ProcessPoolExecutor(max_workers=self.workers, mp_context=multiprocessing.get_context("fork"),
+                                             initializer=fresh_worker)
+        lost: list[int] = []
+        futures = {self._pool.submit(run_counted, jobs[i]): i for i in todo}
         for fut in as_completed(futures):
             i = futures[fut]
             try:
@@ -87,27 +108,37 @@ def _pool_round(jobs: Sequence[Job], todo: list[int], workers: int, results: dic
             results[i] = result
             if progress is not None:
                 progress(i, result)
-    return sorted(lost)
+        if lost:
+            self.close()
+        return sorted(lost)
 
 
 def run_local(jobs: Sequence[Job], workers: int | None = None, progress: Progress | None = None,
-              stats: RunStats | None = None) -> list[dict[str, Any]]:
-    """The jobs on a pool of ``workers`` processes (default one per core). A worker that dies
-    breaks the pool: the jobs lost with it run again in a fresh pool, as long as each round
-    finishes some; then each remaining job alone in a pool of its own, so a job that kills its
-    worker is an ``error`` result and no other job is lost with it."""
+              stats: RunStats | None = None, pool: LocalPool | None = None) -> list[dict[str, Any]]:
+    """The jobs on ``pool`` (else a pool of ``workers`` processes, default one per core, for
+    these jobs only). A worker that dies breaks the pool: the jobs lost with it run again on
+    new processes, as long as each round finishes some; then each remaining job alone on a
+    process of its own, so a job that kills its worker is an ``error`` result and no other job
+    is lost with it."""
+    own = pool is None
+    pool = pool or LocalPool(min(workers or default_workers(), max(1, len(jobs))))
     results: dict[int, dict[str, Any]] = {}
     todo = list(range(len(jobs)))
-    while todo:
-        lost = _pool_round(jobs, todo, workers or default_workers(), results, progress, stats)
-        if len(lost) == len(todo):
-            break
-        todo = lost
+    try:
+        while todo:
+            lost = pool.round(jobs, todo, results, progress, stats)
+            if len(lost) == len(todo):
+                break
+            todo = lost
+    finally:
+        if own:
+            pool.close()
     for i in [i for i in todo if i not in results]:
-        if _pool_round(jobs, [i], 1, results, progress, stats):
-            results[i] = error_result(jobs[i], f"{jobs[i].id}: its worker process died")
-            if progress is not None:
-                progress(i, results[i])
+        with LocalPool(1) as alone:
+            if alone.round(jobs, [i], results, progress, stats):
+                results[i] = error_result(jobs[i], f"{jobs[i].id}: its worker process died")
+                if progress is not None:
+                    progress(i, results[i])
     return [results[i] for i in range(len(jobs))]
 
 
