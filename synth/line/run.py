@@ -13,6 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
+from synth.errors import SynthError
 from synth.line.cache import Cache, with_digests
 from synth.line.jobs import Job, JobKind, line_jobs, station_options
 from synth.line.project import Expect, Line, Station
@@ -157,7 +158,10 @@ def mutant_jobs(line: Line, results: list[dict[str, Any]]) -> list[Job]:
             if (s.name, f"validate {g.name}") in passed:
                 out += grafcet_mutant_jobs(s.name, str(s.plant), str(g), station_options(s))
         if s.filter is not None:
-            out += filter_mutant_jobs(s.name, str(s.filter))
+            try:
+                out += filter_mutant_jobs(s.name, str(s.filter))
+            except SynthError:  # the station's filter check reports it as its error
+                pass
     return out
 
 
