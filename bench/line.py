@@ -73,6 +73,9 @@ def main() -> None:
     rows.append(row)
     same = serial == pooled == dask
     print(f"the same results in the three modes: {same}")
+    for a, b, c in zip(serial, pooled, dask):
+        if not a == b == c:
+            print(f"  differs: {a['id']}")
     out = {"line": args.toml, "mutate": mutate, "runs": rows, "same_results": same, "cache": cache_rerun(args.toml)}
     if args.json:
         Path(args.json).write_text(json.dumps(out, indent=2) + "\n", encoding="utf-8")

@@ -181,3 +181,15 @@ def test_a_worker_that_sees_other_files_refuses_the_job(line_dir: Path) -> None:
     result = run_job(job)
     assert (result["verdict"], result["summary"]) == (
         "error", f"press/validate clamp.g7: {line_dir / 'm' / 'clamp.g7'} differs where the job runs from where it was planned")
+
+
+def test_a_filter_verify_result_holds_no_wall_clock_time(tmp_path: Path) -> None:
+    from synth.line.jobs import Job, JobKind
+    from synth.line.work import run_job
+
+    data = ROOT / "tests" / "data" / "filter"
+    job = Job("s", JobKind.FILTER_VERIFY, "filter verify", str(data / "two.rules"), None, str(data / "two_assume.filter"))
+    first = run_job(job)
+    explored = [x for x in first["text"].splitlines() if x.startswith("explored ")]
+    assert len(explored) == 1 and explored[0].endswith(" cycles")  # "... cycles in 0.01 s" on the terminal
+    assert run_job(job) == first
