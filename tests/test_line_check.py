@@ -193,3 +193,16 @@ def test_a_filter_verify_result_holds_no_wall_clock_time(tmp_path: Path) -> None
     explored = [x for x in first["text"].splitlines() if x.startswith("explored ")]
     assert len(explored) == 1 and explored[0].endswith(" cycles")  # "... cycles in 0.01 s" on the terminal
     assert run_job(job) == first
+
+
+def test_bad_options_exit_2_without_a_traceback(line_dir: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    toml = str(line_dir / "synth.toml")
+    with pytest.raises(SystemExit) as info:
+        main(["check", toml, "--workers", "0"])
+    assert info.value.code == 2
+    assert capsys.readouterr().err.endswith("error: argument --workers: '0' is not a number of workers (1 or more)\n")
+    pytest.importorskip("distributed")
+    assert main(["check", toml, "--no-cache", "--quiet", "--cluster", "nonsense", "--report", str(line_dir / "o")]) == 2
+    assert capsys.readouterr().err == ("error: --cluster nonsense: cannot reach the scheduler: missing port number in "
+                                       "address 'nonsense'\n")
+    assert not (line_dir / "o").exists()  # nothing written

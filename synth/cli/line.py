@@ -22,6 +22,17 @@ if TYPE_CHECKING:  # pragma: no cover
 __all__ = ["register", "cmd_check", "cmd_mutate"]
 
 
+def _positive(text: str) -> int:
+    """``--workers N``: an integer of at least 1 (argparse reports anything else, exit 2)."""
+    try:
+        n = int(text)
+    except ValueError:
+        n = 0
+    if n < 1:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number of workers (1 or more)")
+    return n
+
+
 def register(sub: "argparse._SubParsersAction") -> None:
     c = sub.add_parser("check", help="every check of every station of a line (synth.toml), cached, in parallel",
                        description="Run every station's validate, filter check/verify and st --check; exit 0 only "
@@ -34,7 +45,7 @@ def register(sub: "argparse._SubParsersAction") -> None:
     c.add_argument("--mutate", action="store_true",
                    help="also validate the mutants of every station's passing Grafcets (and filter equations)")
     c.add_argument("--cluster", metavar="tcp://HOST:8786", help="run the jobs on this Dask distributed scheduler")
-    c.add_argument("--workers", metavar="N", type=int, help="local worker processes (default: one per core; 1: serial)")
+    c.add_argument("--workers", metavar="N", type=_positive, help="local worker processes (default: one per core; 1: serial)")
     c.add_argument("--report", metavar="DIR", help="where index.html, the station pages, junit.xml and line.sarif go "
                                                    "(default: reports/<the project's folder name>)")
     c.add_argument("--junit", metavar="FILE", help="write the line's JUnit XML here instead")
@@ -53,7 +64,7 @@ def register(sub: "argparse._SubParsersAction") -> None:
     m.add_argument("--home", metavar="EXPR", action="append", default=[], help="a home state, as for validate")
     m.add_argument("--allow", metavar="ID", action="append", default=[],
                    help="a known survivor (its mutant id; repeatable): it does not fail the run")
-    m.add_argument("--workers", metavar="N", type=int, help="local worker processes (default: one per core; 1: serial)")
+    m.add_argument("--workers", metavar="N", type=_positive, help="local worker processes (default: one per core; 1: serial)")
     m.add_argument("--json", action="store_true", help="print the mutants, the score and the survivors as JSON")
     m.set_defaults(handler=cmd_mutate)
 

@@ -153,7 +153,7 @@ def run_dask(jobs: Sequence[Job], address: str, progress: Progress | None = None
         raise SynthError("--cluster needs dask.distributed: pip install 'synth[line]'") from None
     try:
         client = Client(address, timeout="20s")
-    except (OSError, TimeoutError) as err:
+    except (OSError, TimeoutError, ValueError) as err:
         raise SynthError(f"--cluster {address}: cannot reach the scheduler: {err}") from None
     results: dict[int, dict[str, Any]] = {}
     try:
