@@ -78,3 +78,31 @@ def test_a_wrong_value_a_duplicate_station_and_an_empty_line(tmp_path: Path) -> 
         "synth.toml:1:1: error: the line has no station: add [[station]] tables")
     text = error(tmp_path, STATION + 'checks = ["validate", "filter-check"]\n').splitlines()
     assert text[0].endswith("synth.toml:5:10: error: a filter check needs filter = \"F.filter\"")
+
+
+def test_the_example_line_plans_its_twelve_checks() -> None:
+    from synth.line.jobs import line_jobs
+
+    line = load_line(Path(__file__).parent.parent / "lines" / "example" / "synth.toml")
+    assert [(s.name, s.expect) for s in line.stations] == [
+        ("box sorting", Expect.PASS), ("boxes as workpieces", Expect.PASS), ("four cylinders", Expect.PASS),
+        ("press", Expect.PASS), ("gate", Expect.FAIL)]
+    assert [(j.id, None if j.expect is None else str(j.expect)) for j in line_jobs(line)] == [
+        ("box sorting/validate tri.g7", "pass"), ("box sorting/st --check tri.g7", "pass"),
+        ("box sorting/variant missing order", "fail"),
+        ("boxes as workpieces/validate tri_boxes.g7", "pass"),
+        ("boxes as workpieces/variant plain box-sorting grafcet", "fail"),
+        ("four cylinders/filter verify four_cylinders.filter", "pass"),
+        ("four cylinders/st --check four_cylinders.g7", "pass"), ("four cylinders/variant without the filter", "fail"),
+        ("press/validate clamp.g7", "pass"), ("press/filter check clamp.filter", "pass"),
+        ("press/st --check clamp.g7", "pass"), ("gate/validate gate.g7", "fail")]
+
+
+@pytest.mark.nightly
+def test_the_example_line_meets_every_expectation(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """The whole example line (about a minute of CPU): pytest -m nightly."""
+    from synth.cli.main import main
+
+    toml = Path(__file__).parent.parent / "lines" / "example" / "synth.toml"
+    assert main(["check", str(toml), "--no-cache", "--quiet", "--report", str(tmp_path)]) == 0
+    assert capsys.readouterr().out.splitlines()[6] == "5 station(s), 5 meet their expectation; 12 job(s): 12 run, 0 from the cache"
