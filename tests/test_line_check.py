@@ -206,3 +206,17 @@ def test_bad_options_exit_2_without_a_traceback(line_dir: Path, capsys: pytest.C
     assert capsys.readouterr().err == ("error: --cluster nonsense: cannot reach the scheduler: missing port number in "
                                        "address 'nonsense'\n")
     assert not (line_dir / "o").exists()  # nothing written
+
+
+def test_validation_reports_are_written_and_linked_from_their_station(line_dir: Path) -> None:
+    toml = line_dir / "synth.toml"
+    toml.write_text(TOML.split("\n[[station]]\nname = \"press\"")[0], encoding="utf-8")  # the cylinder alone
+    report = line_dir / "out"
+    assert main(["check", str(toml), "--no-cache", "--quiet", "--workers", "1", "--report", str(report),
+                 "--validation-reports"]) == 0
+    assert sorted(p.name for p in report.iterdir()) == ["index.html", "junit.xml", "line.sarif", "station-cyl-1.html",
+                                                        "station-cyl-2.html", "station-cyl.html"]
+    page = (report / "station-cyl.html").read_text(encoding="utf-8")
+    assert page.count('<a href="station-cyl-') == 2
+    variant, home = ((report / f"station-cyl-{k}.html").read_text(encoding="utf-8") for k in (2, 1))
+    assert "<h2>Blocking 1: situation {X1}" in variant and "<h2>Blocking" not in home  # synth validate --report's

@@ -50,6 +50,9 @@ def register(sub: "argparse._SubParsersAction") -> None:
                                                    "(default: reports/<the project's folder name>)")
     c.add_argument("--junit", metavar="FILE", help="write the line's JUnit XML here instead")
     c.add_argument("--sarif", metavar="FILE", help="write the line's SARIF here instead")
+    c.add_argument("--validation-reports", action="store_true",
+                   help="also write each validation's full report (synth validate --report: traces, drawings), "
+                        "linked from its station's page (explicit engine)")
     c.add_argument("--quiet", action="store_true", help="no progress on stderr")
     c.set_defaults(handler=cmd_check)
 
@@ -94,7 +97,7 @@ def cmd_check(args: argparse.Namespace) -> int:
     line = load_line(args.project)
     cache = None if args.no_cache else Cache(args.cache)
     run = check_line(line, cache, mutate=args.mutate, workers=args.workers, cluster=args.cluster,
-                     progress=_progress(args.quiet))
+                     progress=_progress(args.quiet), reports=args.validation_reports)
     folder = args.report or str(Path("reports") / (line.folder.resolve().name or "line"))
     written = write_line_reports(run, folder, args.junit, args.sarif)
     sys.stdout.write(summary_table(run))

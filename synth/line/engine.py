@@ -20,12 +20,14 @@ __all__ = ["validate_model"]
 
 
 def validate_model(rs: RuleSet, p: Plant, g: Grafcet, *, engine: str = "auto", expert: bool = False,
-                   homes: Sequence[str] = (), max_states: int | None = None) -> Validation:
-    """``synth validate`` on a loaded model: the engine chosen by :mod:`synth.engines`."""
+                   homes: Sequence[str] = (), max_states: int | None = None, needs_listing: bool = False) -> Validation:
+    """``synth validate`` on a loaded model: the engine chosen by :mod:`synth.engines`
+    (``needs_listing``: a full report will list every aggregated state, explicit engine only)."""
     from synth.engines import EngineChoice, choose, concurrency
     from synth.grafcet.language import Semantics
 
-    asked = EngineChoice(engine)
+    asked = choose(engine, 0, needs_listing=True, listing_option="--validation-reports") if needs_listing \
+        else EngineChoice(engine)
     if (p.reads or g.semantics is not Semantics.GRAFCET) and asked == EngineChoice.AUTO:
         asked = EngineChoice.EXPLICIT
     estimate = p.size * max(1, len(g.steps))

@@ -79,10 +79,11 @@ def station_options(s: Station) -> tuple[tuple[str, str], ...]:
             ("expert", str(s.expert).lower())) + ((("max_states", str(s.max_states)),) if s.max_states else ())
 
 
-def station_jobs(s: Station) -> list[Job]:
+def station_jobs(s: Station, reports: bool = False) -> list[Job]:
     """The jobs of one station, in a fixed order: its checks as listed, each on its Grafcets in
-    file order, then its variants."""
-    plant, options = str(s.plant), station_options(s)
+    file order, then its variants; with ``reports`` each validation also renders its full
+    HTML report (explicit engine)."""
+    plant, options = str(s.plant), station_options(s) + ((("report", "true"),) if reports else ())
     jobs: list[Job] = []
     for check in s.checks:
         if check is Check.VALIDATE:
@@ -104,9 +105,9 @@ def station_jobs(s: Station) -> list[Job]:
     return jobs
 
 
-def line_jobs(line: Line) -> list[Job]:
+def line_jobs(line: Line, reports: bool = False) -> list[Job]:
     """Every station's jobs, stations in file order."""
-    return [j for s in line.stations for j in station_jobs(s)]
+    return [j for s in line.stations for j in station_jobs(s, reports)]
 
 
 _USE = re.compile(r'^\s*use\s+"([^"]+)"', re.M)

@@ -100,9 +100,17 @@ def index_html(run: LineRun) -> str:
                                              mutated=run.mutated, version=version(), run=run)
 
 
+def validation_pages(run: LineRun) -> dict[str, str]:
+    """The file name of each full validation report (``--validation-reports``), by job id:
+    its station's page name and the job's rank in the run."""
+    return {r["id"]: station_page(r["station"]).removesuffix(".html") + f"-{i}.html"
+            for i, r in enumerate(run.results, 1) if r.get("html")}
+
+
 def station_html(run: LineRun, v: StationVerdict) -> str:
     results = [r for r in run.results if r["station"] == v.name]
-    return _template("station.html.j2").render(line=run.line, v=v, results=results, score=_score)
+    return _template("station.html.j2").render(line=run.line, v=v, results=results, score=_score,
+                                               pages=validation_pages(run))
 
 
 def write_line_reports(run: LineRun, folder: str | Path, junit: str | Path | None = None,
@@ -117,6 +125,8 @@ def write_line_reports(run: LineRun, folder: str | Path, junit: str | Path | Non
     reports = line_reports(run)
     files = [(folder / "index.html", index_html(run))]
     files += [(folder / station_page(v.name), station_html(run, v)) for v in run.verdicts()]
+    by_id = {r["id"]: r for r in run.results}
+    files += [(folder / name, by_id[ident]["html"]) for ident, name in validation_pages(run).items()]
     junit_path, sarif_path = Path(junit or folder / "junit.xml"), Path(sarif or folder / "line.sarif")
     files += [(junit_path, junit_xml(reports)), (sarif_path, json_text(sarif_json(reports)))]
     for path, text in files:

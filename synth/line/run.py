@@ -166,12 +166,14 @@ def mutant_jobs(line: Line, results: list[dict[str, Any]]) -> list[Job]:
 
 
 def check_line(line: Line, cache: Cache | None, *, mutate: bool = False, workers: int | None = None,
-               cluster: str | None = None, progress: Callable[[Job, dict[str, Any], bool], None] | None = None) -> LineRun:
-    """Run the line (see the module docstring)."""
+               cluster: str | None = None, progress: Callable[[Job, dict[str, Any], bool], None] | None = None,
+               reports: bool = False) -> LineRun:
+    """Run the line (see the module docstring); ``reports``: each validation also renders its
+    full HTML report."""
     stats = RunStats()
     local = None if cluster or workers == 1 else LocalPool(workers)
     try:
-        results, computed = run_jobs(line_jobs(line), cache, workers=workers, cluster=cluster, progress=progress,
+        results, computed = run_jobs(line_jobs(line, reports), cache, workers=workers, cluster=cluster, progress=progress,
                                      stats=stats, pool=local)
         total = len(results)
         if mutate:

@@ -68,14 +68,15 @@ def _validate(job: Job, rs: RuleSet, p: Plant, g: Grafcet) -> Any:
     homes = tuple(h for h in job.option("homes").split("\n") if h)
     budget = int(job.option("max_states")) if job.option("max_states") else None
     return validate_model(rs, p, g, engine=job.option("engine", "auto"), expert=job.option("expert") == "true", homes=homes,
-                          max_states=budget)
+                          max_states=budget, needs_listing=job.option("report") == "true")
 
 
 def _result(job: Job, verdict: str, summary: str, text: str, report: CiReport | None,
-            mutant: dict[str, Any] | None = None) -> dict[str, Any]:
+            mutant: dict[str, Any] | None = None, html: str | None = None) -> dict[str, Any]:
     data = {"id": job.id, "station": job.station, "kind": str(job.kind), "name": job.name,
             "expect": None if job.expect is None else str(job.expect), "verdict": verdict, "summary": summary,
-            "text": text, "report": None if report is None else dataclasses.asdict(report), "mutant": mutant}
+            "text": text, "report": None if report is None else dataclasses.asdict(report), "mutant": mutant,
+            "html": html}
     return json.loads(json.dumps(data))  # plain JSON types: a computed result equals a cached one
 
 
@@ -107,7 +108,12 @@ def _run(job: Job) -> dict[str, Any]:
 
         v = _validate(job, *_grafcet(job))
         text = validation_text(v)
-        return _result(job, "pass" if v.passed else "fail", _first(text), text, validation_report(v))
+        html = None
+        if job.option("report") == "true":
+            from synth.output.html import report_html
+
+            html = report_html(v)
+        return _result(job, "pass" if v.passed else "fail", _first(text), text, validation_report(v), html=html)
     if job.kind is JobKind.ST_CHECK:
         from synth.codegen.check import differential_check
         from synth.output.ci import st_check_report
