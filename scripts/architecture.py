@@ -31,6 +31,7 @@ PACKAGES = {
     "filter": ("safety logic filter: check, solve, verify", "equations, filter FB"),
     "codegen": ("IEC 61131-3 ST, PLCopen XML, ST interpreter", "program, proof"),
     "output": ("summaries, DOT, HTML report, libFAUDES, files", "JSON, text, files"),
+    "line": ("a whole line: synth.toml, jobs, cache, pool/Dask, mutants", "line reports, score"),
     "cli": ("one thin module per command group", "exit 0 / 1 / 2"),
 }
 

@@ -2,7 +2,7 @@
 # Set-up on a fresh machine (stock Debian 12 included): a project virtual environment
 # .venv with synth and its runtime dependencies, Graphviz's dot from Debian when missing;
 # with SYNTH_SETUP_TESTS=1 (CI) also the test dependencies (pytest, pytest-xdist, libFAUDES,
-# jsonschema, Playwright, mypy) and the build tools the wheel test uses, and with
+# jsonschema, Playwright, mypy, Dask) and the build tools the wheel test uses, and with
 # SYNTH_SETUP_BROWSER=1 Debian's chromium and libatomic1 (Playwright's driver needs it)
 # for the report's browser test. Writes nothing outside .venv (and Debian's packages).
 # Safe to run again.

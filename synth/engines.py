@@ -60,7 +60,7 @@ if TYPE_CHECKING:  # pragma: no cover - the engines are imported once chosen
 
 __all__ = ["EngineChoice", "Command", "Need", "Capability", "CAPABILITIES", "Threshold", "THRESHOLDS", "Decision",
            "capability", "refuse", "refusal", "decide", "choose", "concurrency", "VALIDATE_THRESHOLD",
-           "CONCURRENCY_THRESHOLD", "SUP_THRESHOLD", "VERIFY_THRESHOLD", "validate", "SupRun", "supervisor"]
+           "CONCURRENCY_THRESHOLD", "SUP_THRESHOLD", "VERIFY_THRESHOLD", "validate", "validate_models", "SupRun", "supervisor"]
 
 
 class Command(StrEnum):
@@ -246,6 +246,30 @@ def validate(
         options.add(Need.SFC)
     refuse(Command.VALIDATE, engine, options)
     rs, p, g = load_model(grafcet_path, rules_path, semantics)
+    return validate_models(rs, p, g, engine=engine, needs_listing=needs_listing, expert=expert, homes=homes,
+                           max_states=max_states, max_nodes=max_nodes, progress=progress)
+
+
+def validate_models(
+    rs: RuleSet,
+    p: Plant,
+    g: Grafcet,
+    *,
+    engine: EngineChoice | str = EngineChoice.AUTO,
+    needs_listing: bool = False,
+    expert: bool = False,
+    homes: Sequence[str] = (),
+    max_states: int | None = None,
+    max_nodes: int | None = None,
+    progress: Callable[[str], None] | None = None,
+) -> Validation:
+    """:func:`validate` on models already loaded (a line's worker compiles each plant once and
+    validates many Grafcets against it): the same choice, the same engines."""
+    from synth.grafcet.language import Semantics
+
+    options = {Need.LISTING} if needs_listing else set()
+    if g.semantics is not Semantics.GRAFCET:
+        options.add(Need.SFC)
     chosen = decide(Command.VALIDATE, engine, options, estimate=p.size * max(1, len(g.steps)), width=concurrency(g),
                     readers=p.readers)
     if chosen.engine is EngineChoice.SYMBOLIC:
