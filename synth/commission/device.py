@@ -28,7 +28,7 @@ from synth.codegen.interpreter.machine import Module
 from synth.commission.iomap import Coupling, IoMap, Role
 from synth.commission.modbus import LinkError, ModbusClient, ModbusServer, spans
 
-__all__ = ["Timing", "next_count", "ScannedProgram", "InterpretedPlc"]
+__all__ = ["Timing", "next_count", "ScannedProgram", "InterpretedPlc", "program_plc"]
 
 POLL_S = 0.0002
 
@@ -196,3 +196,26 @@ class InterpretedPlc:
             self.server = None
         elif isinstance(image, ModbusClient):
             image.close()
+
+
+def program_plc(grafcet_path: str, plant_path: str | None, io_spec: str, host: str, port: int,
+                **options: object) -> InterpretedPlc:
+    """The device under test for a Grafcet: ``synth st --io`` 's program, parsed once, as a
+    runtime on ``host:port`` (not started); ``options`` as :class:`InterpretedPlc`'s."""
+    from synth.codegen.grafcet_st import generate_program
+    from synth.codegen.interpreter.machine import load_st
+    from synth.codegen.program import with_locations
+    from synth.commission.iomap import io_map
+    from synth.grafcet.language_check import load_grafcet
+
+    if plant_path is not None:
+        from synth.plant.rules_check import load_rules
+
+        rules = load_rules(plant_path)
+        g = load_grafcet(grafcet_path, inputs=rules.inputs, outputs=rules.outputs)
+    else:
+        g = load_grafcet(grafcet_path)
+    io = io_map(io_spec, g.inputs, g.outputs)
+    program = with_locations(generate_program(g, comments=False), io.locations)
+    parsed = load_st(program.text, grafcet_path + ".st")
+    return InterpretedPlc(parsed, program.program, io, host, port, **options)  # type: ignore[arg-type]
