@@ -28,7 +28,7 @@ from synth.codegen.interpreter.machine import Module
 from synth.commission.iomap import Coupling, IoMap, Role
 from synth.commission.modbus import LinkError, ModbusClient, ModbusServer, spans
 
-__all__ = ["Timing", "next_count", "ScannedProgram", "InterpretedPlc", "program_plc"]
+__all__ = ["Timing", "next_count", "ScannedProgram", "InterpretedPlc", "located_program"]
 
 POLL_S = 0.0002
 
@@ -141,11 +141,15 @@ class InterpretedPlc:
         raise LinkError("stopped")
 
     def _loop(self) -> None:
-        try:
-            self._run(self._connect())
-        except LinkError as err:
-            if not self.stopping.is_set():
-                self.error = err
+        while not self.stopping.is_set():
+            try:
+                self._run(self._connect())
+                return
+            except LinkError as err:
+                if self.server is not None or self.stopping.is_set():
+                    self.error = None if self.stopping.is_set() else err
+                    return
+                time.sleep(0.05)  # the device it polls went away: poll again, as a runtime does
 
     def _run(self, image: _Image) -> None:
         grant_at, done_at = self.slot("@grant"), self.slot("@done")
@@ -198,10 +202,9 @@ class InterpretedPlc:
             image.close()
 
 
-def program_plc(grafcet_path: str, plant_path: str | None, io_spec: str, host: str, port: int,
-                **options: object) -> InterpretedPlc:
-    """The device under test for a Grafcet: ``synth st --io`` 's program, parsed once, as a
-    runtime on ``host:port`` (not started); ``options`` as :class:`InterpretedPlc`'s."""
+def located_program(grafcet_path: str, plant_path: str | None, io_spec: str) -> tuple[Module, str, IoMap]:
+    """``synth st --io`` 's program for a Grafcet, parsed once (the slow part): the module, the
+    PROGRAM's name, the map. :class:`InterpretedPlc` runs it as a runtime."""
     from synth.codegen.grafcet_st import generate_program
     from synth.codegen.interpreter.machine import load_st
     from synth.codegen.program import with_locations
@@ -217,5 +220,4 @@ def program_plc(grafcet_path: str, plant_path: str | None, io_spec: str, host: s
         g = load_grafcet(grafcet_path)
     io = io_map(io_spec, g.inputs, g.outputs)
     program = with_locations(generate_program(g, comments=False), io.locations)
-    parsed = load_st(program.text, grafcet_path + ".st")
-    return InterpretedPlc(parsed, program.program, io, host, port, **options)  # type: ignore[arg-type]
+    return load_st(program.text, grafcet_path + ".st"), program.program, io

@@ -26,13 +26,17 @@ from typing import Callable, Sequence
 from synth.commission.device import Timing
 from synth.commission.faults import Fault, FaultKind, wire_values
 from synth.commission.links import Link
+from synth.commission.modbus import LinkError
 from synth.grafcet.language import Grafcet
 from synth.grafcet.machine import GrafcetMachine, Situation
 from synth.logic.events import Event
 from synth.plant.composition import LocalTransition, Plant
 from synth.sup.constraints import CompiledConstraints
 
-__all__ = ["Outcome", "LoopStep", "Walk", "Stop", "Setup", "Choice", "ClosedLoop"]
+WAIT = "+1s"
+"""Without a reference Grafcet, the event "one second of PLC time passes"."""
+
+__all__ = ["WAIT", "Outcome", "LoopStep", "Walk", "Stop", "Setup", "Choice", "ClosedLoop"]
 
 
 class Outcome(StrEnum):
@@ -163,6 +167,8 @@ class ClosedLoop:
     def choices(self) -> list[Choice]:
         """The next possible events, in a stable order; a timer due in the next scan alone."""
         out = [Choice(str(t.event), (t, nxt)) for t, nxt in self.s.plant.successors(self.local) if not t.controllable]
+        if self.machine is None:  # no reference, no timers known: time may pass, one second at a time
+            out.append(Choice(WAIT, None, self.clock() + 1000))
         timer = self.next_timer()
         if timer is not None:
             margin = self.link.period_ms * (1 if self.link.timing is Timing.LOCKSTEP else 3) + \
@@ -182,6 +188,11 @@ class ClosedLoop:
         return Choice(due[0][1], None, due[0][0]) if due else None
 
     def fire(self, c: Choice) -> None:
+        """Play ``c``: the plant's move or the time passing, the scans, the orders."""
+        if c.move is None and self.machine is None:
+            self.wait_until(c.deadline)
+            self.after_scan(c.label)
+            return
         if c.move is None:
             assert self.machine is not None
             self.wait_until(c.deadline)
@@ -268,6 +279,10 @@ class ClosedLoop:
                                                 f"for {self.unchanged} steps")
         except Stop as stop:
             return Walk(index, seed, tuple(self.steps), stop.outcome, stop.message, stop.details)
+        except LinkError as err:  # what was reached, for the exit-2 message
+            trace = " ".join(s.event for s in self.steps[1:]) or "-"
+            raise LinkError(f"{err}; reached walk {index}, step {max(0, len(self.steps) - 1)} (trace {trace}), "
+                            f"{self.scans} scans since its reset") from None
         return Walk(index, seed, tuple(self.steps), Outcome.PASS)
 
 

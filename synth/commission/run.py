@@ -181,11 +181,13 @@ class Commissioning:
 
                 def choose(options: list[Choice]) -> Choice | None:
                     fresh = [c for c in options if c.move is not None and _key(c.move[0]) in target - seen]
-                    return rng.choice(fresh or options)
+                    c = rng.choice(fresh or options)
+                    if c.move is not None and fault is None:
+                        seen.add(_key(c.move[0]))
+                    return c
 
                 walk, loop = self.one(k, seed, steps, choose, fault)
                 if fault is None:
-                    seen.update(_key(t) for t in loop.fired)
                     seen_steps.update(s for st in walk.steps for s in st.steps)
                 out.append(walk)
             runs.append(FaultRun(fault, tuple(out)))
