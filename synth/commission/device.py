@@ -28,7 +28,7 @@ from synth.codegen.interpreter.machine import Module
 from synth.commission.iomap import Coupling, IoMap, Role
 from synth.commission.modbus import LinkError, ModbusClient, ModbusServer, spans
 
-__all__ = ["Timing", "next_count", "ScannedProgram", "InterpretedPlc", "located_program"]
+__all__ = ["Timing", "next_count", "ScannedProgram", "Port", "ScanLoop", "InterpretedPlc", "located_program"]
 
 POLL_S = 0.0002
 
@@ -52,10 +52,10 @@ def next_count(n: int) -> int:
 class ScannedProgram:
     """A PROGRAM of a parsed module, its own clock, one instance restarted by :meth:`reset`."""
 
-    def __init__(self, parsed: Module, pou: str, io: IoMap, period_ms: int, timing: Timing) -> None:
-        self.parsed, self.pou, self.io, self.period_ms, self.timing = parsed, pou, io, period_ms, timing
-        self.sensors = [e.name for e in io.of(Role.SENSOR)]
-        self.orders = [e.name for e in io.of(Role.ORDER)]
+    def __init__(self, parsed: Module, pou: str, sensors: Sequence[str], orders: Sequence[str], period_ms: int,
+                 timing: Timing) -> None:
+        self.parsed, self.pou, self.period_ms, self.timing = parsed, pou, period_ms, timing
+        self.sensors, self.orders = list(sensors), list(orders)
         self.reset()
 
     def reset(self) -> None:
@@ -70,6 +70,18 @@ class ScannedProgram:
             self.module.clock_ms = int((time.monotonic() - self.started) * 1000)
         self.instance.cycle(sensors)
         return {o: bool(self.instance[o]) for o in self.orders}
+
+
+class Port(Protocol):
+    """How a runtime reaches its process image and the two handshake counters."""
+
+    def grant(self) -> int: ...
+
+    def set_done(self, n: int) -> None: ...
+
+    def sensors(self) -> dict[str, bool]: ...
+
+    def set_orders(self, values: dict[str, bool]) -> None: ...
 
 
 class _Image(Protocol):
@@ -91,80 +103,103 @@ class _Local:
         self.server.set(table, index, values)
 
 
-class InterpretedPlc:
-    """The interpreter as a PLC runtime on ``host:port`` (see the module docstring); a context
-    manager: the scan thread runs from :meth:`start` to :meth:`stop`."""
+class _ModbusPort:
+    """The process image over Modbus tables, by the map: each run of addresses in one request."""
 
-    def __init__(self, parsed: Module, pou: str, io: IoMap, host: str, port: int, *, period_ms: int = 10,
-                 timing: Timing = Timing.LOCKSTEP, drop_after: int | None = None,
-                 stall_after: int | None = None) -> None:
-        self.program = ScannedProgram(parsed, pou, io, period_ms, timing)
-        self.io, self.host, self.port = io, host, port
+    def __init__(self, image: _Image, io: IoMap, sensors: Sequence[str], orders: Sequence[str]) -> None:
+        def slot(name: str) -> tuple[str, int]:
+            e = io.entry(name)
+            assert e is not None and io.slot(e) is not None
+            return io.slot(e)  # type: ignore[return-value]
+
+        self.image, self.names, self.outs = image, list(sensors), list(orders)
+        self.grant_at, self.done_at = slot("@grant"), slot("@done")
+        self.reading, self.writing = spans([slot(n) for n in sensors]), spans([slot(n) for n in orders])
+
+    def grant(self) -> int:
+        return self.image.read(*self.grant_at)[0]
+
+    def set_done(self, n: int) -> None:
+        self.image.write(*self.done_at, [n])
+
+    def sensors(self) -> dict[str, bool]:
+        values: dict[str, bool] = {}
+        for table, first, ks in self.reading:
+            got = self.image.read(table, first, len(ks))
+            values.update({self.names[k]: bool(v) for k, v in zip(ks, got)})
+        return values
+
+    def set_orders(self, values: dict[str, bool]) -> None:
+        for table, first, ks in self.writing:
+            self.image.write(table, first, [int(values[self.outs[k]]) for k in ks])
+
+
+class ScanLoop:
+    """A runtime: the scan thread of the handshake (module docstring) over a :class:`Port`, from
+    :meth:`start` to :meth:`stop` (a context manager). ``drop_after``/``stall_after``: misbehave."""
+
+    def __init__(self, program: ScannedProgram, *, drop_after: int | None = None, stall_after: int | None = None) -> None:
+        self.program = program
         self.drop_after, self.stall_after = drop_after, stall_after
         self.scans = 0
         self.stopping = threading.Event()
-        self.thread = threading.Thread(target=self._loop, daemon=True, name=f"plc-{port}")
-        self.server: ModbusServer | None = None
+        self.thread = threading.Thread(target=self._loop, daemon=True, name="plc-scans")
         self.error: BaseException | None = None
 
-    def slot(self, name: str) -> tuple[str, int]:
-        e = self.io.entry(name)
-        assert e is not None and self.io.slot(e) is not None
-        return self.io.slot(e)  # type: ignore[return-value]
-
-    def start(self) -> InterpretedPlc:
-        if self.io.coupling is Coupling.CLIENT:
-            self.server = ModbusServer(self.host, self.port).start()
+    def start(self) -> ScanLoop:
+        self.serve()
         self.thread.start()
         return self
 
     def stop(self) -> None:
         self.stopping.set()
         self.thread.join(10)
-        if self.server is not None:
-            self.server.stop()
+        self.close()
 
-    def __enter__(self) -> InterpretedPlc:
+    def __enter__(self) -> ScanLoop:
         return self.start()
 
     def __exit__(self, *exc: object) -> None:
         self.stop()
 
-    def _connect(self) -> _Image:
-        if self.server is not None:
-            return _Local(self.server)
-        while not self.stopping.is_set():  # polling the plant's server: wait until it serves
-            try:
-                return ModbusClient(self.host, self.port, timeout=2.0)
-            except LinkError:
-                time.sleep(0.05)
-        raise LinkError("stopped")
+    # the protocol's part
+    def serve(self) -> None:
+        """Start serving the process image (when the runtime is the server)."""
+
+    def close(self) -> None:
+        """Stop serving."""
+
+    def port(self) -> Port:
+        raise NotImplementedError
+
+    def drop(self) -> None:
+        """Drop the connection (a failing runtime)."""
+
+    def reconnects(self) -> bool:
+        """Whether the runtime polls again when its peer goes away."""
+        return False
 
     def _loop(self) -> None:
         while not self.stopping.is_set():
             try:
-                self._run(self._connect())
+                self._run(self.port())
                 return
             except LinkError as err:
-                if self.server is not None or self.stopping.is_set():
+                if not self.reconnects() or self.stopping.is_set():
                     self.error = None if self.stopping.is_set() else err
                     return
                 time.sleep(0.05)  # the device it polls went away: poll again, as a runtime does
 
-    def _run(self, image: _Image) -> None:
-        grant_at, done_at = self.slot("@grant"), self.slot("@done")
-        sensors = [(n, self.slot(n)) for n in self.program.sensors]
-        orders = [(n, self.slot(n)) for n in self.program.orders]
-        reading, writing = spans([at for _, at in sensors]), spans([at for _, at in orders])
+    def _run(self, port: Port) -> None:
         done, held, tick = 0, False, time.monotonic()
-        image.write(*done_at, [0])
+        port.set_done(0)
         while not self.stopping.is_set():
-            grant = image.read(*grant_at)[0]
+            grant = port.grant()
             if grant == 0:
                 if not held:
                     self.program.reset()
                     done, held = 0, True
-                    image.write(*done_at, [0])
+                    port.set_done(0)
                 time.sleep(POLL_S)
                 continue
             if held:
@@ -181,25 +216,56 @@ class InterpretedPlc:
                 time.sleep(POLL_S)
                 continue
             if self.drop_after is not None and self.scans >= self.drop_after:
-                self._drop(image)
+                self.drop()
                 return
-            values: dict[str, bool] = {}
-            for table, first, ks in reading:
-                got = image.read(table, first, len(ks))
-                values.update({sensors[k][0]: bool(v) for k, v in zip(ks, got)})
-            out = self.program.scan(values)
-            for table, first, ks in writing:
-                image.write(table, first, [int(out[orders[k][0]]) for k in ks])
+            port.set_orders(self.program.scan(port.sensors()))
             done = next_count(done)
-            image.write(*done_at, [done])
+            port.set_done(done)
             self.scans += 1
 
-    def _drop(self, image: _Image) -> None:
+
+class InterpretedPlc(ScanLoop):
+    """The interpreter as a Modbus TCP runtime on ``host:port``: its server for ``openplc-server``,
+    polling synth's server for ``openplc-device``."""
+
+    def __init__(self, parsed: Module, pou: str, io: IoMap, host: str, port: int, *, period_ms: int = 10,
+                 timing: Timing = Timing.LOCKSTEP, drop_after: int | None = None,
+                 stall_after: int | None = None) -> None:
+        sensors, orders = [e.name for e in io.of(Role.SENSOR)], [e.name for e in io.of(Role.ORDER)]
+        super().__init__(ScannedProgram(parsed, pou, sensors, orders, period_ms, timing),
+                         drop_after=drop_after, stall_after=stall_after)
+        self.io, self.host, self.where = io, host, port
+        self.server: ModbusServer | None = None
+        self.client: ModbusClient | None = None
+
+    def serve(self) -> None:
+        if self.io.coupling is Coupling.CLIENT:
+            self.server = ModbusServer(self.host, self.where).start()
+
+    def close(self) -> None:
         if self.server is not None:
             self.server.stop()
-            self.server = None
-        elif isinstance(image, ModbusClient):
-            image.close()
+        if self.client is not None:
+            self.client.close()
+
+    def reconnects(self) -> bool:
+        return self.io.coupling is Coupling.SERVER
+
+    def port(self) -> Port:
+        p = self.program
+        if self.server is not None:
+            return _ModbusPort(_Local(self.server), self.io, p.sensors, p.orders)
+        while not self.stopping.is_set():  # polling the plant's server: wait until it serves
+            try:
+                self.client = ModbusClient(self.host, self.where, timeout=2.0)
+                return _ModbusPort(self.client, self.io, p.sensors, p.orders)
+            except LinkError:
+                time.sleep(0.05)
+        raise LinkError("stopped")
+
+    def drop(self) -> None:
+        self.close()
+        self.server = self.client = None
 
 
 def located_program(grafcet_path: str, plant_path: str | None, io_spec: str) -> tuple[Module, str, IoMap]:
