@@ -187,3 +187,25 @@ def test_an_event_that_cannot_happen_is_located(cli) -> None:
     with plc:
         code, _, err = _commission(cli, TRI, port, "--events", "↑dcy,↑v11")
     assert code == 2 and err.startswith("--events:1:6: error: ↑v11 cannot happen now")
+
+
+def test_opc_ua_gives_the_same_run_as_modbus(cli) -> None:
+    pytest.importorskip("asyncua")
+    from synth.commission.opcua import InterpretedUaPlc
+
+    parsed, pou, io = _parsed(TRI)
+    url = f"opc.tcp://127.0.0.1:{free_port()}/"
+    ua = InterpretedUaPlc(parsed, pou, [e.name for e in io.of(Role.SENSOR)], [e.name for e in io.of(Role.ORDER)], url)
+    plc, port = _plc(TRI)
+    runs = {}
+    with ua, plc:
+        for name, where in (("opcua", ["--opcua", url]), ("modbus", ["--modbus", f"127.0.0.1:{port}", "--io", "openplc-server"])):
+            code, out, err = cli("commission", TRI, "--plant", RULES, *where, "--lock-step", "--quiet", "--json",
+                                 "--walks", "1", "--steps", "40", "--seed", "5")
+            assert code == 0, err
+            runs[name] = json.loads(out)
+    assert runs["opcua"]["protocol"].startswith("OPC UA opc.tcp://127.0.0.1:")
+    assert runs["opcua"]["runs"] == runs["modbus"]["runs"]
+    code, _, err = cli("commission", TRI, "--plant", RULES, "--opcua", f"opc.tcp://127.0.0.1:{free_port()}/",
+                       "--timeout", "0.5", "--quiet")
+    assert code == 2 and "no OPC UA server at opc.tcp://127.0.0.1:" in err

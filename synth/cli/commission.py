@@ -28,6 +28,8 @@ def register(sub: "argparse._SubParsersAction") -> None:
     p.add_argument("--modbus", metavar="HOST:PORT", help="Modbus TCP: the runtime's server, or where synth serves "
                    "the runtime that polls it (--io openplc-device)")
     p.add_argument("--opcua", metavar="URL", help="OPC UA: the runtime's server, variables by name (opc.tcp://HOST:PORT)")
+    p.add_argument("--node-prefix", metavar="PREFIX",
+                   help="OPC UA: a variable's node id is PREFIX + its name (default ns=2;s=)")
     p.add_argument("--io", metavar="MAP", help="Modbus: the layout the program was generated with (openplc-server, "
                    "openplc-device) or its address table / map (.csv)")
     p.add_argument("--lock-step", action="store_true",
@@ -64,7 +66,7 @@ def cmd_commission(args: argparse.Namespace) -> int:
     setup, rules, io, faults = prepare(args.grafcet, args.plant, args.io, args.fault, args.blocked_after)
     timing = Timing.LOCKSTEP if args.lock_step else Timing.REALTIME
     link = open_link(io, args.modbus, args.opcua, timing=timing, period=period_ms(args.period), timeout=args.timeout,
-                     names=(setup.sensors, setup.orders))
+                     names=(setup.sensors, setup.orders), prefix=args.node_prefix)
     progress = None if args.quiet else (lambda text: print(f"commission: {text}", file=sys.stderr, flush=True))
     try:
         c = Commissioning(setup, link, rules, progress)

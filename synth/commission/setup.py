@@ -60,8 +60,9 @@ def period_ms(text: str) -> int:
 
 
 def open_link(io: IoMap | None, modbus: str | None, opcua: str | None, *, timing: Timing, period: int,
-              timeout: float, names: tuple[Sequence[str], Sequence[str]] = ((), ())) -> Link:
-    """The link to the runtime: ``--modbus HOST:PORT`` with a map, or ``--opcua URL`` by name."""
+              timeout: float, names: tuple[Sequence[str], Sequence[str]] = ((), ()), prefix: str | None = None) -> Link:
+    """The link to the runtime: ``--modbus HOST:PORT`` with a map, or ``--opcua URL`` by name
+    (node ids ``prefix`` + name)."""
     from synth.commission.modbus import split_host_port
 
     if (modbus is None) == (opcua is None):
@@ -76,7 +77,8 @@ def open_link(io: IoMap | None, modbus: str | None, opcua: str | None, *, timing
         from synth.commission.links import ModbusLink
 
         return ModbusLink(io, host, port, timing=timing, period_ms=period, timeout=timeout)
-    from synth.commission.opcua import OpcUaLink
+    from synth.commission.opcua import DEFAULT_PREFIX, OpcUaLink
 
     assert opcua is not None
-    return OpcUaLink(opcua, names[0], names[1], timing=timing, period_ms=period, timeout=timeout)
+    return OpcUaLink(opcua, names[0], names[1], timing=timing, period_ms=period, timeout=timeout,
+                     prefix=DEFAULT_PREFIX if prefix is None else prefix)
