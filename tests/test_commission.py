@@ -10,9 +10,11 @@ import functools
 import json
 from pathlib import Path
 
+import jsonschema
 import pytest
 
 from conftest import ROOT
+from schemas import assert_valid
 from synth.commission.device import InterpretedPlc, Timing, located_program
 from synth.commission.iomap import Layout, Role, layout_map
 from synth.commission.modbus import free_port
@@ -47,7 +49,9 @@ def _commission(cli, g7: str | None, port: int, *args: str, layout: str = "openp
 def _run_json(cli, g7, port, *args, **kw) -> tuple[int, dict]:
     code, out, err = _commission(cli, g7, port, "--json", *args, **kw)
     assert code in (0, 1), err
-    return code, json.loads(out)
+    data = json.loads(out)
+    assert_valid("commission", data)  # every JSON of these tests matches the shipped schema
+    return code, data
 
 
 @pytest.mark.parametrize("layout", ["openplc-server", "openplc-device"])
@@ -97,6 +101,9 @@ def test_missing_order_ends_blocked_with_the_thesis_diagnosis(cli) -> None:
         assert walk["details"][0].startswith("diagnosis [missing_order]: missing order AVANCER2 in step 103")
         assert walk["details"][-1] == "validate's trace: ↑dcy ↑cp12 2s/X101 ↓v10 ↑v11"
     assert scripted["runs"][0]["walks"][0]["trace"] == THESIS.split(",")
+    scripted["runs"][0]["walks"][0]["outcome"] = "stuck"  # the schema does reject drift
+    with pytest.raises(jsonschema.ValidationError):
+        assert_valid("commission", scripted)
 
 
 def test_a_forbidden_order_ends_unsafe_with_its_trace(cli, tmp_path: Path) -> None:

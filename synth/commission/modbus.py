@@ -105,7 +105,10 @@ class ModbusServer:
         self.thread.join(5)
 
     def get(self, table: str, index: int, count: int = 1) -> list[int]:
-        return [int(v) for v in self.store.getValues(FUNCTION[table], index, count)]
+        values = self.store.getValues(FUNCTION[table], index, count)
+        if not isinstance(values, list):  # an exception code: outside the tables
+            raise LinkError(f"Modbus {table} {index}..{index + count - 1} is outside the tables ({values})")
+        return [int(v) for v in values]
 
     def set(self, table: str, index: int, values: Sequence[int]) -> None:
         self.store.setValues(FUNCTION[table], index, [int(v) for v in values])

@@ -48,7 +48,7 @@ class OpcUaLink:
         _quiet()
         self.timing, self.period_ms, self.where = timing, period_ms, f"OPC UA {url}"
         self.sensors, self.orders = list(sensors), list(orders)
-        self.client = Client(url, timeout=timeout)
+        self.client: Any = Client(url, timeout=timeout)
         try:
             self.client.connect()
         except Exception as err:  # refused, timed out, not OPC UA: asyncua raises many kinds
@@ -139,7 +139,7 @@ class InterpretedUaPlc(ScanLoop):
         for n in [*self.program.sensors, *self.program.orders, GRANT, DONE]:
             counter = n in (GRANT, DONE)
             value = ua.Variant(0, ua.VariantType.UInt16) if counter else False
-            self.nodes[n] = plc.add_variable(ua.NodeId(n, idx), n, value)
+            self.nodes[n] = plc.add_variable(ua.NodeId(ua.String(n), idx), n, value)
             self.nodes[n].set_writable()
         self.server.start()
 
