@@ -93,7 +93,8 @@ FORBIDDEN = {
     "synth.logic": ("synth.plant", "synth.sup", "synth.grafcet", "synth.validation", "synth.symbolic",
                     "synth.filter", "synth.codegen", "synth.output", "synth.cli"),
     "synth.filter": ("synth.codegen", "synth.output", "synth.cli", "synth.symbolic"),
-    "synth.output": ("synth.cli",),
+    "synth.output": ("synth.cli", "synth.commission"),
+    "synth.commission": ("synth.cli",),
 }
 
 # (room, module) exceptions: the symbolic closed loop of ``filter verify`` (synth.filter.symbolic_*)
