@@ -123,5 +123,5 @@ def test_map_read_back_from_the_table_and_sensor_on_a_discrete_input_is_read_onl
     again = parse_map(table, "t.csv", g.inputs, g.outputs)
     assert again.locations == layout_map(Layout.OPENPLC_SERVER, g.inputs, g.outputs).locations
     bad = parse_map("dcy,%IX0.0\nTAPIS,%QX0.0\n", "m.csv", g.inputs, g.outputs)
-    with pytest.raises(InputError, match="read-only area written: dcy at %IX0.0 is a discrete the plant cannot write"):
+    with pytest.raises(InputError, match="read-only area written: dcy at %IX0.0 is a discrete input the plant cannot write"):
         bad.check_plant()

@@ -136,6 +136,9 @@ class IoEntry:
     loc: Location | None = None
 
 
+_TABLE_NAME = {"coil": "coil", "discrete": "discrete input", "holding": "holding register", "input": "input register"}
+
+
 def _device(a: Address) -> bool:
     return a.index >= DEVICE_BASE and a.area is not Area.MEMORY
 
@@ -204,7 +207,7 @@ class IoMap:
             ok = (slot[0] in (Table.DISCRETE, Table.INPUT)) if server else (slot[0] in (Table.COIL, Table.HOLDING))
             if writes and not ok:
                 how = "a device the runtime polls serves" if server else "a Modbus client can write"
-                raise InputError(f"read-only area written: {e.name} at {e.address.text} is a {slot[0]} the plant "
+                raise InputError(f"read-only area written: {e.name} at {e.address.text} is a {_TABLE_NAME[slot[0]]} the plant "
                                  f"cannot write ({how} {'%IX100.x and %IW100' if server else 'coils %QX and registers %QW, %MW'})",
                                  e.loc, notes=("sensors go on coils with --io openplc-server, or on %IX100.x with "
                                                "--io openplc-device",))
