@@ -11,9 +11,11 @@ runtime serves; ``openplc-device``: the runtime polls synth) and per timing: loc
 ``--period`` ms task). With ``--modbus`` it drives that runtime instead (an OpenPLC v3 built
 with the handshake of docs/commissioning.md, say), both timings unless ``--lockstep-only``.
 
-Per run: closed-loop steps per second (wall time of the walks, the initial steps included),
-PLC scans per second (lock-step: the timers' scans granted in one request are counted), the
-mean step latency in real time, and the verdict (a mismatch would show there).
+Per run: closed-loop steps per second (wall time of the walks, the initial steps included; in
+real time the timers' waits are in it), PLC scans per second (lock-step: the timers' scans
+granted in one request are counted), in real time the latency of one exchange (write the
+sensors, wait a whole scan, read the orders: 200 of them after the walk), and the verdict (a
+mismatch would show there).
 """
 
 from __future__ import annotations
@@ -29,6 +31,26 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 
+def step_latency(link: object, sensors: tuple[str, ...], n: int = 200) -> dict[str, float]:
+    """One closed-loop exchange without the plant model: write the sensors, wait a whole scan,
+    read the orders; ``n`` times after a reset (mean, median, 95th percentile, in ms)."""
+    import statistics
+
+    values = {s: False for s in sensors}
+    link.reset(values)  # type: ignore[attr-defined]
+    times = []
+    for k in range(n):
+        values[sensors[k % len(sensors)]] = not values[sensors[k % len(sensors)]]
+        t = time.perf_counter()
+        link.write_sensors(values)  # type: ignore[attr-defined]
+        link.scans(1)  # type: ignore[attr-defined]
+        link.read_orders()  # type: ignore[attr-defined]
+        times.append(1000 * (time.perf_counter() - t))
+    times.sort()
+    return {"mean": round(statistics.fmean(times), 2), "median": round(statistics.median(times), 2),
+            "p95": round(times[int(0.95 * (n - 1))], 2)}
+
+
 def one_run(args: argparse.Namespace, layout: str, lockstep: bool, port: int, host: str = "127.0.0.1") -> dict:
     from synth.commission.device import Timing
     from synth.commission.run import Commissioning, run_commission
@@ -42,13 +64,14 @@ def one_run(args: argparse.Namespace, layout: str, lockstep: bool, port: int, ho
         walks, steps = (args.walks, args.steps) if lockstep else (1, args.realtime_steps)
         res = run_commission(c, target=args.grafcet, protocol="Modbus TCP", events=None, walks=walks, steps=steps,
                              seed=1, faults=(), cover=False)
+        latency = step_latency(link, setup.sensors) if not lockstep else None
     finally:
         link.close()
     scans = sum(w.steps[-1].scans for r in res.runs for w in r.walks)
     return {"layout": layout, "timing": str(timing), "walks": walks, "steps": res.steps, "seconds": round(res.seconds, 3),
             "steps_per_s": round(res.steps / res.seconds, 1), "scans": scans,
             "scans_per_s": round(scans / res.seconds, 1), "ms_per_step": round(1000 * res.seconds / res.steps, 2),
-            "verdict": "pass" if res.ok else "fail",
+            "verdict": "pass" if res.ok else "fail", "step_latency_ms": latency,
             "outcomes": [w.outcome.value for r in res.runs for w in r.walks]}
 
 

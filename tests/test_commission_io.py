@@ -125,3 +125,31 @@ def test_map_read_back_from_the_table_and_sensor_on_a_discrete_input_is_read_onl
     bad = parse_map("dcy,%IX0.0\nTAPIS,%QX0.0\n", "m.csv", g.inputs, g.outputs)
     with pytest.raises(InputError, match="read-only area written: dcy at %IX0.0 is a discrete input the plant cannot write"):
         bad.check_plant()
+
+
+@pytest.mark.parametrize("layout", ["plain", "openplc-server", "openplc-device"])
+def test_the_located_program_with_its_task_compiles_through_iec2c_and_the_c_compiler(cli, tmp_path: Path, layout) -> None:
+    """MATIEC's trap: a CONFIGURATION connecting the program to addresses gives a Res0.c that
+    does not compile; located variables inside the PROGRAM do (skipped without MATIEC)."""
+    import shutil
+    import subprocess
+
+    from iec2c import find_iec2c
+
+    found = find_iec2c()
+    if found is None or shutil.which("gcc") is None:
+        pytest.skip("MATIEC's iec2c or gcc is not installed")
+    exe, lib = found
+    out = tmp_path / "tri.st"
+    assert cli("st", TRI, "--plant", RULES, "--io", layout, "--task", "10ms", "-o", out)[0] == 0
+    run = subprocess.run([exe, "-f", "-l", "-p", "-r", "-R", "-a", "-I", str(lib), "-T", str(tmp_path), str(out)],
+                         capture_output=True, text=True, timeout=300)
+    assert run.returncode == 0, run.stderr
+    located = (tmp_path / "LOCATED_VARIABLES.h").read_text()
+    first = "__LOCATED_VAR(BOOL,__IX100_0,I,X,100,0)" if layout == "openplc-device" else (
+        "__LOCATED_VAR(BOOL,__QX0_0,Q,X,0,0)" if layout == "openplc-server" else "__LOCATED_VAR(BOOL,__IX0_0,I,X,0,0)")
+    assert located.splitlines()[0] == first and len(located.splitlines()) == 11 + 7
+    for c in ("Config0.c", "Res0.c"):
+        cc = subprocess.run(["gcc", "-c", "-w", "-I", str(lib / "C"), c], cwd=tmp_path, capture_output=True, text=True,
+                            timeout=300)
+        assert cc.returncode == 0, cc.stderr
