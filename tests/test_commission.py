@@ -111,6 +111,12 @@ def test_a_forbidden_order_ends_unsafe_with_its_trace(cli, tmp_path: Path) -> No
     junit, sarif = tmp_path / "j.xml", tmp_path / "s.sarif"
     with plc:
         code, out, _ = _commission(cli, FORBIDDEN, port, "--events", THESIS, "--junit", str(junit), "--sarif", str(sarif))
+        going, res = _run_json(cli, FORBIDDEN, port, "--events", THESIS, "--keep-going")
+    walk = res["runs"][0]["walks"][0]
+    assert (going, walk["outcome"], walk["trace"]) == (1, "unsafe", THESIS.split(","))  # refused, then on to the end
+    assert walk["details"] == ["2 step(s) with an unsafe move refused; the first: ↑RECULER1 leaves SUP in state "
+                               "{dcy,v10,v20,v30,v40,cp12,TAPIS,AVANCER1}: constraint C2_1 can then be violated "
+                               "(trace ↑dcy ↑cp12 2s/X101)"]
     assert code == 1
     assert "walk 1: unsafe: ↑RECULER1 leaves SUP in state {dcy,v10,v20,v30,v40,cp12,TAPIS,AVANCER1}: constraint C2_1" in out
     assert "    trace: ↑dcy ↑cp12 2s/X101\n" in out

@@ -49,6 +49,9 @@ def register(sub: "argparse._SubParsersAction") -> None:
                         "↑v21+500ms (repeatable: each on its own)")
     p.add_argument("--blocked-after", metavar="N", type=int, default=50,
                    help="blocked when no event changes the situation for N steps (default 50)")
+    p.add_argument("--keep-going", action="store_true",
+                   help="refuse an unsafe move (the plant stays, as validate keeps a prohibited order unapplied), "
+                        "count it and go on: the walk ends unsafe, with every step it refused")
     p.add_argument("--json", action="store_true", help="print the result as JSON")
     p.add_argument("--junit", metavar="FILE", help="also write the findings as JUnit XML")
     p.add_argument("--sarif", metavar="FILE", help="also write the findings as SARIF 2.1.0")
@@ -63,7 +66,7 @@ def cmd_commission(args: argparse.Namespace) -> int:
     from synth.commission.setup import open_link, period_ms, prepare
     from synth.output.summary import print_json
 
-    setup, rules, io, faults = prepare(args.grafcet, args.plant, args.io, args.fault, args.blocked_after)
+    setup, rules, io, faults = prepare(args.grafcet, args.plant, args.io, args.fault, args.blocked_after, args.keep_going)
     timing = Timing.LOCKSTEP if args.lock_step else Timing.REALTIME
     link = open_link(io, args.modbus, args.opcua, timing=timing, period=period_ms(args.period), timeout=args.timeout,
                      names=(setup.sensors, setup.orders), prefix=args.node_prefix)

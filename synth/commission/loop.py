@@ -5,9 +5,12 @@ the reference Grafcet elapse on the PLC's clock; write the sensors as the PLC se
 applied); wait whole scans (:class:`~synth.commission.links.Link`); read the orders; compare them
 with the reference Grafcet's (:class:`~synth.grafcet.machine.GrafcetMachine`, what ``synth run``
 steps): a difference is a **mismatch**; apply each changed order as the plant's controllable move:
-a move the rules refuse or SUP forbids is **unsafe**. A situation (or, with no reference, the
-orders) that no event changes for ``blocked_after`` steps, or a plant with no event left, is
-**blocked** (:mod:`synth.commission.run` diagnoses it as ``validate`` does).
+a move the rules refuse or SUP forbids is **unsafe**. A walk where for ``blocked_after``
+steps no event on offer could change the reference's situation (with no reference: where the
+orders did not change), or a plant with no event left, is **blocked**
+(:mod:`synth.commission.run` diagnoses it as ``validate`` does). With ``keep_going`` an unsafe
+move is refused (the plant stays, as ``validate`` keeps a prohibited order unapplied), counted,
+and the walk goes on.
 
 Time: in lock-step the PLC clock is the scans granted times the task period, so a timer's
 deadline is a number of scans; in real time it is the wall clock. A timer that would elapse
@@ -102,6 +105,7 @@ class Setup:
     orders: tuple[str, ...]
     faults: tuple[Fault, ...] = ()
     blocked_after: int = 50
+    keep_going: bool = False
 
 
 @dataclass(frozen=True)
@@ -125,6 +129,7 @@ class ClosedLoop:
         self.unchanged = 0
         self.last: object = None
         self.fired: list[LocalTransition] = []
+        self.refused: list[str] = []  # keep_going: the unsafe moves refused, with their traces
 
     # ------------------------------------------------------------------ time
     def clock(self) -> int:
@@ -240,9 +245,27 @@ class ClosedLoop:
             raise Stop(Outcome.MISMATCH, f"after {event} the PLC orders {_set(on)}, the Grafcet (synth run) "
                                          f"orders {_set(expected)}", (f"situation {self.sit.text()}",))
         self.apply(got)
-        key = (self.sit if self.machine is not None else None, on)
-        self.unchanged = self.unchanged + 1 if key == self.last else 0
-        self.last = key
+        if self.machine is None:  # no reference: the orders tell whether anything moves
+            self.unchanged = self.unchanged + 1 if on == self.last else 0
+            self.last = on
+
+    def moves(self, options: list[Choice]) -> bool:
+        """Whether one of ``options`` would change the reference's situation (or its orders): a
+        timer always does; a plant move does when the inputs the PLC then reads make it react."""
+        assert self.machine is not None
+        orders = self.machine.orders(self.sit, self.inputs)
+        for c in options:
+            if c.move is None:
+                return True
+            values = self.s.plant.valuation(c.move[1])
+            wire = wire_values({n: values[n] for n in self.s.sensors}, self.s.faults)
+            after = {i: wire.get(i, self.inputs[i]) for i in self.inputs}
+            if after == self.inputs:
+                continue
+            sit = self.machine.react(self.sit, self.inputs, after)
+            if sit != self.sit or self.machine.orders(sit, after) != orders:
+                return True
+        return False
 
     def apply(self, got: dict[str, bool]) -> None:
         """The PLC's orders as the plant's controllable moves, checked by the rules and SUP."""
@@ -253,12 +276,19 @@ class ClosedLoop:
                 continue
             event = Event.edge(o, want)
             move = next(((t, nxt) for t, nxt in p.successors(self.local) if t.controllable and t.event == event), None)
+            why: list[str] = []
             if move is None:
-                raise Stop(Outcome.UNSAFE, f"the plant's rules refuse {event} in state {p.label(self.local)}")
-            ok, why = self.s.oracle.move(move[0], self.local)
-            if not ok:
-                raise Stop(Outcome.UNSAFE, f"{event} leaves SUP in state {p.label(self.local)}: constraint "
-                                           f"{', '.join(why)} can then be violated")
+                problem = f"the plant's rules refuse {event} in state {p.label(self.local)}"
+            else:
+                ok, why = self.s.oracle.move(move[0], self.local)
+                problem = "" if ok else (f"{event} leaves SUP in state {p.label(self.local)}: constraint "
+                                         f"{', '.join(why)} can then be violated")
+            if problem and not self.s.keep_going:
+                raise Stop(Outcome.UNSAFE, problem)
+            if problem or move is None:
+                trace = " ".join(st.event for st in self.steps[1:])
+                self.refused.append(f"{problem} (trace {trace})")
+                continue
             self.local = move[1]
             self.values = p.valuation(self.local)
 
@@ -270,20 +300,31 @@ class ClosedLoop:
                 options = self.choices()
                 if not options:
                     raise Stop(Outcome.BLOCKED, "no plant event can happen")
+                if self.machine is not None:  # stuck: no event on offer would move the Grafcet
+                    self.unchanged = 0 if self.moves(options) else self.unchanged + 1
+                if self.unchanged >= self.s.blocked_after:
+                    raise Stop(Outcome.BLOCKED, f"for {self.unchanged} steps no plant event could change the "
+                                                f"{'situation' if self.machine else 'orders'}")
                 c = choose(options)
                 if c is None:
                     break
                 self.fire(c)
-                if self.unchanged >= self.s.blocked_after:
-                    raise Stop(Outcome.BLOCKED, f"no event changed the {'situation' if self.machine else 'orders'} "
-                                                f"for {self.unchanged} steps")
         except Stop as stop:
-            return Walk(index, seed, tuple(self.steps), stop.outcome, stop.message, stop.details)
+            return self.ended(Walk(index, seed, tuple(self.steps), stop.outcome, stop.message, stop.details))
         except LinkError as err:  # what was reached, for the exit-2 message
             trace = " ".join(s.event for s in self.steps[1:]) or "-"
             raise LinkError(f"{err}; reached walk {index}, step {max(0, len(self.steps) - 1)} (trace {trace}), "
                             f"{self.scans} scans since its reset") from None
-        return Walk(index, seed, tuple(self.steps), Outcome.PASS)
+        return self.ended(Walk(index, seed, tuple(self.steps), Outcome.PASS))
+
+    def ended(self, walk: Walk) -> Walk:
+        """``keep_going``: a walk with refused moves is unsafe, its first refusal the message."""
+        if not self.refused:
+            return walk
+        count = f"{len(self.refused)} step(s) with an unsafe move refused; the first: {self.refused[0]}"
+        if walk.outcome is Outcome.PASS:
+            return Walk(walk.index, walk.seed, walk.steps, Outcome.UNSAFE, self.refused[0].split(" (trace ")[0], (count,))
+        return Walk(walk.index, walk.seed, walk.steps, walk.outcome, walk.message, (*walk.details, count))
 
 
 def _set(names: Sequence[str]) -> str:

@@ -19,7 +19,7 @@ __all__ = ["prepare", "period_ms", "open_link"]
 
 
 def prepare(grafcet_path: str | None, plant_path: str, io_spec: str | None, fault_texts: Sequence[str],
-            blocked_after: int) -> tuple[Setup, RuleSet, IoMap | None, tuple[Fault, ...]]:
+            blocked_after: int, keep_going: bool = False) -> tuple[Setup, RuleSet, IoMap | None, tuple[Fault, ...]]:
     """The run's :class:`~synth.commission.loop.Setup`, rules, map (None: by name, OPC UA) and faults.
     The map is built on the Grafcet's inputs and outputs, as ``synth st --io`` built the program's."""
     from synth.grafcet.language_check import load_grafcet
@@ -44,7 +44,8 @@ def prepare(grafcet_path: str | None, plant_path: str, io_spec: str | None, faul
     faults = parse_faults(fault_texts, sensors, orders)
     if blocked_after < 1:
         raise InputError("--blocked-after must be at least 1", Location("--blocked-after", 1, 1, str(blocked_after)))
-    return Setup(p, CompiledConstraints(p, rules.constraints), grafcet, sensors, orders, (), blocked_after), rules, io, faults
+    setup = Setup(p, CompiledConstraints(p, rules.constraints), grafcet, sensors, orders, (), blocked_after, keep_going)
+    return setup, rules, io, faults
 
 
 def period_ms(text: str) -> int:
