@@ -2,14 +2,14 @@
 
     python bench/commission.py [--grafcet grafcets/tri.g7] [--plant plants/tri.rules]
                                [--walks 5] [--steps 1000] [--realtime-steps 300] [--period 10]
-                               [--modbus HOST:PORT --io LAYOUT] [--json FILE]
+                               [--modbus HOST:PORT --io LAYOUT --timing lock-step|real-time] [--json FILE]
 
 Without ``--modbus`` the device under test is synth's own program in its ST interpreter
 (``synth.commission.device``) on a free local port, once per layout (``openplc-server``: the
 runtime serves; ``openplc-device``: the runtime polls synth) and per timing: lock-step (walks of
 ``--steps`` events, seeds 1..walks) and real time (one walk of ``--realtime-steps`` events at a
 ``--period`` ms task). With ``--modbus`` it drives that runtime instead (an OpenPLC v3 built
-with the handshake of docs/commissioning.md, say), both timings unless ``--lockstep-only``.
+with the handshake of docs/commissioning.md, say) in the ``--timing`` it was started in.
 
 Per run: closed-loop steps per second (wall time of the walks, the initial steps included; in
 real time the timers' waits are in it), PLC scans per second (lock-step: the timers' scans
@@ -85,15 +85,15 @@ def main() -> int:
     ap.add_argument("--period", type=int, default=10, help="task period, ms")
     ap.add_argument("--modbus", help="drive this runtime instead of the interpreted device")
     ap.add_argument("--io", default="openplc-server", help="with --modbus: the layout its program was built with")
-    ap.add_argument("--lockstep-only", action="store_true")
+    ap.add_argument("--timing", choices=("lock-step", "real-time"), default="lock-step",
+                    help="with --modbus: how that runtime was started")
     ap.add_argument("--json", help="write the rows to FILE")
     args = ap.parse_args()
     rows = []
     if args.modbus:
         host, _, port = args.modbus.rpartition(":")
-        for lockstep in (True,) if args.lockstep_only else (True, False):
-            rows.append(one_run(args, args.io, lockstep, int(port), host))
-            print(json.dumps(rows[-1]), flush=True)
+        rows.append(one_run(args, args.io, args.timing == "lock-step", int(port), host))
+        print(json.dumps(rows[-1]), flush=True)
     else:
         from synth.commission.device import InterpretedPlc, Timing, located_program
         from synth.commission.iomap import Layout, Role, layout_map
