@@ -110,7 +110,8 @@ def test_a_forbidden_order_ends_unsafe_with_its_trace(cli, tmp_path: Path) -> No
     plc, port = _plc(FORBIDDEN)
     junit, sarif = tmp_path / "j.xml", tmp_path / "s.sarif"
     with plc:
-        code, out, _ = _commission(cli, FORBIDDEN, port, "--events", THESIS, "--junit", str(junit), "--sarif", str(sarif))
+        code, out, _ = _commission(cli, FORBIDDEN, port, "--events", THESIS, "--junit", str(junit), "--sarif", str(sarif),
+                                   "--report", str(tmp_path / "report"))
         going, res = _run_json(cli, FORBIDDEN, port, "--events", THESIS, "--keep-going")
     walk = res["runs"][0]["walks"][0]
     assert (going, walk["outcome"], walk["trace"]) == (1, "unsafe", THESIS.split(","))  # refused, then on to the end
@@ -121,6 +122,9 @@ def test_a_forbidden_order_ends_unsafe_with_its_trace(cli, tmp_path: Path) -> No
     assert "walk 1: unsafe: ↑RECULER1 leaves SUP in state {dcy,v10,v20,v30,v40,cp12,TAPIS,AVANCER1}: constraint C2_1" in out
     assert "    trace: ↑dcy ↑cp12 2s/X101\n" in out
     assert junit.read_text().count("<failure ") == 1
+    html = (tmp_path / "report" / "index.html").read_text()
+    assert '<h1 class="fail">FAIL</h1>' in html and "<h3>Walk 1: unsafe</h3>" in html
+    assert "<td><code>2s/X101</code></td><td>TAPIS, AVANCER1, RECULER1</td><td>TAPIS, AVANCER1, RECULER1</td>" in html
     result = json.loads(sarif.read_text())["runs"][0]["results"]
     assert [(r["ruleId"], r["level"]) for r in result] == [("unsafe", "error")]
 

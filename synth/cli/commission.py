@@ -53,6 +53,8 @@ def register(sub: "argparse._SubParsersAction") -> None:
                    help="refuse an unsafe move (the plant stays, as validate keeps a prohibited order unapplied), "
                         "count it and go on: the walk ends unsafe, with every step it refused")
     p.add_argument("--json", action="store_true", help="print the result as JSON")
+    p.add_argument("--report", metavar="DIR", help="also write DIR/index.html: each walk, the closed-loop trace of "
+                   "every walk that did not pass (PLC's and Grafcet's orders, steps, plant state, scans), the coverage")
     p.add_argument("--junit", metavar="FILE", help="also write the findings as JUnit XML")
     p.add_argument("--sarif", metavar="FILE", help="also write the findings as SARIF 2.1.0")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
@@ -82,6 +84,13 @@ def cmd_commission(args: argparse.Namespace) -> int:
         from synth.output.ci import write_ci
 
         write_ci([ci_report(result)], args.junit, args.sarif)
+    if args.report:
+        from pathlib import Path
+
+        from synth.output.files import write_atomic
+        from synth.output.html import commission_html
+
+        write_atomic(Path(args.report) / "index.html", commission_html(result_json(result)))
     if args.json:
         print_json(result_json(result))
     else:
