@@ -171,7 +171,7 @@ def test_without_a_grafcet_safety_and_blocking_alone(cli, tmp_path: Path) -> Non
 
 
 @pytest.mark.parametrize(("options", "message"), [
-    ({"stall_after": 4}, "the runtime did not run the 200 scan(s) granted (@grant 203) within 0.5 s"),
+    ({"stall_after": 4}, "the runtime did not run the 200 scan(s) granted (@grant 203): @done stayed 4 for 0.5 s"),
     ({"drop_after": 4}, "Modbus TCP 127.0.0.1:"),
 ])
 def test_a_slow_or_dropping_plc_is_a_clear_exit_2_with_what_was_reached(cli, tmp_path: Path, options, message) -> None:

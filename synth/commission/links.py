@@ -48,14 +48,18 @@ class Counters:
         self.scans_done = 0  # whole scans since the last reset, as the plant saw them
 
     def _wait(self, ok: object, what: str) -> int:
-        deadline = time.monotonic() + self.timeout
+        """Poll ``@done`` until ``ok``; the deadline moves on while the counter does (a runtime
+        running many granted scans slowly is alive; one that stops counting is not)."""
+        deadline, seen = time.monotonic() + self.timeout, None
         while True:
             done = int(self.read_done())  # type: ignore[operator]
             if ok(done):  # type: ignore[operator]
                 return done
+            if done != seen:
+                deadline, seen = time.monotonic() + self.timeout, done
             if time.monotonic() > deadline:
-                raise LinkError(f"{self.where}: the runtime did not {what} within {self.timeout:g} s "
-                                f"(@done is {done}; {self.scans_done} scans reached since the last reset)")
+                raise LinkError(f"{self.where}: the runtime did not {what}: @done stayed {done} for {self.timeout:g} s "
+                                f"({self.scans_done} scans reached since the last reset)")
             time.sleep(POLL_S)
 
     def hold(self) -> None:
