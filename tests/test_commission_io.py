@@ -60,23 +60,25 @@ def test_device_and_plain_layouts() -> None:
         plain.check_plant()  # the wrong layout for commissioning: a located error, exit 2
 
 
-@pytest.mark.parametrize("layout", ["plain", "openplc-server", "openplc-device"])
-def test_the_located_program_runs_as_the_unlocated_one(layout: str) -> None:
+def test_the_located_program_runs_as_the_unlocated_one() -> None:
     g = load_grafcet(TIMERS)
     program = generate_program(g)
-    m = io_map(layout, g.inputs, g.outputs)
-    text = with_locations(program, m.locations, "I/O").text
-    assert "  start AT %" in text and "VAR_INPUT" not in text
-    plain, loc = load_st(program.text, "a.st"), load_st(text, "b.st")
-    a, b = plain.instance("timers"), loc.instance("timers")
-    seen = []
-    for inputs, ms in (({}, 0), ({"start": True}, 0), ({}, 3000), ({"ok": True}, 0), ({"start": False}, 0)):
-        plain.advance(ms)
-        loc.advance(ms)
-        got = {o: a.cycle(inputs)[o] for o in g.outputs}
-        assert got == {o: b.cycle(inputs)[o] for o in g.outputs}
-        seen.append(tuple(o for o in g.outputs if got[o]))
-    assert seen == [(), ("HEAT",), ("ALARM",), (), ()]
+    plain = load_st(program.text, "a.st")
+    for layout in ("plain", "openplc-server", "openplc-device"):
+        m = io_map(layout, g.inputs, g.outputs)
+        text = with_locations(program, m.locations, "I/O").text
+        assert f"  start AT {m.locations['start']} : BOOL;" in text.splitlines() and "VAR_INPUT" not in text
+        loc = load_st(text, "b.st")
+        plain.clock_ms = 0
+        a, b = plain.instance("timers"), loc.instance("timers")
+        seen = []
+        for inputs, ms in (({}, 0), ({"start": True}, 0), ({}, 3000), ({"ok": True}, 0), ({"start": False}, 0)):
+            plain.advance(ms)
+            loc.advance(ms)
+            got = {o: a.cycle(inputs)[o] for o in g.outputs}
+            assert got == {o: b.cycle(inputs)[o] for o in g.outputs}
+            seen.append(tuple(o for o in g.outputs if got[o]))
+        assert seen == [(), ("HEAT",), ("ALARM",), (), ()]
 
 
 def test_st_check_proves_the_located_program_on_every_target(cli) -> None:
