@@ -6,9 +6,9 @@ parser written by others), and its dataclass tree is executed cycle by cycle. No
 here reads synth's own models, so a wrong emitter cannot agree with itself.
 
 The subset: ``PROGRAM`` and ``FUNCTION_BLOCK``; ``VAR``, ``VAR_INPUT``, ``VAR_OUTPUT``,
-``VAR_IN_OUT``, ``VAR CONSTANT``, located variables (``a AT %IX0.0 : BOOL``); ``BOOL``, ``SINT``/``INT``/``DINT``/``LINT`` (and
-unsigned), ``TIME``; ``ARRAY [a..b, …] OF`` those with initialisers (``3(FALSE)``);
-``:=``, ``IF``/``ELSIF``/``ELSE``, ``WHILE``, ``REPEAT``, ``FOR``, ``EXIT``, ``RETURN``;
+``VAR_IN_OUT``, ``VAR CONSTANT``, located variables (``a AT %IX0.0 : BOOL``); ``BOOL``,
+``SINT``/``INT``/``DINT``/``LINT`` (and unsigned), ``TIME``; ``ARRAY [a..b, …] OF`` those
+with initialisers (``3(FALSE)``); ``:=``, ``IF``/``ELSIF``/``ELSE``, ``WHILE``, ``REPEAT``, ``FOR``, ``EXIT``, ``RETURN``;
 calls of user function blocks and of the standard ``TON``, ``TOF``, ``TP``, ``R_TRIG``,
 ``F_TRIG``, ``SR``, ``RS`` with named arguments (``q => x`` outputs too); ``AND``
 (``&``), ``OR``, ``XOR``, ``NOT``, comparisons, ``+ - * / MOD``, ``T#…`` literals,
@@ -134,7 +134,7 @@ class _Compiler(StatementCompiler):
     def declaration(self, decl: Node, section: VarSection, constant: bool) -> Iterator[Variable]:
         if type(decl) is tf.LocatedVariableDeclaration:  # a AT %IX0.0 : BOOL: the address is the runtime's business
             names, init = [name_of(decl.name)], decl.init
-            decl = tf.VariableOneInitDeclaration(variables=[], init=init)
+            decl = tf.VariableOneInitDeclaration(variables=[], init=init, meta=decl.meta)
         else:
             names = [name_of(d.variable.name) for d in decl.variables]
             init = decl.init
