@@ -4,12 +4,13 @@
 
 Example
 -------
->>> from synth.plant.composition import _plants
+>>> from synth.plant.composition import _plants, load_plant
 >>> from synth.filter.from_rules import skeleton
 >>> from synth.filter.cycle import Algorithm
 >>> from synth.filter.loop.product import Product
 >>> sk = skeleton(_plants("tri.rules"), _plants("F.filter"))  # the text only: nothing is written
->>> ex = Explorer(Product(sk.filter, _plants("tri.rules"), None, Algorithm.ALGEBRAIC, Mode.SUPERVISOR, False), 100)
+>>> pr = Product(sk.filter, load_plant(_plants("tri.rules")), None, Algorithm.ALGEBRAIC, Mode.SUPERVISOR, False)
+>>> ex = Explorer(pr, 100)
 >>> ex.run()
 >>> ex.complete, len(ex.seen_keys)
 (False, 100)
@@ -315,7 +316,9 @@ class Explorer:
             self.record(kind, mask, post, node, event, oid, shown)
         if pr.controlled and oid.size:
             dist = (requests[oid] != targets).sum(axis=1)
-            self.corrected += int((dist > 0).sum())
+            # each kept (state, class) stands for every entry merged into it: count them all, as cycles does
+            merged = np.bincount(rep, minlength=keep.size)[entry]
+            self.corrected += int(merged[dist > 0].sum())
             self.max_distance = max(self.max_distance, int(dist.max()))
         if self.track:
             self.edges((sources, taken_all, events_all), rep, entry[ok], aux_after[oid][ok] * size + final[ok],
