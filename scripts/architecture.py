@@ -31,6 +31,7 @@ PACKAGES = {
     "filter": ("safety logic filter: check, solve, verify", "equations, filter FB"),
     "codegen": ("IEC 61131-3 ST, PLCopen XML, ST interpreter", "program, proof"),
     "output": ("summaries, DOT, HTML report, libFAUDES, files", "JSON, text, files"),
+    "commission": ("I/O maps, closed loop with a PLC runtime, Modbus, OPC UA", "walks, findings"),
     "line": ("a whole line: synth.toml, jobs, cache, pool/Dask, mutants", "line reports, score"),
     "cli": ("one thin module per command group", "exit 0 / 1 / 2"),
 }

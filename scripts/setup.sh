@@ -11,7 +11,7 @@
 #   SYNTH_PYTHON        the Python to build the venv from (default: python3)
 #   SYNTH_VENV          where the venv goes (default: .venv in the repository)
 #   SYNTH_SKIP_APT=1    never call apt-get (tests, machines without root)
-#   SYNTH_SETUP_TESTS=1    also install the test dependencies (.[test]) and setuptools>=77, wheel
+#   SYNTH_SETUP_TESTS=1    also install the test dependencies (.[test,commission]) and setuptools>=77, wheel
 #   SYNTH_SETUP_BROWSER=1  also install chromium and libatomic1 (the browser test)
 #   SYNTH_PIP_ARGS      extra pip arguments (e.g. --no-deps for an offline re-install)
 #   SYNTH_VENV_ARGS     extra venv arguments (e.g. --system-site-packages)
@@ -67,7 +67,7 @@ if [ "${SYNTH_SETUP_TESTS:-0}" = 1 ]; then
   # shellcheck disable=SC2086
   "${pip[@]}" ${SYNTH_PIP_ARGS:-} "setuptools>=77" wheel >&2
   # shellcheck disable=SC2086
-  "${pip[@]}" ${SYNTH_PIP_ARGS:-} -e ".[test]" >&2
+  "${pip[@]}" ${SYNTH_PIP_ARGS:-} -e ".[test,commission]" >&2
 else
   echo "== installing synth into $VENV" >&2
   # shellcheck disable=SC2086

@@ -20,6 +20,7 @@ import sys
 TYPE_CHECKING = False  # typing.TYPE_CHECKING, without importing typing (fast --help)
 
 if TYPE_CHECKING:  # pragma: no cover - the library is imported by the commands only (fast --help)
+    from synth.codegen.program import StProgram
     from synth.codegen.targets import Target
     from synth.grafcet.language import Grafcet
 
@@ -94,6 +95,8 @@ def cmd_st(args: argparse.Namespace) -> int:
         from synth.codegen.targets import st_of
 
         program = generate_program(grafcet, name=args.name, sources=sources)
+        if args.io:
+            program = _located(args, program, grafcet)
         header = provenance_lines(f"PROGRAM {program.program}", sources)
         files = render(target, program.pous, text=program.text, name=program.program, header=header)
         text = st_of(target, files, args.file)
@@ -112,6 +115,8 @@ def cmd_st(args: argparse.Namespace) -> int:
         call = filter_call(filter_block(load_filter(args.filter)))
         sources.append(args.filter)
     program = generate_program(grafcet, name=args.name, sources=sources, filter_call=call)
+    if args.io:
+        program = _located(args, program, grafcet)
     config = None
     if args.task:
         from synth.codegen.program import configuration
@@ -121,6 +126,26 @@ def cmd_st(args: argparse.Namespace) -> int:
     write_target(args, render(target, program.pous, text=program.text, name=program.program, header=header,
                               config=config))
     return 0
+
+
+def _located(args: argparse.Namespace, program: "StProgram", grafcet: "Grafcet") -> "StProgram":
+    """``--io``: the program's plant inputs and outputs located by the layout or map; its
+    address table (JSON and CSV) beside ``-o`` (``tri.st`` → ``tri.io.json``, ``tri.io.csv``)."""
+    import json
+    import os
+
+    from synth.codegen.program import with_locations
+    from synth.commission.iomap import io_map
+    from synth.output.files import write_atomic
+
+    m = io_map(args.io, grafcet.inputs, grafcet.outputs)
+    note = f"I/O: --io {m.layout.value if m.layout.value != 'map' else os.path.basename(args.io)}, located variables"
+    located = with_locations(program, m.locations, note)
+    if args.output and not args.check and not args.output.endswith(("/", os.sep)) and not os.path.isdir(args.output):
+        stem = os.path.splitext(args.output)[0]
+        write_atomic(stem + ".io.json", json.dumps(m.table_json(), indent=2) + "\n")
+        write_atomic(stem + ".io.csv", m.table_csv())
+    return located
 
 
 def cmd_sfc(args: argparse.Namespace) -> int:
@@ -190,6 +215,10 @@ def register(sub: "argparse._SubParsersAction") -> None:
     p.add_argument("--task", metavar="PERIOD",
                    help="also write a CONFIGURATION running the PROGRAM every PERIOD (e.g. 10ms): builds as is in "
                         "Beremiz and OpenPLC")
+    p.add_argument("--io", metavar="LAYOUT",
+                   help="located variables (AT %%IX0.0/%%QX0.0) by layout plain, openplc-server (sensors on coils) or "
+                        "openplc-device (sensors on %%IX100.x, the runtime polls synth), or by a map file name,address "
+                        "(docs/commissioning.md); with -o FILE, the address table beside it as FILE.io.json and .io.csv")
     p.add_argument("--check", action="store_true",
                    help="run the program in the ST interpreter against synth run on every event sequence")
     p.add_argument("--depth", type=int, default=3, metavar="N", help="--check: events per sequence (default 3)")

@@ -39,13 +39,13 @@ class _Version(argparse.Action):
 
 
 def build_parser() -> argparse.ArgumentParser:
-    from synth.cli import codegen as cli_codegen, filter as cli_filter, grafcet as cli_grafcet, lib as cli_lib, line as cli_line, plant as cli_plant, validate as cli_validate
+    from synth.cli import codegen as cli_codegen, filter as cli_filter, grafcet as cli_grafcet, commission as cli_commission, lib as cli_lib, line as cli_line, plant as cli_plant, validate as cli_validate
 
     p = _Parser(prog="synth", description="Validate a Grafcet against a rule-based plant model and its safety constraints.")
     p.add_argument("--version", action=_Version, nargs=0, help="print synth's version and exit")
     sub = p.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
-    for module in (cli_plant, cli_grafcet, cli_validate, cli_filter, cli_codegen, cli_line, cli_lib):
+    for module in (cli_plant, cli_grafcet, cli_validate, cli_filter, cli_codegen, cli_commission, cli_line, cli_lib):
         module.register(sub)
     return p
 

@@ -22,7 +22,7 @@ from synth.grafcet.language import Grafcet
 from synth.logic.expr import names
 
 __all__ = ["FilterCall", "StProgram", "program_name", "filter_call", "check_variable_name", "first_location",
-           "compact", "Configuration", "configuration", "case_aliases", "renamed_note"]
+           "compact", "Configuration", "configuration", "case_aliases", "renamed_note", "with_locations"]
 
 
 @dataclass(frozen=True)
@@ -56,6 +56,20 @@ class StProgram:
     def st_name(self, name: str) -> str:
         """The ST variable of a plant input/output or step variable ``X<step>``."""
         return dict(self.renamed).get(name, name)
+
+
+def with_locations(program: StProgram, where: Mapping[str, str], note: str = "") -> StProgram:
+    """``program`` with its plant inputs and outputs located (``name → %IX0.0``, plant names):
+    the ``PROGRAM``'s data re-rendered by :func:`~synth.codegen.st.located`, its text rewritten
+    from the ``PROGRAM`` line on, ``note`` (a comment) just above it."""
+    from synth.codegen.st import located, pou_lines
+
+    *others, pou = program.pous
+    new = located(pou, {program.st_name(n): a for n, a in where.items()})
+    lines = program.text.rstrip("\n").split("\n")
+    start = max(k for k, line in enumerate(lines) if line.startswith(f"PROGRAM {pou.name}"))
+    head = [*lines[:start], *([f"(* {note} *)"] if note else [])]
+    return StProgram("\n".join([*head, *pou_lines(new, "  ")]) + "\n", program.program, program.renamed, (*others, new))
 
 
 def program_name(path: str) -> str:

@@ -15,10 +15,10 @@ Example
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from enum import StrEnum
 from fractions import Fraction
-from typing import Callable, Iterable, Sequence
+from typing import Callable, Iterable, Mapping, Sequence
 
 from synth.errors import InputError, Location
 from synth.grafcet.language import DURATION_RE
@@ -39,6 +39,7 @@ __all__ = [
     "SectionKind",
     "VarSection",
     "Pou",
+    "located",
     "pou_lines",
     "header",
     "indent",
@@ -174,17 +175,20 @@ def st_expression(
 
 @dataclass(frozen=True)
 class Declaration:
-    """One variable line: ``name : TYPE [:= init]; (* comment *)``."""
+    """One variable line: ``name [AT %IX0.0] : TYPE [:= init]; (* comment *)``; ``location``
+    makes it a located variable (``synth st --io``)."""
 
     name: str
     type: str = "BOOL"
     init: str | None = None
     comment: str = ""
+    location: str | None = None
 
     def text(self) -> str:
         init = f" := {self.init}" if self.init is not None else ""
         comment = f" (* {self.comment} *)" if self.comment else ""
-        return f"{self.name} : {self.type}{init};{comment}"
+        at = f" AT {self.location}" if self.location else ""
+        return f"{self.name}{at} : {self.type}{init};{comment}"
 
 
 class PouKind(StrEnum):
@@ -232,6 +236,36 @@ class Pou:
     name: str
     sections: tuple[VarSection, ...]
     body: tuple[str, ...]
+
+
+def located(pou: Pou, where: Mapping[str, str]) -> Pou:
+    """``pou`` with the variables ``where`` names located (``name → %IX0.0``): each leaves its
+    ``VAR_INPUT``/``VAR_OUTPUT`` for one ``VAR`` section of located variables, in their order,
+    since IEC 61131-3 places a directly represented variable in ``VAR``, never in a POU's interface.
+
+    >>> pou = Pou(PouKind.PROGRAM, "P", (VarSection(SectionKind.INPUT, (Declaration("a"), Declaration("b"))),), ("",))
+    >>> print("\\n".join(declaration_lines(located(pou, {"a": "%IX0.0"}))))
+    PROGRAM P
+    VAR_INPUT
+        b : BOOL;
+    END_VAR
+    VAR
+        a AT %IX0.0 : BOOL;
+    END_VAR
+    """
+    upper = {k.upper(): v for k, v in where.items()}
+    kept: list[VarSection] = []
+    moved: list[Declaration] = []
+    for section in pou.sections:
+        mine = [d for d in section.declarations if d.name.upper() in upper
+                and section.kind in (SectionKind.INPUT, SectionKind.OUTPUT)]
+        moved += [replace(d, location=upper[d.name.upper()]) for d in mine]
+        rest = tuple(d for d in section.declarations if d not in mine)
+        if rest:
+            kept.append(VarSection(section.kind, rest))
+    at = next((i for i, s in enumerate(kept) if s.kind not in (SectionKind.INPUT, SectionKind.OUTPUT)), len(kept))
+    sections = [*kept[:at], VarSection(SectionKind.LOCAL, tuple(moved)), *kept[at:]] if moved else kept
+    return replace(pou, sections=tuple(sections))
 
 
 def declaration_lines(pou: Pou, pad: str = "    ") -> list[str]:

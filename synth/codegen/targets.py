@@ -122,7 +122,7 @@ def _pous_of_project(data: bytes, where: str) -> list[Pou]:
             for v in vl.iterfind("{*}variable"):
                 init = v.find("{*}initialValue/{*}simpleValue")
                 decls.append(Declaration(str(v.get("name")), _type_text(v.find("{*}type")),
-                                         None if init is None else str(init.get("value"))))
+                                         None if init is None else str(init.get("value")), location=v.get("address")))
             sections.append(VarSection(kind, tuple(decls)))
         st = pou.find("{*}body/{*}ST")
         if st is None:

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import shutil
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any, Mapping
 
 from synth.errors import SynthError
 from synth.output.files import write_atomic
@@ -19,7 +19,7 @@ from synth.output.files import write_atomic
 if TYPE_CHECKING:
     from synth.validation.result import Validation
 
-__all__ = ["svg", "write_svg", "dot_available", "report_html", "write_report"]
+__all__ = ["svg", "write_svg", "dot_available", "report_html", "write_report", "commission_html"]
 
 
 def dot_available() -> bool:
@@ -212,3 +212,9 @@ def _involved(v: "Validation", b: int, d) -> tuple[list[str], set[str]]:
 def write_report(directory: str | Path, v: "Validation") -> Path:
     """Write ``DIRECTORY/index.html`` atomically; returns its path."""
     return write_atomic(Path(directory) / "index.html", report_html(v))
+
+
+def commission_html(data: Mapping[str, Any]) -> str:
+    """The report of ``synth commission --report``, from its JSON (``commission.json``): each run
+    and walk, the closed-loop trace of every walk that did not pass, the coverage."""
+    return _template("commission.html.j2").render(data=data)

@@ -6,9 +6,9 @@ parser written by others), and its dataclass tree is executed cycle by cycle. No
 here reads synth's own models, so a wrong emitter cannot agree with itself.
 
 The subset: ``PROGRAM`` and ``FUNCTION_BLOCK``; ``VAR``, ``VAR_INPUT``, ``VAR_OUTPUT``,
-``VAR_IN_OUT``, ``VAR CONSTANT``; ``BOOL``, ``SINT``/``INT``/``DINT``/``LINT`` (and
-unsigned), ``TIME``; ``ARRAY [a..b, …] OF`` those with initialisers (``3(FALSE)``);
-``:=``, ``IF``/``ELSIF``/``ELSE``, ``WHILE``, ``REPEAT``, ``FOR``, ``EXIT``, ``RETURN``;
+``VAR_IN_OUT``, ``VAR CONSTANT``, located variables (``a AT %IX0.0 : BOOL``); ``BOOL``,
+``SINT``/``INT``/``DINT``/``LINT`` (and unsigned), ``TIME``; ``ARRAY [a..b, …] OF`` those
+with initialisers (``3(FALSE)``); ``:=``, ``IF``/``ELSIF``/``ELSE``, ``WHILE``, ``REPEAT``, ``FOR``, ``EXIT``, ``RETURN``;
 calls of user function blocks and of the standard ``TON``, ``TOF``, ``TP``, ``R_TRIG``,
 ``F_TRIG``, ``SR``, ``RS`` with named arguments (``q => x`` outputs too); ``AND``
 (``&``), ``OR``, ``XOR``, ``NOT``, comparisons, ``+ - * / MOD``, ``T#…`` literals,
@@ -59,7 +59,7 @@ _SECTIONS: dict[type, VarSection] = {
     tf.VariableDeclarations: VarSection.LOCAL, tf.InputDeclarations: VarSection.INPUT,
     tf.OutputDeclarations: VarSection.OUTPUT, tf.InputOutputDeclarations: VarSection.IN_OUT,
     tf.StaticDeclarations: VarSection.LOCAL, tf.GlobalVariableDeclarations: VarSection.GLOBAL,
-    tf.TemporaryVariableDeclarations: VarSection.TEMP,
+    tf.TemporaryVariableDeclarations: VarSection.TEMP, tf.LocatedVariableDeclarations: VarSection.LOCAL,
 }
 _POU_KINDS: dict[type, str] = {tf.Program: "PROGRAM", tf.FunctionBlock: "FUNCTION_BLOCK"}
 
@@ -132,8 +132,12 @@ class _Compiler(StatementCompiler):
         return Pou(name_of(node.name), kind, tuple(variables), body)
 
     def declaration(self, decl: Node, section: VarSection, constant: bool) -> Iterator[Variable]:
-        names = [name_of(d.variable.name) for d in decl.variables]
-        init = decl.init
+        if type(decl) is tf.LocatedVariableDeclaration:  # a AT %IX0.0 : BOOL: the address is the runtime's business
+            names, init = [name_of(decl.name)], decl.init
+            decl = tf.VariableOneInitDeclaration(variables=[], init=init, meta=decl.meta)
+        else:
+            names = [name_of(d.variable.name) for d in decl.variables]
+            init = decl.init
         make: Callable[[Host], Value]
         if type(decl) is tf.VariableOneInitDeclaration:
             if not hasattr(init.spec, "type"):

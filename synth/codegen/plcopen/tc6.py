@@ -129,7 +129,8 @@ def interface(sections: Sequence[VarSection]) -> Any:
     for section in sections:
         vl = element(_SECTION_TAG[section.kind], {"constant": "true"} if section.kind is SectionKind.CONSTANT else None)
         for d in section.declarations:
-            var = element("variable", {"name": d.name}, element("type", None, plc_type(d.type)))
+            attrs = {"name": d.name} if d.location is None else {"name": d.name, "address": d.location}
+            var = element("variable", attrs, element("type", None, plc_type(d.type)))
             if d.init is not None:
                 var.append(element("initialValue", None, element("simpleValue", {"value": d.init})))
             if d.comment:
