@@ -20,7 +20,7 @@ from __future__ import annotations
 import random
 import re
 import shutil
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import pytest
@@ -32,13 +32,15 @@ from synth.codegen.plcopen.export import sfc_project_xml
 from synth.codegen.plcopen.tc6 import sfc_step_name
 from synth.codegen.program import StProgram, case_aliases, program_name
 from synth.codegen.st import Declaration, Pou, PouKind, SectionKind, VarSection
-from synth.grafcet.language import Grafcet, Semantics
-from synth.grafcet.language_check import load_grafcet
+from synth.grafcet.language import Grafcet, Semantics, Transition
+from synth.grafcet.language_check import load_grafcet, parse_grafcet
 from synth.grafcet.machine import GrafcetMachine, Situation
 from synth.logic.events import Event
 
-PERIOD = 10
-"""The PLC's scan period in the harness, in ms."""
+PERIOD = 7
+"""The PLC's scan period in the harness, in ms: no bundled preset is a multiple of it. On a
+clock moving by exact steps that sum to a whole second, MATIEC's step time is one scan late
+(:func:`test_matiec_sees_a_whole_second_step_time_one_scan_late`)."""
 SEQUENCES, SCANS = 12, 150
 """Random sequences per Grafcet and scans per sequence."""
 # source_sink.g7: synth sfc refuses source and sink transitions (not IEC 61131-3 SFC)
@@ -64,18 +66,21 @@ class MachineSide:
     machine: GrafcetMachine
     sit: Situation
     inputs: dict[str, bool]
+    period: int
     now: int
     since: dict[str, int]
+    fired: set[Transition] = field(default_factory=set)
 
     def scan(self, inputs: dict[str, bool]) -> None:
-        self.now += PERIOD
+        self.now += self.period
         g = self.machine.grafcet
         due = {t.id for t in g.timers if t.step in self.since and t.id not in self.sit.elapsed
                and self.now - self.since[t.step] >= round(t.seconds * 1000)}
         sit = replace(self.sit, elapsed=tuple(sorted({*self.sit.elapsed, *due}))) if due else self.sit
         changed = [n for n in g.inputs if inputs[n] != self.inputs[n]]
         event = Event.edge(changed[0], inputs[changed[0]]) if changed else None
-        after, _ = self.machine.react_event(sit, event, inputs)
+        after, rounds = self.machine.react_event(sit, event, inputs)
+        self.fired.update(t for fire in rounds for t in fire)
         self.since = {s: self.since[s] if s in self.sit.steps else self.now for s in after.steps}
         self.sit, self.inputs = after, dict(inputs)
 
@@ -96,9 +101,20 @@ class Difference:
                 f"synth run --semantics sfc {self.expected}, the PLC {self.got}")
 
 
-def run_on_plc(path: Path, folder: Path, seeds: range, scans: int) -> tuple[int, list[Difference]]:
-    """Scans played and the first difference of each seed's sequence."""
-    g = replace(load_grafcet(path), semantics=Semantics.SFC)
+@dataclass(frozen=True)
+class Outcome:
+    """What a run on the PLC played: scans, transitions the machine fired, differences."""
+
+    scans: int
+    fired: frozenset[Transition]
+    differences: tuple[Difference, ...]
+
+
+def run_on_plc(g: Grafcet, folder: Path, seeds: range, scans: int, period: int = PERIOD) -> Outcome:
+    """``g`` on the PLC and on the machine, one sequence of ``scans`` scans per seed; the first
+    difference of each sequence ends it."""
+    g = replace(g, semantics=Semantics.SFC)
+    folder.mkdir(parents=True, exist_ok=True)
     (folder / "plc.xml").write_bytes(sfc_project_xml(g, version="test"))
     done = beremiz_program(folder / "plc.xml", folder / "generated.st")
     assert done.returncode == 0, done.stderr
@@ -112,7 +128,7 @@ def run_on_plc(path: Path, folder: Path, seeds: range, scans: int) -> tuple[int,
         VarSection(SectionKind.OUTPUT, tuple(Declaration(st[o]) for o in g.outputs)),
         VarSection(SectionKind.LOCAL, tuple(Declaration(f"{sfc_step_name(s.name)}.X") for s in g.steps))), ())
     machine = GrafcetMachine(g)
-    played, differences = 0, []
+    played, differences, fired = 0, [], set()
     plc = CompiledProgram(StProgram(text, pou.name, (), (pou,)), folder / "c")
     start = plc.save()  # the program as loaded: each sequence starts from it
     try:
@@ -130,13 +146,14 @@ def run_on_plc(path: Path, folder: Path, seeds: range, scans: int) -> tuple[int,
                 if side is None:
                     sit = machine.initial(inputs)
                     initial = set(g.initial_steps)  # active from the start; the others from the first scan
-                    side = MachineSide(machine, sit, dict(inputs), PERIOD, {s: 0 if s in initial else PERIOD for s in sit.steps})
+                    side = MachineSide(machine, sit, dict(inputs), period, period,
+                                       {s: 0 if s in initial else period for s in sit.steps})
                 else:
                     side.scan(inputs)
                 cells = {st[n]: v for n, v in inputs.items() if st[n] in declared}
                 cells |= {n: inputs[x] != previous[x] and inputs[x] == rising for n, (rising, x) in edges.items()}
                 previous = dict(inputs)
-                plc.advance(PERIOD)
+                plc.advance(period)
                 plc.cycle(cells)
                 played += 1
                 want = (tuple(side.sit.steps), tuple(o for o in g.outputs if o in machine.orders(side.sit, inputs)))
@@ -144,11 +161,12 @@ def run_on_plc(path: Path, folder: Path, seeds: range, scans: int) -> tuple[int,
                        tuple(o for o in g.outputs if plc.value(st[o])))
                 if sorted(want[0]) != sorted(got[0]) or want[1] != got[1]:
                     values = " ".join(f"{n}={int(v)}" for n, v in inputs.items())
-                    differences.append(Difference(path.name, seed, k, values, _text(want), _text(got)))
+                    differences.append(Difference(Path(g.path).name, seed, k, values, _text(want), _text(got)))
                     break
+            fired |= side.fired if side is not None else set()
     finally:
         plc.close()
-    return played, differences
+    return Outcome(played, frozenset(fired), tuple(differences))
 
 
 def _text(state: tuple[tuple[str, ...], tuple[str, ...]]) -> str:
@@ -160,6 +178,41 @@ def _text(state: tuple[tuple[str, ...], tuple[str, ...]]) -> str:
 def test_the_plc_runs_every_bundled_grafcet_as_synth_run_sfc(path, tmp_path):
     if path.name in NOT_COMPILED:
         pytest.skip("MATIEC refuses a step flag read before the step's declaration (docs/codegen.md)")
-    played, differences = run_on_plc(path, tmp_path, range(SEQUENCES), SCANS)
-    assert played == SEQUENCES * SCANS - sum(SCANS - 1 - d.scan for d in differences)
-    assert [d.text() for d in differences] == []
+    g = load_grafcet(path)
+    scans = scans_for(g)
+    out = run_on_plc(g, tmp_path, range(SEQUENCES), scans)
+    assert [d.text() for d in out.differences] == []
+    assert out.scans == SEQUENCES * scans
+    assert [t.name for t in g.transitions if t not in out.fired] == []  # every transition fired on both sides
+
+
+def scans_for(g: Grafcet) -> int:
+    """:data:`SCANS`, plus enough for the longest timer to elapse twice."""
+    return SCANS + 2 * max((round(t.seconds * 1000) for t in g.timers), default=0) // PERIOD
+
+
+TIMED = """inputs start
+outputs HEAT
+grafcet G {
+  initial step 0
+  step 1: HEAT
+  step 2
+  transition 0 -> 1 when start
+  transition 1 -> 2 when %s/X1
+  transition 2 -> 0 when !start
+}
+"""
+
+
+@needs_plc
+def test_matiec_sees_a_whole_second_step_time_one_scan_late(tmp_path):
+    """MATIEC adds each scan's elapsed time to a step's ``T`` and normalises the sum only past
+    10^9 ns: on a clock moving by exactly 10 ms (Beremiz's emulated cycle, OpenPLC's tick),
+    ``T`` reaches 1 s as 0 s + 10^9 ns, which is less than ``T#1s``, so ``S1.T >= T#1s`` holds
+    one scan after the preset; 990 ms is on time."""
+    late = run_on_plc(parse_grafcet(TIMED % "1s", "late.g7"), tmp_path / "1s", range(1), 120, period=10)
+    assert [d.text() for d in late.differences] == [
+        "late.g7 seed 0 scan 102 (inputs start=1): synth run --semantics sfc steps {2} outputs {}, "
+        "the PLC steps {1} outputs {HEAT}"]
+    on_time = run_on_plc(parse_grafcet(TIMED % "990ms", "on_time.g7"), tmp_path / "990ms", range(1), 120, period=10)
+    assert on_time.differences == () and len(on_time.fired) == 3

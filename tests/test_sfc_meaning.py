@@ -49,10 +49,26 @@ def test_a_conditional_action_is_reset_when_its_step_is_left():
 def test_names_differing_in_case_only_are_renamed_in_the_sfc():
     g = load_grafcet(ROOT / "tests/data/codegen/case_clash.g7")
     xml = sfc_project_xml(g, version="test").decode()
-    assert re.findall(r'<variable name="(\w+)">', xml) == ["go", "a", "b", "A_1", "B_1", "C", "_RE_go"]
+    assert re.findall(r'<variable name="(\w+)">', xml) == ["go", "a", "b", "_RE_go", "A_1", "B_1", "C"]
     assert "<Comment>renamed (Structured Text ignores case): A -&gt; A_1, B -&gt; B_1</Comment>" in xml
     back = import_sfc(xml.encode(), "case_clash.xml")
     assert "outputs A_1, B_1, C\n" in back and "  step 1: A_1\n" in back
+
+
+def test_an_edge_is_an_input_the_caller_sets_and_reads_back_as_the_edge():
+    """``↑b`` is the input ``_RE_b`` (an SFC cannot compute it before its transitions), with the
+    caller's rule in its documentation; synth import reads it back as ``↑b``, not as an input."""
+    g = load_grafcet(ROOT / "grafcets/timers.g7")
+    xml = sfc_project_xml(g, version="test").decode()
+    inputs = re.search(r"<inputVars>(.*?)</inputVars>", xml, re.S)
+    assert inputs is not None and re.findall(r'<variable name="(\w+)">', inputs[1]) == ["start", "ok", "_RE_start",
+                                                                                       "_FE_start"]
+    assert "<localVars>" not in xml
+    assert ("falling edge of start, set by the caller before each scan: NOT start AND start_previous "
+            "(start_previous: start at the previous scan, start itself at the first scan: no edge then)") in xml
+    back = import_sfc(xml.encode(), "timers.xml")
+    assert back.splitlines()[1:3] == ["inputs start, ok", "outputs HEAT, ALARM"]
+    assert "  transition 0 -> 1 when ↑start\n" in back and "  transition 2 -> 0 when ↓start\n" in back
 
 
 needs_beremiz = pytest.mark.skipif(find_beremiz() is None or find_iec2c() is None,

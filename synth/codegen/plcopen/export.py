@@ -16,7 +16,7 @@ Mapping (:mod:`synth.codegen.plcopen.importer` reads it back):
 step ``12`` / ``wait``                  ``<step name="S12">`` / ``name="wait"``
 ``X12``                                 ``S12.X``
 ``2s/X12``                              ``(S12.T >= T#2s)`` (the TIME literal of ``synth st``)
-``↑x`` / ``↓x``                         ``_RE_x`` / ``_FE_x`` (edge flags, see docs/codegen.md)
+``↑x`` / ``↓x``                         inputs ``_RE_x`` / ``_FE_x`` (set by the caller, see docs/codegen.md)
 ``A`` (continuous)                      qualifier ``N``, reference ``A``
 ``A if c``                              qualifier ``N``, inline ST ``A := c;``, and ``P0``,
                                         inline ST ``A := FALSE;`` (reset when the step is left)
@@ -285,12 +285,14 @@ def sfc_project_xml(g: Grafcet, *, name: str | None = None, version: str | None 
             body.append(div)
     pou_name = name or program_name(g.path)
     iface = element("interface")
+    edges = sorted({(n.rising, n.name) for x in g.expressions() for n in expr_names(x) if isinstance(n, Edge)}, key=lambda e: (e[1], not e[0]))
     for key, declared in (("inputVars", g.inputs), ("outputVars", g.outputs)):
         vl = element(key)
         for n in declared:
             vl.append(element("variable", {"name": names(n)}, element("type", None, element("BOOL"))))
+        if key == "inputVars":
+            vl.extend(_edge_input(rising, n, names) for rising, n in edges)
         iface.append(vl)
-    edges = sorted({(n.rising, n.name) for x in g.expressions() for n in expr_names(x) if isinstance(n, Edge)}, key=lambda e: (e[1], not e[0]))
     if g.internals:
         vl = element("localVars")
         for d in internal_declarations(g, names)[:len(g.internals)]:
@@ -305,18 +307,23 @@ def sfc_project_xml(g: Grafcet, *, name: str | None = None, version: str | None 
                 vl.append(element("variable", {"name": shared_flag(names(order), e)}, element("type", None, element("BOOL")),
                                   element("documentation", None, xhtml(f"{order} as step {e} emits it", cdata=False))))
         iface.append(vl)
-    if edges:
-        vl = element("localVars")
-        for rising, n in edges:
-            v = element("variable", {"name": ("_RE_" if rising else "_FE_") + names(n)}, element("type", None, element("BOOL")),
-                   element("documentation", None, xhtml(f"{'rising' if rising else 'falling'} edge of {n}, computed "
-                                                    "by the caller each cycle (R_TRIG/F_TRIG)", cdata=False)))
-            vl.append(v)
-        iface.append(vl)
     pou = element("pou", {"name": pou_name, "pouType": "program"}, iface, element("body", None, body))
     if names.alias:
         comment = "\n".join(c for c in (comment, renamed_note(names.alias)) if c)
     return project(pou_name, version or synth_version(), comment, [pou])
+
+
+def _edge_input(rising: bool, n: str, names: _Names) -> Any:
+    """The input ``_RE_x`` (``_FE_x``) a receptivity ``↑x`` (``↓x``) reads: an SFC has no place
+    before its transitions where the program could compute it (MATIEC runs the action bodies
+    after the transitions, so an edge computed in an action is seen one scan late), so the
+    caller computes it before each scan, from ``x`` and its value at the previous scan."""
+    x = names(n)
+    rule = f"{x} AND NOT {x}_previous" if rising else f"NOT {x} AND {x}_previous"
+    doc = (f"{'rising' if rising else 'falling'} edge of {x}, set by the caller before each scan: {rule} "
+           f"({x}_previous: {x} at the previous scan, {x} itself at the first scan: no edge then)")
+    return element("variable", {"name": ("_RE_" if rising else "_FE_") + x}, element("type", None, element("BOOL")),
+                   element("documentation", None, xhtml(doc, cdata=False)))
 
 
 def shared_flag(order: str, step: str) -> str:
