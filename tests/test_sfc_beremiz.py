@@ -191,6 +191,41 @@ def scans_for(g: Grafcet) -> int:
     return SCANS + 2 * max((round(t.seconds * 1000) for t in g.timers), default=0) // PERIOD
 
 
+SHARED = """inputs go, a, b, c
+outputs RUN
+grafcet G {
+  initial step 0
+  step 1: RUN
+  step 2: RUN if c
+  step 3
+  step 4
+  transition 0 -> 1, 2 when ↑go
+  transition 1 -> 3 when a
+  transition 2 -> 4 when ↓b
+  transition 3, 4 -> 0 when !go
+}
+"""
+
+
+@needs_plc
+def test_the_plc_keeps_a_shared_order_and_its_edges_as_synth_run_sfc(tmp_path):
+    """RUN emitted by two parallel steps (one conditionally), one of them left by a falling edge."""
+    g = parse_grafcet(SHARED, "shared.g7")
+    out = run_on_plc(g, tmp_path, range(SEQUENCES), SCANS)
+    assert [d.text() for d in out.differences] == [] and out.scans == SEQUENCES * SCANS
+    assert len(out.fired) == len(g.transitions)
+
+
+
+@needs_plc
+@pytest.mark.xfail(strict=True, reason="MATIEC sets the S action carrying the shared order only while its "
+                   "initial step is active after a scan: left at the first scan, the OR never runs")
+def test_a_shared_order_is_kept_when_the_initial_step_is_left_at_the_first_scan(tmp_path):
+    g = parse_grafcet(SHARED.replace("when ↑go", "when go").replace("RUN if c", "RUN"), "first_scan.g7")
+    out = run_on_plc(g, tmp_path, range(SEQUENCES), SCANS)
+    assert [d.text() for d in out.differences] == []
+
+
 TIMED = """inputs start
 outputs HEAT
 grafcet G {

@@ -168,7 +168,8 @@ def test_a_shared_order_is_one_or_of_per_step_flags_and_reads_back():
     xml = sfc_project_xml(g, version="test").decode()
     assert xml.count('<variable name="_N_RUN_S1">') == 1 and xml.count('<variable name="_N_RUN_S2">') == 1
     assert "RUN := _N_RUN_S1 OR _N_RUN_S2;" in xml and '<reference name="_N_RUN_S1"/>' in xml
-    assert "_N_RUN_S2 := c;" in xml and "_N_RUN_S2 := FALSE;" in xml
+    assert "_N_RUN_S2 := c; RUN := _N_RUN_S1 OR _N_RUN_S2;" in xml  # the OR again, after the flag
+    assert "_N_RUN_S2 := FALSE; RUN := _N_RUN_S1 OR _N_RUN_S2;" in xml
     back = import_sfc(xml.encode(), "shared.xml")
     assert "  step 1: RUN\n  step 2: RUN if c\n" in back and back.splitlines()[2] == "outputs RUN"
 

@@ -250,10 +250,11 @@ def sfc_project_xml(g: Grafcet, *, name: str | None = None, version: str | None 
             block = element("actionBlock", {"localId": str(ids())}, position(x + 120, y), _conn_in((step_id[s.name], None)))
             for k, a in enumerate(s.actions):
                 own = a.order in shared and a.kind in (CONTINUOUS, CONDITIONAL)
-                block.extend(_actions(a, ids, k, names, shared_flag(names(a.order), s.name) if own else None))
+                block.extend(_actions(a, ids, k, names, (shared_flag(names(a.order), s.name),
+                                                         _shared_or(a.order, shared[a.order], names)) if own else None))
             if s.name == carrier:
                 for k, (order, emitters) in enumerate(shared.items(), len(s.actions)):
-                    text = f"{names(order)} := " + " OR ".join(shared_flag(names(order), e) for e in emitters) + ";"
+                    text = _shared_or(order, emitters, names)
                     block.append(element("action", {"localId": str(ids()), "qualifier": Qualifier.S},
                                          position(0, 30 * k, "relPosition"),
                                          element("inline", None, element("ST", None, xhtml(text)))))
@@ -357,13 +358,21 @@ def shared_orders(g: Grafcet) -> dict[str, list[str]]:
     return {o: steps for o, steps in emitters.items() if len(steps) > 1 and o not in stored}
 
 
-def _actions(a: Action, ids: _Ids, k: int, names: _Names, flag: str | None = None) -> list[Any]:
+def _shared_or(order: str, emitters: Sequence[str], names: _Names) -> str:
+    """The statement writing a shared order as the OR of its steps' flags."""
+    return f"{names(order)} := " + " OR ".join(shared_flag(names(order), e) for e in emitters) + ";"
+
+
+def _actions(a: Action, ids: _Ids, k: int, names: _Names, flag: tuple[str, str] | None = None) -> list[Any]:
     """The SFC action(s) of one ``.g7`` action, with its IEC 61131-3 meaning: ``A if c`` is an
     ST body under ``N`` (run while the step is active) and a ``P0`` body ``A := FALSE;`` (run
     once when it is left), since a PLC does not run an action body again after its step is
     left (MATIEC, hence Beremiz and OpenPLC, run it only while the action is active).
-    ``flag``: the step's own flag of a shared order, written instead of the order."""
-    order = flag or names(a.order)
+    ``flag``: the step's own flag of a shared order, written instead of the order, and the
+    statement writing the order from the flags, which an inline body repeats after its flag
+    (MATIEC runs the bodies one after the other, the initial step's first: the OR there would
+    read this flag as the previous scan left it)."""
+    order, again = (flag[0], " " + flag[1]) if flag else (names(a.order), "")
 
     def new(qualifier: Qualifier, body: Any, row: int = 0) -> Any:
         el = element("action", {"localId": str(ids()), "qualifier": qualifier})
@@ -384,8 +393,8 @@ def _actions(a: Action, ids: _Ids, k: int, names: _Names, flag: str | None = Non
         return [new(Qualifier.N, element("reference", {"name": order}))]
     if a.kind == CONDITIONAL:
         assert a.condition is not None
-        return [new(Qualifier.N, st(f"{order} := {_sfc_expr(a.condition, names)};")),
-                new(Qualifier.P0, st(f"{order} := FALSE;"), 1)]
+        return [new(Qualifier.N, st(f"{order} := {_sfc_expr(a.condition, names)};{again}")),
+                new(Qualifier.P0, st(f"{order} := FALSE;{again}"), 1)]
     if a.when == ON_ACTIVATION:
         return [new(Qualifier.S if a.value else Qualifier.R, element("reference", {"name": order}))]
     if a.when == ON_DEACTIVATION:

@@ -21,7 +21,7 @@ from synth.codegen.plcopen.data import FLAG_PREFIX
 from synth.codegen.plcopen.sfc import Chart
 from synth.errors import InputError, Location
 
-__all__ = ["MARK", "shared_assignment", "merge_shared"]
+__all__ = ["MARK", "shared_assignment", "without_shared_or", "merge_shared"]
 
 MARK = "\x00shared "
 """How an action string carries a shared order until :func:`merge_shared` distributes it."""
@@ -34,6 +34,19 @@ def shared_assignment(body: str) -> tuple[str, list[str]] | None:
         return None
     flags = re.split(r"\s+OR\s+", m[2], flags=re.I)
     return (m[1], flags) if all(f.startswith(FLAG_PREFIX) for f in flags) else None
+
+
+def without_shared_or(body: str) -> str:
+    """``body`` without its last statement when that one writes a shared order from its flags
+    (a flag's body repeats it, see :func:`synth.codegen.plcopen.export.shared_orders`).
+
+    >>> without_shared_or("_N_RUN_S2 := c; RUN := _N_RUN_S1 OR _N_RUN_S2;")
+    '_N_RUN_S2 := c;'
+    """
+    parts = [x for x in body.split(";") if x.strip()]
+    if len(parts) > 1 and shared_assignment(parts[-1]) is not None:
+        return ";".join(parts[:-1]).strip() + ";"
+    return body
 
 
 def merge_shared(chart: Chart, at: Callable[[Any], Location]) -> None:
