@@ -163,13 +163,16 @@ grafcet G {
 
 def test_a_shared_order_is_one_or_of_per_step_flags_and_reads_back():
     """RUN emitted by steps 1 and 2: each step drives its own flag, an S action on the initial
-    step writes RUN as their OR at every scan; the import reads the .g7 back."""
+    step (and on the steps the first scan reaches) writes RUN as their OR at every scan; the
+    import reads the .g7 back."""
     g = parse_grafcet(SHARED, "shared.g7")
     xml = sfc_project_xml(g, version="test").decode()
     assert xml.count('<variable name="_N_RUN_S1">') == 1 and xml.count('<variable name="_N_RUN_S2">') == 1
     assert "RUN := _N_RUN_S1 OR _N_RUN_S2;" in xml and '<reference name="_N_RUN_S1"/>' in xml
     assert "_N_RUN_S2 := c; RUN := _N_RUN_S1 OR _N_RUN_S2;" in xml  # the OR again, after the flag
     assert "_N_RUN_S2 := FALSE; RUN := _N_RUN_S1 OR _N_RUN_S2;" in xml
+    # the S action writing RUN on the initial step 0 and on steps 1 and 2, which the first scan reaches
+    assert xml.count('qualifier="S"') == 3
     back = import_sfc(xml.encode(), "shared.xml")
     assert "  step 1: RUN\n  step 2: RUN if c\n" in back and back.splitlines()[2] == "outputs RUN"
 

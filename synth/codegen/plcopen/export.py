@@ -215,7 +215,7 @@ def sfc_project_xml(g: Grafcet, *, name: str | None = None, version: str | None 
         return trans_id[i], None
 
     shared = shared_orders(g)
-    carrier = next(s.name for s in g.steps if s.initial) if shared else None
+    carriers = first_scan_steps(g) if shared else set()
     body = element("SFC")
     column: dict[str, int] = {p.name: k for k, p in enumerate(g.grafcets)}
     row: dict[str, int] = {}
@@ -231,7 +231,7 @@ def sfc_project_xml(g: Grafcet, *, name: str | None = None, version: str | None 
         elif incoming[s.name]:
             el.append(_conn_in(producer_of_transition(incoming[s.name][0], s.name)))
         el.append(element("connectionPointOut", {"formalParameter": ""}))
-        if s.actions or s.name == carrier:
+        if s.actions or s.name in carriers:
             el.append(element("connectionPointOutAction", {"formalParameter": ""}))
         data = element("data", {"name": SYNTH_DATA, "handleUnknown": "discard"}, element("grafcet", {"name": s.grafcet}))
         el.append(element("addData", None, data))
@@ -246,13 +246,13 @@ def sfc_project_xml(g: Grafcet, *, name: str | None = None, version: str | None 
             for k in range(len(outgoing[s.name])):
                 div.append(element("connectionPointOut", {"formalParameter": str(k)}))
             body.append(div)
-        if s.actions or s.name == carrier:
+        if s.actions or s.name in carriers:
             block = element("actionBlock", {"localId": str(ids())}, position(x + 120, y), _conn_in((step_id[s.name], None)))
             for k, a in enumerate(s.actions):
                 own = a.order in shared and a.kind in (CONTINUOUS, CONDITIONAL)
                 block.extend(_actions(a, ids, k, names, (shared_flag(names(a.order), s.name),
                                                          _shared_or(a.order, shared[a.order], names)) if own else None))
-            if s.name == carrier:
+            if s.name in carriers:
                 for k, (order, emitters) in enumerate(shared.items(), len(s.actions)):
                     text = _shared_or(order, emitters, names)
                     block.append(element("action", {"localId": str(ids()), "qualifier": Qualifier.S},
@@ -343,8 +343,9 @@ def shared_orders(g: Grafcet) -> dict[str, list[str]]:
     MATIEC (Beremiz, OpenPLC) resets an ``N`` action's variable when one of its steps is left
     even while another keeps it (measured: the order off for one scan), so each emitting step
     drives a flag of its own (:func:`shared_flag`, with the action it has in the ``.g7``) and
-    an ``S`` action on an initial step, run at every scan from the first one (as Beremiz runs
-    its function blocks), writes the order as the OR of the flags."""
+    an ``S`` action on the initial steps (and the steps the first scan reaches,
+    :func:`first_scan_steps`), run at every scan from the first one (as Beremiz runs its
+    function blocks), writes the order as the OR of the flags."""
     emitters: dict[str, list[str]] = {}
     stored: set[str] = set()
     for s in g.steps:
@@ -356,6 +357,17 @@ def shared_orders(g: Grafcet) -> dict[str, list[str]]:
             else:
                 stored.add(a.order)
     return {o: steps for o, steps in emitters.items() if len(steps) > 1 and o not in stored}
+
+
+def first_scan_steps(g: Grafcet) -> set[str]:
+    """The steps that can be active after the first scan: the initial steps and the targets of
+    the transitions from initial steps only. Each carries the ``S`` action writing the shared
+    orders: MATIEC sets an ``S`` action only while its step is active after the scan's
+    evolution, so on an initial step alone the OR would never run once that step is left at
+    the first scan (measured); whichever of them is active starts it, and it then runs at
+    every scan."""
+    initial = {s.name for s in g.steps if s.initial}
+    return initial | {x for t in g.transitions if t.sources and set(t.sources) <= initial for x in t.targets}
 
 
 def _shared_or(order: str, emitters: Sequence[str], names: _Names) -> str:

@@ -50,14 +50,16 @@ def without_shared_or(body: str) -> str:
 
 
 def merge_shared(chart: Chart, at: Callable[[Any], Location]) -> None:
-    """Each marked action of ``chart`` (on an initial step, else a located error) distributed:
+    """Each marked action of ``chart`` (on an initial step, or a copy of one on another step,
+    else a located error) distributed:
     the steps' actions on its flags become actions on the order."""
     renames: dict[str, str] = {}
+    on_initial = {a for st in chart.steps if st.initial for a in st.actions if a.startswith(MARK)}
     for st in chart.steps:
         for action in [a for a in st.actions if a.startswith(MARK)]:
             st.actions.remove(action)
             order, flags = action[len(MARK):].split(" := ", 1)
-            if not st.initial:
+            if not st.initial and action not in on_initial:  # else: a copy that starts it (first_scan_steps)
                 raise InputError(f"the order {order} written as {flags.replace(' ', ' OR ')} by an S action of step "
                                  f"{st.name}, which is not initial: that action runs only once the step is reached",
                                  at(st.el))
