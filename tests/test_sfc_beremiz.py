@@ -28,6 +28,7 @@ import pytest
 from beremiz import beremiz_program, find_beremiz
 from conftest import ROOT
 from iec2c import CompiledProgram, find_iec2c
+from test_sfc_meaning import SHARED
 from synth.codegen.plcopen.export import sfc_project_xml
 from synth.codegen.plcopen.tc6 import sfc_step_name
 from synth.codegen.program import StProgram, case_aliases, program_name
@@ -191,26 +192,15 @@ def scans_for(g: Grafcet) -> int:
     return SCANS + 2 * max((round(t.seconds * 1000) for t in g.timers), default=0) // PERIOD
 
 
-SHARED = """inputs go, a, b, c
-outputs RUN
-grafcet G {
-  initial step 0
-  step 1: RUN
-  step 2: RUN if c
-  step 3
-  step 4
-  transition 0 -> 1, 2 when ↑go
-  transition 1 -> 3 when a
-  transition 2 -> 4 when ↓b
-  transition 3, 4 -> 0 when !go
-}
-"""
+# test_sfc_meaning's chart with RUN in two parallel steps, started and left on edges
+SHARED_EDGES = SHARED.replace("0 -> 1, 2 when go", "0 -> 1, 2 when ↑go").replace("2 -> 4 when b", "2 -> 4 when ↓b")
 
 
 @needs_plc
 def test_the_plc_keeps_a_shared_order_and_its_edges_as_synth_run_sfc(tmp_path):
     """RUN emitted by two parallel steps (one conditionally), one of them left by a falling edge."""
-    g = parse_grafcet(SHARED, "shared.g7")
+    g = parse_grafcet(SHARED_EDGES, "shared.g7")
+    assert [t.receptivity.text() for t in g.transitions] == ["↑go", "a", "↓b", "!go"]
     out = run_on_plc(g, tmp_path, range(SEQUENCES), SCANS)
     assert [d.text() for d in out.differences] == [] and out.scans == SEQUENCES * SCANS
     assert len(out.fired) == len(g.transitions)
@@ -221,7 +211,7 @@ def test_the_plc_keeps_a_shared_order_and_its_edges_as_synth_run_sfc(tmp_path):
 def test_a_shared_order_is_kept_when_the_initial_step_is_left_at_the_first_scan(tmp_path):
     """MATIEC sets an S action only while its step is active after a scan: the OR is carried by
     the steps the first scan reaches too (4 of the 12 seeds start with go)."""
-    g = parse_grafcet(SHARED.replace("when ↑go", "when go").replace("RUN if c", "RUN"), "first_scan.g7")
+    g = parse_grafcet(SHARED.replace("RUN if c", "RUN"), "first_scan.g7")
     out = run_on_plc(g, tmp_path, range(SEQUENCES), SCANS)
     assert [d.text() for d in out.differences] == [] and len(out.fired) == len(g.transitions)
 
