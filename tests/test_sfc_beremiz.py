@@ -26,9 +26,8 @@ from pathlib import Path
 import pytest
 
 from beremiz import beremiz_program, find_beremiz
-from conftest import ROOT
 from iec2c import CompiledProgram, find_iec2c
-from test_sfc_meaning import SHARED
+from test_sfc_meaning import GRAFCETS, MATIEC_FORWARD_STEP_FLAGS, SHARED
 from synth.codegen.plcopen.export import sfc_project_xml
 from synth.codegen.plcopen.tc6 import sfc_step_name
 from synth.codegen.program import StProgram, case_aliases, program_name
@@ -44,10 +43,8 @@ clock moving by exact steps that sum to a whole second, MATIEC's step time is on
 (:func:`test_matiec_sees_a_whole_second_step_time_one_scan_late`)."""
 SEQUENCES, SCANS = 12, 150
 """Random sequences per Grafcet and scans per sequence."""
-# source_sink.g7: synth sfc refuses source and sink transitions (not IEC 61131-3 SFC)
-EXPORTED = [p for p in sorted((ROOT / "grafcets").glob("*.g7")) if p.name != "source_sink.g7"]
-# MATIEC reads a step flag only after the step's declaration (docs/codegen.md, section 3)
-NOT_COMPILED = {"tri.g7", "tri_missing_order.g7", "tri_counting.g7", "tri_boxes.g7"}
+# GRAFCETS: the bundled ones but source_sink.g7, which synth sfc refuses (not IEC 61131-3 SFC);
+# MATIEC_FORWARD_STEP_FLAGS: those MATIEC does not compile (docs/codegen.md, section 3)
 EDGE = re.compile(r"_(RE|FE)_(\w+)")
 
 needs_plc = pytest.mark.skipif(find_beremiz() is None or find_iec2c() is None or shutil.which("gcc") is None,
@@ -175,16 +172,16 @@ def _text(state: tuple[tuple[str, ...], tuple[str, ...]]) -> str:
 
 
 @needs_plc
-@pytest.mark.parametrize("path", EXPORTED, ids=lambda p: p.name)
+@pytest.mark.parametrize("path", GRAFCETS, ids=lambda p: p.name)
 def test_the_plc_runs_every_bundled_grafcet_as_synth_run_sfc(path, tmp_path):
-    if path.name in NOT_COMPILED:
+    if path.name in MATIEC_FORWARD_STEP_FLAGS:
         pytest.skip("MATIEC refuses a step flag read before the step's declaration (docs/codegen.md)")
     g = load_grafcet(path)
     scans = scans_for(g)
     out = run_on_plc(g, tmp_path, range(SEQUENCES), scans)
     assert [d.text() for d in out.differences] == []
     assert out.scans == SEQUENCES * scans
-    assert [t.name for t in g.transitions if t not in out.fired] == []  # every transition fired on both sides
+    assert [t.name for t in g.transitions if t not in out.fired] == []  # every transition fired (the PLC: the same steps)
 
 
 def scans_for(g: Grafcet) -> int:
