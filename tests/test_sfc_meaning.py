@@ -177,6 +177,20 @@ def test_a_shared_order_is_one_or_of_per_step_flags_and_reads_back():
     assert "  step 1: RUN\n  step 2: RUN if c\n" in back and back.splitlines()[2] == "outputs RUN"
 
 
+def test_the_shared_or_on_a_step_the_first_scan_reaches_is_read_only_as_a_copy_of_the_initial_one():
+    """Without the initial step's S action, the one on step 1 runs only once step 1 is reached."""
+    from synth.errors import InputError
+
+    xml = sfc_project_xml(parse_grafcet(SHARED, "shared.g7"), version="test").decode()
+    alone = re.sub(r'<action localId="\d+" qualifier="S">.*?</action>', "", xml, count=1, flags=re.S)
+    assert alone.count('qualifier="S"') == 2
+    with pytest.raises(InputError) as err:
+        import_sfc(alone.encode(), "shared.xml")
+    assert str(err.value).splitlines()[0] == (
+        "shared.xml:93:13: error: the order RUN written as _N_RUN_S1 OR _N_RUN_S2 by an S action of step 1, which "
+        "is not initial: that action runs only once the step is reached")
+
+
 @needs_beremiz
 @pytest.mark.skipif(shutil.which("gcc") is None, reason="no gcc")
 def test_on_the_plc_a_shared_order_stays_on_while_one_of_its_steps_is_active(tmp_path):
