@@ -18,6 +18,7 @@ holds one instance and reads commands on standard input, one per line:
 from __future__ import annotations
 
 import os
+import re
 import shutil
 import subprocess
 from pathlib import Path
@@ -97,7 +98,7 @@ def compile_st(text: str, folder: Path) -> subprocess.CompletedProcess[str]:
 class CompiledProgram:
     """The generated program compiled by ``iec2c`` and gcc, driven through the harness;
     ``pou``: the POU to run (default: the ``PROGRAM``; a ``FUNCTION_BLOCK`` runs the same way,
-    one call per cycle)."""
+    one call per cycle). A declaration ``S12.X`` of an SFC program watches step ``S12``'s flag."""
 
     def __init__(self, program: StProgram, folder: Path, pou: str | None = None) -> None:
         found = find_iec2c()
@@ -113,10 +114,17 @@ class CompiledProgram:
         self.input_index = {n.upper(): i for i, n in enumerate(inputs)}
         self.watched_index = {n.upper(): i for i, n in enumerate(watched)}
         c_type = main.name.upper()
+        # an SFC's step S12 is MATIEC's __step_list[k] (a macro of POUS.c): watch S12.X through it
+        steps = dict(re.findall(r"^#define (\w+) (__step_list\[\d+\])$", (folder / "POUS.c").read_text(), re.M))
+
+        def field(n: str) -> str:
+            head, _, tail = n.upper().partition(".")
+            return f"{steps.get(head, head)}{_ + tail}.value"
+
         (folder / "harness.c").write_text(_HARNESS % {
             "type": c_type,
             "inputs": ", ".join(f"&inst.{n.upper()}.value" for n in inputs) or "0",
-            "watched": ", ".join(f"&inst.{n.upper()}.value" for n in watched),
+            "watched": ", ".join(f"&inst.{field(n)}" for n in watched),
             "n_watched": len(watched),
             "numbers": ", ".join(f"&inst.{n.upper()}.value" for n in numbers) or "0",
             "n_numbers": len(numbers),

@@ -49,10 +49,26 @@ def test_a_conditional_action_is_reset_when_its_step_is_left():
 def test_names_differing_in_case_only_are_renamed_in_the_sfc():
     g = load_grafcet(ROOT / "tests/data/codegen/case_clash.g7")
     xml = sfc_project_xml(g, version="test").decode()
-    assert re.findall(r'<variable name="(\w+)">', xml) == ["go", "a", "b", "A_1", "B_1", "C", "_RE_go"]
+    assert re.findall(r'<variable name="(\w+)">', xml) == ["go", "a", "b", "_RE_go", "A_1", "B_1", "C"]
     assert "<Comment>renamed (Structured Text ignores case): A -&gt; A_1, B -&gt; B_1</Comment>" in xml
     back = import_sfc(xml.encode(), "case_clash.xml")
     assert "outputs A_1, B_1, C\n" in back and "  step 1: A_1\n" in back
+
+
+def test_an_edge_is_an_input_the_caller_sets_and_reads_back_as_the_edge():
+    """``↑b`` is the input ``_RE_b`` (an SFC cannot compute it before its transitions), with the
+    caller's rule in its documentation; synth import reads it back as ``↑b``, not as an input."""
+    g = load_grafcet(ROOT / "grafcets/timers.g7")
+    xml = sfc_project_xml(g, version="test").decode()
+    inputs = re.search(r"<inputVars>(.*?)</inputVars>", xml, re.S)
+    assert inputs is not None and re.findall(r'<variable name="(\w+)">', inputs[1]) == ["start", "ok", "_RE_start",
+                                                                                       "_FE_start"]
+    assert "<localVars>" not in xml
+    assert ("falling edge of start, set by the caller before each scan: NOT start AND start_previous "
+            "(start_previous: start at the previous scan, start itself at the first scan: no edge then)") in xml
+    back = import_sfc(xml.encode(), "timers.xml")
+    assert back.splitlines()[1:3] == ["inputs start, ok", "outputs HEAT, ALARM"]
+    assert "  transition 0 -> 1 when ↑start\n" in back and "  transition 2 -> 0 when ↓start\n" in back
 
 
 needs_beremiz = pytest.mark.skipif(find_beremiz() is None or find_iec2c() is None,
@@ -147,14 +163,32 @@ grafcet G {
 
 def test_a_shared_order_is_one_or_of_per_step_flags_and_reads_back():
     """RUN emitted by steps 1 and 2: each step drives its own flag, an S action on the initial
-    step writes RUN as their OR at every scan; the import reads the .g7 back."""
+    step (and on the steps the first scan reaches) writes RUN as their OR at every scan; the
+    import reads the .g7 back."""
     g = parse_grafcet(SHARED, "shared.g7")
     xml = sfc_project_xml(g, version="test").decode()
     assert xml.count('<variable name="_N_RUN_S1">') == 1 and xml.count('<variable name="_N_RUN_S2">') == 1
     assert "RUN := _N_RUN_S1 OR _N_RUN_S2;" in xml and '<reference name="_N_RUN_S1"/>' in xml
-    assert "_N_RUN_S2 := c;" in xml and "_N_RUN_S2 := FALSE;" in xml
+    assert "_N_RUN_S2 := c; RUN := _N_RUN_S1 OR _N_RUN_S2;" in xml  # the OR again, after the flag
+    assert "_N_RUN_S2 := FALSE; RUN := _N_RUN_S1 OR _N_RUN_S2;" in xml
+    # the S action writing RUN on the initial step 0 and on steps 1 and 2, which the first scan reaches
+    assert xml.count('qualifier="S"') == 3
     back = import_sfc(xml.encode(), "shared.xml")
     assert "  step 1: RUN\n  step 2: RUN if c\n" in back and back.splitlines()[2] == "outputs RUN"
+
+
+def test_the_shared_or_on_a_step_the_first_scan_reaches_is_read_only_as_a_copy_of_the_initial_one():
+    """Without the initial step's S action, the one on step 1 runs only once step 1 is reached."""
+    from synth.errors import InputError
+
+    xml = sfc_project_xml(parse_grafcet(SHARED, "shared.g7"), version="test").decode()
+    alone = re.sub(r'<action localId="\d+" qualifier="S">.*?</action>', "", xml, count=1, flags=re.S)
+    assert alone.count('qualifier="S"') == 2
+    with pytest.raises(InputError) as err:
+        import_sfc(alone.encode(), "shared.xml")
+    assert str(err.value).splitlines()[0] == (
+        "shared.xml:93:13: error: the order RUN written as _N_RUN_S1 OR _N_RUN_S2 by an S action of step 1, which "
+        "is not initial: that action runs only once the step is reached")
 
 
 @needs_beremiz

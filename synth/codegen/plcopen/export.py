@@ -16,7 +16,7 @@ Mapping (:mod:`synth.codegen.plcopen.importer` reads it back):
 step ``12`` / ``wait``                  ``<step name="S12">`` / ``name="wait"``
 ``X12``                                 ``S12.X``
 ``2s/X12``                              ``(S12.T >= T#2s)`` (the TIME literal of ``synth st``)
-``↑x`` / ``↓x``                         ``_RE_x`` / ``_FE_x`` (edge flags, see docs/codegen.md)
+``↑x`` / ``↓x``                         inputs ``_RE_x`` / ``_FE_x`` (set by the caller, see docs/codegen.md)
 ``A`` (continuous)                      qualifier ``N``, reference ``A``
 ``A if c``                              qualifier ``N``, inline ST ``A := c;``, and ``P0``,
                                         inline ST ``A := FALSE;`` (reset when the step is left)
@@ -215,7 +215,7 @@ def sfc_project_xml(g: Grafcet, *, name: str | None = None, version: str | None 
         return trans_id[i], None
 
     shared = shared_orders(g)
-    carrier = next(s.name for s in g.steps if s.initial) if shared else None
+    carriers = first_scan_steps(g) if shared else set()
     body = element("SFC")
     column: dict[str, int] = {p.name: k for k, p in enumerate(g.grafcets)}
     row: dict[str, int] = {}
@@ -231,7 +231,7 @@ def sfc_project_xml(g: Grafcet, *, name: str | None = None, version: str | None 
         elif incoming[s.name]:
             el.append(_conn_in(producer_of_transition(incoming[s.name][0], s.name)))
         el.append(element("connectionPointOut", {"formalParameter": ""}))
-        if s.actions or s.name == carrier:
+        if s.actions or s.name in carriers:
             el.append(element("connectionPointOutAction", {"formalParameter": ""}))
         data = element("data", {"name": SYNTH_DATA, "handleUnknown": "discard"}, element("grafcet", {"name": s.grafcet}))
         el.append(element("addData", None, data))
@@ -246,14 +246,15 @@ def sfc_project_xml(g: Grafcet, *, name: str | None = None, version: str | None 
             for k in range(len(outgoing[s.name])):
                 div.append(element("connectionPointOut", {"formalParameter": str(k)}))
             body.append(div)
-        if s.actions or s.name == carrier:
+        if s.actions or s.name in carriers:
             block = element("actionBlock", {"localId": str(ids())}, position(x + 120, y), _conn_in((step_id[s.name], None)))
             for k, a in enumerate(s.actions):
                 own = a.order in shared and a.kind in (CONTINUOUS, CONDITIONAL)
-                block.extend(_actions(a, ids, k, names, shared_flag(names(a.order), s.name) if own else None))
-            if s.name == carrier:
+                block.extend(_actions(a, ids, k, names, (shared_flag(names(a.order), s.name),
+                                                         _shared_or(a.order, shared[a.order], names)) if own else None))
+            if s.name in carriers:
                 for k, (order, emitters) in enumerate(shared.items(), len(s.actions)):
-                    text = f"{names(order)} := " + " OR ".join(shared_flag(names(order), e) for e in emitters) + ";"
+                    text = _shared_or(order, emitters, names)
                     block.append(element("action", {"localId": str(ids()), "qualifier": Qualifier.S},
                                          position(0, 30 * k, "relPosition"),
                                          element("inline", None, element("ST", None, xhtml(text)))))
@@ -285,12 +286,14 @@ def sfc_project_xml(g: Grafcet, *, name: str | None = None, version: str | None 
             body.append(div)
     pou_name = name or program_name(g.path)
     iface = element("interface")
+    edges = sorted({(n.rising, n.name) for x in g.expressions() for n in expr_names(x) if isinstance(n, Edge)}, key=lambda e: (e[1], not e[0]))
     for key, declared in (("inputVars", g.inputs), ("outputVars", g.outputs)):
         vl = element(key)
         for n in declared:
             vl.append(element("variable", {"name": names(n)}, element("type", None, element("BOOL"))))
+        if key == "inputVars":
+            vl.extend(_edge_input(rising, n, names) for rising, n in edges)
         iface.append(vl)
-    edges = sorted({(n.rising, n.name) for x in g.expressions() for n in expr_names(x) if isinstance(n, Edge)}, key=lambda e: (e[1], not e[0]))
     if g.internals:
         vl = element("localVars")
         for d in internal_declarations(g, names)[:len(g.internals)]:
@@ -305,18 +308,23 @@ def sfc_project_xml(g: Grafcet, *, name: str | None = None, version: str | None 
                 vl.append(element("variable", {"name": shared_flag(names(order), e)}, element("type", None, element("BOOL")),
                                   element("documentation", None, xhtml(f"{order} as step {e} emits it", cdata=False))))
         iface.append(vl)
-    if edges:
-        vl = element("localVars")
-        for rising, n in edges:
-            v = element("variable", {"name": ("_RE_" if rising else "_FE_") + names(n)}, element("type", None, element("BOOL")),
-                   element("documentation", None, xhtml(f"{'rising' if rising else 'falling'} edge of {n}, computed "
-                                                    "by the caller each cycle (R_TRIG/F_TRIG)", cdata=False)))
-            vl.append(v)
-        iface.append(vl)
     pou = element("pou", {"name": pou_name, "pouType": "program"}, iface, element("body", None, body))
     if names.alias:
         comment = "\n".join(c for c in (comment, renamed_note(names.alias)) if c)
     return project(pou_name, version or synth_version(), comment, [pou])
+
+
+def _edge_input(rising: bool, n: str, names: _Names) -> Any:
+    """The input ``_RE_x`` (``_FE_x``) a receptivity ``↑x`` (``↓x``) reads: an SFC has no place
+    before its transitions where the program could compute it (MATIEC runs the action bodies
+    after the transitions, so an edge computed in an action is seen one scan late), so the
+    caller computes it before each scan, from ``x`` and its value at the previous scan."""
+    x = names(n)
+    rule = f"{x} AND NOT {x}_previous" if rising else f"NOT {x} AND {x}_previous"
+    doc = (f"{'rising' if rising else 'falling'} edge of {x}, set by the caller before each scan: {rule} "
+           f"({x}_previous: {x} at the previous scan, {x} itself at the first scan: no edge then)")
+    return element("variable", {"name": ("_RE_" if rising else "_FE_") + x}, element("type", None, element("BOOL")),
+                   element("documentation", None, xhtml(doc, cdata=False)))
 
 
 def shared_flag(order: str, step: str) -> str:
@@ -335,8 +343,9 @@ def shared_orders(g: Grafcet) -> dict[str, list[str]]:
     MATIEC (Beremiz, OpenPLC) resets an ``N`` action's variable when one of its steps is left
     even while another keeps it (measured: the order off for one scan), so each emitting step
     drives a flag of its own (:func:`shared_flag`, with the action it has in the ``.g7``) and
-    an ``S`` action on an initial step, run at every scan from the first one (as Beremiz runs
-    its function blocks), writes the order as the OR of the flags."""
+    an ``S`` action on the initial steps (and the steps the first scan reaches,
+    :func:`first_scan_steps`), run at every scan from the first one (as Beremiz runs its
+    function blocks), writes the order as the OR of the flags."""
     emitters: dict[str, list[str]] = {}
     stored: set[str] = set()
     for s in g.steps:
@@ -350,13 +359,32 @@ def shared_orders(g: Grafcet) -> dict[str, list[str]]:
     return {o: steps for o, steps in emitters.items() if len(steps) > 1 and o not in stored}
 
 
-def _actions(a: Action, ids: _Ids, k: int, names: _Names, flag: str | None = None) -> list[Any]:
+def first_scan_steps(g: Grafcet) -> set[str]:
+    """The steps that can be active after the first scan: the initial steps and the targets of
+    the transitions from initial steps only. Each carries the ``S`` action writing the shared
+    orders: MATIEC sets an ``S`` action only while its step is active after the scan's
+    evolution, so on an initial step alone the OR would never run once that step is left at
+    the first scan (measured); whichever of them is active starts it, and it then runs at
+    every scan."""
+    initial = {s.name for s in g.steps if s.initial}
+    return initial | {x for t in g.transitions if t.sources and set(t.sources) <= initial for x in t.targets}
+
+
+def _shared_or(order: str, emitters: Sequence[str], names: _Names) -> str:
+    """The statement writing a shared order as the OR of its steps' flags."""
+    return f"{names(order)} := " + " OR ".join(shared_flag(names(order), e) for e in emitters) + ";"
+
+
+def _actions(a: Action, ids: _Ids, k: int, names: _Names, flag: tuple[str, str] | None = None) -> list[Any]:
     """The SFC action(s) of one ``.g7`` action, with its IEC 61131-3 meaning: ``A if c`` is an
     ST body under ``N`` (run while the step is active) and a ``P0`` body ``A := FALSE;`` (run
     once when it is left), since a PLC does not run an action body again after its step is
     left (MATIEC, hence Beremiz and OpenPLC, run it only while the action is active).
-    ``flag``: the step's own flag of a shared order, written instead of the order."""
-    order = flag or names(a.order)
+    ``flag``: the step's own flag of a shared order, written instead of the order, and the
+    statement writing the order from the flags, which an inline body repeats after its flag
+    (MATIEC runs the bodies one after the other, the initial step's first: the OR there would
+    read this flag as the previous scan left it)."""
+    order, again = (flag[0], " " + flag[1]) if flag else (names(a.order), "")
 
     def new(qualifier: Qualifier, body: Any, row: int = 0) -> Any:
         el = element("action", {"localId": str(ids()), "qualifier": qualifier})
@@ -377,8 +405,8 @@ def _actions(a: Action, ids: _Ids, k: int, names: _Names, flag: str | None = Non
         return [new(Qualifier.N, element("reference", {"name": order}))]
     if a.kind == CONDITIONAL:
         assert a.condition is not None
-        return [new(Qualifier.N, st(f"{order} := {_sfc_expr(a.condition, names)};")),
-                new(Qualifier.P0, st(f"{order} := FALSE;"), 1)]
+        return [new(Qualifier.N, st(f"{order} := {_sfc_expr(a.condition, names)};{again}")),
+                new(Qualifier.P0, st(f"{order} := FALSE;{again}"), 1)]
     if a.when == ON_ACTIVATION:
         return [new(Qualifier.S if a.value else Qualifier.R, element("reference", {"name": order}))]
     if a.when == ON_DEACTIVATION:

@@ -42,7 +42,7 @@ from synth.codegen.plcopen.data import DATA, duration
 from synth.codegen.plcopen.instances import separate_instances
 from synth.codegen.plcopen.project import NAMESPACES, PouSummary, body_language, list_pous, pous_of, read_project
 from synth.codegen.plcopen.sfc import Chart, Source, read_chart
-from synth.codegen.plcopen.shared import MARK, merge_shared, shared_assignment
+from synth.codegen.plcopen.shared import MARK, merge_shared, shared_assignment, without_shared_or
 from synth.codegen.plcopen.timers import prepare_scope
 from synth.codegen.plcopen.vendor import IecQualifier
 from synth.codegen.plcopen.tc6 import Qualifier
@@ -312,7 +312,7 @@ def _one_action(a: Any, src: Source, steps: dict[str, str], q: Any, qualifier: s
     if inline is None or inline.find(q("ST")) is None:
         raise InputError("an action without a reference or an inline ST body", src.at(a))
     st = inline.find(q("ST"))
-    body = st_text(st).strip()
+    body = without_shared_or(st_text(st).strip())
     where = lambda off, w, h=st, t=st_text(st): src.text_at(h, t, off, w)  # noqa: E731
     m = re.fullmatch(r"(\w+)\s*:=\s*(TRUE|FALSE|1|0)\s*;?", body, re.I)  # 1, 0: BOOL literals
     scope = DATA.get()

@@ -192,6 +192,8 @@ def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
     pou_actions = {str(x.get("name")): x for x in pou.iterfind(f"{q('actions')}/{q('action')}")}
     inputs = [v.get("name") for v in pou.iterfind(f"{q('interface')}/{q('inputVars')}/{q('variable')}")
               if v.find(f"{q('type')}/{q('derived')}") is None]  # a block instance is no Boolean input
+    # synth sfc's edge inputs _RE_x/_FE_x (set by the caller) are the edges ↑x/↓x of the input x
+    inputs = [n for n in inputs if not (n[:4] in ("_RE_", "_FE_") and n[4:] in inputs)]
     outputs = [v.get("name") for v in pou.iterfind(f"{q('interface')}/{q('outputVars')}/{q('variable')}")]
     named_conditions: dict[str, tuple[Any, str]] = {}
     named_fbd: dict[str, tuple[Any, Any]] = {}

@@ -21,7 +21,7 @@ from synth.codegen.plcopen.data import FLAG_PREFIX
 from synth.codegen.plcopen.sfc import Chart
 from synth.errors import InputError, Location
 
-__all__ = ["MARK", "shared_assignment", "merge_shared"]
+__all__ = ["MARK", "shared_assignment", "without_shared_or", "merge_shared"]
 
 MARK = "\x00shared "
 """How an action string carries a shared order until :func:`merge_shared` distributes it."""
@@ -36,15 +36,30 @@ def shared_assignment(body: str) -> tuple[str, list[str]] | None:
     return (m[1], flags) if all(f.startswith(FLAG_PREFIX) for f in flags) else None
 
 
+def without_shared_or(body: str) -> str:
+    """``body`` without its last statement when that one writes a shared order from its flags
+    (a flag's body repeats it, see :func:`synth.codegen.plcopen.export.shared_orders`).
+
+    >>> without_shared_or("_N_RUN_S2 := c; RUN := _N_RUN_S1 OR _N_RUN_S2;")
+    '_N_RUN_S2 := c;'
+    """
+    parts = [x for x in body.split(";") if x.strip()]
+    if len(parts) > 1 and shared_assignment(parts[-1]) is not None:
+        return ";".join(parts[:-1]).strip() + ";"
+    return body
+
+
 def merge_shared(chart: Chart, at: Callable[[Any], Location]) -> None:
-    """Each marked action of ``chart`` (on an initial step, else a located error) distributed:
+    """Each marked action of ``chart`` (on an initial step, or a copy of one on another step,
+    else a located error) distributed:
     the steps' actions on its flags become actions on the order."""
     renames: dict[str, str] = {}
+    on_initial = {a for st in chart.steps if st.initial for a in st.actions if a.startswith(MARK)}
     for st in chart.steps:
         for action in [a for a in st.actions if a.startswith(MARK)]:
             st.actions.remove(action)
             order, flags = action[len(MARK):].split(" := ", 1)
-            if not st.initial:
+            if not st.initial and action not in on_initial:  # else: a copy that starts it (first_scan_steps)
                 raise InputError(f"the order {order} written as {flags.replace(' ', ' OR ')} by an S action of step "
                                  f"{st.name}, which is not initial: that action runs only once the step is reached",
                                  at(st.el))
