@@ -335,7 +335,7 @@ class SymbolicSync(SyncGraph):
             machine = self.machine
             enabled = machine.awaited(sit)
             has_edges = any(isinstance(n, ExprEdge) for t in enabled for n in names(t.receptivity))
-            has_events = any(machine._event_inputs[st] or any(getattr(a, "when", None) == ON_EVENT for a in machine.grafcet.step(st).actions)
+            has_events = any(machine.event_inputs(st) or any(getattr(a, "when", None) == ON_EVENT for a in machine.grafcet.step(st).actions)
                              for st in sit.steps)
             if has_edges or has_events:
                 hit = frozenset()
