@@ -9,7 +9,7 @@ handle all the situations of a level at once. Same semantics as :mod:`synth.symb
 
 - *regions*: an element's region moves depend on the orders emitted for it, which are a
   function of X; per element and set of its own orders (a few), the closure of its region
-  moves is computed once (``SymbolicSync._element_region``) and selected by the step
+  moves is computed once (:class:`~synth.symbolic.regions.ElementRegions`) and selected by the step
   variables: ``closure(X, x, x')`` is the product over the elements; ``settled`` states
   have no region move left;
 - *exploration*: from the frontier F(X, x), each uncontrollable move gives entries
@@ -45,10 +45,11 @@ from synth.logic.events import Event
 from synth.plant.composition import Plant
 from synth.plant.rules import Constraint
 from synth.symbolic.encoding import Copy, NodeBudget, live_nodes
+from synth.symbolic.numbering import SituationIndex
+from synth.symbolic.regions import ElementRegions
 from synth.symbolic.relation import Move, flipped, image
 from synth.symbolic.steps.encoding import StepEncoding, Unsupported, anchors, unsupported
 from synth.symbolic.supervisor import SymbolicSupervisor
-from synth.symbolic.situations.sync import SymbolicSync
 
 __all__ = ["StepSync", "step_sync", "MAX_OWN_ORDERS"]
 
@@ -68,7 +69,8 @@ class StepSync:
         self.plant: Plant = sup.plant
         self.machine = machine
         self.steps = StepEncoding(machine, sup.enc)
-        self.helper = SymbolicSync(sup, machine)  # its per-element region closures, cached
+        self.closures = ElementRegions(sup)  # per element: region moves and closures, cached
+        self.helper = SituationIndex(self.plant, machine)  # the situations as the searches name them
         self.progress = progress
         self.false: Function = self.engine.false
         self.true: Function = self.engine.true
@@ -102,11 +104,11 @@ class StepSync:
         entry set); ``moving(X, x)``: a region move is left; ``refused(X, x)``: SUP
         refuses a move towards an order emitted there (a prohibited order)."""
         emitted = self.steps.orders()
-        helper = self.helper
+        regions = self.closures
         closure: Function | None = self.true
         moving, refused = self.false, self.false
         for axis in range(self.plant.ndim):
-            own_all = sorted(helper._orders_of[axis])
+            own_all = sorted(regions.orders_of[axis])
             if len(own_all) > MAX_OWN_ORDERS:
                 raise Unsupported(f"an element with more than {MAX_OWN_ORDERS} orders")
             piece = moves = self.false
@@ -116,12 +118,11 @@ class StepSync:
                 select = self.engine.conjunction(w if o in own else ~w for o, w in wanted.items())
                 if select == self.false:
                     continue
-                rel, can, bad = helper._element_intra(axis, own)
-                others = helper._other_orders[axis]
-                if rel != self.false and any(n in others for n in self.engine.support(rel)):
+                rel, can, bad = regions.intra(axis, own)
+                if regions.reads_others(axis, rel):
                     closure = None
                 if closure is not None:
-                    piece |= select & helper._element_region(axis, rel)
+                    piece |= select & regions.closure(axis, rel)
                 moves |= select & rel
                 moving |= select & can
                 for event, b in bad.items():
@@ -136,7 +137,7 @@ class StepSync:
         """The pairs (X, n, x') of ``entries`` (X, n) and the states x' their region
         reaches (forward over the region moves, element by element), without a
         precomputed closure."""
-        reach = frontier = entries & self.helper.equal
+        reach = frontier = entries & self.closures.equal
         while frontier != self.false:
             new = self.false  # an element's move: its next copy quantified, its auxiliary copy set
             for axis, moves in enumerate(self.region_moves):
