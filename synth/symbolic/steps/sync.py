@@ -92,8 +92,10 @@ class StepSync:
         self._inputs = frozenset(n for n in machine.inputs if n in self.plant.owner)
         self._moves = tuple(m for m in sup.moves if not m.controllable)
         e = self.engine
-        self._current = [e.declare(v) for v in self.enc.variables] + self.steps.names(Copy.CURRENT)
-        self._next = [e.declare(v + Copy.NEXT.value) for v in self.enc.variables] + self.steps.names(Copy.NEXT)
+        self.current_vars: list[str] = [e.declare(v) for v in self.enc.variables] + self.steps.names(Copy.CURRENT)
+        """A node's variables: the plant's and the steps' current copies."""
+        self.next_vars: list[str] = [e.declare(v + Copy.NEXT.value) for v in self.enc.variables] + self.steps.names(Copy.NEXT)
+        """Their next copies (an edge's target)."""
         self.closure, self.moving, self.refused = self._regions()
 
     # ---- regions
@@ -204,7 +206,7 @@ class StepSync:
         self.reacted = {}
         self._reactions = {}
         self.pairs = self.false
-        self.edge_count = sum(self.count(e, self._current + self._next) for _, e in self.edges)
+        self.edge_count = sum(self.count(e, self.current_vars + self.next_vars) for _, e in self.edges)
         by_axis: dict[int, tuple[Function, Function]] = {}  # per element: where its edges end, their union
         for m, e in self.edges:
             end, rel = by_axis.get(m.axis, (self.false, self.false))
@@ -226,11 +228,11 @@ class StepSync:
 
     @property
     def sync_states(self) -> int:
-        return self.count(self.members, self._current)
+        return self.count(self.members, self.current_vars)
 
     @property
     def aggregated_states(self) -> int:
-        return self.count(self.nodes, self._current)
+        return self.count(self.nodes, self.current_vars)
 
     @property
     def situations(self) -> int:
@@ -241,7 +243,7 @@ class StepSync:
         return frozenset(s for s in self.steps.steps if (self.nodes & self.steps.var(s)) != self.false)
 
     # ---- fixpoints
-    def _primed(self, u: Function) -> Function:
+    def primed(self, u: Function) -> Function:
         """``u`` from the current copies (plant and steps) to the next ones."""
         return self._rename(u, Copy.CURRENT, Copy.NEXT)
 
@@ -261,12 +263,12 @@ class StepSync:
         """Nodes (of ``within``, default all) with an edge (of ``edges``, default all) into
         ``u``. An edge of a move ends where its flipped variable has its new value (region
         moves flip orders only): the others are skipped without a relational product."""
-        target = self._primed(u)
+        target = self.primed(u)
         out = self.false
         arcs = self.links if edges is None else [(m.after, e) for m, e in edges]
         for end, e in arcs:
             if (u & end) != self.false:
-                found = self.engine.and_exists(e, target, self._next)
+                found = self.engine.and_exists(e, target, self.next_vars)
                 out |= found if within is None else found & within
         return out
 
@@ -274,7 +276,7 @@ class StepSync:
         """Targets of the edges ``e`` of move ``m`` from ``u``, in the next copies."""
         if (u & m.guard) == self.false:
             return self.false
-        return self.engine.and_exists(e, u, self._current)
+        return self.engine.and_exists(e, u, self.current_vars)
 
     def unprimed(self, u: Function) -> Function:
         """``u`` from the next copies (plant and steps) to the current ones."""
@@ -286,10 +288,6 @@ class StepSync:
         for m, e in (self.edges if edges is None else edges):
             out |= self.image(u, m, e)
         return self.unprimed(out)
-
-    @property
-    def _edge_relations(self) -> list[Function]:
-        return [e for _, e in self.edges]
 
     def backward(self, targets: Function, within: Function | None = None) -> Function:
         """Nodes from which ``targets`` can be reached (targets included; only through
