@@ -66,9 +66,16 @@ class Path:
 class Numbered(Protocol):
     """The stable situations met, numbered as the nodes ``(situation, plant state)`` name them."""
 
-    plant: Plant
-    machine: GrafcetMachine
-    situations: list[Situation]
+    @property
+    def plant(self) -> Plant: ...
+
+    @property
+    def machine(self) -> GrafcetMachine: ...
+
+    @property
+    def situations(self) -> list[Situation]:
+        """The situations by index."""
+        ...
 
     def situation(self, sit: Situation) -> int:
         """The index of ``sit`` (numbered when first asked for, where the representation allows it)."""
@@ -78,7 +85,10 @@ class Numbered(Protocol):
 class SymbolicGraph(Protocol[S, M]):
     """An explored symbolic SYNC: sets ``S`` of aggregated nodes and moves ``M`` (see the module docstring)."""
 
-    numbering: Numbered
+    @property
+    def numbering(self) -> Numbered:
+        """The situations' numbering the nodes' keys use."""
+        ...
 
     # ---- node-set algebra
     @property

@@ -56,7 +56,7 @@ class ElementRegions:
             for a in range(p.ndim))
         """Per element, the other elements' orders in the next copy (what a region move must not read)."""
         self._controllable = tuple(tuple(m for m in sup.moves if m.controllable and m.axis == a) for a in range(p.ndim))
-        self._moves: dict[tuple[int, int], tuple[Function, Function, Function]] = {}
+        self._moves: dict[int, tuple[Function, Function, Function]] = {}
         self._intras: dict[tuple[int, frozenset[str]], Intra] = {}
         self._eq: Function | None = None
 
