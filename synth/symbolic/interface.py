@@ -20,16 +20,10 @@ recipe "explored SYNC → :class:`~synth.validation.result.Validation`"
 
 Example
 -------
->>> from synth.plant.composition import _plants
->>> from synth.validation.result import load_model
->>> from synth.grafcet.machine import GrafcetMachine
->>> from synth.symbolic.situations.reach import SituationReach
->>> from synth.symbolic.situations.sync import symbolic_sync
->>> rs, p, g = load_model(_plants("../tests/data/home/no_restart.g7"), _plants("../tests/data/home/cylinder.rules"))
->>> graph: SymbolicGraph = SituationReach(symbolic_sync(p, rs.constraints, GrafcetMachine(g)))
->>> key = graph.pick(graph.initial)
->>> key, graph.count(graph.cube(key)), graph.contains(graph.initial, key)
-((0, (0, 4)), 1, True)
+>>> from synth.logic.events import Event
+>>> path = Path(((0, (0, 4)), (1, (1, 4))), (Event.rise("dcy"),))  # node (situation 0, state (0, 4)) --↑dcy--> …
+>>> len(path.nodes) == len(path.events) + 1
+True
 """
 
 from __future__ import annotations
@@ -67,10 +61,14 @@ class Numbered(Protocol):
     """The stable situations met, numbered as the nodes ``(situation, plant state)`` name them."""
 
     @property
-    def plant(self) -> Plant: ...
+    def plant(self) -> Plant:
+        """The plant whose states the nodes hold."""
+        ...
 
     @property
-    def machine(self) -> GrafcetMachine: ...
+    def machine(self) -> GrafcetMachine:
+        """The Grafcet's machine (the situations' reading of IEC 60848)."""
+        ...
 
     @property
     def situations(self) -> list[Situation]:

@@ -34,8 +34,7 @@ class SituationIndex:
 
     def situation(self, sit: Situation) -> int:
         """The index of ``sit`` (a new one the first time it is asked for)."""
-        i = self._index.get(sit)
-        if i is None:
-            i = self._index[sit] = len(self.situations)
+        if sit not in self._index:
+            self._index[sit] = len(self.situations)
             self.situations.append(sit)
-        return i
+        return self._index[sit]

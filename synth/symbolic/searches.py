@@ -25,17 +25,7 @@ step path batches the same searches (:mod:`synth.symbolic.steps.batch`, checked 
 
 Example
 -------
->>> from synth.plant.composition import _plants
->>> from synth.validation.result import load_model
->>> from synth.grafcet.machine import GrafcetMachine
->>> from synth.symbolic.steps.reach import StepReach
->>> from synth.symbolic.steps.sync import step_sync
->>> rs, p, g = load_model(_plants("../tests/data/home/no_restart.g7"), _plants("../tests/data/home/cylinder.rules"))
->>> r = StepReach(step_sync(p, rs.constraints, GrafcetMachine(g)))
->>> [c] = terminal_components(r, r.minus(r.reached, r.backward(r.initial)))
->>> key, depth, path = first_node(r, c)
->>> depth, [str(e) for e in shortest_trace(r, key).events]
-(3, ['↑dcy', '↓v0', '↑v1'])
+>>> # tests/test_symbolic_interface.py runs them on both representations against the explicit SYNC
 """
 
 from __future__ import annotations

@@ -14,18 +14,9 @@ the JSON are the explicit engine's.
 Example
 -------
 >>> from synth.plant.composition import _plants
->>> from synth.validation.result import load_model
->>> from synth.grafcet.machine import GrafcetMachine
->>> from synth.sup.constraints import CompiledConstraints
->>> from synth.symbolic.searches import OneByOne
->>> from synth.symbolic.situations.reach import SituationReach
->>> from synth.symbolic.situations.sync import symbolic_sync
->>> rs, p, g = load_model(_plants("../tests/data/home/no_restart.g7"), _plants("../tests/data/home/cylinder.rules"))
->>> machine = GrafcetMachine(g)
->>> r = SituationReach(symbolic_sync(p, rs.constraints, machine))
->>> model = Model(rs, p, g, machine, CompiledConstraints(p, rs.constraints))
->>> v = validation_of(r, OneByOne(r), model, expert=False, homes=(), engine_stats=lambda: {})
->>> v.passed, len(v.analysis.blocking), v.stats["aggregated_states"]
+>>> from synth.symbolic.validate import validate_symbolic
+>>> v = validate_symbolic(_plants("../tests/data/home/no_restart.g7"), _plants("../tests/data/home/cylinder.rules"))
+>>> v.passed, len(v.analysis.blocking), v.stats["aggregated_states"]  # the step path, through validation_of
 (False, 1, 7)
 """
 

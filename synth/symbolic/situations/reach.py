@@ -10,15 +10,7 @@ whole SYNC or node by node, and the prohibited orders per situation.
 
 Example
 -------
->>> from synth.plant.composition import _plants
->>> from synth.validation.result import load_model
->>> from synth.grafcet.machine import GrafcetMachine
->>> from synth.symbolic.situations.sync import symbolic_sync
->>> rs, p, g = load_model(_plants("../tests/data/home/no_restart.g7"), _plants("../tests/data/home/cylinder.rules"))
->>> r = SituationReach(symbolic_sync(p, rs.constraints, GrafcetMachine(g)))
->>> stuck = r.minus(r.reached, r.backward(r.initial))
->>> r.count(stuck), r.listed(r.held(), 10)
-(6, [(0, (0, 8)), (0, (1, 8))])
+>>> # tests/test_symbolic_interface.py checks every set against the explicit SYNC
 """
 
 from __future__ import annotations

@@ -57,6 +57,8 @@ class StepReach:
         self.s = s
         self.false = s.false
         self.numbering = s.helper
+        self.initial: Function = s.initial  # the graph is explored: its sets no longer change
+        self.reached: Function = s.nodes
         self.situations: list[Situation] = s.helper.situations  # the explicit nodes' numbering
         self._cubes: dict[Key, Function] = {}
         self._primed: tuple[Function, Function] | None = None  # the last set renamed to the next copies
@@ -87,14 +89,6 @@ class StepReach:
         return self.s.count(a, self.s.current_vars)
 
     # ---- the explored graph
-    @property
-    def initial(self) -> Function:
-        return self.s.initial
-
-    @property
-    def reached(self) -> Function:
-        return self.s.nodes
-
     def rings(self) -> Sequence[Function]:
         return self.s.rings
 

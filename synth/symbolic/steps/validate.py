@@ -16,11 +16,8 @@ Example
 -------
 >>> from synth.plant.composition import _plants
 >>> from synth.validation.result import load_model
->>> from synth.grafcet.machine import GrafcetMachine
->>> from synth.sup.constraints import CompiledConstraints
->>> from synth.symbolic.steps.encoding import anchors
->>> from synth.symbolic.supervisor import SymbolicSupervisor
 >>> rs, p, g = load_model(_plants("../tests/data/home/no_restart.g7"), _plants("../tests/data/home/cylinder.rules"))
+>>> from synth.symbolic.steps.encoding import anchors
 >>> m = GrafcetMachine(g)
 >>> sup = SymbolicSupervisor(p, rs.constraints, anchored=anchors(m, p))
 >>> v = validate_steps(rs, p, g, sup, m, CompiledConstraints(p, rs.constraints))
