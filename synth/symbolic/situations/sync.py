@@ -203,10 +203,6 @@ class SymbolicSync(SyncGraph):
         members = self.post_pairs(self.true, reach)
         return reach & ~self.enc.rename(progress, Copy.CURRENT, Copy.NEXT), members, members & ~progress
 
-    def post_pairs(self, sources: Function, pairs: Function) -> Function:
-        """The x' of the pairs ``(x, x')`` whose x is in ``sources``, as current states."""
-        return self.enc.rename(self.enc.and_exists(sources, pairs, Copy.CURRENT), Copy.NEXT, Copy.CURRENT)
-
     def enter(self, s: int, entries: Function) -> Function:
         """Enter situation ``s`` at ``entries``; returns the settled states not seen before."""
         reg = self.regions[s]
