@@ -128,17 +128,15 @@ def greedy(g: SymbolicGraph[S, M], steps: list[S], order: Callable[[M], Order],
         walk.ranks.append(rank)
     walk.chosen.append(current)
     for k in range(1, len(steps)):
-        options: dict[Order, tuple[list[M], S]] = {}
+        options: dict[Order, tuple[list[M], list[S]]] = {}
         for m in g.moves_from(current):
             v = g.post_by(current, m, steps[k])
-            if g.is_empty(v):
-                continue
-            key = order(m)
-            taken, nxt = options.get(key, ([], g.empty))
-            taken.append(m)
-            options[key] = (taken, g.union(nxt, v))
+            if not g.is_empty(v):
+                taken, reached = options.setdefault(order(m), ([], []))
+                taken.append(m)
+                reached.append(v)
         best = min(options)
-        taken, current = options[best]
+        taken, current = options[best][0], g.join(options[best][1])
         if settled is not None:
             current, rank = first_of(g, current, (g.pick(walk.chosen[-1]), taken), settled)
             walk.ranks.append(rank)
@@ -159,13 +157,9 @@ def first_of(g: SymbolicGraph[S, M], u: S, via: tuple[Key, Sequence[M]] | None, 
     else:
         parent, moves = via
         source = g.cube(parent)
-        entered, leaving = g.empty, None
-        for m in moves:
-            v = g.post_by(source, m)
-            if not g.is_empty(v):
-                entered = g.union(entered, v)
-                leaving = m if leaving is None else leaving
-        arc = moves[0] if leaving is None else leaving
+        leaving = [(m, v) for m in moves if not g.is_empty(v := g.post_by(source, m))]
+        entered = g.join(v for _, v in leaving)
+        arc = leaving[0][0] if leaving else moves[0]
         event, move = g.event(arc), g.plant_move(arc)
     if g.count(entered) == 1:
         return u, 0
@@ -198,9 +192,7 @@ def shortest_trace(g: SymbolicGraph[S, M], key: Key) -> Path:
     nodes = [key]  # one concrete node per ring, backwards from the target
     for k in range(depth - 1, -1, -1):
         target = g.cube(nodes[-1])
-        before = g.empty
-        for m in walk.taken[k]:
-            before = g.union(before, g.pre_by(target, m))
+        before = g.join(g.pre_by(target, m) for m in walk.taken[k])
         nodes.append(g.pick(g.meet(before, walk.chosen[k])))
     nodes.reverse()
     return Path(tuple(nodes), tuple(walk.keys))

@@ -79,10 +79,7 @@ def empty_validation(model: Model, *, expert: bool, homes: Sequence[str], sup_em
 def home_nodes(g: SymbolicGraph[S, M], texts: Sequence[str], model: Model) -> S:
     """The home nodes: the initial ones (and the initial situation once its timers
     elapsed), and those where a ``--home`` condition holds."""
-    homes = g.waited()
-    for c in home_conditions(texts, model.p, model.g):
-        homes = g.union(homes, g.where(c))
-    return homes
+    return g.join([g.waited(), *(g.where(c) for c in home_conditions(texts, model.p, model.g))])
 
 
 def validation_of(g: SymbolicGraph[S, M], finder: Finder[S], model: Model, *, expert: bool, homes: Sequence[str],

@@ -15,7 +15,7 @@ Example
 
 from __future__ import annotations
 
-from typing import Collection, Iterator, Sequence
+from typing import Collection, Iterable, Iterator, Sequence
 
 from synth.errors import LimitExceeded
 from synth.logic.bdd import Function
@@ -123,6 +123,13 @@ class SituationReach:
         out = dict(a)
         for s, u in b.items():
             out[s] = out.get(s, self.false) | u
+        return out
+
+    def join(self, sets: Iterable[NodeSet]) -> NodeSet:
+        out: NodeSet = {}
+        for u in sets:
+            for s, v in u.items():
+                out[s] = out.get(s, self.false) | v
         return out
 
     def meet(self, a: NodeSet, b: NodeSet) -> NodeSet:

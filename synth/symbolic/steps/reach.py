@@ -26,7 +26,7 @@ Example
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Collection, Sequence
+from typing import TYPE_CHECKING, Collection, Iterable, Sequence
 
 from synth.errors import LimitExceeded
 from synth.grafcet.language import step_variable
@@ -75,6 +75,9 @@ class StepReach:
 
     def union(self, a: Function, b: Function) -> Function:
         return a | b
+
+    def join(self, sets: Iterable[Function]) -> Function:
+        return self.s.engine.disjunction(sets)
 
     def meet(self, a: Function, b: Function) -> Function:
         return a & b
