@@ -5,13 +5,12 @@ The same assertions run against the per-situation representation
 (:class:`~synth.symbolic.steps.reach.StepReach`), each checked against the explicit
 engine's SYNC: node sets, rings, moves, fixpoints, held nodes, components, first nodes
 and traces. Then: the batched searches of the step path equal the one search on the
-bench families; the choice of the path is a function's answer; no module of
-``synth/symbolic`` reads another object's private member.
+bench families; the choice of the path is a function's answer. (That no module of
+``synth/symbolic`` reads another object's private member is tests/test_structure.py's scan.)
 """
 
 from __future__ import annotations
 
-import ast
 import sys
 from pathlib import Path
 from typing import Any
@@ -200,21 +199,3 @@ def test_choosing_the_path():
                            "grafcet G { initial step 0 step 1: set AVANCER on activation\n"
                            "transition 0 -> 1 when ↑dcy  transition 1 -> 0 when v1 }", "s.g7")
     assert choose_path(GrafcetMachine(stored), p) == PathChoice(SymbolicPath.SITUATIONS, "stored actions")
-
-
-def _private_reads(source: str) -> list[tuple[int, str]]:
-    """``obj._name`` where ``obj`` is not ``self`` or ``cls`` (dunders aside): (line, text)."""
-    found = []
-    for node in ast.walk(ast.parse(source)):
-        if isinstance(node, ast.Attribute) and node.attr.startswith("_") and not node.attr.startswith("__"):
-            if not (isinstance(node.value, ast.Name) and node.value.id in ("self", "cls")):
-                found.append((node.lineno, ast.unparse(node)))
-    return found
-
-
-def test_symbolic_reads_no_private_member_of_another_object():
-    assert sorted(_private_reads("class A:\n    def f(self, o):\n        return self._x + o._y + o.__class__ + o.p._z\n")) == \
-        [(3, "o._y"), (3, "o.p._z")]
-    found = [(str(path.relative_to(ROOT)), line, text) for path in sorted((ROOT / "synth" / "symbolic").rglob("*.py"))
-             for line, text in _private_reads(path.read_text(encoding="utf-8"))]
-    assert found == []
