@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import ast
 import functools
-from collections import Counter
 from pathlib import Path
 
 import pytest
@@ -163,29 +162,6 @@ def test_no_module_over_the_size_of_one_concept() -> None:
 
 # --------------------------------------------------------------------------- privates
 
-# The reaches into another object's private members left in synth/symbolic/, which another
-# branch (issue 34, build 3: one interface for the symbolic graphs) removes: exact, so this
-# list may only shrink, and shrinks with the code (empty it when that work is merged).
-SYMBOLIC_PRIVATES = Counter({
-    "synth.symbolic.situations.sync: machine._event_inputs": 1,
-    "synth.symbolic.steps.batch: r._key": 1,
-    "synth.symbolic.steps.batch: s._current": 1,
-    "synth.symbolic.steps.batch: s._next": 2,
-    "synth.symbolic.steps.batch: s._primed": 3,
-    "synth.symbolic.steps.batch: self.s._next": 1,
-    "synth.symbolic.steps.encoding: self.machine._cond": 1,
-    "synth.symbolic.steps.encoding: self.machine._rec": 1,
-    "synth.symbolic.steps.reach: s._edge_relations": 1,
-    "synth.symbolic.steps.reach: s._next": 1,
-    "synth.symbolic.steps.reach: self.s._current": 2,
-    "synth.symbolic.steps.reach: self.s._primed": 1,
-    "synth.symbolic.steps.sync: helper._element_intra": 1,
-    "synth.symbolic.steps.sync: helper._element_region": 1,
-    "synth.symbolic.steps.sync: helper._orders_of": 1,
-    "synth.symbolic.steps.sync: helper._other_orders": 1,
-})
-
-
 def private_reaches(name: str, source: str) -> list[str]:
     """Every ``x._private`` of the module ``name`` (read or written; ``__dunder__`` names
     are public) whose ``x`` is not ``self`` or ``cls`` nor one of the module's own
@@ -214,9 +190,7 @@ def test_the_private_scan_sees_a_reach_and_spares_self_and_own_names() -> None:
 
 def test_no_module_reads_another_objects_private_members() -> None:
     found = [r for n, p in modules().items() for r in private_reaches(n, p.read_text(encoding="utf-8"))]
-    outside = [r for r in found if not r.startswith("synth.symbolic.")]
-    assert outside == []
-    assert Counter(r for r in found if r.startswith("synth.symbolic.")) == SYMBOLIC_PRIVATES
+    assert found == []
 
 
 def test_the_tests_share_one_root() -> None:

@@ -297,6 +297,19 @@ class GrafcetMachine:
         """Step variables read by ``t``'s receptivity whose step is not active in ``sit``."""
         return tuple(sorted(step_variable(s) for s in self._rec_steps[self._index[t]] if s not in sit.steps))
 
+    def receptivity(self, i: int) -> CompiledFn:
+        """Transition ``i``'s receptivity, compiled: what every evolution of this machine
+        calls (the symbolic step encoding calls it on recorded inputs)."""
+        return self._rec[i]
+
+    def condition(self, step: str, i: int) -> CompiledFn:
+        """The compiled condition of action ``i`` of ``step`` (a conditional action)."""
+        return self._cond[(step, i)]
+
+    def event_inputs(self, step: str) -> frozenset[str]:
+        """The inputs read by ``step``'s stored actions and assignments on an event."""
+        return self._event_inputs[step]
+
     def relevant_inputs(self, sit: Situation) -> frozenset[str]:
         """Inputs whose change may change ``sit``: read by an enabled transition or by an
         event action of an active step."""

@@ -1,9 +1,8 @@
 """The explicit nodes and edges a symbolic report shows.
 
-Both symbolic paths (:mod:`synth.symbolic.validate`, :mod:`synth.symbolic.steps.validate`)
-decide on BDDs, then make explicit :class:`~synth.validation.sync.Node` objects of the
-few nodes a report shows (initial nodes, trace nodes, component members), numbered as
-they are asked for, so the existing diagnosis and output run on a small
+Both symbolic paths decide on BDDs (:mod:`synth.symbolic.verdicts`), then make explicit
+:class:`~synth.validation.sync.Node` objects of the few nodes a report shows (initial
+nodes, trace nodes, component members), numbered as they are asked for, so the existing diagnosis and output run on a small
 :class:`~synth.validation.sync.Sync` unchanged.
 
 Example
@@ -26,24 +25,21 @@ from typing import Callable
 
 from synth.plant.composition import Plant
 from synth.sup.constraints import CompiledConstraints
-from synth.symbolic.situations.reach import Path, shortest_trace
-from synth.symbolic.situations.sync import SymbolicSync
+from synth.symbolic.interface import Key, Numbered, Path, PathKey
 from synth.validation.analysis import Trace
 from synth.validation.sync import Edge, Node, Prohibition, _order_moves
 
-__all__ = ["ExplicitNodes", "Key", "PathKey", "Blocking"]
+__all__ = ["ExplicitNodes", "Blocking"]
 
-Key = tuple[int, tuple[int, ...]]  # a node: situation, plant state
-PathKey = tuple[tuple[int, ...], ...]  # a shortest path, in the explicit exploration's order (with ranks: synth.symbolic.ties)
 Blocking = tuple[list[int], dict[int, tuple[int, ...]], dict[int, Trace], dict[int, int]]
 
 
 class ExplicitNodes:
     """The explicit nodes and edges a report needs, numbered as they are asked for."""
 
-    def __init__(self, ssync: SymbolicSync, oracle: CompiledConstraints) -> None:
-        self.ssync = ssync
-        self.p: Plant = ssync.plant
+    def __init__(self, numbering: Numbered, oracle: CompiledConstraints) -> None:
+        self.numbering = numbering
+        self.p: Plant = numbering.plant
         self.oracle = oracle
         self.moves = _order_moves(self.p)
         self.nodes: list[Node] = []
@@ -56,8 +52,8 @@ class ExplicitNodes:
         if i is not None:
             return i
         s, local = key
-        sit = self.ssync.situations[s]
-        machine = self.ssync.machine
+        sit = self.numbering.situations[s]
+        machine = self.numbering.machine
         inputs = {n: v for n, v in self.p.valuation(local).items() if n in machine.inputs}
         wanted = machine.orders(sit, inputs)
         val = self.p.valuation(local)
@@ -75,9 +71,6 @@ class ExplicitNodes:
         self.index[key] = len(self.nodes)
         self.nodes.append(Node(sit, local, frozenset(wanted), ords, tuple(sorted(refused))))
         return self.index[key]
-
-    def trace(self, key: Key) -> Trace:
-        return self.trace_of(shortest_trace(self.ssync, *key))
 
     def blocking(self, found: list[tuple[int, PathKey, Key, list[Key]]], trace: Callable[[Key], Trace],
                  comes_back: Callable[[Key], bool]) -> Blocking:

@@ -1,6 +1,6 @@
 """The explicit engine's order among the nodes one edge enters, for the first nodes of both
-symbolic paths (:mod:`synth.symbolic.steps.reach` and :mod:`synth.symbolic.steps.batch` on the
-step path, :mod:`synth.symbolic.situations.reach` per situation).
+symbolic paths (:func:`synth.symbolic.searches.first_of`, and its batched twin
+:mod:`synth.symbolic.steps.batch`).
 
 The explicit engine numbers SYNC's nodes breadth-first: it expands the nodes in the
 order it numbered them, each node's events in the plant's order (then its timers), and an event's target
@@ -34,14 +34,11 @@ from typing import Callable
 from synth.errors import LimitExceeded
 from synth.logic.events import Event
 from synth.sup.constraints import CompiledConstraints
+from synth.symbolic.interface import Key, Local, Numbered
 from synth.symbolic.relation import Move
-from synth.symbolic.situations.sync import SymbolicSync
 from synth.validation.sync import _grafcet_inputs, _order_moves, region
 
 __all__ = ["Settled", "REGION_LIMIT"]
-
-Local = tuple[int, ...]
-Key = tuple[int, Local]  # a node: situation, plant state (as synth.symbolic.explicit.Key)
 
 REGION_LIMIT = 100_000
 """A region of more states is not run explicitly (the symbolic engine is there for them):
@@ -51,9 +48,10 @@ its tie is broken by the smallest situation, then state, and the rank is 0."""
 class Settled:
     """The settled states of the region a node enters by an event (or of the initial
     region), in the explicit engine's order, computed once per (node, event). ``sync``
-    numbers the situations (the step path's helper, or the per-situation path itself)."""
+    numbers the situations (the step path's :class:`~synth.symbolic.numbering.SituationIndex`,
+    or the per-situation path's :class:`~synth.symbolic.situations.sync.SymbolicSync`)."""
 
-    def __init__(self, sync: SymbolicSync, oracle: CompiledConstraints) -> None:
+    def __init__(self, sync: Numbered, oracle: CompiledConstraints) -> None:
         self.sync = sync
         self.p = sync.plant
         self.oracle = oracle

@@ -89,7 +89,6 @@ class SyncGraph:
         self._into: dict[int, list[Link]] = {}
         self._from: dict[int, list[Link]] = {}
         self._out: dict[int, list[Bundle]] = {}
-        self._in: dict[int, list[Bundle]] = {}
 
     def link(self, bundles: list[Bundle]) -> None:
         """Take the explored ``bundles`` (their pair relations computed): merge them per
@@ -116,7 +115,6 @@ class SyncGraph:
             self._from.setdefault(link.source, []).append(link)
         for b in self.bundles:
             self._out.setdefault(b.source, []).append(b)
-            self._in.setdefault(b.target, []).append(b)
 
     def post_pairs(self, sources: Function, pairs: Function) -> Function:
         """The x' of the pairs ``(x, x')`` whose x is in ``sources``, as current states."""
@@ -191,9 +189,6 @@ class SyncGraph:
     def out_bundles(self, source: int) -> list[Bundle]:
         return self._out.get(source, [])
 
-    def in_bundles(self, target: int) -> list[Bundle]:
-        return self._in.get(target, [])
-
     def out_links(self, source: int) -> list[Link]:
         return self._from.get(source, [])
 
@@ -233,10 +228,3 @@ class SyncGraph:
 
     def nodes(self) -> NodeSet:
         return {s: r.nodes for s, r in enumerate(self.regions) if r.nodes != self.false}
-
-    def depth(self, s: int, u: Function) -> int | None:
-        """The ring of the first node of ``u`` (in situation ``s``)."""
-        for k, ring in enumerate(self.onion_rings()):
-            if (ring.get(s, self.false) & u) != self.false:
-                return k
-        return None

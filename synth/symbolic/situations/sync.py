@@ -53,6 +53,7 @@ from synth.logic.expr import Edge as ExprEdge, names
 from synth.plant.composition import Plant
 from synth.plant.rules import Constraint
 from synth.symbolic.encoding import Copy, NodeBudget, live_nodes
+from synth.symbolic.regions import ElementRegions
 from synth.symbolic.situations.graph import Bundle, NodeSet, Region, SyncGraph
 from synth.symbolic.relation import Move, image, pair_preimage, preimage
 from synth.symbolic.supervisor import SymbolicSupervisor
@@ -81,18 +82,11 @@ class SymbolicSync(SyncGraph):
         self._conflict_log = ConflictLog()
         self._inputs = tuple(n for n in machine.inputs if n in self.plant.owner)
         self._intra: dict[frozenset[str], tuple[tuple[Function, ...], Function, dict[Event, Function]]] = {}
-        self._eq: Function | None = None
         self._domain_cache: dict[frozenset[str], tuple[Function, ...]] = {}
         self._unread_cache: dict[Situation, frozenset[str]] = {}
-        self._region_moves: dict[int, tuple[Function, Function, Function]] = {}
         self._products: dict[frozenset[str], tuple[Function, Function] | None] = {}
         self._pieces: dict[tuple[int, frozenset[str]], Function | None] = {}  # None: reads other elements' orders
-        self._element_intras: dict[tuple[int, frozenset[str]], tuple[Function, Function, dict[Event, Function]]] = {}
-        self._orders_of = tuple(frozenset(e.orders) for e in self.plant.elements)
-        self._controllable = tuple(tuple(m for m in sup.moves if m.controllable and m.axis == a) for a in range(self.plant.ndim))
-        self._other_orders: tuple[frozenset[str], ...] = tuple(
-            frozenset(o + Copy.NEXT.value for b, e in enumerate(self.plant.elements) if b != a for o in e.orders)
-            for a in range(self.plant.ndim))
+        self.closures = ElementRegions(sup)  # per element: region moves and closures
         self.progress = progress
 
     # ------------------------------------------------------------------ helpers
@@ -129,14 +123,6 @@ class SymbolicSync(SyncGraph):
                 out.append((result, part))
         return out
 
-    @property
-    def equal(self) -> Function:
-        """x = x' on every plant variable."""
-        if self._eq is None:
-            self._eq = self.engine.conjunction(
-                self.engine.var(v).equiv(self.engine.var(v + Copy.NEXT.value)) for v in self.enc.variables)
-        return self._eq
-
     def intra(self, wanted: frozenset[str]) -> tuple[tuple[Function, ...], Function, dict[Event, Function]]:
         """For emitted orders ``wanted``: per element the region moves as a relation over
         (member x', next member x''), the states with a region move left, and per order
@@ -148,48 +134,12 @@ class SymbolicSync(SyncGraph):
         progress = self.false
         refused: dict[Event, Function] = {}
         for axis in range(self.plant.ndim):
-            r, can, bad = self._element_intra(axis, self._own_orders(axis, wanted))
+            r, can, bad = self.closures.intra(axis, self.closures.own(axis, wanted))
             rel.append(r)
             progress |= can
             refused.update(bad)
         hit = (tuple(rel), progress, refused)
         self._intra[wanted] = hit
-        return hit
-
-    def _own_orders(self, axis: int, wanted: frozenset[str]) -> frozenset[str]:
-        return wanted & self._orders_of[axis]
-
-    def _element_intra(self, axis: int, own: frozenset[str]) -> tuple[Function, Function, dict[Event, Function]]:
-        """:meth:`intra` for one element, whose region moves depend only on its own
-        emitted orders ``own`` (a controllable move flips one of its orders)."""
-        key = (axis, own)
-        hit = self._element_intras.get(key)
-        if hit is None:
-            rel = progress = self.false
-            refused: dict[Event, Function] = {}
-            for m in self._controllable[axis]:
-                if m.event.rising != (m.variable in own):
-                    continue
-                shifted, can, bad = self._region_move(m)
-                progress |= can
-                if bad != self.false:
-                    refused[m.event] = refused.get(m.event, self.false) | bad
-                rel |= shifted
-            hit = self._element_intras[key] = (rel, progress, refused)
-        return hit
-
-    def _region_move(self, m: Move) -> tuple[Function, Function, Function]:
-        """For one controllable move, computed once: its allowed part over (member x',
-        next member x''), the states where it is allowed, those where SUP refuses it."""
-        hit = self._region_moves.get(m.key)
-        if hit is None:
-            ok = self.sup.allowed(m)
-            names = self.enc.element_variables[m.axis]
-            can = self.enc.exists(ok, Copy.NEXT, names)
-            bad = m.guard & ~can  # the guard: where the move exists at all
-            shifted = self.enc.rename(self.enc.rename(ok, Copy.NEXT, Copy.AUX, names), Copy.CURRENT, Copy.NEXT)
-            hit = (shifted, can, bad)
-            self._region_moves[m.key] = hit
         return hit
 
     def _product_region(self, wanted: frozenset[str]) -> tuple[Function, Function] | None:
@@ -202,11 +152,9 @@ class SymbolicSync(SyncGraph):
         rel, progress, _ = self.intra(wanted)
         pieces = []
         for axis, r in enumerate(rel):
-            key = (axis, self._own_orders(axis, wanted))
+            key = (axis, self.closures.own(axis, wanted))
             if key not in self._pieces:
-                others = self._other_orders[axis]
-                reads_others = r != self.false and any(n in others for n in self.engine.support(r))
-                self._pieces[key] = None if reads_others else self._element_region(axis, r)
+                self._pieces[key] = None if self.closures.reads_others(axis, r) else self.closures.closure(axis, r)
             piece = self._pieces[key]
             if piece is None:
                 self._products[wanted] = None
@@ -216,17 +164,6 @@ class SymbolicSync(SyncGraph):
         hit = (members, members & ~self.enc.rename(progress, Copy.CURRENT, Copy.NEXT))
         self._products[wanted] = hit
         return hit
-
-    def _element_region(self, axis: int, r: Function) -> Function:
-        """Pairs (x_a, x'_a) of element ``axis``: x'_a reachable from x_a by its region moves ``r``."""
-        names = self.enc.element_variables[axis]
-        reach = self.engine.conjunction(self.engine.var(v).equiv(self.engine.var(v + Copy.NEXT.value)) for v in names)
-        frontier = reach
-        while frontier != self.false and r != self.false:
-            step = self.enc.rename(self.enc.and_exists(frontier, r, Copy.NEXT, names), Copy.AUX, Copy.NEXT, names)
-            frontier = step & ~reach
-            reach |= frontier
-        return reach
 
     def _domains(self, wanted: frozenset[str]) -> tuple[Function, ...]:
         """Per element, the members (next copy) from which it has a region move."""
@@ -244,14 +181,14 @@ class SymbolicSync(SyncGraph):
         (current copy)."""
         rel, progress, _ = self.intra(wanted)
         if (entries & progress) == self.false:  # already settled: the region is its entry
-            return entries & self.equal, entries, entries
+            return entries & self.closures.equal, entries, entries
         product = self._product_region(wanted)
         if product is not None:
             members, settled = product
             members = self.post_pairs(entries, members)
             return entries & settled, members, members & ~progress  # settled: members with no region move left
         domains = self._domains(wanted)
-        reach = entries & self.equal
+        reach = entries & self.closures.equal
         frontier = reach
         while frontier != self.false:
             new = self.false
@@ -265,10 +202,6 @@ class SymbolicSync(SyncGraph):
             reach |= frontier
         members = self.post_pairs(self.true, reach)
         return reach & ~self.enc.rename(progress, Copy.CURRENT, Copy.NEXT), members, members & ~progress
-
-    def post_pairs(self, sources: Function, pairs: Function) -> Function:
-        """The x' of the pairs ``(x, x')`` whose x is in ``sources``, as current states."""
-        return self.enc.rename(self.enc.and_exists(sources, pairs, Copy.CURRENT), Copy.NEXT, Copy.CURRENT)
 
     def enter(self, s: int, entries: Function) -> Function:
         """Enter situation ``s`` at ``entries``; returns the settled states not seen before."""
@@ -335,7 +268,7 @@ class SymbolicSync(SyncGraph):
             machine = self.machine
             enabled = machine.awaited(sit)
             has_edges = any(isinstance(n, ExprEdge) for t in enabled for n in names(t.receptivity))
-            has_events = any(machine._event_inputs[st] or any(getattr(a, "when", None) == ON_EVENT for a in machine.grafcet.step(st).actions)
+            has_events = any(machine.event_inputs(st) or any(getattr(a, "when", None) == ON_EVENT for a in machine.grafcet.step(st).actions)
                              for st in sit.steps)
             if has_edges or has_events:
                 hit = frozenset()

@@ -12,8 +12,8 @@ number is written in a few *tag* variables at the top of the BDD order, so one B
   all the targets (``pre`` does not touch the tags);
 - **one forward greedy pass**: per ring and move, one image of the tagged current sets;
   the tags that reach their layer by a move are read from that image, and each tag
-  takes its smallest move (the per-target order, ties as :meth:`StepReach._greedy`:
-  the last move of an order key); the tags' paths are read from the chosen tag sets;
+  takes its smallest key and every move of it (as :func:`~synth.symbolic.searches.greedy`);
+  the tags' paths are read from the chosen tag sets;
 - **traces** (event order): the same two passes from the single target nodes, then the
   concrete nodes one ring back at a time for every trace at once (a pre-image per
   event used at that step), the smallest node per tag when a tag has several.
@@ -47,15 +47,14 @@ from typing import TYPE_CHECKING, Callable, Sequence
 
 from synth.logic.bdd import Engine, Function
 from synth.logic.events import Event
-from synth.symbolic.explicit import Key, PathKey
-from synth.symbolic.situations.reach import Path, path_key
-from synth.symbolic.relation import Move
-from synth.symbolic.steps.reach import Order, StepReach
+from synth.symbolic.interface import Key, PathKey
+from synth.symbolic.searches import Order, Path, depth_of, first_of, path_key
+from synth.symbolic.steps.reach import Arc, StepReach
 
 if TYPE_CHECKING:  # pragma: no cover
     from synth.symbolic.ties import Settled
 
-__all__ = ["Tags", "Findings"]
+__all__ = ["Tags", "Findings", "Batched"]
 
 
 class Tags:
@@ -116,11 +115,11 @@ class _Batch:
         self.false = r.false
         self.tags = Tags(self.s.engine, len(targets))
         bdd = self.s.engine.bdd
-        self._next_cube = bdd.cube(set(self.s._next))
+        self._next_cube = bdd.cube(set(self.s.next_vars))
         self.depths: list[int] = []
         by_depth: dict[int, Function] = {}
         for j, u in enumerate(targets):
-            d = r.depth(u)
+            d = depth_of(r, u)
             if d is None:
                 raise ValueError("no candidate is reachable")
             self.depths.append(d)
@@ -135,16 +134,17 @@ class _Batch:
         layers = [self.false] * (depth + 1)
         layers[depth] = by_depth.get(depth, self.false)
         for k in range(depth - 1, -1, -1):
-            before = s.engine.and_exists(every, s._primed(layers[k + 1]), s._next)
+            before = s.engine.and_exists(every, s.primed(layers[k + 1]), s.next_vars)
             layers[k] = (before & s.rings[k]) | by_depth.get(k, self.false)
         return layers
 
-    def greedy(self, order: Callable[[Move], Order], settled: "Settled | None" = None,
+    def greedy(self, order: Callable[[Arc], Order], settled: "Settled | None" = None,
                ) -> tuple[list[Function], list[list[tuple[Order, Event, Function]]], list[dict[int, int]]]:
         """Forward through the layers, each tag taking its smallest move (by ``order``):
-        the tagged current sets per ring, per step the (order, event, tags) chosen, and
+        the tagged current sets per ring, per step the (order, event, tags) chosen (every
+        move of a tag's smallest key, as :func:`~synth.symbolic.searches.greedy`), and
         with ``settled`` each tag's set narrowed at each ring to the node the explicit
-        engine enters first, with its rank (:meth:`StepReach.first_of`)."""
+        engine enters first, with its rank (:func:`~synth.symbolic.searches.first_of`)."""
         s, false, exists = self.s, self.false, self.s.engine.bdd.apply
         current = self.layers[0]
         ranks: list[dict[int, int]] = []
@@ -154,24 +154,23 @@ class _Batch:
         steps: list[list[tuple[Order, Event, Function]]] = []
         for k in range(1, len(self.layers)):
             layer = self.layers[k]
-            target = s._primed(layer)
+            target = s.primed(layer)
             options: dict[Order, list[tuple[Event, Function, Function]]] = {}
             for m, e in s.edges:
                 v = s.image(current, m, e) & target
                 if v != false:
-                    options.setdefault(order(m), []).append((m.event, v, exists("exists", self._next_cube, v)))
+                    options.setdefault(order((m, e)), []).append((m.event, v, exists("exists", self._next_cube, v)))
             taken = nxt = false
             record: list[tuple[Order, Event, Function]] = []
             for key in sorted(options):
-                # per tag, the last move of this key that reaches its layer (as StepReach._greedy)
-                later = false
-                for event, v, tags in reversed(options[key]):
-                    sel = tags & ~later & ~taken
-                    later |= tags
+                # the tags whose smallest key this is take every move of it that reaches their layer
+                mine = s.engine.disjunction(tags for _, _, tags in options[key]) & ~taken
+                for event, v, tags in options[key]:
+                    sel = tags & mine
                     if sel != false:
                         nxt |= v & sel
                         record.append((key, event, sel))
-                taken |= later
+                taken |= mine
             current = s.unprimed(nxt)
             if settled is not None:
                 current = self._first(current, (chosen[-1], record), settled, ranks)
@@ -182,39 +181,41 @@ class _Batch:
     def _first(self, current: Function, via: "tuple[Function, list[tuple[Order, Event, Function]]] | None",
                settled: "Settled", ranks: list[dict[int, int]]) -> Function:
         """Each tag's part of ``current`` narrowed to its first node (as
-        :meth:`StepReach.first_of`; ``via``: the previous ring's tagged nodes and the moves
-        the tags took), each tag's rank appended to ``ranks``."""
+        :func:`~synth.symbolic.searches.first_of`; ``via``: the previous ring's tagged nodes
+        and the moves the tags took), each tag's rank appended to ``ranks``."""
         r, tags = self.r, self.tags
         arcs = {m.event: (m, e) for m, e in self.s.edges}
         before: dict[int, Function] = {}
-        moved: dict[int, Event] = {}
+        moved: dict[int, tuple[Event, ...]] = {}
         if via is not None:
             before = tags.split(via[0])
             for _, event, sel in via[1]:
-                moved.update((j, event) for j in tags.split(sel))
-        memo: dict[tuple[Function | None, Event | None, Function], tuple[Function, int]] = {}
+                for j in tags.split(sel):
+                    moved[j] = moved.get(j, ()) + (event,)
+        memo: dict[tuple[Function | None, tuple[Event, ...], Function], tuple[Function, int]] = {}
         out, rank = self.false, {}
         for j, u in tags.split(current).items():
-            key = (before.get(j), moved.get(j), u)
+            key = (before.get(j), moved.get(j, ()), u)
             hit = memo.get(key)
             if hit is None:
-                parent: tuple[Key, Move, Function] | None = None
+                parent: tuple[Key, list[Arc]] | None = None
                 if via is not None:
-                    m, e = arcs[moved[j]]
-                    parent = (r.pick(before[j]), m, e)
-                hit = memo[key] = r.first_of(u, parent, settled)
+                    parent = (r.pick(before[j]), [arcs[event] for event in moved[j]])
+                hit = memo[key] = first_of(r, u, parent, settled)
             out |= tags.cube(j) & hit[0]
             rank[j] = hit[1]
         ranks.append(rank)
         return out
 
     def paths(self, steps: list[list[tuple[Order, Event, Function]]]) -> list[list[tuple[Order, Event]]]:
-        """Each tag's (order, event) per step, read from the chosen tag sets."""
+        """Each tag's (order, event) per step, read from the chosen tag sets (the first
+        move of the key it took)."""
         out: list[list[tuple[Order, Event]]] = [[] for _ in self.depths]
-        for record in steps:
+        for k, record in enumerate(steps):
             for key, event, sel in record:
                 for j in self.tags.split(sel):
-                    out[j].append((key, event))
+                    if len(out[j]) == k:
+                        out[j].append((key, event))
         return out
 
 
@@ -232,7 +233,7 @@ class Findings:
         if not sets:
             return
         b = self._batch = _Batch(r, sets)
-        chosen, steps, ranks = b.greedy(r._key, r.settled)
+        chosen, steps, ranks = b.greedy(r.order, r.settled)
         paths = b.paths(steps)
         ends: dict[int, dict[int, Function]] = {}
         s = r.s
@@ -241,7 +242,7 @@ class Findings:
                 ends[d] = b.tags.split(chosen[d])
             key = r.pick(ends[d][j])
             self.firsts.append((key, d, path_key([k for k, _ in paths[j]], [rk[j] for rk in ranks[:d + 1]])))
-            if key not in self._whole and s.count(sets[j] & s.rings[d], s._current) == 1:
+            if key not in self._whole and s.count(sets[j] & s.rings[d], s.current_vars) == 1:
                 self._whole[key] = j
 
     def traces(self, keys: Sequence[Key]) -> list[Path]:
@@ -257,12 +258,29 @@ class Findings:
         return [found[k] for k in keys]
 
 
+class Batched:
+    """A report's first nodes and traces by :class:`Findings` (the one-target twin:
+    :class:`~synth.symbolic.searches.OneByOne`): :meth:`firsts` once, then :meth:`traces`."""
+
+    def __init__(self, r: StepReach) -> None:
+        self.r = r
+        self._found: Findings | None = None
+
+    def firsts(self, sets: Sequence[Function]) -> list[tuple[Key, int, PathKey]]:
+        self._found = Findings(self.r, sets)
+        return self._found.firsts
+
+    def traces(self, keys: Sequence[Key]) -> list[Path]:
+        assert self._found is not None, "firsts before traces"
+        return self._found.traces(keys)
+
+
 def _traces(r: StepReach, b: _Batch, wanted: dict[int, Key]) -> dict[Key, Path]:
     """The traces of the tags ``wanted`` of ``b`` (each the tag of one node, its target):
     the events by the greedy walk in event order, then the nodes one ring back at a time
     for every trace at once."""
     s, false = r.s, r.false
-    chosen, steps, _ = b.greedy(lambda m: m.event)
+    chosen, steps, _ = b.greedy(r.event)
     mask = s.engine.disjunction(b.tags.cube(j) for j in wanted)
     paths = b.paths(steps)
     arcs = {m.event: e for m, e in s.edges}
@@ -271,11 +289,11 @@ def _traces(r: StepReach, b: _Batch, wanted: dict[int, Key]) -> dict[Key, Path]:
     here = false  # per tag, its node at ring k + 1
     for k in range(len(b.layers) - 2, -1, -1):
         here |= b.targets.get(k + 1, false) & mask
-        primed = s._primed(here)
+        primed = s.primed(here)
         before = false
         for _, event, sel in steps[k]:
             if (sel & mask) != false:
-                before |= s.engine.and_exists(arcs[event], primed & sel, s._next)
+                before |= s.engine.and_exists(arcs[event], primed & sel, s.next_vars)
         before &= chosen[k]
         several = picked = false  # tags with several candidate nodes, and the one each picked
         for j, u in b.tags.split(before).items():

@@ -8,7 +8,7 @@ state) and a whole breadth-first level of the exploration is a few BDD operation
 
 The reading of IEC 60848 is the machine's (:class:`~synth.grafcet.machine.GrafcetMachine`):
 
-- a receptivity is the machine's own compiled function (``machine._rec``), called on
+- a receptivity is the machine's own compiled function (``machine.receptivity(i)``), called on
   recorded inputs and recorded step activity (:class:`~synth.grafcet.recorder.InputRecorder`
   and :class:`_Steps`): each call holds on the cube of what it read, so the BDD of the
   receptivity is the union of the cubes where it answered true (per event: an edge
@@ -196,7 +196,7 @@ class StepEncoding:
             for i, a in enumerate(s.actions):
                 where = self.var(s.name)
                 if a.kind == CONDITIONAL:
-                    where &= self._cells(self.machine._cond[(s.name, i)], None)
+                    where &= self._cells(self.machine.condition(s.name, i), None)
                 out[a.order] = out.get(a.order, self.engine.false) | where
         return out
 
@@ -207,7 +207,7 @@ class StepEncoding:
         key = (i, event)
         hit = self._recs.get(key)
         if hit is None:
-            hit = self._recs[key] = self._cells(self.machine._rec[i], event)
+            hit = self._recs[key] = self._cells(self.machine.receptivity(i), event)
         if copy is Copy.CURRENT:
             return hit
         return self.rename(hit, Copy.CURRENT, copy)

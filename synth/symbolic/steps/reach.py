@@ -1,16 +1,10 @@
-"""Findings on the SYNC over (steps, plant state): components, first nodes, shortest traces.
+"""The SYNC over (steps, plant state) seen through :class:`~synth.symbolic.interface.SymbolicGraph`.
 
-The reading of :mod:`synth.symbolic.situations.reach`, on one BDD per set instead of one BDD
-per situation (:class:`~synth.symbolic.steps.sync.StepSync`):
+A set of nodes is one BDD over (steps, plant state) (:class:`~synth.symbolic.steps.sync.StepSync`),
+a move a plant move with its edge relation; the searches are :mod:`synth.symbolic.searches`'s:
 
 - the onion rings are the exploration's levels (a level is exactly the nodes one edge
   beyond the previous ones not met before);
-- *terminal components* of the stuck nodes by descent (from a node of the deepest ring,
-  its forward set is terminal iff every node of it comes back);
-- the *first node* of a set: least distance, then the shortest path smallest in the
-  explicit exploration's order of events (element, variable), layer by layer; the
-  *trace* to a node: the shortest path smallest by event name (the explicit
-  breadth-first search's parent choice);
 - a node is named ``(situation index, plant state)`` for
   :class:`~synth.symbolic.explicit.ExplicitNodes`, the situations numbered as they are
   named (the initial one first); where several nodes tie (the known differences of
@@ -32,40 +26,124 @@ Example
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Callable, TypeVar
+from typing import TYPE_CHECKING, Collection, Iterable, Sequence
 
 from synth.errors import LimitExceeded
+from synth.grafcet.language import step_variable
 from synth.grafcet.machine import Situation
 from synth.logic.bdd import Function
 from synth.logic.events import Event
+from synth.logic.expr import Expr, evaluate
 from synth.symbolic.encoding import Copy, first_path
-from synth.symbolic.explicit import Key, PathKey
-from synth.symbolic.situations.reach import MAX_LISTED, Path, path_key
+from synth.symbolic.interface import Key, PathKey, Steps
 from synth.symbolic.relation import Move
+from synth.symbolic.searches import MAX_LISTED, Path, first_node, shortest_trace, terminal_components
 from synth.symbolic.steps.encoding import step_name
 from synth.symbolic.steps.sync import StepSync
 
 if TYPE_CHECKING:  # pragma: no cover - the explicit order needs the explicit engine's region search
     from synth.symbolic.ties import Settled
 
-__all__ = ["StepReach"]
+__all__ = ["StepReach", "Arc"]
 
-Order = TypeVar("Order", tuple[int, int, int], Event)  # how events are ordered: by plant transition, or by name
+Arc = tuple[Move, Function]  # a plant move and its edges (X, x, X', x')
 
 
 class StepReach:
-    """Named nodes and the searches the findings need, on an explored :class:`StepSync`."""
+    """:class:`~synth.symbolic.interface.SymbolicGraph` over an explored :class:`StepSync`:
+    named nodes, and the searches the findings need."""
 
     def __init__(self, s: StepSync) -> None:
         self.s = s
         self.false = s.false
+        self.numbering = s.helper
+        self.initial: Function = s.initial  # the graph is explored: its sets no longer change
+        self.reached: Function = s.nodes
         self.situations: list[Situation] = s.helper.situations  # the explicit nodes' numbering
         self._cubes: dict[Key, Function] = {}
+        self._primed: tuple[Function, Function] | None = None  # the last set renamed to the next copies
         self.settled: Settled | None = None
         """When set, first nodes are the explicit engine's where a region settles in
         several states (:mod:`synth.symbolic.ties`); else the smallest (:meth:`pick`)."""
         assert s.initial_situation is not None
         s.helper.situation(s.initial_situation)  # situation 0
+
+    # ---- node-set algebra
+    @property
+    def empty(self) -> Function:
+        return self.false
+
+    def union(self, a: Function, b: Function) -> Function:
+        return a | b
+
+    def join(self, sets: Iterable[Function]) -> Function:
+        return self.s.engine.disjunction(sets)
+
+    def meet(self, a: Function, b: Function) -> Function:
+        return a & b
+
+    def minus(self, a: Function, b: Function) -> Function:
+        return a & ~b
+
+    def is_empty(self, a: Function) -> bool:
+        return a == self.false
+
+    def count(self, a: Function) -> int:
+        return self.s.count(a, self.s.current_vars)
+
+    # ---- the explored graph
+    def rings(self) -> Sequence[Function]:
+        return self.s.rings
+
+    def moves_from(self, u: Function) -> list[Arc]:
+        return self.s.edges
+
+    def order(self, arc: Arc) -> tuple[int, int, int]:
+        """Plant moves by element, then variable (no timers on this path)."""
+        m = arc[0]
+        return (0, m.axis, self.s.plant.elements[m.axis].variables.index(m.variable))
+
+    def event(self, arc: Arc) -> Event:
+        return arc[0].event
+
+    def plant_move(self, arc: Arc) -> Move:
+        return arc[0]
+
+    def post_by(self, u: Function, arc: Arc, within: Function | None = None) -> Function:
+        v = self.s.image(u, *arc)
+        if within is not None:
+            v &= self.primed(within)
+        return self.false if v == self.false else self.s.unprimed(v)
+
+    def primed(self, u: Function) -> Function:
+        """``u`` in the next copies (the last one asked for kept: a search asks again per move)."""
+        if self._primed is None or self._primed[0] != u:
+            self._primed = (u, self.s.primed(u))
+        return self._primed[1]
+
+    def pre_by(self, u: Function, arc: Arc) -> Function:
+        return self.s.pre(u, [arc])
+
+    def pre(self, u: Function, within: Function) -> Function:
+        return self.s.pre(u, within=within)
+
+    def forward(self, u: Function) -> Function:
+        return self.s.forward(u)
+
+    def backward(self, u: Function, within: Function | None = None) -> Function:
+        return self.s.backward(u, within)
+
+    def held(self) -> Function:
+        """Nodes from which no node with other active steps is reachable."""
+        s = self.s
+        other = ~s.steps.equal(Copy.CURRENT, Copy.NEXT)
+        changers = self.false
+        for _, e in s.edges:
+            changers |= s.engine.and_exists(e, other, s.next_vars)
+        return s.nodes & ~s.backward(changers)
+
+    def is_held(self, key: Key) -> bool:
+        return self.s.held(self.cube(key))
 
     # ---- naming nodes
     def steps_of(self, u: Function) -> Function:
@@ -87,6 +165,9 @@ class StepReach:
             hit = self._cubes[key] = self.s.steps.cube(self.situations[s]) & self.s.enc.state(local)
         return hit
 
+    def contains(self, u: Function, key: Key) -> bool:
+        return (self.cube(key) & u) != self.false
+
     def within(self, u: Function, sit: Situation) -> Function:
         """The plant states of ``u`` in situation ``sit``."""
         return self.s.steps.exists(u & self.s.steps.cube(sit), Copy.CURRENT)
@@ -94,7 +175,7 @@ class StepReach:
     def pick(self, u: Function) -> Key:
         """The node of ``u`` (not empty) with the smallest situation, then the smallest state."""
         st = self.s.steps
-        if self.s.count(u, self.s._current) == 1:  # one node: its path to 1 sets every variable
+        if self.count(u) == 1:  # one node: its path to 1 sets every variable
             values = first_path(self.s.engine, u)
             key = self.s.helper.situation(st.situation(values)), self.s.enc.local(values)
             self._cubes.setdefault(key, u)
@@ -120,19 +201,26 @@ class StepReach:
             raise LimitExceeded(f"more than {limit} nodes to list")
         return out
 
-    # ---- sets
-    def held(self) -> Function:
-        """Nodes from which no node with other active steps is reachable."""
-        s = self.s
-        other = ~s.steps.equal(Copy.CURRENT, Copy.NEXT)
-        changers = self.false
-        for e in s._edge_relations:
-            changers |= s.engine.and_exists(e, other, s._next)
-        return s.nodes & ~s.backward(changers)
+    # ---- what the report asks
+    def waited(self) -> Function:
+        """The initial nodes (no timers on this path: no elapsed initial situation)."""
+        return self.s.initial
 
-    def prohibited(self) -> dict[tuple[tuple[str, ...], Event], Function]:
+    def where(self, condition: Expr) -> Function:
+        """The nodes where ``condition`` holds (a step variable is the step's BDD variable)."""
+        s, owner = self.s, self.s.plant.owner
+        variables = {step_variable(st): st for st in s.steps.steps}
+
+        def value(name: str) -> Function:
+            if name in owner:
+                return s.engine.var(name)
+            return s.steps.var(variables[name]) if name in variables else s.engine.false
+
+        return evaluate(condition, value) & s.nodes
+
+    def prohibited(self) -> dict[tuple[Steps, Event], Function]:
         """Per (active steps, refused order event), the nodes where SUP refuses it."""
-        out: dict[tuple[tuple[str, ...], Event], Function] = {}
+        out: dict[tuple[Steps, Event], Function] = {}
         for event, refused in self.s.refused_by.items():
             hit = self.s.nodes & refused
             if hit == self.false:
@@ -141,115 +229,42 @@ class StepReach:
                 out[(sit.steps, event)] = hit & self.s.steps.cube(sit)
         return dict(sorted(out.items()))
 
-    def _deepest(self, u: Function) -> Function:
-        """One node of ``u`` from the farthest ring meeting it."""
-        for ring in reversed(self.s.rings):
-            v = u & ring
-            if v != self.false:
-                return self.cube(self.pick(v))
-        raise ValueError("no node of the set is reachable")
+    def only_steps(self, u: Function, steps: Collection[Steps]) -> bool:
+        covered = self.s.engine.disjunction(self.s.steps.cube(Situation(st)) for st in steps)
+        return (self.steps_of(u) & ~covered) == self.false
 
+    def conflicts(self) -> list[tuple[Function, Event, str, tuple[str, ...]]]:
+        """None: an OR-divergence conflict sends the model to the per-situation path."""
+        return []
+
+    def never_leaves(self) -> bool:
+        assert self.s.initial_situation is not None
+        return (self.steps_of(self.s.nodes) & ~self.s.steps.cube(self.s.initial_situation)) == self.false
+
+    def one_per_situation(self) -> list[Key]:
+        nodes = self.s.nodes
+        return [(self.s.helper.situation(sit), self.s.enc.one(self.within(nodes, sit))) for sit in self.situations_of(nodes)]
+
+    def reached_steps(self) -> frozenset[str]:
+        return self.s.reached_steps()
+
+    def stats(self) -> dict[str, int]:
+        return {"sync_states": self.s.sync_states, "aggregated_states": self.s.aggregated_states,
+                "aggregated_transitions": self.s.edge_count}
+
+    def situation_count(self) -> int:
+        return self.s.situations
+
+    # ---- the searches (synth.symbolic.searches) on this representation
     def terminal_components(self, stuck: Function) -> list[Function]:
-        """The terminal strongly connected components of ``stuck`` (descent, as
-        :func:`synth.symbolic.situations.reach.terminal_components`)."""
-        comps: list[Function] = []
-        candidates = stuck
-        while candidates != self.false:
-            v = self._deepest(candidates)
-            while True:
-                fwd = self.s.forward(v)
-                below = fwd & ~self.s.backward(v, within=fwd)
-                if below == self.false:
-                    comps.append(fwd)
-                    break
-                v = self._deepest(below)
-            candidates &= ~self.s.backward(comps[-1], within=candidates)
-        return comps
-
-    # ---- paths
-    def _layers(self, target: Function, depth: int) -> list[Function]:
-        rings = self.s.rings
-        layers = [self.false] * (depth + 1)
-        layers[depth] = target & rings[depth]
-        for k in range(depth - 1, -1, -1):
-            layers[k] = self.s.pre(layers[k + 1], within=rings[k])
-        return layers
-
-    def _greedy(self, layers: list[Function], order: Callable[[Move], Order], settled: "Settled | None" = None,
-                ) -> tuple[list[Function], list[Event], list[Order], list[int]]:
-        """Forward through ``layers``, the smallest move (by ``order``) at each ring; with
-        ``settled``, each ring's set narrowed to the node the explicit engine enters first
-        (:meth:`first_of`), and its rank there."""
-        current = layers[0]
-        ranks: list[int] = []
-        if settled is not None:
-            current, rank = self.first_of(current, None, settled)
-            ranks.append(rank)
-        chosen, events, keys = [current], [], []
-        for k in range(1, len(layers)):
-            options: dict[Order, tuple[Move, Function, Function]] = {}
-            target = self.s._primed(layers[k])
-            for m, e in self.s.edges:
-                v = self.s.image(current, m, e) & target
-                if v != self.false:
-                    options[order(m)] = (m, e, v)
-            best = min(options)
-            m, e, current = options[best]
-            current = self.s.unprimed(current)
-            if settled is not None:
-                current, rank = self.first_of(current, (self.pick(chosen[-1]), m, e), settled)
-                ranks.append(rank)
-            events.append(m.event)
-            keys.append(best)
-            chosen.append(current)
-        return chosen, events, keys, ranks
-
-    def first_of(self, u: Function, via: "tuple[Key, Move, Function] | None", settled: "Settled") -> tuple[Function, int]:
-        """The node of ``u`` the explicit engine numbers first, ``u`` being nodes the
-        region entered from node ``via[0]`` by move ``via[1]`` (edges ``via[2]``) settles
-        in (None: the initial region), and its rank among that region's settled states
-        (0 where it settles in one: no region is run explicitly; 0 and the smallest
-        node past :data:`~synth.symbolic.ties.REGION_LIMIT` states)."""
-        entered = self.s.initial if via is None else self.s.unprimed(self.s.image(self.cube(via[0]), via[1], via[2]))
-        if self.s.count(entered, self.s._current) == 1:
-            return u, 0
-        parent, move = (None, None) if via is None else via[:2]
-        found = settled.first(parent, None if move is None else move.event, move,
-                              lambda key: (self.cube(key) & u) != self.false)
-        if found is None:  # a region too large to run explicitly: the smallest node
-            return self.cube(self.pick(u)), 0
-        return self.cube(found[0]), found[1]
-
-    def _key(self, m: Move) -> tuple[int, int, int]:
-        return (0, m.axis, self.s.plant.elements[m.axis].variables.index(m.variable))
-
-    def depth(self, u: Function) -> int | None:
-        for k, ring in enumerate(self.s.rings):
-            if (ring & u) != self.false:
-                return k
-        return None
+        """The terminal strongly connected components of ``stuck``."""
+        return terminal_components(self, stuck)
 
     def first_node(self, candidates: Function) -> tuple[Key, int, PathKey]:
-        """The candidate the explicit engine numbers first: (node, distance, path key).
-        With :attr:`settled` the path key holds each ring's rank (:mod:`synth.symbolic.ties`),
-        without it the smallest node of the last ring is taken (:meth:`pick`)."""
-        depth = self.depth(candidates)
-        if depth is None:
-            raise ValueError("no candidate is reachable")
-        chosen, _, keys, ranks = self._greedy(self._layers(candidates, depth), self._key, self.settled)
-        return self.pick(chosen[-1]), depth, path_key(keys, ranks)
+        """The candidate the explicit engine numbers first: (node, distance, path key),
+        with :attr:`settled` ties broken as it breaks them."""
+        return first_node(self, candidates, self.settled)
 
     def shortest_trace(self, key: Key) -> Path:
         """The shortest path from an initial node to ``key`` whose events are smallest by name."""
-        node = self.cube(key)
-        depth = self.depth(node)
-        if depth is None:
-            raise ValueError("node not reachable")
-        chosen, events, _, _ = self._greedy(self._layers(node, depth), lambda m: m.event)
-        nodes = [key]
-        for k in range(depth - 1, -1, -1):
-            arcs = [(m, e) for m, e in self.s.edges if m.event == events[k]]
-            nodes.append(self.pick(self.s.pre(self.cube(nodes[-1]), arcs) & chosen[k]))
-        nodes.reverse()
-        return Path(tuple(nodes), tuple(events))
-
+        return shortest_trace(self, key)

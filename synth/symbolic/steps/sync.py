@@ -9,7 +9,7 @@ handle all the situations of a level at once. Same semantics as :mod:`synth.symb
 
 - *regions*: an element's region moves depend on the orders emitted for it, which are a
   function of X; per element and set of its own orders (a few), the closure of its region
-  moves is computed once (``SymbolicSync._element_region``) and selected by the step
+  moves is computed once (:class:`~synth.symbolic.regions.ElementRegions`) and selected by the step
   variables: ``closure(X, x, x')`` is the product over the elements; ``settled`` states
   have no region move left;
 - *exploration*: from the frontier F(X, x), each uncontrollable move gives entries
@@ -45,10 +45,11 @@ from synth.logic.events import Event
 from synth.plant.composition import Plant
 from synth.plant.rules import Constraint
 from synth.symbolic.encoding import Copy, NodeBudget, live_nodes
+from synth.symbolic.numbering import SituationIndex
+from synth.symbolic.regions import ElementRegions
 from synth.symbolic.relation import Move, flipped, image
 from synth.symbolic.steps.encoding import StepEncoding, Unsupported, anchors, unsupported
 from synth.symbolic.supervisor import SymbolicSupervisor
-from synth.symbolic.situations.sync import SymbolicSync
 
 __all__ = ["StepSync", "step_sync", "MAX_OWN_ORDERS"]
 
@@ -68,7 +69,8 @@ class StepSync:
         self.plant: Plant = sup.plant
         self.machine = machine
         self.steps = StepEncoding(machine, sup.enc)
-        self.helper = SymbolicSync(sup, machine)  # its per-element region closures, cached
+        self.closures = ElementRegions(sup)  # per element: region moves and closures, cached
+        self.helper = SituationIndex(self.plant, machine)  # the situations as the searches name them
         self.progress = progress
         self.false: Function = self.engine.false
         self.true: Function = self.engine.true
@@ -90,8 +92,10 @@ class StepSync:
         self._inputs = frozenset(n for n in machine.inputs if n in self.plant.owner)
         self._moves = tuple(m for m in sup.moves if not m.controllable)
         e = self.engine
-        self._current = [e.declare(v) for v in self.enc.variables] + self.steps.names(Copy.CURRENT)
-        self._next = [e.declare(v + Copy.NEXT.value) for v in self.enc.variables] + self.steps.names(Copy.NEXT)
+        self.current_vars: list[str] = [e.declare(v) for v in self.enc.variables] + self.steps.names(Copy.CURRENT)
+        """A node's variables: the plant's and the steps' current copies."""
+        self.next_vars: list[str] = [e.declare(v + Copy.NEXT.value) for v in self.enc.variables] + self.steps.names(Copy.NEXT)
+        """Their next copies (an edge's target)."""
         self.closure, self.moving, self.refused = self._regions()
 
     # ---- regions
@@ -102,11 +106,11 @@ class StepSync:
         entry set); ``moving(X, x)``: a region move is left; ``refused(X, x)``: SUP
         refuses a move towards an order emitted there (a prohibited order)."""
         emitted = self.steps.orders()
-        helper = self.helper
+        regions = self.closures
         closure: Function | None = self.true
         moving, refused = self.false, self.false
         for axis in range(self.plant.ndim):
-            own_all = sorted(helper._orders_of[axis])
+            own_all = sorted(regions.orders_of[axis])
             if len(own_all) > MAX_OWN_ORDERS:
                 raise Unsupported(f"an element with more than {MAX_OWN_ORDERS} orders")
             piece = moves = self.false
@@ -116,12 +120,11 @@ class StepSync:
                 select = self.engine.conjunction(w if o in own else ~w for o, w in wanted.items())
                 if select == self.false:
                     continue
-                rel, can, bad = helper._element_intra(axis, own)
-                others = helper._other_orders[axis]
-                if rel != self.false and any(n in others for n in self.engine.support(rel)):
+                rel, can, bad = regions.intra(axis, own)
+                if regions.reads_others(axis, rel):
                     closure = None
                 if closure is not None:
-                    piece |= select & helper._element_region(axis, rel)
+                    piece |= select & regions.closure(axis, rel)
                 moves |= select & rel
                 moving |= select & can
                 for event, b in bad.items():
@@ -136,7 +139,7 @@ class StepSync:
         """The pairs (X, n, x') of ``entries`` (X, n) and the states x' their region
         reaches (forward over the region moves, element by element), without a
         precomputed closure."""
-        reach = frontier = entries & self.helper.equal
+        reach = frontier = entries & self.closures.equal
         while frontier != self.false:
             new = self.false  # an element's move: its next copy quantified, its auxiliary copy set
             for axis, moves in enumerate(self.region_moves):
@@ -203,7 +206,7 @@ class StepSync:
         self.reacted = {}
         self._reactions = {}
         self.pairs = self.false
-        self.edge_count = sum(self.count(e, self._current + self._next) for _, e in self.edges)
+        self.edge_count = sum(self.count(e, self.current_vars + self.next_vars) for _, e in self.edges)
         by_axis: dict[int, tuple[Function, Function]] = {}  # per element: where its edges end, their union
         for m, e in self.edges:
             end, rel = by_axis.get(m.axis, (self.false, self.false))
@@ -225,11 +228,11 @@ class StepSync:
 
     @property
     def sync_states(self) -> int:
-        return self.count(self.members, self._current)
+        return self.count(self.members, self.current_vars)
 
     @property
     def aggregated_states(self) -> int:
-        return self.count(self.nodes, self._current)
+        return self.count(self.nodes, self.current_vars)
 
     @property
     def situations(self) -> int:
@@ -240,7 +243,7 @@ class StepSync:
         return frozenset(s for s in self.steps.steps if (self.nodes & self.steps.var(s)) != self.false)
 
     # ---- fixpoints
-    def _primed(self, u: Function) -> Function:
+    def primed(self, u: Function) -> Function:
         """``u`` from the current copies (plant and steps) to the next ones."""
         return self._rename(u, Copy.CURRENT, Copy.NEXT)
 
@@ -260,12 +263,12 @@ class StepSync:
         """Nodes (of ``within``, default all) with an edge (of ``edges``, default all) into
         ``u``. An edge of a move ends where its flipped variable has its new value (region
         moves flip orders only): the others are skipped without a relational product."""
-        target = self._primed(u)
+        target = self.primed(u)
         out = self.false
         arcs = self.links if edges is None else [(m.after, e) for m, e in edges]
         for end, e in arcs:
             if (u & end) != self.false:
-                found = self.engine.and_exists(e, target, self._next)
+                found = self.engine.and_exists(e, target, self.next_vars)
                 out |= found if within is None else found & within
         return out
 
@@ -273,7 +276,7 @@ class StepSync:
         """Targets of the edges ``e`` of move ``m`` from ``u``, in the next copies."""
         if (u & m.guard) == self.false:
             return self.false
-        return self.engine.and_exists(e, u, self._current)
+        return self.engine.and_exists(e, u, self.current_vars)
 
     def unprimed(self, u: Function) -> Function:
         """``u`` from the next copies (plant and steps) to the current ones."""
@@ -285,10 +288,6 @@ class StepSync:
         for m, e in (self.edges if edges is None else edges):
             out |= self.image(u, m, e)
         return self.unprimed(out)
-
-    @property
-    def _edge_relations(self) -> list[Function]:
-        return [e for _, e in self.edges]
 
     def backward(self, targets: Function, within: Function | None = None) -> Function:
         """Nodes from which ``targets`` can be reached (targets included; only through
