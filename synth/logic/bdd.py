@@ -194,6 +194,10 @@ class Engine:
     def level(self, name: str) -> int:
         return self.bdd.level_of_var(self.declare(name))
 
+    def level_of(self, u: Function) -> int:
+        """The level of ``u``'s top variable; a constant lies below every variable."""
+        return len(self._inner) if u.var is None else int(u.level)
+
     def rank(self, name: str) -> int:
         """The position of ``name`` in the text order (names it does not list come after,
         in their variable order)."""
