@@ -214,7 +214,11 @@ class SymbolicSupervisor:
     def _others(self, axis: int) -> int:
         """Counting over both copies counts the unconstrained next variables of the other
         elements too: this factor removes them."""
-        return 1 << sum(len(v) for a, v in enumerate(self.enc.element_variables) if a != axis)
+        return 1 << (self._bits - len(self.enc.element_variables[axis]))
+
+    @cached_property
+    def _bits(self) -> int:
+        return sum(len(v) for v in self.enc.element_variables)
 
     def summary(self) -> dict[str, int | None]:
         """The same keys as :meth:`synth.sup.supervisor.Supervisor.summary`, all computed."""
@@ -238,14 +242,24 @@ class SymbolicSupervisor:
 
     @cached_property
     def _defended(self) -> Function:
-        """States with an uncontrollable move into an illegal state."""
+        """Legal states with an uncontrollable move into an illegal state. A move changes
+        one element's variables: from a legal state it can only make true the terms with a
+        factor on that element, so each move's pre-image is taken of those terms alone
+        (small sets, where the whole illegal set made the loop quadratic in the elements);
+        its target is in the domain when its source is."""
         from synth.symbolic.relation import preimage
 
-        out = self.enc.engine.false
+        e = self.enc.engine
+        on_axis: dict[int, Function] = {}
+        out = e.false
         for m in self.moves:
-            if not m.controllable:
-                out |= preimage(self.enc, self.illegal, m)
-        return out & self.enc.domain
+            if m.controllable:
+                continue
+            if m.axis not in on_axis:
+                on_axis[m.axis] = e.disjunction(self._product(t.factors) for t in self.compiled.level_terms
+                                                if any(a == m.axis for a, _ in t.factors))
+            out |= preimage(self.enc, on_axis[m.axis], m)
+        return out & self.enc.domain & ~self.illegal
 
 
 def symbolic_supervisor(
