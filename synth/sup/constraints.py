@@ -119,6 +119,7 @@ class CompiledConstraints:
         # elements that read each other: "can reach" is no product of per-element closures
         # (a move depends on other elements' values); one exact grid per term instead
         self.reach_grids: list[np.ndarray] | None = _reach_grids(p, self.constraints, self.level_terms) if p.reads else None
+        self._kept: dict[tuple[int, ...], bool] = {}
         self.edge_terms: dict[str, list[Term]] = {}
         for t in self.terms:
             if t.event is not None:
@@ -136,10 +137,16 @@ class CompiledConstraints:
         return ids
 
     def kept(self, local: tuple[int, ...]) -> bool:
-        """No constraint violation is reachable from ``local`` by uncontrollable events."""
-        if self.reach_grids is not None:
-            return not any(g[local] for g in self.reach_grids)
-        return not any(all(vec[local[a]] for a, vec in factors) for factors in self.level_reach)
+        """No constraint violation is reachable from ``local`` by uncontrollable events
+        (remembered per state: validation asks again for every situation it meets there)."""
+        hit = self._kept.get(local)
+        if hit is None:
+            if self.reach_grids is not None:
+                hit = not any(g[local] for g in self.reach_grids)
+            else:
+                hit = not any(all(vec[local[a]] for a, vec in factors) for factors in self.level_reach)
+            self._kept[local] = hit
+        return hit
 
     def violated(self, local: tuple[int, ...]) -> list[str]:
         """Ids of the constraints the state violates (levels)."""
