@@ -26,6 +26,7 @@ Example
 from __future__ import annotations
 
 import sys
+import weakref
 from functools import reduce
 from typing import Any, Iterable, Mapping, Sequence
 
@@ -379,7 +380,8 @@ class Engine:
         the text order (:class:`~synth.logic.isop.Covers`). :class:`CoverTooLarge` when the
         Minato–Morreale cover has more than ``limit`` cubes."""
         if self._covers is None:
-            self._covers = Covers(self.bdd, lambda inner: self._inner_ranks()[inner])
+            engine = weakref.ref(self)  # no cycle: the engine (and the cubes it caches) freed as soon as unused
+            self._covers = Covers(self.bdd, lambda inner: engine()._inner_ranks()[inner])  # type: ignore[union-attr]
         return [{self._outer[v]: x for v, x in c.items()} for c in self._covers.cover(lower, upper, limit)]
 
     def text(self, lower: Function, upper: Function | None = None, limit: int | None = None) -> str:
