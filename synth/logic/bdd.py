@@ -26,9 +26,11 @@ Example
 from __future__ import annotations
 
 import sys
+import weakref
 from functools import reduce
 from typing import Any, Iterable, Mapping, Sequence
 
+from synth.logic.native import native
 from synth.logic.past import PRE_SUFFIX, pre_name
 from synth.logic.expr import And, Const, Edge, Expr, Not, Var
 from synth.logic.isop import CoverTooLarge, Covers, Cube, expanded
@@ -142,6 +144,8 @@ class Engine:
             n: i for i, n in enumerate(dict.fromkeys(text_order))}
         self._ranks_by_inner: dict[str, int] = {}
         self._covers: Covers | None = None
+        self._cubes: dict[frozenset[str], Function] = {}
+        self._native = native(self.bdd) if self.cudd else None
         for n in order:
             self.declare(n)
 
@@ -193,6 +197,10 @@ class Engine:
 
     def level(self, name: str) -> int:
         return self.bdd.level_of_var(self.declare(name))
+
+    def level_of(self, u: Function) -> int:
+        """The level of ``u``'s top variable; a constant lies below every variable."""
+        return len(self._inner) if u.var is None else int(u.level)
 
     def rank(self, name: str) -> int:
         """The position of ``name`` in the text order (names it does not list come after,
@@ -262,16 +270,28 @@ class Engine:
             inner[self.declare(n)] = self.var(v) if isinstance(v, str) else v
         return self.bdd.let(inner, u) if inner else u
 
+    def quantified(self, inner: Iterable[str]) -> Function:
+        """The positive cube of the variables ``inner`` (internal names), built once per set
+        (dd's ``exist`` and ``forall`` walk every declared variable to build one each call)."""
+        key = frozenset(inner)
+        hit = self._cubes.get(key)
+        if hit is None:
+            hit = self._cubes[key] = self.bdd.cube(key)
+        return hit
+
     def exists(self, names: Iterable[str], u: Function) -> Function:
         vs = [self.declare(n) for n in names]
-        return self.bdd.exist(vs, u) if vs else u
+        return self.bdd.apply("exists", self.quantified(vs), u) if vs else u
 
     def and_exists(self, u: Function, v: Function, inner: Sequence[str]) -> Function:
-        """The relational product ``∃inner. u ∧ v`` in one pass (CUDD's and-abstract), over
-        the manager's variables ``inner`` (internal names, from :meth:`declare`)."""
+        """The relational product ``∃inner. u ∧ v`` in one pass (CUDD's and-abstract over a
+        cached cube, :mod:`synth.logic.native`), over the manager's variables ``inner``
+        (internal names, from :meth:`declare`)."""
+        if self._native is not None:
+            return self._native.product(u, v, self.quantified(inner))
         if not self.cudd:  # pragma: no cover - dd without its CUDD extension
             return self.bdd.exist(inner, u & v)
-        return _backend.and_exists(u, v, inner)
+        return _backend.and_exists(u, v, inner)  # pragma: no cover - a dd whose layout is not known
 
     def live_nodes(self) -> int:
         """The manager's live BDD nodes. With CUDD, its running count (keys − dead, which
@@ -292,15 +312,13 @@ class Engine:
         that is not a terminal case); 0 without CUDD."""
         if not self.cudd:  # pragma: no cover - dd without its CUDD extension
             return 0
-        import warnings
-
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")  # dd's note that the key 'mem' is now in bytes
-            return int(self.bdd.statistics()["cache_lookups"])
+        if self._native is not None:
+            return self._native.lookups()
+        return int(self.bdd.statistics()["cache_lookups"])  # pragma: no cover - a dd whose layout is not known
 
     def forall(self, names: Iterable[str], u: Function) -> Function:
         vs = [self.declare(n) for n in names]
-        return self.bdd.forall(vs, u) if vs else u
+        return self.bdd.apply("forall", self.quantified(vs), u) if vs else u
 
     def support(self, u: Function) -> list[str]:
         """The names ``u`` depends on, in variable order."""
@@ -362,7 +380,8 @@ class Engine:
         the text order (:class:`~synth.logic.isop.Covers`). :class:`CoverTooLarge` when the
         Minato–Morreale cover has more than ``limit`` cubes."""
         if self._covers is None:
-            self._covers = Covers(self.bdd, lambda inner: self._inner_ranks()[inner])
+            engine = weakref.ref(self)  # no cycle: the engine (and the cubes it caches) freed as soon as unused
+            self._covers = Covers(self.bdd, lambda inner: engine()._inner_ranks()[inner])  # type: ignore[union-attr]
         return [{self._outer[v]: x for v, x in c.items()} for c in self._covers.cover(lower, upper, limit)]
 
     def text(self, lower: Function, upper: Function | None = None, limit: int | None = None) -> str:

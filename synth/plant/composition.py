@@ -160,9 +160,22 @@ class Plant:
         return np.asarray(t.guard, dtype=bool)[code]
 
     def guard_grid(self, t: LocalTransition) -> np.ndarray:
-        """``t``'s guard as an array broadcastable to the grid of its sources ``[..., src, ...]``."""
+        """``t``'s guard as an array broadcastable to the grid of its sources ``[..., src, ...]``
+        (built once per transition: read-only)."""
         if t.guard is None:
             return np.ones((1,) * (self.ndim - 1), dtype=bool)
+        grid = self._guard_grids.get(t)
+        if grid is None:
+            grid = self._guard_grids[t] = self._build_guard_grid(t)
+            grid.flags.writeable = False
+        return grid
+
+    @functools.cached_property
+    def _guard_grids(self) -> dict[LocalTransition, np.ndarray]:
+        return {}
+
+    def _build_guard_grid(self, t: LocalTransition) -> np.ndarray:
+        assert t.guard is not None
         code = np.zeros((1,) * self.ndim, dtype=np.int64)
         for j, r in enumerate(self.elements[t.axis].reads):
             code = code | (self.values(r).astype(np.int64) << j)

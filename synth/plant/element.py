@@ -48,6 +48,13 @@ __all__ = ["ElementAutomaton", "element_automaton"]
 MAX_ELEMENT_VARIABLES = 20
 
 
+
+def distinct(a: np.ndarray) -> np.ndarray:
+    """``np.unique(a)`` for an integer array, by sorting: ``np.unique`` asks whether its
+    argument is a masked array, which imports ``numpy.ma`` (25 ms of every start)."""
+    a = np.sort(a)
+    return a[np.concatenate(([True], a[1:] != a[:-1]))] if a.size else a
+
 @dataclass(frozen=True, eq=False)
 class ElementAutomaton:
     """States are codes over the element's variables (bit i = ``variables[i]``).
@@ -132,7 +139,7 @@ class ElementAutomaton:
             if not counts.sum():
                 break
             idx = np.repeat(lo - np.concatenate(([0], np.cumsum(counts)[:-1])), counts) + np.arange(counts.sum())
-            found = np.unique(nbr[idx])
+            found = distinct(nbr[idx])
             frontier = found[~reach[found]]
             reach[frontier] = True
         return reach
@@ -251,7 +258,7 @@ def element_automaton(e: ElementSpec) -> ElementAutomaton:
             src = frontier[mask[frontier]]
             dst = src ^ (1 << i)
             found.append(dst[coherent[dst]])
-        new = np.unique(np.concatenate(found)) if found else frontier[:0]
+        new = distinct(np.concatenate(found)) if found else frontier[:0]
         frontier = new[~seen_mask[new]]
         seen_mask[frontier] = True
     codes = np.nonzero(seen_mask)[0].astype(np.int64)  # the reachable codes, sorted: state k is codes[k]

@@ -18,12 +18,14 @@ True
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass
 from typing import Iterable, Sequence
 
 import numpy as np
 
 from synth.logic.expr import disjunctive_normal_form, edge_text
+from synth.plant.closure import backward_closures
 from synth.plant.composition import LocalTransition, Plant
 from synth.plant.rules import Constraint
 
@@ -74,14 +76,20 @@ def _closed(p: Plant, factors: Iterable[tuple[int, np.ndarray]]) -> tuple[tuple[
     return tuple((a, p.elements[a].can_reach(v)) for a, v in factors)
 
 
-def _backward(p: Plant, grid: np.ndarray) -> np.ndarray:
-    """The states from which uncontrollable moves (guards evaluated) reach ``grid``."""
-    reach = grid.copy()
-    while True:
-        more = p.preimage(reach, controllable=False) & ~reach
-        if not more.any():
-            return reach
-        reach |= more
+_reach_cache: "weakref.WeakKeyDictionary[Plant, dict[tuple[Constraint, ...], list[np.ndarray]]]" = weakref.WeakKeyDictionary()
+
+
+def _reach_grids(p: Plant, constraints: tuple[Constraint, ...], level_terms: Sequence[Term]) -> list[np.ndarray]:
+    """Per level term, the states from which uncontrollable moves (guards evaluated) reach
+    it: computed once per plant and constraints (compared by content; validation, SUP and
+    the filter's closed loop share them), read-only."""
+    per_plant = _reach_cache.setdefault(p, {})
+    if constraints not in per_plant:
+        grids = backward_closures(p, [_product(p, t.factors) for t in level_terms], controllable=False)
+        for g in grids:
+            g.flags.writeable = False
+        per_plant[constraints] = grids
+    return list(per_plant[constraints])
 
 
 def _holds(factors: Sequence[tuple[int, np.ndarray]], digits: np.ndarray) -> np.ndarray:
@@ -110,9 +118,8 @@ class CompiledConstraints:
         self.level_reach = [_closed(p, t.factors) for t in self.level_terms]
         # elements that read each other: "can reach" is no product of per-element closures
         # (a move depends on other elements' values); one exact grid per term instead
-        self.reach_grids: list[np.ndarray] | None = (
-            [_backward(p, _product(p, t.factors)) for t in self.level_terms] if p.reads else None
-        )
+        self.reach_grids: list[np.ndarray] | None = _reach_grids(p, self.constraints, self.level_terms) if p.reads else None
+        self._kept: dict[tuple[int, ...], bool] = {}
         self.edge_terms: dict[str, list[Term]] = {}
         for t in self.terms:
             if t.event is not None:
@@ -130,10 +137,16 @@ class CompiledConstraints:
         return ids
 
     def kept(self, local: tuple[int, ...]) -> bool:
-        """No constraint violation is reachable from ``local`` by uncontrollable events."""
-        if self.reach_grids is not None:
-            return not any(g[local] for g in self.reach_grids)
-        return not any(all(vec[local[a]] for a, vec in factors) for factors in self.level_reach)
+        """No constraint violation is reachable from ``local`` by uncontrollable events
+        (remembered per state: validation asks again for every situation it meets there)."""
+        hit = self._kept.get(local)
+        if hit is None:
+            if self.reach_grids is not None:
+                hit = not any(g[local] for g in self.reach_grids)
+            else:
+                hit = not any(all(vec[local[a]] for a, vec in factors) for factors in self.level_reach)
+            self._kept[local] = hit
+        return hit
 
     def violated(self, local: tuple[int, ...]) -> list[str]:
         """Ids of the constraints the state violates (levels)."""

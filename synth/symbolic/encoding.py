@@ -133,6 +133,7 @@ class PlantEncoding:
         self._quantified: dict[tuple, Function] = {}
         self._qvars: dict[tuple, list[str]] = {}
         self._inner = {v: self.engine.declare(v) for v in self.variables}
+        self._levels: dict[tuple[Copy, ...], list[int]] = {}
 
     # ---- names and renaming
     @staticmethod
@@ -244,7 +245,15 @@ class PlantEncoding:
     def count(self, u: Function, copies: Sequence[Copy] = (Copy.CURRENT,)) -> int:
         """The exact number of valuations of the given copies of the variables in ``u``
         (``u`` must depend on those copies only; :func:`synth.logic.counting.count`)."""
-        return count(self.engine, u, (self.engine.level(v + c.value) for v in self.variables for c in copies))
+        return count(self.engine, u, self.levels(copies))
+
+    def levels(self, copies: Sequence[Copy]) -> list[int]:
+        """The sorted BDD levels of the given copies of every plant variable."""
+        key = tuple(copies)
+        levels = self._levels.get(key)
+        if levels is None:
+            levels = self._levels[key] = sorted(self.engine.level(v + c.value) for v in self.variables for c in copies)
+        return levels
 
     def check(self, where: str) -> None:
         self.budget.check(self.engine, where)

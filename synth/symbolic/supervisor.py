@@ -29,6 +29,7 @@ from typing import Callable, Mapping, Sequence
 import numpy as np
 
 from synth.logic.bdd import Function
+from synth.logic.counting import Conjunctions
 from synth.plant.composition import Plant
 from synth.plant.rules import Constraint
 from synth.sup.constraints import CompiledConstraints
@@ -161,42 +162,63 @@ class SymbolicSupervisor:
         """(controllable kept, uncontrollable kept, controllable cut), as Supervisor._counts."""
         kept = [0, 0]
         cut = 0
-        both = (Copy.CURRENT, Copy.NEXT)
-        for m in self.moves:
-            src = self.states & m.relation
-            ok = self.enc.count(src & self.allowed(m), both) // self._others(m.axis)
-            n = self.enc.count(src, both) // self._others(m.axis)
-            kept[0 if m.controllable else 1] += ok
-            if m.controllable:
-                cut += n - ok
+        # per move, its transitions from SUP's states, and those SUP keeps (allowed(m) lies in m.relation)
+        sets = [(m, g, keep) for m in self.moves for g, keep in ((self.allowed(m), True), (m.relation, False))]
+        sizes = self._within_counts([g for _, g, _ in sets])
+        for (m, _, keep), n in zip(sets, sizes):
+            n //= self._others(m.axis)
+            if keep:
+                kept[0 if m.controllable else 1] += n
+                cut -= n if m.controllable else 0
+            elif m.controllable:
+                cut += n
         return kept[0], kept[1], cut
 
     def forbidden_counts(self) -> dict[str, int]:
         """Cut controllable transitions per constraint id, as
         :meth:`synth.sup.supervisor.Supervisor.forbidden_counts` (a transition counts for
         every constraint whose violation it would make reachable, or that forbids its event)."""
-        both = (Copy.CURRENT, Copy.NEXT)
         counts = {c.id: 0 for c in self.constraints}
+        hits: list[tuple[str, int, Function]] = []
+        # a constraint none of whose terms reads the move's element is no threat after the
+        # move (SUP's states threaten nothing) and forbids its event only by an edge term
+        on_axis: dict[str, set[int]] = {}
+        for t, f in zip(self.compiled.level_terms, self.compiled.level_reach):
+            on_axis.setdefault(t.constraint, set()).update(a for a, _ in f)
         for cid in counts:
             threat = self.threatened(cid)
             edge = {e: self.enc.engine.disjunction(self._product(t.factors) for t in ts if t.constraint == cid)
-                    for e, ts in self.compiled.edge_terms.items()}
+                    for e, ts in self.compiled.edge_terms.items() if any(t.constraint == cid for t in ts)}
             for m in self.moves:
-                if not m.controllable:
+                reads = m.axis in on_axis.get(cid, ())
+                if not m.controllable or not (reads or m.event in edge):
                     continue
                 names = self.enc.element_variables[m.axis]
-                bad = self.enc.rename(threat, Copy.CURRENT, Copy.NEXT, names)
+                bad = self.enc.rename(threat, Copy.CURRENT, Copy.NEXT, names) if reads else self.enc.engine.false
                 if m.event in edge:
                     bad |= edge[m.event]
-                hit = self.states & m.relation & bad
-                if hit != self.enc.engine.false:
-                    counts[cid] += self.enc.count(hit, both) // self._others(m.axis)
+                hits.append((cid, m.axis, m.relation & bad))
+        for (cid, axis, _), n in zip(hits, self._within_counts([g for _, _, g in hits])):
+            counts[cid] += n // self._others(axis)
         return {k: v for k, v in counts.items() if v}
+
+    def _within_counts(self, sets: Sequence[Function]) -> list[int]:
+        """``|states ∧ g|`` over both copies for each ``g`` (a move's relation, or part of
+        it), exactly, computed in the order of the sets' top levels: one sweep of the cuts."""
+        within = Conjunctions(self.enc.engine, self.states, self.enc.levels((Copy.CURRENT, Copy.NEXT)))
+        out = [0] * len(sets)
+        for k in sorted(range(len(sets)), key=lambda k: self.enc.engine.level_of(sets[k])):
+            out[k] = within.count(sets[k])
+        return out
 
     def _others(self, axis: int) -> int:
         """Counting over both copies counts the unconstrained next variables of the other
         elements too: this factor removes them."""
-        return 1 << sum(len(v) for a, v in enumerate(self.enc.element_variables) if a != axis)
+        return 1 << (self._bits - len(self.enc.element_variables[axis]))
+
+    @cached_property
+    def _bits(self) -> int:
+        return sum(len(v) for v in self.enc.element_variables)
 
     def summary(self) -> dict[str, int | None]:
         """The same keys as :meth:`synth.sup.supervisor.Supervisor.summary`, all computed."""
@@ -220,14 +242,24 @@ class SymbolicSupervisor:
 
     @cached_property
     def _defended(self) -> Function:
-        """States with an uncontrollable move into an illegal state."""
+        """Legal states with an uncontrollable move into an illegal state. A move changes
+        one element's variables: from a legal state it can only make true the terms with a
+        factor on that element, so each move's pre-image is taken of those terms alone
+        (small sets, where the whole illegal set made the loop quadratic in the elements);
+        its target is in the domain when its source is."""
         from synth.symbolic.relation import preimage
 
-        out = self.enc.engine.false
+        e = self.enc.engine
+        on_axis: dict[int, Function] = {}
+        out = e.false
         for m in self.moves:
-            if not m.controllable:
-                out |= preimage(self.enc, self.illegal, m)
-        return out & self.enc.domain
+            if m.controllable:
+                continue
+            if m.axis not in on_axis:
+                on_axis[m.axis] = e.disjunction(self._product(t.factors) for t in self.compiled.level_terms
+                                                if any(a == m.axis for a, _ in t.factors))
+            out |= preimage(self.enc, on_axis[m.axis], m)
+        return out & self.enc.domain & ~self.illegal
 
 
 def symbolic_supervisor(

@@ -193,8 +193,29 @@ def synchronous_product(
     edges: list[Edge] = []
     conflicts: list[Conflict] = []
 
+    # per plant state, the Grafcet's inputs (and their values as a key); per situation and
+    # input values, the orders: SYNC meets each many times (its plant states differ in the
+    # orders, which the Grafcet does not read)
+    seen_inputs: dict[Local, tuple[dict[str, bool], tuple[bool, ...]]] = {}
+
+    def read(local: Local) -> tuple[dict[str, bool], tuple[bool, ...]]:
+        hit = seen_inputs.get(local)
+        if hit is None:
+            values = _grafcet_inputs(p, machine, local)
+            hit = seen_inputs[local] = (values, tuple(values.values()))
+        return hit
+
     def inputs(local: Local) -> dict[str, bool]:
-        return _grafcet_inputs(p, machine, local)
+        return read(local)[0]
+
+    orders_cache: dict[tuple[Situation, tuple[bool, ...]], frozenset[str]] = {}
+
+    def orders(sit: Situation, local: Local) -> frozenset[str]:
+        values, key = read(local)
+        hit = orders_cache.get((sit, key))
+        if hit is None:
+            hit = orders_cache[(sit, key)] = machine.orders(sit, values)
+        return hit
     moves = _order_moves(p)
     uncontrollable = [t for t in p.transitions if not t.controllable]
     index: dict[tuple[Situation, Local], int] = {}
@@ -204,7 +225,7 @@ def synchronous_product(
     def enter(sit: Situation, entry: Local) -> list[int]:
         key = (sit, entry)
         if key not in region_cache:
-            wanted = machine.orders(sit, inputs(entry))
+            wanted = orders(sit, entry)
             members, settled = region(p, oracle, entry, wanted, moves)
             sync_seen.update((sit, m) for m in members)
             region_cache[key] = settled
@@ -212,7 +233,7 @@ def synchronous_product(
         for q, proh in region_cache[key]:
             nk = (sit, q)
             if nk not in index:
-                wanted = machine.orders(sit, inputs(q))
+                wanted = orders(sit, q)
                 val = p.valuation(q)
                 ords = tuple(sorted(o for o in wanted if val.get(o, False)))
                 index[nk] = len(nodes)

@@ -21,7 +21,6 @@ from synth.grafcet.machine import GrafcetMachine
 from synth.logic.expr import Expr, evaluate
 from synth.plant.composition import Plant
 from synth.plant.rules import RuleSet
-from synth.sup.constraints import CompiledConstraints
 from synth.validation.analysis import analyse
 from synth.validation.result import Validation, home_conditions, load_model
 from synth.validation.sync import Sync, synchronous_product
@@ -77,8 +76,8 @@ def validate_loaded(
     ``progress(aggregated states, states to visit)`` is called now and then."""
     conditions = home_conditions(homes, p, g)
     machine = GrafcetMachine(g)
-    sup_empty = not CompiledConstraints(p, rs.constraints).kept(p.initial)
     sync = synchronous_product(p, rs.constraints, machine, max_states=max_states, progress=progress)
+    sup_empty = not sync.oracle.kept(p.initial)  # the constraints compiled once
     analysis = analyse(sync, home_states(sync, conditions))
     if not (analysis.blocking or analysis.never_starts or analysis.prohibited):  # a passing run imports no diagnosis
         return Validation(rs, p, g, sync, analysis, {}, expert, sup_empty, tuple(homes), None)

@@ -1,0 +1,107 @@
+"""CPU seconds of the everyday station, the symbolic SUP of long lines and the explicit
+engine per SYNC state, for one or more synth trees side by side (issue 37).
+
+    python3 bench/speed.py [--tree DIR]... [--runs 3] [--lines 100,200,300] [--explicit par_8,line_8]
+
+Each measure runs in a fresh process (``python -m synth`` or a short script, that tree
+first on ``PYTHONPATH``, run from a neutral folder so the tree is the one imported) and
+is timed in CPU seconds (user + system of the child, ``resource.getrusage``): the machine
+is shared, wall time says little. Trees and runs are interleaved, so a change in the
+load hits every tree alike; the minimum of the runs is printed.
+
+- ``four cylinders``: ``synth validate grafcets/four_cylinders.g7 --plant plants/four_cylinders.rules``
+  (the whole command: start, constraints, SYNC, diagnosis, report text);
+- ``sup line_N``: ``synth sup line_N.rules --engine symbolic --quiet`` on the line of N
+  double-acting cylinders of ``bench/gen_line.py`` (a tree that fails says why);
+- ``explicit F``: the explicit validation of a bench family (``par_8``: ``gen_par.py``,
+  ``line_8``: ``gen_line.py``), timed inside the process from the loaded model to the
+  result, divided by its SYNC states: microseconds per state.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import resource
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+
+EXPLICIT = r"""
+import json, sys, time
+from synth.validation.result import load_model
+from synth.validation.validate import validate_loaded
+rs, p, g = load_model(sys.argv[1], sys.argv[2])
+t = time.process_time()
+v = validate_loaded(rs, p, g)
+print(json.dumps({"cpu": time.process_time() - t, "states": v.sync.sync_states}))
+"""
+
+
+def _child(tree: Path, argv: list[str], timeout: float) -> tuple[float, str, int]:
+    """CPU seconds, stdout and exit code of one fresh process."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    env = dict(os.environ, PYTHONPATH=str(tree))
+    try:
+        done = subprocess.run([sys.executable, *argv], capture_output=True, text=True, env=env, timeout=timeout,
+                              cwd=tempfile.gettempdir(), check=False)
+        out, code = done.stdout, done.returncode
+    except subprocess.TimeoutExpired:
+        out, code = "", -1
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime, out, code
+
+
+def measures(work: Path, lines: list[int], families: list[str]) -> dict[str, list[str]]:
+    """Name -> argv (after the interpreter) of every measure, its inputs generated into ``work``."""
+    out = {"four cylinders": ["-m", "synth", "validate", str(ROOT / "grafcets/four_cylinders.g7"),
+                              "--plant", str(ROOT / "plants/four_cylinders.rules")]}
+    for n in lines:
+        subprocess.run([sys.executable, str(ROOT / "bench/gen_line.py"), str(n), str(work)], check=True, capture_output=True)
+        out[f"sup line_{n}"] = ["-m", "synth", "sup", str(work / f"line_{n}.rules"), "--engine", "symbolic", "--quiet"]
+    for family in families:
+        name, n = family.rsplit("_", 1)
+        subprocess.run([sys.executable, str(ROOT / f"bench/gen_{name}.py"), n, str(work)], check=True, capture_output=True)
+        out[f"explicit {family}"] = ["-c", EXPLICIT, str(work / f"{family}.g7"), str(work / f"{family}.rules")]
+    return out
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--tree", action="append", type=Path, help="a synth source tree (default: this one); repeat to compare")
+    ap.add_argument("--runs", type=int, default=3)
+    ap.add_argument("--lines", default="100,200,300", help="line sizes for the symbolic SUP ('' for none)")
+    ap.add_argument("--explicit", default="par_8,line_8", help="bench families for the explicit engine ('' for none)")
+    ap.add_argument("--timeout", type=float, default=600.0, help="seconds per process")
+    args = ap.parse_args()
+    trees = args.tree or [ROOT]
+    with tempfile.TemporaryDirectory() as tmp:
+        todo = measures(Path(tmp), [int(n) for n in args.lines.split(",") if n], [f for f in args.explicit.split(",") if f])
+        for name, argv in todo.items():
+            best: dict[Path, str] = {}
+            cpu: dict[Path, float] = {}
+            for _ in range(args.runs):
+                for tree in trees:
+                    seconds, out, code = _child(tree, argv, args.timeout)
+                    if code not in ((0,) if name.startswith("sup") else (0, 1)):  # validate: 1 is a failing model
+                        best[tree] = "timeout" if code == -1 else f"exit {code}"
+                        continue
+                    if name.startswith("explicit"):
+                        data = json.loads(out)
+                        seconds = data["cpu"]
+                        text = f"{seconds:.2f} CPU s, {data['states']} SYNC states, {1e6 * seconds / data['states']:.0f} µs/state"
+                    else:
+                        text = f"{seconds:.2f} CPU s"
+                    if tree not in cpu or seconds < cpu[tree]:
+                        cpu[tree], best[tree] = seconds, text
+            for tree in trees:
+                print(f"{name:22} {str(tree):30} {best.get(tree, '-')}", flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
