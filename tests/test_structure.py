@@ -188,9 +188,17 @@ def test_the_private_scan_sees_a_reach_and_spares_self_and_own_names() -> None:
     assert private_reaches("synth.x", source) == ["synth.x: cls_of(m)._d", "synth.x: m._c", "synth.x: other._b"]
 
 
+# The one module allowed to reach into another library's internals: synth.logic.native calls
+# CUDD's combined and-abstract on dd's own nodes (dd has no call that takes a ready-made cube),
+# so it converts between dd's variables, indices and node pointers with dd's private helpers;
+# it checks dd's object layout first and falls back to dd's public calls when it differs.
+THIRD_PARTY_INTERNALS = ["synth.logic.native: bdd._index_of_var", "synth.logic.native: bdd._var_with_index",
+                         "synth.logic.native: self.bdd._add_int"]
+
+
 def test_no_module_reads_another_objects_private_members() -> None:
     found = [r for n, p in modules().items() for r in private_reaches(n, p.read_text(encoding="utf-8"))]
-    assert found == []
+    assert found == THIRD_PARTY_INTERNALS
 
 
 def test_the_tests_share_one_root() -> None:
@@ -198,3 +206,13 @@ def test_the_tests_share_one_root() -> None:
     own = [p.name for p in sorted((ROOT / "tests").glob("*.py"))
            if p.name != "conftest.py" and any(line.startswith("ROOT = ") for line in p.read_text("utf-8").splitlines())]
     assert own == []
+
+
+def test_no_module_imports_another_modules_private_names() -> None:
+    """``from synth.x import _name`` reaches into another module as ``obj._name`` does."""
+    found = sorted(
+        f"{n}: from {node.module} import {a.name}" for n, p in modules().items()
+        for node in ast.walk(ast.parse(p.read_text(encoding="utf-8")))
+        if isinstance(node, ast.ImportFrom) and (node.module or "").startswith("synth")
+        for a in node.names if a.name.startswith("_") and not a.name.startswith("__"))
+    assert found == []

@@ -225,15 +225,15 @@ class Engine:
         for u in us:
             first = None if cache is None else cache.get(u)
             if first is None and u.var is not None:
-                ranks = self._inner_ranks()
+                ranks = self.inner_ranks()
                 first = min(self.bdd.support(u), key=ranks.__getitem__)
                 if cache is not None:
                     cache[u] = first
             if first is not None:
                 firsts.append(first)
-        return min(firsts, key=self._inner_ranks().__getitem__)
+        return min(firsts, key=self.inner_ranks().__getitem__)
 
-    def _inner_ranks(self) -> dict[str, int]:
+    def inner_ranks(self) -> dict[str, int]:
         """Internal name -> rank in the text order, rebuilt when variables were declared."""
         if len(self._ranks_by_inner) != len(self._outer):
             self._ranks_by_inner = {i: self.rank(n) for i, n in self._outer.items()}
@@ -381,7 +381,7 @@ class Engine:
         Minato–Morreale cover has more than ``limit`` cubes."""
         if self._covers is None:
             engine = weakref.ref(self)  # no cycle: the engine (and the cubes it caches) freed as soon as unused
-            self._covers = Covers(self.bdd, lambda inner: engine()._inner_ranks()[inner])  # type: ignore[union-attr]
+            self._covers = Covers(self.bdd, lambda inner: engine().inner_ranks()[inner])  # type: ignore[union-attr]
         return [{self._outer[v]: x for v, x in c.items()} for c in self._covers.cover(lower, upper, limit)]
 
     def text(self, lower: Function, upper: Function | None = None, limit: int | None = None) -> str:

@@ -29,7 +29,7 @@ from synth.plant.closure import backward_closures
 from synth.plant.composition import LocalTransition, Plant
 from synth.plant.rules import Constraint
 
-__all__ = ["CompiledConstraints", "GRID_LIMIT", "Term", "split_terms"]
+__all__ = ["CompiledConstraints", "GRID_LIMIT", "Term", "split_terms", "grid_of_term", "term_holds"]
 
 
 @dataclass(frozen=True)
@@ -62,7 +62,7 @@ def split_terms(p: Plant, constraints: Sequence[Constraint]) -> list[Term]:
     return out
 
 
-def _product(p: Plant, factors: Iterable[tuple[int, np.ndarray]]) -> np.ndarray:
+def grid_of_term(p: Plant, factors: Iterable[tuple[int, np.ndarray]]) -> np.ndarray:
     grid = np.ones(p.shape, dtype=bool)
     for axis, vec in factors:
         shape = [1] * p.ndim
@@ -85,14 +85,14 @@ def _reach_grids(p: Plant, constraints: tuple[Constraint, ...], level_terms: Seq
     the filter's closed loop share them), read-only."""
     per_plant = _reach_cache.setdefault(p, {})
     if constraints not in per_plant:
-        grids = backward_closures(p, [_product(p, t.factors) for t in level_terms], controllable=False)
+        grids = backward_closures(p, [grid_of_term(p, t.factors) for t in level_terms], controllable=False)
         for g in grids:
             g.flags.writeable = False
         per_plant[constraints] = grids
     return list(per_plant[constraints])
 
 
-def _holds(factors: Sequence[tuple[int, np.ndarray]], digits: np.ndarray) -> np.ndarray:
+def term_holds(factors: Sequence[tuple[int, np.ndarray]], digits: np.ndarray) -> np.ndarray:
     """Whether a product term holds at each of the states whose digits (ndim × n) are given."""
     out = np.ones(digits.shape[1], dtype=bool)
     for a, vec in factors:

@@ -41,7 +41,7 @@ import numpy as np
 from synth.errors import LimitExceeded
 from synth.plant.composition import LocalTransition, Plant
 from synth.plant.rules import Constraint
-from synth.sup.constraints import GRID_LIMIT, CompiledConstraints, _holds, _product
+from synth.sup.constraints import GRID_LIMIT, CompiledConstraints, term_holds, grid_of_term
 
 __all__ = ["Supervisor", "supremal_controllable", "VisitedSet", "FLAT_BITMAP_LIMIT"]
 
@@ -76,7 +76,7 @@ class Supervisor(CompiledConstraints):
                 bad |= g.ravel()[codes]
             return ~bad
         for factors in self.level_reach:
-            bad |= _holds(factors, digits)
+            bad |= term_holds(factors, digits)
         return ~bad
 
     # ------------------------------------------------------------------ SUP
@@ -125,7 +125,7 @@ class Supervisor(CompiledConstraints):
                 ]
             if t.controllable:
                 for term in self.edge_terms.get(t.event, ()):
-                    hits.append((term.constraint, _holds(term.factors, digits[:, sel])))
+                    hits.append((term.constraint, term_holds(term.factors, digits[:, sel])))
             yield t, src, dst, hits
 
     @cached_property
@@ -193,7 +193,7 @@ class Supervisor(CompiledConstraints):
         """The union of the terms, each a product of per-element factors (axis, local states)."""
         out = np.zeros(self.plant.shape, dtype=bool)
         for factors in terms:
-            out |= _product(self.plant, factors)
+            out |= grid_of_term(self.plant, factors)
         return out
 
     @cached_property

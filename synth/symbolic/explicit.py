@@ -27,7 +27,7 @@ from synth.plant.composition import Plant
 from synth.sup.constraints import CompiledConstraints
 from synth.symbolic.interface import Key, Numbered, Path, PathKey
 from synth.validation.analysis import Trace
-from synth.validation.sync import Edge, Node, Prohibition, _order_moves
+from synth.validation.sync import Edge, Node, Prohibition, moves_by_order
 
 __all__ = ["ExplicitNodes", "Blocking"]
 
@@ -41,7 +41,7 @@ class ExplicitNodes:
         self.numbering = numbering
         self.p: Plant = numbering.plant
         self.oracle = oracle
-        self.moves = _order_moves(self.p)
+        self.moves = moves_by_order(self.p)
         self.nodes: list[Node] = []
         self.index: dict[Key, int] = {}
         self.edges: list[Edge] = []

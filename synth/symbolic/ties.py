@@ -36,7 +36,7 @@ from synth.logic.events import Event
 from synth.sup.constraints import CompiledConstraints
 from synth.symbolic.interface import Key, Local, Numbered
 from synth.symbolic.relation import Move
-from synth.validation.sync import _grafcet_inputs, _order_moves, region
+from synth.validation.sync import grafcet_inputs, moves_by_order, region
 
 __all__ = ["Settled", "REGION_LIMIT"]
 
@@ -55,7 +55,7 @@ class Settled:
         self.sync = sync
         self.p = sync.plant
         self.oracle = oracle
-        self.moves = _order_moves(self.p)
+        self.moves = moves_by_order(self.p)
         self._found: dict[tuple[Key | None, Event | None], tuple[int, list[Local] | None]] = {}
 
     def order(self, parent: Key | None, event: Event | None, move: Move | None) -> tuple[int, list[Local] | None]:
@@ -85,7 +85,7 @@ class Settled:
         p, machine = self.p, self.sync.machine
 
         def inputs(local: Local) -> dict[str, bool]:
-            return _grafcet_inputs(p, machine, local)
+            return grafcet_inputs(p, machine, local)
 
         if parent is None or event is None:
             entry = p.initial

@@ -40,7 +40,7 @@ from synth.plant.rules import Constraint
 from synth.sup.constraints import CompiledConstraints
 from synth.validation.conflicts import Conflict, ConflictLog
 
-__all__ = ["Prohibition", "Node", "Edge", "Sync", "synchronous_product", "region"]
+__all__ = ["Prohibition", "Node", "Edge", "Sync", "synchronous_product", "region", "grafcet_inputs", "moves_by_order"]
 
 Local = tuple[int, ...]
 
@@ -110,18 +110,22 @@ class Sync:
 
     def inputs(self, local: Local) -> dict[str, bool]:
         """The Grafcet's inputs in plant state ``local``."""
-        return _grafcet_inputs(self.plant, self.machine, local)
+        return grafcet_inputs(self.plant, self.machine, local)
 
     def vectors(self, i: int) -> tuple[str, str]:
         return self.plant.vectors(self.nodes[i].plant)
 
 
-def _grafcet_inputs(p: Plant, machine: GrafcetMachine, local: Local) -> dict[str, bool]:
+def grafcet_inputs(p: Plant, machine: GrafcetMachine, local: Local) -> dict[str, bool]:
+    """The values of the Grafcet's inputs in the plant state ``local`` (the symbolic engine's
+    ties read them too)."""
     val = p.valuation(local)
     return {n: val[n] for n in machine.inputs if n in val}
 
 
-def _order_moves(p: Plant) -> dict[str, list[LocalTransition]]:
+def moves_by_order(p: Plant) -> dict[str, list[LocalTransition]]:
+    """The plant's controllable moves by the order that starts them, in the explicit engine's
+    order (both symbolic paths follow it when they make nodes explicit)."""
     moves: dict[str, list[LocalTransition]] = {}
     for t in p.transitions:
         if t.controllable:
@@ -143,7 +147,7 @@ def region(
     changes SUP refuses there. ``limit``: raise :class:`~synth.errors.LimitExceeded`
     past this many members.
     """
-    moves = order_moves if order_moves is not None else _order_moves(p)
+    moves = order_moves if order_moves is not None else moves_by_order(p)
     members = [entry]
     seen = {entry}
     settled: list[tuple[Local, tuple[Prohibition, ...]]] = []
@@ -201,7 +205,7 @@ def synchronous_product(
     def read(local: Local) -> tuple[dict[str, bool], tuple[bool, ...]]:
         hit = seen_inputs.get(local)
         if hit is None:
-            values = _grafcet_inputs(p, machine, local)
+            values = grafcet_inputs(p, machine, local)
             hit = seen_inputs[local] = (values, tuple(values.values()))
         return hit
 
@@ -216,7 +220,7 @@ def synchronous_product(
         if hit is None:
             hit = orders_cache[(sit, key)] = machine.orders(sit, values)
         return hit
-    moves = _order_moves(p)
+    moves = moves_by_order(p)
     uncontrollable = [t for t in p.transitions if not t.controllable]
     index: dict[tuple[Situation, Local], int] = {}
     region_cache: dict[tuple[Situation, Local], list[tuple[Local, tuple[Prohibition, ...]]]] = {}

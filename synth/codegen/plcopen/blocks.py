@@ -26,7 +26,7 @@ from synth.codegen.plcopen.actions import rising
 from synth.codegen.plcopen.data import DATA, duration
 from synth.errors import InputError, Location, Severity
 
-__all__ = ["FBD_FUNCTION_BLOCKS", "sel", "trigger", "ton_output"]
+__all__ = ["FBD_FUNCTION_BLOCKS", "sel", "trigger", "ton_output", "warn_block"]
 
 FBD_FUNCTION_BLOCKS = ("SEL", "R_TRIG", "F_TRIG", "TON")
 """The blocks other than AND/OR/NOT read in an FBD transition condition."""
@@ -45,7 +45,7 @@ def _bare(text: str) -> str:
     return text
 
 
-def _warn(message: str, where: Location) -> None:
+def warn_block(message: str, where: Location) -> None:
     scope = DATA.get()
     if scope is not None and not any(w.message == message for w in scope.warnings):  # a block shared by transitions
         scope.warnings.append(InputError(message, where, severity=Severity.WARNING))
@@ -63,7 +63,7 @@ def trigger(kind: str, instance: str, clk: str, where: Location) -> str:
                          "a conjunction of inputs", where)
     if re.search(r"\bX\w+\b|/X", edge):
         raise InputError(f"{kind} {instance} of a step's activity or timer ({clk}): .g7 edges are input events", where)
-    _warn(f"{kind} {instance} is read as {edge}: the PLC's instance remembers CLK from its last call (made while the "
+    warn_block(f"{kind} {instance} is read as {edge}: the PLC's instance remembers CLK from its last call (made while the "
           "transition is evaluated, i.e. while its step is active), so a change of CLK while the step was inactive "
           "is seen at its activation by the PLC, never by .g7", where)
     return edge
@@ -125,7 +125,7 @@ def ton_output(instance: str, c: str, pt_text: str, sources: list[str], where: L
             scope.helper_charts.append(chart)  # read twice: an SR latch's loop
         what = (f"{timer}, the timer of step {on} of the partial grafcet {instance}_TON, active while step {step} is "
                 f"and {c} holds")
-    _warn(f"the TON {instance} wired with IN:={given} to the condition of a transition leaving step {step}: {instance}.Q "
+    warn_block(f"the TON {instance} wired with IN:={given} to the condition of a transition leaving step {step}: {instance}.Q "
           f"is read as {what} (a TON keeps Q until it is called with IN FALSE; a .g7 timer restarts at each "
           "activation of its step)", where)
     return timer

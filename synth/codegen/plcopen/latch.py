@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import re
 
-from synth.codegen.plcopen.blocks import _warn
+from synth.codegen.plcopen.blocks import warn_block
 from synth.codegen.plcopen.data import DATA, HelperChart
 from synth.errors import InputError, Location
 
@@ -92,7 +92,7 @@ def latch_chart(kind: str, instance: str, set_in: str, reset_in: str, sources: l
                          "reads one latch per step", where)
     if chart not in scope.extra_charts:
         scope.extra_charts.append(chart)
-    _warn(f"the {kind} {instance} wired to the condition of a transition leaving step {step}: {instance}.Q1 is read "
+    warn_block(f"the {kind} {instance} wired to the condition of a transition leaving step {step}: {instance}.Q1 is read "
           f"as X{on}, the activity of step {on} of the partial grafcet {name}, set when {set_c} and reset when "
           f"{reset_c} ({rule}); the PLC calls {instance} only while the transition is evaluated and reads the outputs "
           "of the blocks it calls after the latch from the previous scan, .g7 sets and resets the latch in the "
