@@ -216,3 +216,16 @@ def test_no_module_imports_another_modules_private_names() -> None:
         if isinstance(node, ast.ImportFrom) and (node.module or "").startswith("synth")
         for a in node.names if a.name.startswith("_") and not a.name.startswith("__"))
     assert found == []
+
+
+def test_families_live_in_folders_not_in_name_prefixes() -> None:
+    """No folder holds four or more modules sharing a name prefix (``plcopen_*``, ``step*``):
+    a family of four gets a folder of its own (a language's model, reader and checker are three)."""
+    crowded = {}
+    for folder in sorted({p.parent for p in SYNTH.rglob("*.py")}):
+        stems = [p.stem for p in folder.glob("*.py") if p.stem != "__init__"]
+        for prefix in {s.split("_")[0] for s in stems}:
+            family = sorted(s for s in stems if s == prefix or s.startswith(prefix + "_"))
+            if len(family) >= 4:
+                crowded[str(folder.relative_to(ROOT))] = family
+    assert crowded == {}
