@@ -170,7 +170,7 @@ def cmd_st(args: argparse.Namespace) -> int:
 
 def _algorithm_mode(p: argparse.ArgumentParser) -> None:
     p.add_argument("--algorithm", choices=("algebraic", "loop"), default="algebraic",
-                   help="the solve equations (default) or the correction loop of FILTER.md §1.4")
+                   help="the solve equations (default) or the correction loop (docs/filter.md)")
     p.add_argument("--mode", choices=("supervisor", "blocking"), default="supervisor",
                    help="supervisor (default): g1 = R; blocking: g1 = 0 after a violation until Ack")
 
@@ -219,7 +219,7 @@ def cmd_from_rules(args: argparse.Namespace) -> int:
 
 
 def register_verify(commands: "argparse._SubParsersAction") -> None:
-    v = commands.add_parser("verify", help="explore the filter in closed loop with the plant (FILTER.md §3.4)")
+    v = commands.add_parser("verify", help="explore the filter in closed loop with the plant (docs/filter.md)")
     v.add_argument("filter", metavar="F.filter", help="the .filter file")
     v.add_argument("--plant", metavar="P.rules", required=True, help="the plant's rules file")
     source = v.add_mutually_exclusive_group(required=True)

@@ -1,4 +1,4 @@
-"""``synth filter verify``: the filter in closed loop with synth's plant (FILTER.md §3.4).
+"""``synth filter verify``: the filter in closed loop with synth's plant (docs/filter.md, "The closed loop").
 
 The explored product has one node per (plant state, filter memory, Blocked latch,
 Grafcet situation). One **PLC cycle** from a node:
