@@ -46,9 +46,11 @@ def _load(args: argparse.Namespace) -> tuple["Grafcet", dict[str, bool], list[st
 
 
 def _write(args: argparse.Namespace, data: str | bytes) -> None:
+    """To ``-o`` or standard output; with ``--json`` and no ``-o`` the JSON carries it instead."""
     from synth.output.files import write_or_print
 
-    write_or_print(args.output, data)
+    if args.output or not getattr(args, "json", False):
+        write_or_print(args.output, data)
 
 
 def target_of(args: argparse.Namespace) -> "Target":
@@ -61,18 +63,29 @@ def target_of(args: argparse.Namespace) -> "Target":
     return Target(args.target or (Target.PLCOPEN if args.xml else Target.IEC))
 
 
-def write_target(args: argparse.Namespace, files: list[tuple[str, bytes]]) -> None:
+def write_target(args: argparse.Namespace, files: list[tuple[str, bytes]]) -> list[str | None]:
     """One file to ``-o`` (or standard output); several (TwinCAT: one per POU) into ``-o DIR``,
-    as is one into an existing folder or a path ending with ``/``."""
+    as is one into an existing folder or a path ending with ``/``. The paths written (None:
+    printed, or carried by ``--json``)."""
     import os
 
-    from synth.output.files import write_files, write_or_print
+    from synth.output.files import write_files
 
     folder = args.output is not None and (args.output.endswith(("/", os.sep)) or os.path.isdir(args.output))
     if len(files) == 1 and not folder:
-        write_or_print(args.output, files[0][1])
-    else:
-        write_files(args.output, files)
+        _write(args, files[0][1])
+        return [args.output]
+    write_files(args.output, files)
+    return [os.path.join(args.output, name) for name, _ in files]
+
+
+def _print_files(args: argparse.Namespace, command: str, pou: str, target: str, sources: list[str],
+                 files: list[tuple[str, bytes]], written: list[str | None]) -> None:
+    if getattr(args, "json", False):
+        from synth.output.codegen_json import files_json
+        from synth.output.summary import print_json
+
+        print_json(files_json(command, pou, target, sources, files, written))
 
 
 def cmd_st(args: argparse.Namespace) -> int:
@@ -102,7 +115,13 @@ def cmd_st(args: argparse.Namespace) -> int:
             from synth.output.ci import st_check_report, write_ci
 
             write_ci([st_check_report(grafcet, report)], args.junit, args.sarif)
-        sys.stdout.write(report.text())
+        if args.json:
+            from synth.output.codegen_json import st_check_json
+            from synth.output.summary import print_json
+
+            print_json(st_check_json(report))
+        else:
+            sys.stdout.write(report.text())
         return 0 if report.ok else 1
     call = None
     if args.filter:
@@ -118,8 +137,8 @@ def cmd_st(args: argparse.Namespace) -> int:
 
         config = configuration(program.program, args.task)
     header = provenance_lines(f"PROGRAM {program.program}", sources)
-    write_target(args, render(target, program.pous, text=program.text, name=program.program, header=header,
-                              config=config))
+    files = render(target, program.pous, text=program.text, name=program.program, header=header, config=config)
+    _print_files(args, "st", program.program, str(target), sources, files, write_target(args, files))
     return 0
 
 
@@ -130,7 +149,11 @@ def cmd_sfc(args: argparse.Namespace) -> int:
 
     grafcet, _, sources = _load(args)
     comment = "\n".join(provenance_lines("SFC " + (args.name or program_name(grafcet.path)), sources))
-    _write(args, sfc_project_xml(grafcet, name=args.name, comment=comment))
+    pou = args.name or program_name(grafcet.path)
+    xml = sfc_project_xml(grafcet, name=args.name, comment=comment)
+    _write(args, xml)
+    _print_files(args, "sfc", pou, "plcopen", sources, [(f"{pou}.xml", xml.encode("utf-8") if isinstance(xml, str) else xml)],
+                 [args.output])
     return 0
 
 
@@ -138,10 +161,18 @@ def cmd_import(args: argparse.Namespace) -> int:
     from synth.codegen.plcopen.importer import import_sfc, list_pous
     from synth.grafcet.language_check import parse_grafcet
 
-    with open(args.file, "rb") as fh:
-        data = fh.read()
+    from synth.syntax import read_bytes
+
+    data = read_bytes(args.file)
     if args.list:
-        for summary in list_pous(data, args.file):
+        pous = list_pous(data, args.file)
+        if args.json:
+            from synth.output.codegen_json import import_list_json
+            from synth.output.summary import print_json
+
+            print_json(import_list_json(args.file, pous))
+            return 0
+        for summary in pous:
             print(summary.text())
         return 0
     notes: list[str] = []
@@ -160,6 +191,11 @@ def cmd_import(args: argparse.Namespace) -> int:
               "(IEC 61131-3 SFC, their actions run) where IEC 60848 passes through them in one evolution: validate "
               "with --semantics sfc for the meaning the program has on the PLC", file=sys.stderr)
     _write(args, text)
+    if args.json:
+        from synth.output.codegen_json import import_json
+        from synth.output.summary import print_json
+
+        print_json(import_json(args.file, args.output, text, notes, [w.render() for w in warnings], steps or ()))
     return 0
 
 
@@ -188,6 +224,7 @@ def register(sub: "argparse._SubParsersAction") -> None:
     p.add_argument("--depth", type=int, default=3, metavar="N", help="--check: events per sequence (default 3)")
     p.add_argument("--junit", metavar="FILE", help="--check: also write the result as JUnit XML (one test case per mismatch)")
     p.add_argument("--sarif", metavar="FILE", help="--check: also write the result as SARIF 2.1.0 (one result per mismatch)")
+    p.add_argument("--json", action="store_true", help="print JSON: the files generated (their text without -o), or --check's result")
     p.set_defaults(handler=cmd_st)
     p = sub.add_parser("sfc", help="a Grafcet as a PLCopen XML SFC",
                        description="Export the Grafcet as a PLCopen TC6 XML SFC program.")
@@ -195,6 +232,7 @@ def register(sub: "argparse._SubParsersAction") -> None:
     p.add_argument("--plant", metavar="RULES", help="plant .rules file: its inputs and outputs")
     p.add_argument("--name", metavar="NAME", help="the POU's name (default: the file's stem)")
     p.add_argument("-o", "--output", metavar="FILE", help="write to FILE (default: standard output)")
+    p.add_argument("--json", action="store_true", help="print JSON: the file generated (its text without -o)")
     p.set_defaults(handler=cmd_sfc)
     p = sub.add_parser("import", help="a PLCopen XML SFC as a .g7 Grafcet",
                        description="Read the SFC of a PLCopen TC6 XML file into the .g7 language.")
@@ -202,4 +240,5 @@ def register(sub: "argparse._SubParsersAction") -> None:
     p.add_argument("-o", "--output", metavar="FILE", help="write to FILE (default: standard output)")
     p.add_argument("--pou", metavar="NAME", help="import this SFC POU only (default: every SFC POU)")
     p.add_argument("--list", action="store_true", help="list the POUs, their languages and what an import reads")
+    p.add_argument("--json", action="store_true", help="print JSON: the Grafcet read (its text without -o), notes and warnings")
     p.set_defaults(handler=cmd_import)

@@ -239,12 +239,12 @@ def register_verify(commands: "argparse._SubParsersAction") -> None:
                         "the first level past N, default no limit)")
     v.add_argument("--engine", choices=("auto", "explicit", "symbolic"), default="auto",
                    help="explicit: node by node; symbolic: BDDs, level by level (--any-control only, without "
-                        "--progress); auto (default): symbolic there on a plant of more than 2000000 states")
+                        "--eventually); auto (default): symbolic there on a plant of more than 2000000 states")
     v.add_argument("--events-per-cycle", type=int, default=1, metavar="K",
                    help="the plant makes 0..K events between two PLC scans (default 1)")
-    v.add_argument("--progress", metavar="GOAL",
-                   help="GOAL (a condition on the plant's variables, or ↑x / ↓x) stays reachable from every state "
-                        "and no fair cycle avoids it")
+    v.add_argument("--eventually", "--progress", dest="progress", metavar="GOAL",
+                   help="a liveness goal: GOAL (a condition on the plant's variables, or ↑x / ↓x) stays reachable "
+                        "from every state and no fair cycle avoids it (--progress: the same, its former name)")
     v.add_argument("--json", action="store_true", help="print JSON instead of text")
     ci_options(v)
     v.set_defaults(handler=cmd_verify)

@@ -1,9 +1,18 @@
-"""Progress lines for long runs, on a terminal only (never in pipes, files or CI logs).
+"""Progress of long runs: one live line on a terminal (never in pipes, files or CI logs), and
+what the run has reached, which a Ctrl-C prints.
+
+A run calls :func:`start_run` once; its stages report with the function :func:`tty_progress`
+returns (always a function: off a terminal it only records). :func:`reached` says how far it
+went.
 
 Example
 -------
->>> tty_progress(False) is None
-True
+>>> start_run()
+>>> show = tty_progress(False)
+>>> show("exploring: 12 states")
+>>> reached().split(": ", 1)[1]
+'exploring: 12 states'
+>>> clear_progress(show)
 """
 
 from __future__ import annotations
@@ -12,24 +21,68 @@ import sys
 import time
 from typing import Callable
 
-__all__ = ["tty_progress", "clear_progress"]
+__all__ = ["start_run", "reached", "tty_progress", "clear_progress", "live_line", "Counter"]
+
+_state: dict[str, float | str] = {"start": time.monotonic(), "last": "", "shown": 0.0}
 
 
-def tty_progress(enabled: bool) -> Callable[[str], None] | None:
-    """A function that overwrites one stderr line with ``[seconds] text``, or None when disabled."""
-    if not enabled:
-        return None
-    start = time.monotonic()
+def start_run() -> None:
+    """Start the clock of a command; nothing reached yet."""
+    _state.update(start=time.monotonic(), last="", shown=0.0)
+
+
+def _elapsed() -> float:
+    return time.monotonic() - float(_state["start"])
+
+
+def reached() -> str:
+    """`` after 3.2 s: <the last progress text>`` (the text only if a stage reported one)."""
+    last = str(_state["last"])
+    return f" after {_elapsed():.1f} s" + (f": {last}" if last else "")
+
+
+def live_line(enabled: bool) -> bool:
+    """Whether to draw a live line: asked for (not ``--quiet``) and standard error a terminal."""
+    return enabled and sys.stderr.isatty()
+
+
+def tty_progress(enabled: bool) -> Callable[[str], None]:
+    """A function recording a stage's progress text; when ``enabled`` (the caller checks
+    the terminal: :func:`live_line`) it also overwrites one stderr line with
+    ``[seconds] text``, at most ten times a second."""
 
     def show(text: str) -> None:
-        sys.stderr.write(f"\r\033[K[{time.monotonic() - start:6.1f}s] {text}")
+        _state["last"] = text
+        if not enabled:
+            return
+        now = time.monotonic()
+        if now - float(_state["shown"]) < 0.1:
+            return
+        _state["shown"] = now
+        sys.stderr.write(f"\r\033[K[{_elapsed():6.1f}s] {text}")
         sys.stderr.flush()
 
+    show.enabled = enabled  # type: ignore[attr-defined]
     return show
 
 
 def clear_progress(show: Callable[[str], None] | None) -> None:
-    """Erase the progress line, if one was shown."""
-    if show is not None:
+    """Erase the progress line, if one was drawn."""
+    if show is not None and getattr(show, "enabled", False) and float(_state["shown"]):
         sys.stderr.write("\r\033[K")
         sys.stderr.flush()
+        _state["shown"] = 0.0
+
+
+class Counter:
+    """Counts work items (states, cycles, sequences) and reports ``N <what> (R/s)`` now and then."""
+
+    def __init__(self, show: Callable[[str], None], what: str, every: int = 256) -> None:
+        self.show, self.what, self.every, self.count = show, what, every, 0
+        self.begin = time.monotonic()
+
+    def add(self, n: int = 1) -> None:
+        self.count += n
+        if self.count % self.every < n:
+            rate = self.count / max(time.monotonic() - self.begin, 1e-9)
+            self.show(f"{self.what}: {self.count} ({rate:.0f}/s)")
