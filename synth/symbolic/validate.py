@@ -80,7 +80,8 @@ def _homes(ssync: SymbolicSync, texts: Sequence[str], p: Plant, g: Grafcet) -> N
 
         hit = engine.false
         for c in conditions:
-            hit |= evaluate(c, value)
+            v = evaluate(c, value)  # a condition folding to a constant (`1`, `X0 & 0`) is a bool
+            hit |= (engine.true if v else engine.false) if isinstance(v, bool) else v
         hit &= r.nodes
         if hit != engine.false:
             homes[s] = homes.get(s, engine.false) | hit

@@ -73,7 +73,8 @@ def _homes(s: StepSync, texts: Sequence[str], p: Plant, g: Grafcet) -> Function:
 
     hit = engine.false
     for c in home_conditions(texts, p, g):
-        hit |= evaluate(c, value)
+        v = evaluate(c, value)  # a condition folding to a constant (`1`, `X0 & 0`) is a bool
+        hit |= (engine.true if v else engine.false) if isinstance(v, bool) else v
     return s.initial | (hit & s.nodes)
 
 
