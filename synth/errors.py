@@ -145,15 +145,21 @@ class ModelFailure(InputError):
     its variable's range): reported like an input error, with exit code 1, a failing model."""
 
 
+MAX_SHOWN = 20
+"""How many errors of one pass are shown; a line "… and N more errors" says the rest."""
+
+
 class InputErrors(SynthError):
-    """Several input errors found in one pass, reported together."""
+    """Several input errors found in one pass, reported together (the first :data:`MAX_SHOWN`)."""
 
     def __init__(self, errors: Sequence[InputError]) -> None:
-        super().__init__("\n".join(e.render() for e in errors))
         self.errors = tuple(errors)
+        super().__init__(self.render())
 
     def render(self) -> str:
-        return "\n\n".join(e.render() for e in self.errors)
+        shown = "\n\n".join(e.render() for e in self.errors[:MAX_SHOWN])
+        rest = len(self.errors) - MAX_SHOWN
+        return shown + (f"\n\n… and {rest} more error{'s' if rest > 1 else ''}" if rest > 0 else "")
 
 
 class ModelError(SynthError):

@@ -184,3 +184,20 @@ def test_render_quotes_a_window_around_the_column():
     assert caret == "    | " + " " * 41 + "^~~"
     short = InputError("m", Location("f", 2, 3, "abcdef", 2)).render().splitlines()
     assert short == ["f:2:3: error: m", "  2 | abcdef", "    |   ^~"]
+
+
+def test_many_errors_are_capped(cli, tmp_path):
+    """A span repeated 50 times gave 160 KB of "declared twice": the first 20, then a count."""
+    f = tmp_path / "many.filter"
+    f.write_text("inputs a, b, c, d\n" * 10 + "outputs o\nsafety S: a & o\n")
+    code, _, err = cli("filter", "check", f)
+    assert code == 2
+    assert err.count("error: ") == 20
+    assert err.endswith("\n\n… and 16 more errors\n")
+
+
+def test_why_state_errors_are_located(cli):
+    code, _, err = cli("sup", ROOT / "plants/tri_annex.rules", "--why", "TAPIS,v1O,v20")
+    assert code == 2
+    assert err.splitlines()[:3] == ["--why:1:7: error: unknown variable 'v1O' in the state",
+                                    "  1 | TAPIS,v1O,v20", "    |       ^~~"]

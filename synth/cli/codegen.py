@@ -110,7 +110,12 @@ def cmd_st(args: argparse.Namespace) -> int:
         header = provenance_lines(f"PROGRAM {program.program}", sources)
         files = render(target, program.pous, text=program.text, name=program.program, header=header)
         text = st_of(target, files, args.file)
-        report = differential_check(grafcet, initial, depth=args.depth, program=dataclasses.replace(program, text=text))
+        from synth.output.progress import clear_progress, live_line, tty_progress
+
+        show = tty_progress(live_line(not args.quiet))
+        report = differential_check(grafcet, initial, depth=args.depth, program=dataclasses.replace(program, text=text),
+                                    report=show)
+        clear_progress(show)
         if args.junit or args.sarif:
             from synth.output.ci import st_check_report, write_ci
 
@@ -225,6 +230,7 @@ def register(sub: "argparse._SubParsersAction") -> None:
     p.add_argument("--junit", metavar="FILE", help="--check: also write the result as JUnit XML (one test case per mismatch)")
     p.add_argument("--sarif", metavar="FILE", help="--check: also write the result as SARIF 2.1.0 (one result per mismatch)")
     p.add_argument("--json", action="store_true", help="print JSON: the files generated (their text without -o), or --check's result")
+    p.add_argument("--quiet", action="store_true", help="--check: no live progress line on a terminal")
     p.set_defaults(handler=cmd_st)
     p = sub.add_parser("sfc", help="a Grafcet as a PLCopen XML SFC",
                        description="Export the Grafcet as a PLCopen TC6 XML SFC program.")

@@ -246,6 +246,7 @@ def register_verify(commands: "argparse._SubParsersAction") -> None:
                    help="a liveness goal: GOAL (a condition on the plant's variables, or ↑x / ↓x) stays reachable "
                         "from every state and no fair cycle avoids it (--progress: the same, its former name)")
     v.add_argument("--json", action="store_true", help="print JSON instead of text")
+    v.add_argument("--quiet", action="store_true", help="no live progress line on a terminal")
     ci_options(v)
     v.set_defaults(handler=cmd_verify)
 
@@ -267,10 +268,14 @@ def cmd_verify(args: argparse.Namespace) -> int:
         from synth.filter.loop.control_st import StSource
 
         control = StSource(args.control, load_st)
+    from synth.output.progress import clear_progress, live_line, tty_progress
+
+    show = tty_progress(live_line(not args.quiet))
     v = verify(f, args.plant, args.grafcet, any_control=args.any_control, algorithm=Algorithm(args.algorithm),
                mode=Mode(args.mode), atomic=args.atomic_outputs, strict=args.strict, require_sup=args.require_sup,
                max_states=args.max_states, events_per_cycle=args.events_per_cycle, progress=args.progress,
-               control=control, engine=EngineChoice(args.engine))
+               control=control, engine=EngineChoice(args.engine), report=show)
+    clear_progress(show)
     if args.junit or args.sarif:
         from synth.output.ci import filter_verify_report, write_ci
 

@@ -60,6 +60,7 @@ from __future__ import annotations
 import dataclasses
 import time
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 
@@ -89,11 +90,11 @@ def verify(f: Filter, rules_path: str, grafcet: str | None = None, *, any_contro
            algorithm: Algorithm = Algorithm.ALGEBRAIC, mode: Mode = Mode.SUPERVISOR, atomic: bool = False,
            strict: bool = False, require_sup: bool = False, max_states: int | None = DEFAULT_MAX_STATES,
            events_per_cycle: int = 1, progress: str | None = None, control: StSource | None = None,
-           engine: EngineChoice = EngineChoice.EXPLICIT) -> Verification:
+           engine: EngineChoice = EngineChoice.EXPLICIT, report: Callable[[str], None] | None = None) -> Verification:
     """Explore the closed loop (see the module docstring); ``control``: ``--control PROG.st[:NAME]``.
     ``engine``: ``symbolic`` (or ``auto`` on a large plant) runs
     :func:`~synth.filter.loop.symbolic.verify.verify_symbolic` (``--any-control`` only; there
-    ``max_states=None`` is no limit, explicitly it is 1000000)."""
+    ``max_states=None`` is no limit, explicitly it is 1000000). ``report`` receives progress lines."""
     if (grafcet is not None) + any_control + (control is not None) != 1:
         raise InputError("verify needs a request source: --grafcet G.g7, --control PROG.st or --any-control "
                          "(one of them)", None)
@@ -116,6 +117,7 @@ def verify(f: Filter, rules_path: str, grafcet: str | None = None, *, any_contro
     pr = Product(f, rules_path, grafcet, Algorithm(algorithm), Mode(mode), atomic, control)
     goal = goal_of(progress, pr) if progress is not None else None
     ex = Explorer(pr, max_states, events_per_cycle, edges=goal is not None)
+    ex.report = report
     ex.run()
     prog = progress_of(ex, goal) if goal is not None and ex.complete else None
     findings = ex.findings()
