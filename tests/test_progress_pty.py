@@ -75,3 +75,19 @@ def test_st_check_live_line_on_a_terminal():
     assert err.endswith("\r\x1b[K")
     piped = _run(argv, tty=False)
     assert piped[0] == 0 and piped[1] == out and piped[2] == ""
+
+
+@pytest.mark.parametrize("argv", [["filter", "check", "plants/tri.filter"], ["filter", "solve", "plants/loop_a.filter"],
+                                  ["import", "tests/data/plcopen/beremiz_counter.xml"]])
+def test_stage_lines_of_check_solve_import(argv):
+    """Shorter runs name their stage on the line (and erase it); piped, nothing."""
+    code, out, err = _run(argv, tty=True)
+    piped = _run(argv, tty=False)
+    assert (piped[0], piped[1]) == (code, out)
+    assert "\r\x1b[K[" in err
+    # the live line drawn and erased, and else exactly what a pipe receives (the terminal
+    # turns \n into \r\n)
+    import re
+
+    assert re.sub(r"\r\x1b\[K(\[ *\d+\.\ds\] [^\r\n]*)?", "", err) == piped[2].replace("\n", "\r\n")
+    assert "\x1b" not in piped[2] and "\r" not in piped[2]

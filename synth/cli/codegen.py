@@ -182,7 +182,12 @@ def cmd_import(args: argparse.Namespace) -> int:
         return 0
     notes: list[str] = []
     warnings: list = []
+    from synth.output.progress import clear_progress, live_line, tty_progress
+
+    show = tty_progress(live_line(not args.quiet))
+    show(f"reading the SFC of {args.file}")
     text = import_sfc(data, args.file, pou=args.pou, notes=notes, warnings=warnings)
+    clear_progress(show)
     for n in notes:
         print(f"{args.file}: note: {n}", file=sys.stderr)
     for w in warnings:
@@ -190,7 +195,10 @@ def cmd_import(args: argparse.Namespace) -> int:
     g = parse_grafcet(text, args.output or "<imported>")  # the result must be a valid .g7
     from synth.grafcet.semantics import scan_only_steps
 
+    show = tty_progress(live_line(not args.quiet))
+    show("the steps a PLC scan keeps active (IEC 61131-3 against IEC 60848)")
     steps = scan_only_steps(g)
+    clear_progress(show)
     if steps:
         print(f"{args.file}: note: step{'s' if len(steps) > 1 else ''} {', '.join(steps)} stay active for a PLC scan "
               "(IEC 61131-3 SFC, their actions run) where IEC 60848 passes through them in one evolution: validate "
@@ -247,4 +255,5 @@ def register(sub: "argparse._SubParsersAction") -> None:
     p.add_argument("--pou", metavar="NAME", help="import this SFC POU only (default: every SFC POU)")
     p.add_argument("--list", action="store_true", help="list the POUs, their languages and what an import reads")
     p.add_argument("--json", action="store_true", help="print JSON: the Grafcet read (its text without -o), notes and warnings")
+    p.add_argument("--quiet", action="store_true", help="no live progress line on a terminal")
     p.set_defaults(handler=cmd_import)

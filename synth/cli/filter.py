@@ -33,6 +33,7 @@ def register(sub: "argparse._SubParsersAction") -> None:
     c.add_argument("--all-spellings", action="store_true",
                    help="compare the keep/force spellings of every relief on every input, past the work "
                         "limit, naming every output each drives differently (no witness points)")
+    c.add_argument("--quiet", action="store_true", help="no live progress line on a terminal")
     ci_options(c)
     c.set_defaults(handler=cmd_check)
 
@@ -42,6 +43,7 @@ def register(sub: "argparse._SubParsersAction") -> None:
     s.add_argument("--order", metavar="O1,O2,...", help="the order of the Sim criteria (default: the file's)")
     s.add_argument("--flat", action="store_true",
                    help="print every equation over Y only (flat ISOP; refused past a size limit) instead of chained")
+    s.add_argument("--quiet", action="store_true", help="no live progress line on a terminal")
     s.set_defaults(handler=cmd_solve)
     register_st(commands)
 
@@ -92,17 +94,26 @@ def cmd_check(args: argparse.Namespace) -> int:
     from synth.filter.coherence import check
     from synth.output.filter_text import check_json, check_text
 
+    from synth.output.progress import clear_progress, live_line, tty_progress
+
+    show = tty_progress(live_line(not args.quiet))
+    show(f"reading {args.filter}")
     f = _load(args.filter)
     inv = None
     if args.plant:
         from synth.filter.invariants import assumed, invariants
 
+        show(f"the valuations {args.plant} can reach")
         inv = invariants(f, args.plant)
         f = assumed(f, inv)
+    show("coherence: P1-P4, GO, pair conditions, global consistency")
     c = check(f)
     from synth.filter.reliefs import SPELLING_WORK, spelling_warnings
 
-    for w in spelling_warnings(f, limit=None if args.all_spellings else SPELLING_WORK).reports():
+    show("the keep/force spellings of the reliefs")
+    warnings = spelling_warnings(f, limit=None if args.all_spellings else SPELLING_WORK).reports()
+    clear_progress(show)
+    for w in warnings:
         print(w.render(), file=sys.stderr)
     if args.junit or args.sarif:
         from synth.output.ci import filter_check_report, write_ci
@@ -126,7 +137,12 @@ def cmd_solve(args: argparse.Namespace) -> int:
     from synth.filter.solve import synthesis
     from synth.output.filter_text import synthesis_json, synthesis_text
 
+    from synth.output.progress import clear_progress, live_line, tty_progress
+
+    show = tty_progress(live_line(not args.quiet))
+    show(f"algebraic synthesis of {args.filter}")
     s = synthesis(_load(args.filter), _order(args.order), flat=args.flat)
+    clear_progress(show)
     if args.json:
         print_json(synthesis_json(args.filter, s))
     else:

@@ -18,6 +18,7 @@ Example
 from __future__ import annotations
 
 import sys
+import threading
 import time
 from typing import Callable
 
@@ -46,32 +47,56 @@ def live_line(enabled: bool) -> bool:
     return enabled and sys.stderr.isatty()
 
 
+_lock = threading.Lock()
+_ticker: dict[str, threading.Event | None] = {"stop": None}
+
+
+def _draw(text: str, stop: threading.Event | None = None) -> None:
+    with _lock:
+        if stop is not None and stop.is_set():  # erased meanwhile: draw nothing more
+            return
+        _state["shown"] = time.monotonic()
+        sys.stderr.write(f"\r\033[K[{_elapsed():6.1f}s] {text}")
+        sys.stderr.flush()
+
+
+def _tick(stop: threading.Event) -> None:
+    """Redraw the line every half second, so the seconds run on during a long stage."""
+    while not stop.wait(0.5):
+        if _state["last"]:
+            _draw(str(_state["last"]), stop)
+
+
 def tty_progress(enabled: bool) -> Callable[[str], None]:
     """A function recording a stage's progress text; when ``enabled`` (the caller checks
     the terminal: :func:`live_line`) it also overwrites one stderr line with
-    ``[seconds] text``, at most ten times a second."""
+    ``[seconds] text``, at most ten times a second, and a thread keeps the seconds running."""
+    if enabled and _ticker["stop"] is None:
+        stop = _ticker["stop"] = threading.Event()
+        threading.Thread(target=_tick, args=(stop,), daemon=True, name="synth-progress").start()
 
     def show(text: str) -> None:
         _state["last"] = text
-        if not enabled:
-            return
-        now = time.monotonic()
-        if now - float(_state["shown"]) < 0.1:
-            return
-        _state["shown"] = now
-        sys.stderr.write(f"\r\033[K[{_elapsed():6.1f}s] {text}")
-        sys.stderr.flush()
+        if enabled and time.monotonic() - float(_state["shown"]) >= 0.1:
+            _draw(text)
 
     show.enabled = enabled  # type: ignore[attr-defined]
     return show
 
 
 def clear_progress(show: Callable[[str], None] | None) -> None:
-    """Erase the progress line, if one was drawn."""
-    if show is not None and getattr(show, "enabled", False) and float(_state["shown"]):
-        sys.stderr.write("\r\033[K")
-        sys.stderr.flush()
-        _state["shown"] = 0.0
+    """Stop the redrawing and erase the line, if one was drawn."""
+    if show is None or not getattr(show, "enabled", False):
+        return
+    stop = _ticker["stop"]
+    if stop is not None:
+        stop.set()
+        _ticker["stop"] = None
+    with _lock:
+        if float(_state["shown"]):
+            sys.stderr.write("\r\033[K")
+            sys.stderr.flush()
+            _state["shown"] = 0.0
 
 
 class Counter:
