@@ -255,7 +255,7 @@ def fuzz(runs: int, seed: int, timeout: float = 10.0, out: Path | None = None,
                 if log is not None:
                     log(f"{kind}: {lang.name} run {n} (from {seed_input}): {first}")
             if log is not None and (n + 1) % 500 == 0:
-                log(f"{n + 1}/{runs} runs")
+                log(f"{n + 1}/{runs} runs\n{report(tallies)}")
     return tallies
 
 
