@@ -206,3 +206,26 @@ def test_an_index_of_four_blockings_and_one_grafcet(browser, tmp_path, capsys):
     assert (fits_x, fits_y, outside) == (True, True, 0)
     page.screenshot(path=str(tmp_path / "four_blockings.png"), full_page=True)
     assert errors == []
+
+
+def test_the_aggregated_automaton_at_a_readable_scale(browser, tmp_path, capsys):
+    """The 90 states of the passing box sorting: text at 100 % (at least 10 px), no longer a
+    strip 10 900 px wide and 94 % white (left to right): top to bottom, tight."""
+    path = _report(tmp_path, "grafcets/tri.g7", "plants/tri.rules")
+    capsys.readouterr()
+    errors: list[str] = []
+    page = _open(browser, path, errors)
+    page.evaluate("document.querySelectorAll('details').forEach(d => d.open = true)")
+    width, height, nodes, covered, text = page.evaluate("""() => {
+      const s = document.querySelector('#aggregated svg'), r = s.getBoundingClientRect();
+      const g = Array.from(s.querySelectorAll('g.node'));
+      const area = g.map(n => n.getBoundingClientRect()).reduce((a, b) => a + b.width * b.height, 0);
+      const text = Math.min(...Array.from(s.querySelectorAll('text')).map(t => t.getBoundingClientRect().height));
+      return [r.width, r.height, g.length, area / (r.width * r.height), text];
+    }""")
+    assert nodes == 90
+    assert text >= 10
+    assert width < 4000 and width / height < 1.5
+    assert covered > 0.10
+    page.locator("#aggregated").screenshot(path=str(tmp_path / "aggregated.png"))
+    assert errors == []
