@@ -353,6 +353,8 @@ _KINDS = {
     "rules": (".rules", "a plant's rules file (.rules)", ("element ", "free ", "constraint ", "model ")),
     "grafcet": (".g7", "a Grafcet file (.g7)", ("grafcet ",)),
     "filter": (".filter", "a safety filter file (.filter)", ("safety ",)),
+    "xml": (".xml", "a PLCopen XML file (.xml)", ("<?xml", "<project")),
+    "st": (".st", "a Structured Text file (.st)", ("PROGRAM ", "FUNCTION_BLOCK ")),
 }
 
 
@@ -364,6 +366,8 @@ def file_kind_hint(grammar: str, file: str, source: str) -> str | None:
     "tri.g7 is a Grafcet file (.g7), not a plant's rules file (.rules): check the order of the arguments"
     >>> file_kind_hint("grafcet", "tri.g7", "grafcet G {") is None
     True
+    >>> file_kind_hint("xml", "tri.g7", "grafcet G {")
+    'tri.g7 is a Grafcet file (.g7), not a PLCopen XML file (.xml): check the order of the arguments'
     """
     if grammar not in _KINDS:
         return None

@@ -146,3 +146,15 @@ def test_help_documents_the_exit_codes(capsys):
     out = " ".join(capsys.readouterr().out.split())
     assert ("exit codes: 0 pass, 1 the model fails (problems found), 2 bad input or a limit reached, "
             "3 a bug in synth (SYNTH_TRACEBACK=1 shows its traceback), 130 interrupted") in out
+
+
+def test_wrong_file_kind_is_named(cli):
+    code, out, err = cli("import", "grafcets/tri.g7")
+    assert (code, out) == (2, "")
+    assert err.splitlines()[0] == "grafcets/tri.g7:1:1: error: not well-formed XML: Start tag expected, '<' not found"
+    assert err.splitlines()[-1] == ("  = note: grafcets/tri.g7 is a Grafcet file (.g7), not a PLCopen XML file (.xml): "
+                                    "check the order of the arguments")
+    code, _, err = cli("validate", "plants/tri.rules", "--plant", "grafcets/tri.g7")
+    assert code == 2
+    assert err.splitlines()[-1] == ("  = note: grafcets/tri.g7 is a Grafcet file (.g7), not a plant's rules file "
+                                    "(.rules): check the order of the arguments")

@@ -111,7 +111,11 @@ def load_st(text: str, file: str = "<st>") -> Module:
             column = len(text.rstrip("\n").rsplit("\n", 1)[-1]) + 1
         expected = sorted(set(getattr(exc, "expected", None) or getattr(exc, "allowed", None) or ()))
         what = "unexpected end of the text" if getattr(exc, "line", 1) == -1 else "not valid IEC 61131-3 Structured Text (blark)"
-        raise InputError(what, location_in(file, text, line, column), expected=tuple(expected)[:8])
+        from synth.syntax import file_kind_hint
+
+        hint = file_kind_hint("st", file, text)
+        raise InputError(what, location_in(file, text, line, column), expected=tuple(expected)[:8],
+                         notes=(hint,) if hint else ())
     source = result.transform()
     compiler = _Compiler(file, text)
     pous: dict[str, Pou] = {}

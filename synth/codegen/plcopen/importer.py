@@ -86,7 +86,11 @@ def _project(data: bytes | str, file: str) -> tuple[Any, Source, Any]:
         line, col = err.position if hasattr(err, "position") else (err.lineno, 1)
         raw_line = src.lines[line - 1] if 0 < line <= len(src.lines) else ""
         message = re.sub(r", line \d+, column \d+$", "", str(err.msg))
-        raise InputError(f"not well-formed XML: {message}", Location(file, line, max(1, col), raw_line)) from None
+        from synth.syntax import file_kind_hint
+
+        hint = file_kind_hint("xml", file, "\n".join(src.lines[:200]))
+        raise InputError(f"not well-formed XML: {message}", Location(file, line, max(1, col), raw_line),
+                         notes=(hint,) if hint else ()) from None
     ns = etree.QName(root).namespace
     if ns not in NAMESPACES or etree.QName(root).localname != "project":
         raise InputError(f"not a PLCopen TC6 XML project (root element {root.tag})", src.at(root),
