@@ -79,3 +79,20 @@ def test_import_json(capsys, xml):
 def test_a_schema_rejects_drift():
     with pytest.raises(jsonschema.ValidationError):
         assert_valid("run", {"grafcet": "g", "rows": [{"event": "initial"}]})
+
+
+def test_filter_st_json(capsys):
+    data = _json(capsys, "filter", "st", str(ROOT / "plants/loop_a.filter"), "--json")
+    assert_valid("codegen_files", data)
+    (f,) = data["files"]
+    assert (data["command"], data["pou"], f["path"]) == ("filter st", "FB_loop_a_Filter", None)
+    assert "FUNCTION_BLOCK FB_loop_a_Filter" in f["text"]
+
+
+def test_filter_from_rules_json(capsys, tmp_path):
+    out = tmp_path / "F.filter"
+    data = _json(capsys, "filter", "from-rules", str(ROOT / "plants/tri.rules"), "-o", str(out), "--json")
+    assert_valid("filter_from_rules", data)
+    assert out.is_file()
+    kinds = {c["id"]: c["kind"] for c in data["constraints"]}
+    assert [k for k, v in kinds.items() if v == "combined"] == ["C2_1", "C2_2", "C2_6", "C2_7"]

@@ -23,7 +23,7 @@ if TYPE_CHECKING:  # pragma: no cover - the library is imported by the commands 
     from synth.codegen.targets import Target
     from synth.grafcet.language import Grafcet
 
-__all__ = ["register", "cmd_st", "cmd_sfc", "cmd_import"]
+__all__ = ["register", "cmd_st", "cmd_sfc", "cmd_import", "print_files", "write_target", "target_of"]
 
 
 def _load(args: argparse.Namespace) -> tuple["Grafcet", dict[str, bool], list[str]]:
@@ -79,7 +79,7 @@ def write_target(args: argparse.Namespace, files: list[tuple[str, bytes]]) -> li
     return [os.path.join(args.output, name) for name, _ in files]
 
 
-def _print_files(args: argparse.Namespace, command: str, pou: str, target: str, sources: list[str],
+def print_files(args: argparse.Namespace, command: str, pou: str, target: str, sources: list[str],
                  files: list[tuple[str, bytes]], written: list[str | None]) -> None:
     if getattr(args, "json", False):
         from synth.output.codegen_json import files_json
@@ -143,7 +143,7 @@ def cmd_st(args: argparse.Namespace) -> int:
         config = configuration(program.program, args.task)
     header = provenance_lines(f"PROGRAM {program.program}", sources)
     files = render(target, program.pous, text=program.text, name=program.program, header=header, config=config)
-    _print_files(args, "st", program.program, str(target), sources, files, write_target(args, files))
+    print_files(args, "st", program.program, str(target), sources, files, write_target(args, files))
     return 0
 
 
@@ -157,7 +157,7 @@ def cmd_sfc(args: argparse.Namespace) -> int:
     pou = args.name or program_name(grafcet.path)
     xml = sfc_project_xml(grafcet, name=args.name, comment=comment)
     _write(args, xml)
-    _print_files(args, "sfc", pou, "plcopen", sources, [(f"{pou}.xml", xml.encode("utf-8") if isinstance(xml, str) else xml)],
+    print_files(args, "sfc", pou, "plcopen", sources, [(f"{pou}.xml", xml.encode("utf-8") if isinstance(xml, str) else xml)],
                  [args.output])
     return 0
 

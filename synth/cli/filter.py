@@ -61,6 +61,7 @@ def register_st(commands: "argparse._SubParsersAction") -> None:
     t.add_argument("--order", metavar="O1,O2,...", help="the order of the Sim criteria (algebraic)")
     t.add_argument("--split", action="store_true",
                    help="one FUNCTION_BLOCK per independent cluster of outputs (FB_NAME_<k>_Filter)")
+    t.add_argument("--json", action="store_true", help="print JSON: the files generated (their text without -o)")
     t.set_defaults(handler=cmd_st)
 
     register_run(commands)
@@ -174,6 +175,11 @@ def cmd_st(args: argparse.Namespace) -> int:
     text = "\n".join(b.text for b in blocks)
     files = render(target, [b.pou for b in blocks], text=text, name=blocks[0].name,
                    header=provenance_lines(what, [args.filter]))
+    if args.json:
+        from synth.cli.codegen import print_files
+
+        print_files(args, "filter st", blocks[0].name, str(target), [args.filter], files, write_target(args, files))
+        return 0
     if target is Target.IEC and args.output is None:
         sys.stdout.write(text)
         return 0
@@ -219,6 +225,7 @@ def register_from_rules(commands: "argparse._SubParsersAction") -> None:
     g = commands.add_parser("from-rules", help="write a .filter skeleton from a rules file's constraints")
     g.add_argument("rules", metavar="P.rules", help="the plant's rules file")
     g.add_argument("-o", "--output", metavar="F.filter", required=True, help="the filter file to write")
+    g.add_argument("--json", action="store_true", help="print JSON: the constraints as the skeleton takes them")
     g.set_defaults(handler=cmd_from_rules)
 
 
@@ -229,6 +236,13 @@ def cmd_from_rules(args: argparse.Namespace) -> int:
 
     sk = skeleton(args.rules, args.output)
     write_atomic(args.output, sk.text)
+    if args.json:
+        from synth.output.summary import print_json
+
+        print_json({"rules": args.rules, "output": args.output,
+                    "constraints": [{"id": c.id, "kind": str(c.kind), "outputs": list(c.outputs),
+                                     "expression": c.expression} for c in sk.constraints]})
+        return 0
     sys.stdout.write(skeleton_text(sk))
     print(f"wrote {args.output}")
     return 0
