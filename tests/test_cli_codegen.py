@@ -88,7 +88,7 @@ def test_st_xml_is_valid_plcopen(capsys, tmp_path):
 def test_st_check_passes_and_a_broken_generator_fails_with_exit_1(capsys, monkeypatch):
     code, out, _ = run(capsys, "st", "--check", "grafcets/timers.g7", "--depth", "3")
     assert (code, out) == (0, "grafcets/timers.g7: the ST program equals synth run on 13 event sequences "
-                              "(21 PLC cycles, depth 3): 0 mismatches\n")
+                              "(25 PLC cycles, depth 3): 0 mismatches\n")
     from synth.codegen import grafcet_st
 
     emit = grafcet_st._Writer.emit

@@ -124,3 +124,20 @@ def test_a_broken_generator_is_caught(monkeypatch, file, old, new, first):
     report = differential_check(load_grafcet(ROOT / file), depth=3)
     assert not report.ok
     assert report.mismatches[0].text() == first
+
+
+
+@pytest.mark.parametrize("preset, first", [
+    ("3s", None),
+    ("2990ms", "after ↑a, ↓a, 2999 ms before 3s/X1: active steps of synth run {X1}, of the ST program {X0}"),
+    ("3010ms", "after ↑a, ↓a, 3s/X1: active steps of synth run {X0}, of the ST program {X1}"),
+])
+def test_a_timer_preset_off_by_10_ms_is_seen(preset, first):
+    """The proof plays a cycle 1 ms before each preset and one at it: a program whose 3 s timer
+    was changed by 10 ms either way differs from synth run."""
+    pytest.importorskip("blark")
+    text = "grafcet G {{ initial step 0 step 1: A transition 0 -> 1 when ↑a transition 1 -> 0 when {}/X1 }}"
+    g = parse_grafcet(text.format("3s"), "g.g7")
+    program = grafcet_st.generate_program(parse_grafcet(text.format(preset), "g.g7"), version="check")
+    report = differential_check(g, {"a": False}, depth=3, program=program)
+    assert [m.text() for m in report.mismatches][:1] == ([first] if first else [])

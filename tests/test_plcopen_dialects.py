@@ -108,6 +108,15 @@ def test_list_pous_of_a_file_without_sfc():
     assert [p.imported for p in list_pous(xml.encode())] == [False, False, False]
 
 
+LAMP_HELD = [
+    "ide_sfc.xml:132:15: warning: an N action assigning LAMP in step Lamp is read as the continuous action "
+    "'LAMP if !bottom': LAMP falls when the step is left, while the PLC keeps its last value",
+    '  132 |               <action localId="12" qualifier="N">',
+    "      |               ^~~~~~~",
+    "  = note: to keep the continuous meaning on the PLC, add a P0 action 'LAMP := FALSE;' to step Lamp; for a stored "
+    "order, write S/R actions (set LAMP / reset LAMP)"]
+
+
 def test_a_selection_divergence_keeps_its_sfc_priority_with_a_warning():
     warnings: list[InputError] = []
     root = Path(__file__).resolve().parent / "data" / "codegen"
@@ -118,7 +127,9 @@ def test_a_selection_divergence_keeps_its_sfc_priority_with_a_warning():
         "right), .g7 every true branch; the later branches' receptivities are made exclusive",
         '  154 |             <selectionDivergence localId="16">',
         "      |             ^~~~~~~~~~~~~~~~~~~~",
-        "  = note: Wait -> Up when (guard) & !(2s/XWait)"]]
+        "  = note: Wait -> Up when (guard) & !(2s/XWait)",
+        "  = note: on MATIEC (the compiler of Beremiz and OpenPLC) every true branch fires, priorities ignored: for a "
+        "program that runs there, validate the receptivities as written, without this rewrite"], LAMP_HELD]
 
 
 def test_a_level_self_loop_jump_is_imported_with_a_warning():
@@ -143,6 +154,23 @@ def test_a_chart_inside_an_action_of_a_function_block_is_named_not_dropped(cli, 
         "not imported (.g7 reads the SFC body of a POU, not a chart inside an action of a function block)"]
     code, _, err = cli("import", tmp_path / "fb.xml", "-o", tmp_path / "fb.g7")
     assert code == 0 and "SFC in its action ACT_Extend: not imported" in err
+
+
+def test_a_chart_inside_an_action_is_named_when_its_pou_alone_is_imported(cli, tmp_path):
+    """`--pou Stack` of an SFC function block whose action holds another chart: the chart
+    imported is the body's, and the one inside the action is named as not imported."""
+    text = (DATA / "codesys_v35.xml").read_text()
+    action = ('<actions><action name="ACT_Auto"><body><SFC><step localId="1" name="A0" initialStep="true">'
+              '<position x="0" y="0"/></step></SFC></body></action></actions>\n        <body>\n          <SFC>')
+    assert text.count("<body>\n          <SFC>") >= 1
+    (tmp_path / "fb.xml").write_text(text.replace("<body>\n          <SFC>", action, 1))
+    code, _, err = cli("import", tmp_path / "fb.xml", "--pou", "Crane", "-o", tmp_path / "fb.g7")
+    last = err.splitlines()[-1]
+    assert code == 0 and ": note: POU Crane: " in last and last.endswith(
+        "; SFC in its action ACT_Auto: not imported (.g7 reads the SFC body of a POU, not a chart "
+        "inside an action of a function block)")
+    code, _, err = cli("import", tmp_path / "fb.xml", "--pou", "Belt", "-o", tmp_path / "belt.g7")
+    assert code == 0 and "ACT_Auto" not in err
 
 
 def _with_pou_action(body: str, qualifier: str = "N") -> bytes:
@@ -650,3 +678,189 @@ def test_what_is_not_a_latch_or_a_blinker_is_located(old, new, first):
     with pytest.raises(InputError) as info:
         import_sfc(xml.replace(old, new).encode(), "l.xml")
     assert info.value.render().splitlines()[0] == first
+
+
+def _ide_sfc_with_priorities(first: str, second: str) -> bytes:
+    root = Path(__file__).resolve().parent / "data" / "codegen"
+    text = (root / "ide_sfc.xml").read_text()
+    assert text.count('<transition localId="17">') == 1 and text.count('<transition localId="18">') == 1
+    return (text.replace('<transition localId="17">', f'<transition localId="17" priority="{first}">')
+            .replace('<transition localId="18">', f'<transition localId="18" priority="{second}">').encode())
+
+
+def test_a_selection_divergence_honours_the_transitions_priorities():
+    # the right branch (guard) has priority 1, the left one (2s/XWait) priority 2: the PLC tests guard first
+    warnings: list[InputError] = []
+    text = import_sfc(_ide_sfc_with_priorities("2", "1"), "prio.xml", warnings=warnings)
+    assert "  transition Wait -> Up when (2s/XWait) & !(guard)\n  transition Wait -> Up when guard\n" in text
+    assert [w.render().splitlines()[0] for w in warnings] == [
+        "prio.xml:154:13: warning: a selection divergence: IEC 61131-3 SFC fires the true branch of highest priority "
+        "(smallest `priority`, then left to right), .g7 every true branch; the later branches' receptivities are "
+        "made exclusive", LAMP_HELD[0].replace("ide_sfc.xml", "prio.xml")]
+    assert warnings[0].render().splitlines()[-2] == "  = note: Wait -> Up when (2s/XWait) & !(guard)"
+
+
+def test_equal_priorities_fall_back_to_the_branch_order():
+    text = import_sfc(_ide_sfc_with_priorities("1", "1"), "prio.xml", warnings=[])
+    assert "  transition Wait -> Up when 2s/XWait\n  transition Wait -> Up when (guard) & !(2s/XWait)\n" in text
+
+
+@pytest.mark.parametrize("bad", ["-1", "high", "1" * 30])
+def test_a_priority_that_is_not_a_number_is_located(bad):
+    with pytest.raises(InputError) as info:
+        import_sfc(_ide_sfc_with_priorities(bad, "1"), "prio.xml", warnings=[])
+    assert info.value.render().splitlines()[0] == (
+        f"prio.xml:160:13: error: transition priority '{bad[:40]}' is not a non-negative integer")
+
+
+def test_an_n_assignment_with_its_p0_reset_is_continuous_without_a_warning():
+    """synth sfc writes `A if c` as N `A := c;` and P0 `A := FALSE;`: the pair is the continuous
+    action on the PLC too, so no warning; without the P0 body the PLC keeps A (warning above)."""
+    root = Path(__file__).resolve().parent / "data" / "codegen"
+    text = (root / "ide_sfc.xml").read_text()
+    p0 = ('<action localId="12" qualifier="N">',
+          '<action localId="90" qualifier="P0"><inline><ST><xhtml:p><![CDATA[LAMP := FALSE;]]></xhtml:p></ST>'
+          '</inline></action><action localId="12" qualifier="N">')
+    assert text.count(p0[0]) == 1
+    warnings: list[InputError] = []
+    g7 = import_sfc(text.replace(*p0).encode(), "ide_sfc.xml", warnings=warnings)
+    assert "LAMP if !bottom" in g7 and "reset LAMP on deactivation" not in g7
+    assert [w.render().splitlines()[0].split(": warning: ")[1][:24] for w in warnings] == ["a selection divergence: "]
+
+
+@pytest.mark.parametrize("value, action", [("TRUE", "set LAMP on activation"), ("0", "reset LAMP on activation")])
+def test_an_n_assignment_of_a_constant_is_a_stored_action(value, action):
+    """`pump := 1;` in an N action: the PLC sets it while the step is active and keeps it after;
+    not the continuous `pump if 1` (which ends with the step), nor `pump if 0` (a no-op)."""
+    root = Path(__file__).resolve().parent / "data" / "codegen"
+    text = (root / "ide_sfc.xml").read_text()
+    assert text.count("LAMP := NOT bottom;") == 1
+    warnings: list[InputError] = []
+    g7 = import_sfc(text.replace("LAMP := NOT bottom;", f"LAMP := {value};").encode(), "ide_sfc.xml",
+                    warnings=warnings)
+    assert f"step Lamp: {action}" in g7 and "LAMP if" not in g7
+    assert len(warnings) == 1  # the selection divergence's alone
+
+
+def test_codesys_implicit_chart_flags_are_named_not_silently_dropped():
+    """CODESYS's SFCReset/SFCInit/SFCPause (declared in the POU, set by the caller on an emergency
+    stop) force the chart on the PLC; the .g7 has no such forcing: a located warning each."""
+    text = (DATA / "codesys_v35.xml").read_text()
+    old = '            <variable name="xGripOk"><type><BOOL /></type></variable>\n          </inputVars>\n'
+    assert text.count(old) == 1
+    flags = ('            <variable name="SFCReset"><type><BOOL /></type></variable>\n'
+             '            <variable name="SFCError"><type><BOOL /></type></variable>\n')
+    warnings: list[InputError] = []
+    import_sfc(text.replace(old, old.replace("          </inputVars>\n", flags + "          </inputVars>\n")).encode(),
+               "flags.xml", pou="Crane", warnings=warnings)
+    found = [w.render().splitlines() for w in warnings if "implicit SFC flag" in w.render()]
+    assert found == [[
+        "flags.xml:25:13: warning: 'SFCReset' is CODESYS's implicit SFC flag: on the PLC it puts the chart back to its "
+        "initial step while it is TRUE; the .g7 has no such forcing, so the import reads it as a plain variable and "
+        "the chart ignores it",
+        '  25 |             <variable name="SFCReset"><type><BOOL /></type></variable>',
+        "     |             ^~~~~~~~~",
+        "  = note: validate the emergency stop separately, or model it as transitions back to the initial steps "
+        "guarded by the flag"]]
+
+
+def test_several_pous_keep_their_own_variables():
+    """Two POUs declaring the same names (two cranes) imported whole: each keeps its own
+    variables on the PLC, so each chart's are prefixed, with a warning at each declaration."""
+    lines = (DATA / "codesys_v35.xml").read_text().splitlines(keepends=True)
+    assert lines[18].strip() == '<pou name="Crane" pouType="program">' and lines[102].strip() == "</pou>"
+    crane2 = "".join(lines[18:103]).replace('<pou name="Crane"', '<pou name="Crane2"')
+    xml = "".join(lines[:103]) + crane2 + "".join(lines[103:])
+    warnings: list[InputError] = []
+    g7 = import_sfc(xml.encode(), "cranes.xml", warnings=warnings)
+    assert g7.splitlines()[1:3] == [
+        "inputs Crane_xStart, Crane_xDown, Crane_xGripOk, Crane2_xStart, Crane2_xDown, Crane2_xGripOk, xPart",
+        "outputs Crane_LOWER, Crane2_LOWER, MOTOR"]
+    assert "  transition Crane2_Init -> Crane2_Lower when Crane2_xStart & !Crane2_xDown\n" in g7
+    assert "  step Crane2_Lower: Crane2_LOWER\n" in g7 and "  step Belt_Run: MOTOR\n" in g7
+    own = [w.render().splitlines()[0] for w in warnings if "each has its own" in w.render()]
+    assert len(own) == 8 and own[0] == (
+        "cranes.xml:22:13: warning: 'xStart' is declared by POU Crane and by Crane2: each has its own on the PLC, "
+        "so this chart's is named Crane_xStart in the .g7")
+    parse_grafcet(g7, "cranes.g7")  # a valid .g7
+
+
+LD_OFF = """<LD>
+                <leftPowerRail localId="40"><connectionPointOut formalParameter=""/></leftPowerRail>
+                <contact localId="41" negated="{negated}">
+                  <connectionPointIn><connection refLocalId="40"/></connectionPointIn>
+                  <connectionPointOut/>
+                  <variable>c</variable>
+                </contact>
+                <coil localId="44" negated="false">
+                  <connectionPointIn><connection refLocalId="41"/></connectionPointIn>
+                  <connectionPointOut/>
+                  <variable>OFF</variable>
+                </coil>
+              </LD>"""
+
+
+@pytest.mark.parametrize("negated, expr", [("true", "!c"), ("false", "c")])
+def test_a_named_transition_written_in_ld_is_read(negated, expr):
+    """OpenPLC writes a named transition's body in LD: a coil named after the transition."""
+    text = (DATA / "beremiz_ld_fbd.xml").read_text()
+    start, end = text.index("<FBD>"), text.index("</FBD>") + len("</FBD>")
+    g7 = import_sfc((text[:start] + LD_OFF.format(negated=negated) + text[end:]).encode(), "ld.xml")
+    assert f"  transition On -> Idle when {expr}\n" in g7
+
+
+def test_a_named_transition_body_without_its_name_is_read():
+    """`:= c;` (the transition's name left out) as well as `OFF := c;`."""
+    text = (DATA / "beremiz_ld_fbd.xml").read_text()
+    start, end = text.index("<FBD>"), text.index("</FBD>") + len("</FBD>")
+    st = '<ST><xhtml:p xmlns:xhtml="http://www.w3.org/1999/xhtml"><![CDATA[:= NOT c;]]></xhtml:p></ST>'
+    g7 = import_sfc((text[:start] + st + text[end:]).encode(), "st.xml")
+    assert "  transition On -> Idle when !c\n" in g7
+
+
+def test_tc6_1_0_condition_connected_without_connection_point():
+    """TC6 1.0 files wire a condition as <condition><connection refLocalId=…/></condition>."""
+    text = (DATA / "beremiz_tc6_1_0.xml").read_text()
+    old = '<connectionPointIn><connection refLocalId="22"><position x="559" y="109"/><position x="401" y="109"/></connection></connectionPointIn>'
+    assert text.count(old) == 1
+    g7 = import_sfc(text.replace(old, '<connection refLocalId="22"/>').encode(), "tc6.xml")
+    assert "  transition Idle -> On when (a) & !b\n" in g7
+
+
+def test_two_statements_in_an_inline_n_action_are_stored_actions():
+    root = Path(__file__).resolve().parent / "data" / "codegen"
+    text = (root / "ide_sfc.xml").read_text()
+    assert text.count("LAMP := NOT bottom;") == 1
+    g7 = import_sfc(text.replace("LAMP := NOT bottom;", "LAMP := TRUE; BUSY := FALSE;").encode(), "x.xml")
+    assert "  step Lamp: set LAMP, reset BUSY\n" in g7
+    with pytest.raises(InputError) as info:
+        import_sfc(text.replace("LAMP := NOT bottom;", "LAMP := NOT bottom; BUSY := TRUE;").encode(), "x.xml")
+    assert info.value.render().splitlines()[0].startswith(
+        "x.xml:134:90: error: a statement of action N (inline) that .g7 cannot hold (LAMP := NOT bottom)")
+
+
+def test_the_scan_note_says_when_it_is_not_computed(cli, tmp_path):
+    """The import's note on steps a PLC keeps for a scan explores both readings within a small
+    budget; past it, the note says it was not checked instead of disappearing."""
+    lines = ["inputs " + ", ".join(f"a{i}" for i in range(12)), "outputs " + ", ".join(f"Q{i}" for i in range(12))]
+    lines += [f"grafcet G{i} {{ initial step {i}0 step {i}1: Q{i} transition {i}0 -> {i}1 when a{i} "
+              f"transition {i}1 -> {i}0 when !a{i} }}" for i in range(12)]  # 4 096 situations
+    (tmp_path / "wide.g7").write_text("\n".join(lines) + "\n")
+    assert cli("sfc", tmp_path / "wide.g7", "-o", tmp_path / "wide.xml")[0] == 0
+    code, _, err = cli("import", tmp_path / "wide.xml", "-o", tmp_path / "back.g7")
+    assert code == 0 and err == (
+        f"{tmp_path / 'wide.xml'}: note: not checked whether some steps stay active for a PLC scan where IEC 60848 "
+        "passes through them (more than 2000 situations to explore): validate with --semantics sfc for the meaning "
+        "the program has on the PLC\n")
+
+
+def test_import_list_says_refused_for_a_pou_the_import_refuses(cli, tmp_path):
+    text = (DATA / "codesys_v35.xml").read_text()
+    assert text.count("<expression>xStart AND NOT xDown</expression>") == 1
+    (tmp_path / "p.xml").write_text(text.replace("xStart AND NOT xDown", "xStart AND NOT xNowhere"))
+    code, out, _ = cli("import", "--list", tmp_path / "p.xml")
+    assert code == 0 and out.splitlines() == [
+        "Crane\tprogram\tSFC\tnot imported: refused: a transition reads 'xNowhere', which the POU Crane does not "
+        "declare",
+        "Belt\tprogram\tSFC\timported",
+        "PLC_PRG\tprogram\tST\tnot imported: an ST body: .g7 holds SFC charts only"]

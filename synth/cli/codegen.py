@@ -163,14 +163,14 @@ def cmd_sfc(args: argparse.Namespace) -> int:
 
 
 def cmd_import(args: argparse.Namespace) -> int:
-    from synth.codegen.plcopen.importer import import_sfc, list_pous
+    from synth.codegen.plcopen.importer import checked_pous, import_sfc
     from synth.grafcet.language_check import parse_grafcet
 
     from synth.syntax import read_bytes
 
     data = read_bytes(args.file)
     if args.list:
-        pous = list_pous(data, args.file)
+        pous = checked_pous(data, args.file)
         if args.json:
             from synth.output.codegen_json import import_list_json
             from synth.output.summary import print_json
@@ -193,12 +193,22 @@ def cmd_import(args: argparse.Namespace) -> int:
     for w in warnings:
         print(w.render(), file=sys.stderr)
     g = parse_grafcet(text, args.output or "<imported>")  # the result must be a valid .g7
-    from synth.grafcet.semantics import scan_only_steps
+    from synth.errors import LimitExceeded
+    from synth.grafcet.semantics import IMPORT_BUDGET, scan_only_steps
 
     show = tty_progress(live_line(not args.quiet))
     show("the steps a PLC scan keeps active (IEC 61131-3 against IEC 60848)")
-    steps = scan_only_steps(g)
-    clear_progress(show)
+    over = False
+    try:
+        steps = scan_only_steps(g)
+    except LimitExceeded:
+        steps, over = None, True
+    finally:
+        clear_progress(show)
+    if over:
+        print(f"{args.file}: note: not checked whether some steps stay active for a PLC scan where IEC 60848 passes "
+              f"through them (more than {IMPORT_BUDGET} situations to explore): validate with --semantics sfc for "
+              "the meaning the program has on the PLC", file=sys.stderr)
     if steps:
         print(f"{args.file}: note: step{'s' if len(steps) > 1 else ''} {', '.join(steps)} stay active for a PLC scan "
               "(IEC 61131-3 SFC, their actions run) where IEC 60848 passes through them in one evolution: validate "

@@ -7,7 +7,10 @@ situation and plays each one on both sides:
   event (``↑x``/``↓x``) or timer event (``2s/X101``) at a time;
 * the generated program (:func:`~synth.codegen.grafcet_st.generate_program`) parsed by blark and
   run by :mod:`synth.codegen.interpreter.machine`, one PLC cycle per event; a timer event is the clock
-  advanced until the timer reaches its preset, then one cycle with unchanged inputs.
+  advanced to 1 ms before the timer's preset, one cycle with unchanged inputs in which nothing
+  may change (a timer that fires early is seen there), then 1 ms more and one cycle in which the
+  timer fires (a timer that fires late is seen there). Where an idle scan would evolve the
+  situation (``--semantics sfc``), the clock jumps to the preset at once.
 
 After every cycle the active steps (``X<step>``) and the outputs must be equal; a transient
 cycle that never stabilises (an :class:`~synth.errors.InputError` of the machine) must set the
@@ -22,9 +25,9 @@ Example
 ...                   "transition 1 -> 0 when 2s/X1 }", "g.g7")
 >>> report = differential_check(g, {"a": False}, depth=3)
 >>> report.ok, report.sequences, report.cycles
-(True, 3, 7)
+(True, 3, 9)
 >>> report.text().splitlines()[0]
-'g.g7: the ST program equals synth run on 3 event sequences (7 PLC cycles, depth 3): 0 mismatches'
+'g.g7: the ST program equals synth run on 3 event sequences (9 PLC cycles, depth 3): 0 mismatches'
 """
 
 from __future__ import annotations
@@ -288,6 +291,14 @@ class _Checker:
         since = {s: (now if s in restarted else side.since[s]) for s in sit.steps}
         return _Side(sit, inputs, now, since)
 
+    def before_preset(self, side: _Side, events: tuple[str, ...], event: Event, delay: int) -> bool:
+        """One PLC cycle 1 ms before the timer event's preset (the clock advanced ``delay - 1``
+        ms, inputs unchanged): nothing may have changed yet, so a timer that fires early is
+        seen (its own cycle at the preset then shows one that fires late). False on a mismatch."""
+        self.runner.advance(delay - 1)
+        self.runner.cycle({})
+        return self.compare(events + (f"{delay - 1} ms before {event}",), side)
+
     def explore(self, side: _Side, events: tuple[str, ...]) -> None:
         if len(events) == self.depth or len(self.mismatches) >= self.max_mismatches:
             self.sequences += 1
@@ -300,8 +311,13 @@ class _Checker:
                 self.out_of_range += 1
                 continue
             saved = self.runner.save()
+            probe = delay > 1 and not self.machine.scans(side.sit, side.inputs)
+            if probe and not self.before_preset(side, events, event, delay):
+                self.sequences += 1
+                self.runner.restore(saved)
+                continue
             if delay:
-                self.runner.advance(delay)
+                self.runner.advance(1 if probe else delay)
             if event.is_edge:
                 self.runner.cycle({self.program.st_name(event.name): event.rising})
             else:

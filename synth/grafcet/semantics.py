@@ -17,23 +17,29 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from synth.errors import InputError, LimitExceeded
+from synth.errors import InputError
 from synth.grafcet.ass import stable_situation_automaton
 from synth.grafcet.language import Grafcet, Semantics, step_key
 from synth.grafcet.machine import GrafcetMachine
 
-__all__ = ["scan_only_steps"]
+__all__ = ["IMPORT_BUDGET", "scan_only_steps"]
 
 
-def scan_only_steps(g: Grafcet, max_states: int = 20_000) -> tuple[str, ...] | None:
+IMPORT_BUDGET = 2_000
+"""Situations each reading may explore for ``synth import``'s note: a note, not a verdict, so
+it stays well under a second on a chart of 200 steps and says so when it is not computed."""
+
+
+def scan_only_steps(g: Grafcet, max_states: int = IMPORT_BUDGET) -> tuple[str, ...] | None:
     """The steps active in some situation of the SFC reading and in no stable situation of the
-    IEC 60848 one (inputs free); None when either cannot be explored (a limit, or a Grafcet
-    that never stabilises in IEC 60848)."""
+    IEC 60848 one (inputs free); None when the Grafcet never stabilises in IEC 60848.
+    :class:`~synth.errors.LimitExceeded` when either reading has more than ``max_states``
+    situations."""
     try:
         stable = stable_situation_automaton(GrafcetMachine(replace(g, semantics=Semantics.GRAFCET)),
                                             max_states=max_states)
         scans = stable_situation_automaton(GrafcetMachine(replace(g, semantics=Semantics.SFC)), max_states=max_states)
-    except (LimitExceeded, InputError):
+    except InputError:
         return None
     seen = {s for st in stable.states for s in st.situation.steps}
     return tuple(sorted({s for st in scans.states for s in st.situation.steps} - seen, key=step_key))

@@ -153,7 +153,7 @@ def fbd_condition(cond: Any, elements: dict[int, Any], q: Callable[[str], str], 
         return trigger(name, instance, params["CLK"][0], src.at(el))
 
     cp = cond.find(q("connectionPointIn"))
-    return one_source(cp, cond)
+    return one_source(cp if cp is not None else cond, cond)  # TC6 1.0: <condition><connection> directly
 
 
 def fbd_transition(transition: Any, fbd: Any, q: Callable[[str], str], src: Any, steps: dict[str, str],
@@ -169,9 +169,12 @@ def fbd_transition(transition: Any, fbd: Any, q: Callable[[str], str], src: Any,
         if not isinstance(el.tag, str) or el.get("localId") is None or not el.get("localId").isdigit():
             continue
         elements[int(el.get("localId"))] = el
-        ex = el.find(q("expression"))
-        if etree.QName(el).localname == "outVariable" and ex is not None and (ex.text or "").strip().upper() == name.upper():
+        kind = etree.QName(el).localname
+        ex = el.find(q("expression" if kind == "outVariable" else "variable"))
+        if kind in ("outVariable", "coil") and ex is not None and (ex.text or "").strip().upper() == name.upper():
             target = el
     if target is None:
-        raise InputError(f"the FBD body of transition {name} has no <outVariable> {name}", src.at(transition))
-    return fbd_condition(target, elements, q, src, steps, sources)
+        raise InputError(f"the FBD/LD body of transition {name} has no <outVariable> or <coil> {name}",
+                         src.at(transition))
+    expr = fbd_condition(target, elements, q, src, steps, sources)
+    return f"!({expr})" if etree.QName(target).localname == "coil" and _negated(target) else expr

@@ -32,134 +32,24 @@ grafcet G {
 
 from __future__ import annotations
 
+import contextvars
 import re
-from dataclasses import dataclass
 from typing import Any
 
 from synth.codegen.plcopen.actions import ACTION_WARNINGS, action_body
 from synth.codegen.plcopen.assign import sum_text
 from synth.codegen.plcopen.data import DATA, duration
+from synth.codegen.plcopen.instances import separate_instances
+from synth.codegen.plcopen.project import NAMESPACES, PouSummary, body_language, list_pous, pous_of, read_project
 from synth.codegen.plcopen.sfc import Chart, Source, read_chart
 from synth.codegen.plcopen.timers import prepare_scope
 from synth.codegen.plcopen.vendor import IecQualifier
 from synth.codegen.plcopen.tc6 import Qualifier
 from synth.codegen.plcopen.st_condition import PREDICATES, ExprReader, st_text
-from synth.errors import InputError, Location
+from synth.errors import InputError, Location, Severity
 from synth.version import version as synth_version
 
-__all__ = ["import_sfc", "list_pous", "PouSummary", "NAMESPACES"]
-
-NAMESPACES = {
-    "http://www.plcopen.org/xml/tc6_0201": "TC6 2.01",
-    "http://www.plcopen.org/xml/tc6_0200": "TC6 2.00",
-    "http://www.plcopen.org/xml/tc6.xsd": "TC6 1.0",
-}
-"""The PLCopen namespaces read, with the version they name."""
-
-_LANGUAGES = ("SFC", "ST", "IL", "FBD", "LD")
-
-
-@dataclass(frozen=True)
-class PouSummary:
-    """What ``synth import --list`` prints for one POU."""
-
-    name: str
-    kind: str  # program, functionBlock, function
-    language: str
-    imported: bool
-    note: str
-
-    def text(self) -> str:
-        return f"{self.name}\t{self.kind}\t{self.language}\t{'imported' if self.imported else 'not imported'}" + \
-            (f": {self.note}" if self.note else "")
-
-
-def _project(data: bytes | str, file: str) -> tuple[Any, Source, Any]:
-    """The root element, the located source and the namespace function ``q``."""
-    from lxml import etree
-
-    raw = data if isinstance(data, bytes) else data.encode("utf-8")
-    src = Source(file, raw.decode("utf-8", errors="replace"))
-    try:
-        root = etree.fromstring(raw, etree.XMLParser(remove_blank_text=False, resolve_entities=False))
-    except etree.XMLSyntaxError as err:
-        line, col = err.position if hasattr(err, "position") else (err.lineno, 1)
-        raw_line = src.lines[line - 1] if 0 < line <= len(src.lines) else ""
-        message = re.sub(r", line \d+, column \d+$", "", str(err.msg))
-        from synth.syntax import file_kind_hint
-
-        hint = file_kind_hint("xml", file, "\n".join(src.lines[:200]))
-        raise InputError(f"not well-formed XML: {message}", Location(file, line, max(1, col), raw_line),
-                         notes=(hint,) if hint else ()) from None
-    ns = etree.QName(root).namespace
-    if ns not in NAMESPACES or etree.QName(root).localname != "project":
-        raise InputError(f"not a PLCopen TC6 XML project (root element {root.tag})", src.at(root),
-                         expected=tuple(f'<project xmlns="{n}">' for n in NAMESPACES))
-    _check_numbers(root, src)
-    return root, src, lambda tag: f"{{{ns}}}{tag}"
-
-
-_IDS = ("localId", "refLocalId", "executionOrderId")
-_COORDINATES = ("x", "y", "width", "height")
-
-
-def _check_numbers(root: Any, src: Source) -> None:
-    """Identifiers of at most 18 digits and finite coordinates, before anything reads them
-    as numbers (a 4 300-digit ``localId`` is past what Python converts; ``x="1e400"`` is
-    infinite): a located error at the element otherwise."""
-    for el in root.iter():
-        if not isinstance(el.tag, str):  # comments, processing instructions
-            continue
-        for name in _IDS:
-            value = el.get(name)
-            if value is not None and value.strip().isdigit() and len(value.strip()) > 18:
-                raise InputError(f"{name} of {len(value.strip())} digits: synth reads identifiers of at most 18",
-                                 src.at(el))
-        for name in _COORDINATES:
-            value = el.get(name)
-            if value is None or len(value) <= 24:
-                try:
-                    if value is None or abs(float(value)) < 1e15:
-                        continue
-                except ValueError:
-                    continue  # not a number: left to the reader of that attribute
-            raise InputError(f"{name}=\"{value[:24]}{'…' if len(value) > 24 else ''}\" is not a coordinate "
-                             f"(a finite number below 10^15)", src.at(el))
-
-
-def _language(pou: Any, q: Any) -> str:
-    body = pou.find(q("body"))
-    if body is None:
-        return "none"
-    for lang in _LANGUAGES:
-        if body.find(q(lang)) is not None:
-            return lang
-    return "other"
-
-
-def _pous(root: Any, q: Any) -> list[Any]:
-    # CODESYS exports with a device put POUs in the resource's addData as well as in types/pous
-    return list(root.iter(q("pou")))
-
-
-def list_pous(data: bytes | str, file: str = "<xml>") -> list[PouSummary]:
-    """Every POU of the project: its kind, body language and whether ``import`` reads it."""
-    root, src, q = _project(data, file)
-    out = []
-    for pou in _pous(root, q):
-        lang = _language(pou, q)
-        note = "" if lang == "SFC" else f"an {lang} body: .g7 holds SFC charts only"
-        if pou.find(q("actions")) is not None and lang == "SFC":
-            note = "POU actions are read where an action block references them"
-        charts = [str(a.get("name", "")) for a in pou.findall(f"{q('actions')}/{q('action')}")
-                  if a.find(f"{q('body')}/{q('SFC')}") is not None]
-        if charts:
-            note += ("; " if note else "") + (f"SFC in its action{'s' if len(charts) > 1 else ''} {', '.join(charts)}: "
-                                              "not imported (.g7 reads the SFC body of a POU, not a chart inside "
-                                              "an action of a function block)")
-        out.append(PouSummary(str(pou.get("name", "")), str(pou.get("pouType", "")), lang, lang == "SFC", note))
-    return out
-
+__all__ = ["import_sfc", "checked_pous", "list_pous", "PouSummary", "NAMESPACES"]
 
 def import_sfc(data: bytes | str, file: str = "<xml>", pou: str | None = None,
                notes: list[str] | None = None, warnings: list[InputError] | None = None) -> str:
@@ -171,8 +61,8 @@ def import_sfc(data: bytes | str, file: str = "<xml>", pou: str | None = None,
     at their line. ``notes`` receives what was left out (POUs that are not SFC), ``warnings``
     where IEC 61131-3 SFC and IEC 60848 read the chart differently (located).
     """
-    root, src, q = _project(data, file)
-    all_pous = _pous(root, q)
+    root, src, q = read_project(data, file)
+    all_pous = pous_of(root, q)
     sfc_pous = [(p, p.find(f"{q('body')}/{q('SFC')}")) for p in all_pous]
     sfc_pous = [(p, s) for p, s in sfc_pous if s is not None]
     names = [str(p.get("name", "")) for p in all_pous]
@@ -188,15 +78,18 @@ def import_sfc(data: bytes | str, file: str = "<xml>", pou: str | None = None,
     if not sfc_pous:
         raise InputError("no POU with an SFC body in this file", src.at(root),
                          notes=(("POUs: " + ", ".join(names)) if names else "the file has no POU",))
-    if notes is not None and pou is None:
+    if notes is not None:  # the whole file: every POU left out; one POU (--pou): the charts inside it left out
         notes += [f"POU {s.name} not imported: {s.note}" if not s.imported else f"POU {s.name}: {s.note}"
-                  for s in list_pous(data, file) if not s.imported or "SFC in its action" in s.note]
+                  for s in list_pous(data, file) if (pou is None and not s.imported or "SFC in its action" in s.note)
+                  and (pou is None or s.name == pou)]
     several = len(sfc_pous) > 1
     charts = []
     for p, s in sfc_pous:
         token = PREDICATES.set({})  # comparisons become declared predicates while a chart is read
         action_warnings: list[InputError] = []
         token2 = ACTION_WARNINGS.set(action_warnings)
+        held: list[tuple[str, str, Location]] = []
+        token4 = HELD.set(held)
         prefix = f"{p.get('name')}_" if several else ""
         scope = prepare_scope(p, s, q, src.at, prefix, src.text_at)
         token3 = DATA.set(scope)
@@ -206,11 +99,14 @@ def import_sfc(data: bytes | str, file: str = "<xml>", pou: str | None = None,
             PREDICATES.reset(token)
             ACTION_WARNINGS.reset(token2)
             DATA.reset(token3)
-        charts[-1].warnings.extend(action_warnings + scope.warnings)
+            HELD.reset(token4)
+        charts[-1].warnings.extend(action_warnings + scope.warnings + _held_warnings(charts[-1], held))
         charts[-1].internals = scope.declarations()
         charts[-1].outputs[:] = [o for o in charts[-1].outputs if o.upper() not in scope.used]
         charts[-1].outputs.extend(n for n in [*scope.action_refs, *scope.globals_out.values(), *scope.inputs_out.values()]
                                   if n not in charts[-1].outputs and n.upper() not in scope.used)
+    if several:
+        separate_instances(charts, [p for p, _ in sfc_pous], q, src.at)
     _feedback(charts, src)
     if warnings is not None:
         warnings += [w for c in charts for w in c.warnings]
@@ -296,6 +192,30 @@ def _g7_text(charts: list[Chart], file: str, several: bool) -> str:
     return "\n".join(lines) + "\n"
 
 
+HELD: contextvars.ContextVar[list[tuple[str, str, Location]] | None] = contextvars.ContextVar("HELD", default=None)
+"""While a chart is read: the ``N`` actions ``X := c;`` read as ``X if c`` (step, action, where)."""
+
+
+def _held_warnings(chart: Chart, held: list[tuple[str, str, Location]]) -> list[InputError]:
+    """``X := c;`` in an ``N`` action: the PLC assigns X while the step is active and keeps its
+    last value once the step is left; ``X if c`` (continuous) lets X fall. The two agree when the
+    step also resets X on deactivation (a ``P0`` action, as ``synth sfc`` writes it); otherwise a
+    located warning says what changed."""
+    actions = {s.name: s.actions for s in chart.steps}
+    out = []
+    for step, action, where in held:
+        target, cond = action.split(" if ", 1)
+        if f"reset {target} on deactivation" in actions.get(step, ()):
+            continue
+        out.append(InputError(
+            f"an N action assigning {target} in step {step} is read as the continuous action '{action}': "
+            f"{target} falls when the step is left, while the PLC keeps its last value",
+            where, severity=Severity.WARNING,
+            notes=(f"to keep the continuous meaning on the PLC, add a P0 action '{target} := FALSE;' to step {step}; "
+                   f"for a stored order, write S/R actions (set {target} / reset {target})",)))
+    return out
+
+
 def _paired(actions: list[str]) -> list[str]:
     """``A if c`` is exported as an ``N`` body and a ``P0`` body ``A := FALSE;`` (its IEC
     meaning: reset when the step is left); read back, the pair is ``A if c`` alone."""
@@ -344,7 +264,10 @@ def _read_action(a: Any, src: Source, steps: dict[str, str], q: Any, pou_actions
                              src.at(a))
         timer = f"{d}/X{step}"
         return [f"{name} if {timer}" if qualifier == IecQualifier.D else f"{name} if !{timer}"]
-    return [_one_action(a, src, steps, q, qualifier)]
+    action = _one_action(a, src, steps, q, qualifier)
+    if qualifier == IecQualifier.N and " if " in action and (held := HELD.get()) is not None:
+        held.append((step, action, src.at(a)))  # X := c; the PLC keeps X once the step is left
+    return [action]
 
 
 def _pou_action(a: Any, name: str, action: Any, qualifier: IecQualifier, src: Source, q: Any,
@@ -392,7 +315,9 @@ def _one_action(a: Any, src: Source, steps: dict[str, str], q: Any, qualifier: s
     scope = DATA.get()
     data = re.fullmatch(r"(\w+)\s*:=\s*([^;]*?)\s*;?", body, re.S)
     target = scope.find(data[1]) if scope is not None and data is not None else None
-    if qualifier in (Qualifier.P0, Qualifier.P1) and len([x for x in body.split(";") if x.strip()]) > 1:
+    several = len([x for x in body.split(";") if x.strip()]) > 1
+    if_body = qualifier == Qualifier.N and re.match(r"IF\b", body, re.I)  # IF c THEN X := TRUE; END_IF;
+    if several and qualifier in (Qualifier.N, Qualifier.P0, Qualifier.P1) and not if_body:
         return ", ".join(action_body(f"{qualifier} (inline)", st_text(st), IecQualifier(qualifier), where, steps))
     if qualifier in (Qualifier.P0, Qualifier.P1) and target is not None and data is not None and scope is not None:
         raw = st_text(st)
@@ -424,6 +349,8 @@ def _one_action(a: Any, src: Source, steps: dict[str, str], q: Any, qualifier: s
             if re.search(r"[A-Za-z]", value):
                 scope.every_scan(body.strip(), "an N action", where(0, len(cm[1])))
             return f"{target.name} := {value}"
+        if m:  # X := TRUE; at every scan while the step is active, kept once it is left: stored
+            return f"{'set' if m[2].upper() in ('TRUE', '1') else 'reset'} {m[1]} on activation"
         if cm:
             raw = st_text(st)
             off = raw.find(cm[2])
@@ -435,3 +362,18 @@ def _one_action(a: Any, src: Source, steps: dict[str, str], q: Any, qualifier: s
             return f"{cm[1]} if {cond}"
     raise InputError(f"a {qualifier} action body that .g7 cannot represent (expected 'NAME := condition;')",
                      where(0, 1))
+
+
+def checked_pous(data: bytes | str, file: str = "<xml>") -> list[PouSummary]:
+    """:func:`list_pous` with each SFC POU imported on its own: a POU the import refuses is
+    listed as not imported, with the first line of the reason (``synth import --list``)."""
+    out = []
+    for s in list_pous(data, file):
+        if s.imported:
+            try:
+                import_sfc(data, file, pou=s.name)
+            except InputError as err:
+                reason = err.render().splitlines()[0].split(": error: ", 1)[-1]
+                s = PouSummary(s.name, s.kind, s.language, False, "refused: " + reason)
+        out.append(s)
+    return out

@@ -22,7 +22,7 @@ from synth.codegen.plcopen.data import DATA
 from synth.codegen.plcopen.ids import number_ids
 from synth.codegen.plcopen.scan import one_scan_steps
 from synth.codegen.plcopen.timers import ton_chart
-from synth.codegen.plcopen.vendor import step_actions
+from synth.codegen.plcopen.vendor import chart_flag_warnings, step_actions
 from synth.codegen.plcopen.fbd import FBD_ELEMENTS, fbd_condition, fbd_transition
 from synth.codegen.plcopen.tc6 import SYNTH_DATA
 from synth.codegen.plcopen.st_condition import PREDICATES, ExprReader, st_text
@@ -162,6 +162,27 @@ def _x(el: Any) -> int:
         return 0
 
 
+MATIEC_DIVERGENCE = ("on MATIEC (the compiler of Beremiz and OpenPLC) every true branch fires, priorities ignored: "
+                     "for a program that runs there, validate the receptivities as written, without this rewrite")
+"""The runtime that reads a selection divergence otherwise than IEC 61131-3 (measured: two
+tokens after a divergence whose branches were both true)."""
+
+NO_PRIORITY = 2 ** 63
+"""The rank of a transition without a ``priority`` attribute: after every written one."""
+
+
+def _priority(el: Any, src: Source) -> int:
+    """The ``priority`` attribute of an SFC ``<transition>`` (TC6: the smaller, the earlier a
+    selection divergence tests it), :data:`NO_PRIORITY` when absent; anything else than a
+    non-negative integer is a located error."""
+    text = el.get("priority")
+    if text is None:
+        return NO_PRIORITY
+    if not text.strip().isdigit() or len(text.strip()) > 18:
+        raise InputError(f"transition priority '{text[:40]}' is not a non-negative integer", src.at(el))
+    return int(text)
+
+
 def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
                read_action: Callable[..., list[str]], prefix: str = "") -> Chart:
     """The chart of ``pou`` (its SFC body ``sfc``); step names get ``prefix`` (several POUs
@@ -178,12 +199,14 @@ def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
         body = t.find(q("body"))
         st = body.find(q("ST")) if body is not None else None
         fbd = body.find(q("FBD")) if body is not None else None
+        if fbd is None and body is not None:
+            fbd = body.find(q("LD"))  # OpenPLC writes a named transition in LD: a coil named after it
         if st is not None:
             named_conditions[t.get("name")] = (st, st_text(st))
         elif fbd is not None:
             named_fbd[t.get("name")] = (t, fbd)
         else:
-            raise InputError("a named transition whose body is neither ST nor FBD", src.at(t))
+            raise InputError("a named transition whose body is neither ST, FBD nor LD", src.at(t))
 
     number_ids(sfc, q, src.at)
     elements: dict[int, Any] = {}  # localId -> lxml element
@@ -290,7 +313,7 @@ def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
 
     # transitions
     transitions: list[tuple[str, list[str], list[str], str, object]] = []
-    branches: dict[int, list[tuple[tuple[int, int], int]]] = {}  # selection divergence -> (order, transition)
+    branches: dict[int, list[tuple[tuple[int, int, int], int]]] = {}  # selection divergence -> (order, transition)
     warnings: list[InputError] = []
     for lid, el in elements.items():
         if kind(el) != "transition":
@@ -319,10 +342,10 @@ def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
                 raise InputError(f"condition '{ref.get('name')}' is not defined in the POU's <transitions>",
                                  src.at(ref), suggestions=close_names(ref.get("name", ""), named_conditions))
             holder, ctext = named_conditions[ref.get("name")]
-            m = re.fullmatch(r"\s*\w+\s*:=\s*(.*?);?\s*", ctext, re.S)
+            m = re.fullmatch(r"\s*(?:\w+\s*)?:=\s*(.*?);?\s*", ctext, re.S)  # NAME := c; or := c;
             if m:
                 ctext = m[1]
-        elif cond.find(q("connectionPointIn")) is not None:
+        elif cond.find(q("connectionPointIn")) is not None or cond.find(q("connection")) is not None:  # TC6 1.0
             holder = None
         else:
             raise InputError("a transition condition with neither ST nor a connection", src.at(cond))
@@ -341,7 +364,7 @@ def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
         div = [(ref, c) for ref, c in producers(el) if kind(elements[ref]) == "selectionDivergence"]
         if len(div) == 1:
             branch = div[0][1].get("formalParameter", "")
-            key = (int(branch) if branch.strip().isdigit() else 10 ** 6, _x(el))
+            key = (_priority(el, src), int(branch) if branch.strip().isdigit() else 10 ** 6, _x(el))
             branches.setdefault(div[0][0], []).append((key, len(transitions) - 1))
         if sources and sources == targets and "↑" not in expr and "↓" not in expr:
             warnings.append(InputError(
@@ -357,21 +380,25 @@ def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
         transitions += [("", a, b, expr, pou) for a, b, expr in htrans]
     _declare_predicates(inputs, warnings)
     _check_names(pou, q, src, transitions, {st.name for st in [*steps.values(), *helpers]}, inputs, outputs, warnings)
+    warnings += chart_flag_warnings(pou, q, src.at)
     written_by_synth = any(st.grafcet for st in steps.values())  # its .g7 is the meaning: no rewriting
     for d, members in branches.items():  # IEC 61131-3: the first true branch, left to right; .g7: every one
         if len(members) < 2 or written_by_synth:
             continue
         ranked = [i for _, i in sorted(members)]
+        prioritised = any(key[0] < NO_PRIORITY for key, _ in members)
         rewritten = []
         for k, i in enumerate(ranked[1:], 1):
             label, sources, targets, expr, el = transitions[i]
             before = " & ".join(f"!({transitions[j][3]})" for j in ranked[:k])
             transitions[i] = (label, sources, targets, f"({expr}) & {before}", el)
             rewritten.append(f"{' -> '.join([', '.join(sources), ', '.join(targets)])} when {transitions[i][3]}")
+        rule = ("the true branch of highest priority (smallest `priority`, then left to right)" if prioritised
+                 else "the first true branch (left to right)")
         warnings.append(InputError(
-            "a selection divergence: IEC 61131-3 SFC fires the first true branch (left to right), .g7 every true "
+            f"a selection divergence: IEC 61131-3 SFC fires {rule}, .g7 every true "
             "branch; the later branches' receptivities are made exclusive", src.at(elements[d]),
-            severity=Severity.WARNING, notes=tuple(rewritten)))
+            severity=Severity.WARNING, notes=(*rewritten, MATIEC_DIVERGENCE)))
 
     # actions: CODESYS/TwinCAT step actions (vendor addData), then the action blocks
     if scope is not None:

@@ -18,7 +18,9 @@ from __future__ import annotations
 from enum import Enum, StrEnum
 from typing import Any, Callable
 
-__all__ = ["IecQualifier", "StepAction", "SFC_ELEMENT_DATA", "step_actions"]
+from synth.errors import InputError, Location, Severity
+
+__all__ = ["IecQualifier", "StepAction", "SFC_ELEMENT_DATA", "step_actions", "CHART_FLAGS", "chart_flag_warnings"]
 
 
 class IecQualifier(StrEnum):
@@ -73,3 +75,29 @@ def step_actions(step: Any, q: Callable[[str], str]) -> list[tuple[StepAction, s
             if kind is not None and name:
                 found[kind] = (name, attr)
     return [(k, *found[k]) for k in StepAction if k in found]
+
+
+CHART_FLAGS = {
+    "SFCINIT": "puts the chart back to its initial step and holds it there while it is TRUE",
+    "SFCRESET": "puts the chart back to its initial step while it is TRUE",
+    "SFCPAUSE": "freezes the chart while it is TRUE",
+}
+"""CODESYS's implicit SFC flags that change what the chart does (declared by the user in the
+POU, set by the calling program, typically on an emergency stop). The others (``SFCError``,
+``SFCCurrentStep``, ...) only report."""
+
+
+def chart_flag_warnings(pou: Any, q: Callable[[str], str], at: Callable[[Any], Location]) -> list[InputError]:
+    """A located warning for each CODESYS implicit flag the POU declares: ``.g7`` has no forcing
+    of a chart from outside, so the import cannot keep what the flag does on the PLC."""
+    out = []
+    for v in pou.iterfind(f"{q('interface')}/*/{q('variable')}"):
+        name = str(v.get("name"))
+        if name.upper() in CHART_FLAGS:
+            out.append(InputError(
+                f"'{name}' is CODESYS's implicit SFC flag: on the PLC it {CHART_FLAGS[name.upper()]}; the .g7 has no "
+                "such forcing, so the import reads it as a plain variable and the chart ignores it",
+                at(v), severity=Severity.WARNING,
+                notes=("validate the emergency stop separately, or model it as transitions back to the initial "
+                       "steps guarded by the flag",)))
+    return out

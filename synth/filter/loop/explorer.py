@@ -317,7 +317,9 @@ class Explorer:
             self.record(kind, mask, post, node, event, oid, shown)
         if pr.controlled and oid.size:
             dist = (requests[oid] != targets).sum(axis=1)
-            self.corrected += int((dist > 0).sum())
+            # each kept (state, class) stands for every entry merged into it: count them all, as cycles does
+            merged = np.bincount(rep, minlength=keep.size)[entry]
+            self.corrected += int(merged[dist > 0].sum())
             self.max_distance = max(self.max_distance, int(dist.max()))
         if self.track:
             self.edges((sources, taken_all, events_all), rep, entry[ok], aux_after[oid][ok] * size + final[ok],
