@@ -31,16 +31,12 @@ EPILOG = ("exit codes: 0 pass, 1 the model fails (problems found), 2 bad input o
           f"3 a bug in synth ({TRACEBACK_ENV}=1 shows its traceback), 130 interrupted")
 
 
-def _close(word: str, valid: Sequence[str]) -> list[str]:
-    """The valid names closest to ``word`` (difflib), best first."""
+def did_you_mean(word: str, valid: Sequence[str]) -> str:
+    """``; did you mean 'x'?`` (or ``'x' or 'y'``: the closest by difflib, best first), empty
+    when nothing is close."""
     import difflib
 
-    return difflib.get_close_matches(word, list(valid), n=3, cutoff=0.6)
-
-
-def did_you_mean(word: str, valid: Sequence[str]) -> str:
-    """``; did you mean 'x'?`` (or ``'x' or 'y'``), empty when nothing is close."""
-    close = _close(word, valid)
+    close = difflib.get_close_matches(word, list(valid), n=3, cutoff=0.6)
     return f"; did you mean {' or '.join(repr(c) for c in close)}?" if close else ""
 
 
@@ -164,11 +160,14 @@ def _main(argv: Sequence[str] | None) -> int:
     args = parse(parser, argv)
     handler: Callable[[argparse.Namespace], int] = args.handler
     from synth.errors import InputError, InputErrors, LimitExceeded, ModelError, ModelFailure, SynthError
-    from synth.output.progress import start_run
+    from synth.output.progress import start_run, stop_progress
 
     start_run()
     try:
-        return handler(args)
+        try:
+            return handler(args)
+        finally:  # a live line still drawn (an error, Ctrl-C) is erased before any message
+            stop_progress()
     except ModelFailure as err:  # located, but a verdict: the model fails
         print(err.render(), file=sys.stderr)
         return 1

@@ -22,7 +22,7 @@ import threading
 import time
 from typing import Callable
 
-__all__ = ["start_run", "reached", "tty_progress", "clear_progress", "live_line", "Counter"]
+__all__ = ["start_run", "reached", "tty_progress", "clear_progress", "stop_progress", "live_line"]
 
 _state: dict[str, float | str] = {"start": time.monotonic(), "last": "", "shown": 0.0}
 
@@ -88,6 +88,12 @@ def clear_progress(show: Callable[[str], None] | None) -> None:
     """Stop the redrawing and erase the line, if one was drawn."""
     if show is None or not getattr(show, "enabled", False):
         return
+    stop_progress()
+
+
+def stop_progress() -> None:
+    """Stop the redrawing and erase the line if one is drawn (the end of any run, an error or
+    a Ctrl-C included)."""
     stop = _ticker["stop"]
     if stop is not None:
         stop.set()
@@ -97,17 +103,3 @@ def clear_progress(show: Callable[[str], None] | None) -> None:
             sys.stderr.write("\r\033[K")
             sys.stderr.flush()
             _state["shown"] = 0.0
-
-
-class Counter:
-    """Counts work items (states, cycles, sequences) and reports ``N <what> (R/s)`` now and then."""
-
-    def __init__(self, show: Callable[[str], None], what: str, every: int = 256) -> None:
-        self.show, self.what, self.every, self.count = show, what, every, 0
-        self.begin = time.monotonic()
-
-    def add(self, n: int = 1) -> None:
-        self.count += n
-        if self.count % self.every < n:
-            rate = self.count / max(time.monotonic() - self.begin, 1e-9)
-            self.show(f"{self.what}: {self.count} ({rate:.0f}/s)")
