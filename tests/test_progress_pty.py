@@ -61,6 +61,14 @@ def test_filter_verify_live_line_on_a_terminal(loop):
     assert err.endswith("\r\x1b[K")  # the line is erased at the end: nothing left on the terminal
 
 
+def test_symbolic_filter_verify_live_line(loop):
+    argv = [*loop[:-1], "symbolic"]
+    code, out, err = _run(argv, tty=True)
+    assert code == 0 and "safe:" in out
+    assert "s] closed loop (symbolic): level 1, " in err and " BDD nodes" in err
+    assert _run(argv, tty=False)[2] == ""
+
+
 def test_filter_verify_silent_when_piped_or_quiet(loop):
     assert _run(loop, tty=False)[2] == ""
     code, out, err = _run([*loop, "--quiet"], tty=True)

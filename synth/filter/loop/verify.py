@@ -110,7 +110,8 @@ def verify(f: Filter, rules_path: str, grafcet: str | None = None, *, any_contro
         if choose_engine(engine, any_control=any_control, progress=progress is not None,
                          plant_size=size) is EngineChoice.SYMBOLIC:
             return verify_symbolic(f, rules_path, algorithm=algorithm, mode=mode, atomic=atomic, strict=strict,
-                                   require_sup=require_sup, max_states=max_states, events_per_cycle=events_per_cycle)
+                                   require_sup=require_sup, max_states=max_states, events_per_cycle=events_per_cycle,
+                                   report=report)
     if max_states is None:
         max_states = DEFAULT_MAX_STATES
     started = time.perf_counter()

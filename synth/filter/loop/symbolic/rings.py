@@ -33,6 +33,8 @@ Example
 
 from __future__ import annotations
 
+from typing import Callable
+
 from synth.filter.cycle import Algorithm, Mode
 from synth.filter.language import Filter
 from synth.filter.loop.symbolic.cycle import FALLBACK, OUTSIDE, SymbolicCycle, next_name
@@ -56,6 +58,7 @@ class SymbolicLoop:
         from synth.plant.composition import plant
         from synth.plant.rules_check import load_rules
 
+        self.report: Callable[[str], None] | None = None  # progress lines, one per level (the CLI's live line)
         rs = load_rules(rules_path)
         self.sc = sc = SymbolicCycle(f, rs, plant(rs), algorithm, mode, atomic)
         self.k, self.max_states = events_per_cycle, max_states
@@ -150,6 +153,8 @@ class SymbolicLoop:
             frontier = self.level(frontier, depth)
             self.levels.append(frontier)
             depth += 1
+            if self.report is not None:
+                self.report(f"closed loop (symbolic): level {depth}, {e.live_nodes()} BDD nodes")
         if self.levels[-1] == e.false:
             self.levels.pop()
         self.states = self.count(self.reach, self.node_vars)

@@ -24,6 +24,7 @@ Example
 from __future__ import annotations
 
 import time
+from typing import Callable
 
 import numpy as np
 
@@ -94,7 +95,7 @@ def explicit_findings(f: Filter, rules_path: str, algorithm: Algorithm, mode: Mo
 def verify_symbolic(f: Filter, rules_path: str, *, algorithm: Algorithm = Algorithm.ALGEBRAIC,
                     mode: Mode = Mode.SUPERVISOR, atomic: bool = False, strict: bool = False,
                     require_sup: bool = False, max_states: int | None = None, events_per_cycle: int = 1,
-                    trace_budget: int = TRACE_BUDGET) -> Verification:
+                    trace_budget: int = TRACE_BUDGET, report: Callable[[str], None] | None = None) -> Verification:
     """The closed loop under any control on the symbolic engine. Every count is the
     explicit engine's; each finding's trace is the explicit engine's shortest one or, when
     the explicit engine cannot render it within ``trace_budget`` nodes (see the module
@@ -103,6 +104,7 @@ def verify_symbolic(f: Filter, rules_path: str, *, algorithm: Algorithm = Algori
 
     started = time.perf_counter()
     loop = SymbolicLoop(f, rules_path, Algorithm(algorithm), Mode(mode), atomic, events_per_cycle, max_states)
+    loop.report = report
     loop.run()
     counts = loop.counts()
     kinds = [k for k in FindingKind if k in loop.first_level and (require_sup or k is not FindingKind.OUTSIDE_SUP)]
