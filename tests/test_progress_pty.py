@@ -99,3 +99,34 @@ def test_stage_lines_of_check_solve_import(argv):
 
     assert re.sub(r"\r\x1b\[K(\[ *\d+\.\ds\] [^\r\n]*)?", "", err) == piped[2].replace("\n", "\r\n")
     assert "\x1b" not in piped[2] and "\r" not in piped[2]
+
+
+def test_ctrl_c_during_a_long_run_says_how_far_it_went():
+    """SIGINT once the live line shows the closed loop's first levels: the line is erased,
+    then one line says how far the run went, exit 130, no traceback."""
+    import re
+    import signal
+
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    master, slave = os.openpty()
+    proc = subprocess.Popen([sys.executable, "-m", "synth", "filter", "verify", "plants/four_cylinders.filter",
+                             "--plant", "plants/four_cylinders.rules", "--any-control", "--engine", "explicit"],
+                            cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=slave)
+    os.close(slave)
+    seen = b""
+    while b"closed loop: " not in seen:
+        seen += os.read(master, 4096)
+    proc.send_signal(signal.SIGINT)
+    while True:
+        try:
+            data = os.read(master, 4096)
+        except OSError:
+            break
+        if not data:
+            break
+        seen += data
+    assert proc.wait(timeout=60) == 130
+    os.close(master)
+    tail = seen.decode().rsplit("\r\x1b[K", 1)[1]
+    assert re.fullmatch(r"interrupted after \d+\.\d s: closed loop: \d+ states, \d+ cycles \(\d+ cycles/s\), "
+                        r"level \d+\r\n", tail), tail
