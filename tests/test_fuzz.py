@@ -19,13 +19,13 @@ LANGUAGES = ["rules", "g7", "filter", "xml", "st", "csv", "events", "home", "why
 
 
 def test_a_seeded_slice_finds_nothing():
-    tallies = fuzz.fuzz(runs=9 * 14, seed=38, timeout=10.0)
+    tallies = fuzz.fuzz(runs=9 * 10, seed=38, timeout=10.0)
     assert list(tallies) == LANGUAGES
-    assert [t.runs for t in tallies.values()] == [14] * 9
+    assert [t.runs for t in tallies.values()] == [10] * 9
     findings = [f for t in tallies.values() for f in t.findings]
     assert findings == []
     # not vacuous: the mutants both pass and fail to read
-    assert sum(t.codes.get(2, 0) for t in tallies.values()) > 50
+    assert sum(t.codes.get(2, 0) for t in tallies.values()) > 40
     assert sum(t.codes.get(0, 0) for t in tallies.values()) > 5
 
 
