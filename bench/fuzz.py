@@ -200,8 +200,9 @@ def classify(code: int | None, err: str, escaped: str) -> str | None:
         return "crash"
     if len(err) > 65536:
         return "huge"
-    if code == 2:
-        first = err.lstrip("\n").split("\n", 1)[0]
+    if code == 2:  # the first line that is not a note or a warning (nor one's quoted line) is the error
+        lines = [ln for ln in err.split("\n") if ln and not ln.startswith(" ")]
+        first = next((ln for ln in lines if not re.match(r"^(\S.*: )?(note|warning): ", ln)), "")
         if not (LOCATED.match(first) or UNPLACED.match(first)) or re.match(r"^.+:-?\d*-1:-?\d+:|^.+:\d+:-1:", first):
             return "unlocated"
         if first.startswith("error: ") and not first.startswith("error: cannot "):

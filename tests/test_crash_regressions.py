@@ -201,3 +201,13 @@ def test_why_state_errors_are_located(cli):
     assert code == 2
     assert err.splitlines()[:3] == ["--why:1:7: error: unknown variable 'v1O' in the state",
                                     "  1 | TAPIS,v1O,v20", "    |       ^~~"]
+
+
+def test_a_pou_variable_without_a_name(cli, tmp_path):
+    """From the full fuzz run: `<variable nam="LAMP">` in an interface was an AttributeError."""
+    text = (ROOT / "tests/data/plcopen/beremiz_tc6_1_0.xml").read_text()
+    f = tmp_path / "noname.xml"
+    f.write_text(text.replace('<variable name="LAMP">', '<variable nam="LAMP">', 1))
+    code, out, err = cli("import", f)
+    assert (code, out) == (2, "")
+    assert err.splitlines()[0] == f"{f}:22:13: error: a variable of POU lamp's interface has no name"

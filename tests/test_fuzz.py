@@ -47,3 +47,9 @@ def test_mutations_are_deterministic():
     a = fuzz.mutate("inputs a\noutputs o\n", random.Random(5), fuzz.TOKENS["filter"])
     b = fuzz.mutate("inputs a\noutputs o\n", random.Random(5), fuzz.TOKENS["filter"])
     assert a == b != "inputs a\noutputs o\n"
+
+
+def test_notes_before_the_error_do_not_hide_its_location():
+    err = "x.xml: note: POU P not imported\nx.xml:3:4: error: bad\n  3 | <a>\n    |    ^\n"
+    assert fuzz.classify(2, err, "") is None
+    assert fuzz.classify(2, "x.xml: note: POU P not imported\nerror: bad\n", "") == "unlocated"

@@ -164,7 +164,6 @@ def cmd_sfc(args: argparse.Namespace) -> int:
 
 def cmd_import(args: argparse.Namespace) -> int:
     from synth.codegen.plcopen.importer import checked_pous, import_sfc
-    from synth.grafcet.language_check import parse_grafcet
 
     from synth.syntax import read_bytes
 
@@ -192,7 +191,7 @@ def cmd_import(args: argparse.Namespace) -> int:
         print(f"{args.file}: note: {n}", file=sys.stderr)
     for w in warnings:
         print(w.render(), file=sys.stderr)
-    g = parse_grafcet(text, args.output or "<imported>")  # the result must be a valid .g7
+    g = _imported_grafcet(text, args)  # the result must be a valid .g7
     from synth.errors import LimitExceeded
     from synth.grafcet.semantics import IMPORT_BUDGET, scan_only_steps
 
@@ -220,6 +219,21 @@ def cmd_import(args: argparse.Namespace) -> int:
 
         print_json(import_json(args.file, args.output, text, notes, [w.render() for w in warnings], steps or ()))
     return 0
+
+
+def _imported_grafcet(text: str, args: argparse.Namespace) -> "Grafcet":
+    """The Grafcet ``import`` read, checked as a ``.g7``; an error in it says where it came from."""
+    from synth.errors import InputError, InputErrors
+    from synth.grafcet.language_check import parse_grafcet
+
+    name = args.output or "<imported>"
+    try:
+        return parse_grafcet(text, name)
+    except (InputError, InputErrors) as err:
+        note = f"{name} is the Grafcet read from {args.file}: the chart of the XML file does not make a valid Grafcet"
+        errors = err.errors if isinstance(err, InputErrors) else (err,)
+        raise InputErrors([InputError(e.message, e.location, expected=e.expected, suggestions=e.suggestions,
+                                      notes=(*e.notes, note)) for e in errors]) from None
 
 
 def register(sub: "argparse._SubParsersAction") -> None:
