@@ -27,6 +27,7 @@ PACKAGES = {
     "grafcet": (".g7 language, IEC 60848 machine, ASS", "Grafcet, GrafcetMachine, ASS"),
     "validation": ("SYNC, analysis, diagnosis", "Validation"),
     "symbolic": ("BDD engine for SUP and validation", "same results, symbolically"),
+    "engines": ("the one engine chooser: capabilities, thresholds", "the engine that runs"),
     "filter": ("safety logic filter: check, solve, verify", "equations, filter FB"),
     "codegen": ("IEC 61131-3 ST, PLCopen XML, ST interpreter", "program, proof"),
     "output": ("summaries, DOT, HTML report, libFAUDES, files", "JSON, text, files"),
@@ -38,7 +39,8 @@ def package_imports() -> set[tuple[str, str]]:
     """(importer, imported) pairs between synth's packages, from the source files."""
     edges: set[tuple[str, str]] = set()
     for pkg in PACKAGES:
-        for path in sorted((ROOT / "synth" / pkg).glob("*.py")):
+        where = ROOT / "synth" / pkg
+        for path in sorted(where.rglob("*.py")) if where.is_dir() else [where.with_suffix(".py")]:
             tree = ast.parse(path.read_text(encoding="utf-8"))
             for node in ast.walk(tree):
                 if isinstance(node, ast.ImportFrom) and node.module and node.module.startswith("synth."):
@@ -49,7 +51,8 @@ def package_imports() -> set[tuple[str, str]]:
 
 
 def architecture_dot() -> str:
-    nodes = [(p, f"{p}/\n{what}\n→ {out}", {"shape": "box", "style": "rounded"}) for p, (what, out) in PACKAGES.items()]
+    nodes = [(p, f"{p}{'/' if (ROOT / 'synth' / p).is_dir() else '.py'}\n{what}\n→ {out}",
+              {"shape": "box", "style": "rounded"}) for p, (what, out) in PACKAGES.items()]
     edges = [(a, b, "", {}) for a, b in sorted(package_imports())]
     return dot_graph("synth", nodes, edges)
 

@@ -1,36 +1,42 @@
-"""Which engine runs, and running it: ``--engine {auto,explicit,symbolic}`` for
-``synth validate`` and ``synth sup``, above both engines (:mod:`synth.validation`,
-:mod:`synth.symbolic`), which know nothing of each other.
+"""The one engine chooser: ``--engine {auto,explicit,symbolic}`` for ``synth validate``,
+``synth sup`` and ``synth filter verify``, above the engines (:mod:`synth.validation`,
+:mod:`synth.symbolic`, the filter's closed loop), which know nothing of each other.
 
-``auto`` estimates both engines' work before running anything:
+Everything that decides is here, in three tables and one function:
 
-- ``validate``: symbolic when the model is large (the product of the element state
-  counts times the number of Grafcet steps above :data:`VALIDATE_THRESHOLD`, 10^5) *and*
-  the Grafcet moves many actuators at once (:func:`concurrency`, the widest AND
-  divergence, at least :data:`CONCURRENCY_THRESHOLD`, 4). Both engines pay per stable
-  situation; per situation the explicit engine lists every interleaving of the moving
-  elements (about r^D SYNC states for D branches at once, r ≈ 3 for a cylinder), the
-  symbolic one builds BDDs whose size grows polynomially in D. Measured
-  (docs/performance.md, bench/symbolic.py): at D = 3 the explicit engine is as fast or
-  faster on every family (branches × sequence: 2.7× faster), from D = 4 on the symbolic
-  one wins (par, steep). ``--report`` and ``--cor`` need every aggregated state, so
-  ``auto`` keeps them explicit.
-- ``sup``: symbolic above :data:`SUP_THRESHOLD` (10^6) plant states, unless ``--export``
-  or ``--why`` ask for the explicit listing.
-- a plant whose elements read each other's variables (``reads``) is always explicit:
-  the symbolic engine refuses it.
+- :data:`CAPABILITIES`: what each engine declares it serves, per command. A run's
+  :class:`Need` (an option such as ``--report``, or a model whose elements read each other)
+  that the asked engine does not declare is refused, with the one message of
+  :func:`refusal` (exit 2); with ``auto`` it rules that engine out.
+- :data:`THRESHOLDS`: ``auto``'s estimate, per command, above which the symbolic engine runs:
 
-The engines themselves are imported only once chosen: a passing box-sorting
-validation never imports the BDD library.
+  - ``validate``: plant states × Grafcet steps above 10^5 *and* the Grafcet moves at least
+    4 actuators at once (:func:`concurrency`, the widest AND divergence). Both engines pay
+    per stable situation; per situation the explicit engine lists every interleaving of the
+    moving elements (about r^D SYNC states for D branches at once, r ≈ 3 for a cylinder),
+    the symbolic one builds BDDs whose size grows polynomially in D. Measured
+    (docs/performance.md, bench/symbolic.py): at D = 3 the explicit engine is as fast or
+    faster on every family (branches × sequence: 2.7× faster), from D = 4 on the symbolic
+    one wins (par, steep);
+  - ``sup``: plant states above 10^6;
+  - ``filter verify``: plant states above 2·10^6 (the explicit engine's arrays over the
+    plant's grid).
+- :func:`decide`: the engine that runs and why (:class:`Decision`).
+
+The runners load each input once and hand the loaded models to the engine chosen:
+:func:`validate` and :func:`supervisor` here, ``filter verify`` in
+:func:`synth.filter.loop.verify.verify` (the filter lies above this module, so the
+filter's runner calls the chooser, not the other way round). The engines themselves are
+imported only once chosen: a passing box-sorting validation never imports the BDD library.
 
 Example
 -------
->>> choose(EngineChoice.AUTO, 10**8)
+>>> decide(Command.VALIDATE, EngineChoice.AUTO, estimate=10**8, width=4).engine
 <EngineChoice.SYMBOLIC: 'symbolic'>
->>> choose(EngineChoice.AUTO, 10**8, width=3)
-<EngineChoice.EXPLICIT: 'explicit'>
->>> choose(EngineChoice.AUTO, 10**8, needs_listing=True)
-<EngineChoice.EXPLICIT: 'explicit'>
+>>> decide(Command.VALIDATE, EngineChoice.AUTO, estimate=10**8, width=3).reason
+'auto: the widest AND divergence starts 3 branches, fewer than 4'
+>>> decide(Command.VALIDATE, EngineChoice.AUTO, {Need.LISTING}, estimate=10**8, width=4).reason
+'auto: the symbolic engine does not serve listing'
 """
 
 from __future__ import annotations
@@ -38,9 +44,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 from enum import StrEnum
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Callable, Sequence
+from typing import TYPE_CHECKING, Callable, Collection, Sequence
 
-from synth.errors import LimitExceeded, SynthError
+from synth.choices import EngineChoice
+from synth.errors import InputError, LimitExceeded, SynthError
 
 if TYPE_CHECKING:  # pragma: no cover - the engines are imported once chosen
     from synth.grafcet.language import Grafcet, Semantics
@@ -51,8 +58,62 @@ if TYPE_CHECKING:  # pragma: no cover - the engines are imported once chosen
     from synth.symbolic.supervisor import SymbolicSupervisor
     from synth.validation.result import Validation
 
-__all__ = ["EngineChoice", "choose", "concurrency", "VALIDATE_THRESHOLD", "CONCURRENCY_THRESHOLD", "SUP_THRESHOLD",
-           "validate", "SupRun", "supervisor"]
+__all__ = ["EngineChoice", "Command", "Need", "Capability", "CAPABILITIES", "Threshold", "THRESHOLDS", "Decision",
+           "capability", "refuse", "refusal", "decide", "choose", "concurrency", "VALIDATE_THRESHOLD",
+           "CONCURRENCY_THRESHOLD", "SUP_THRESHOLD", "VERIFY_THRESHOLD", "validate", "SupRun", "supervisor"]
+
+
+class Command(StrEnum):
+    """The commands that have two engines."""
+
+    VALIDATE = "validate"
+    SUP = "sup"
+    FILTER_VERIFY = "filter verify"
+
+
+class Need(StrEnum):
+    """What one run asks of the engine that serves it."""
+
+    LISTING = "listing"  # validate --report/--cor, sup --export/--why: every state, listed
+    READS = "reads"  # the plant's elements read each other's variables (`reads`)
+    SFC = "sfc"  # validate --semantics sfc: one evolution per PLC scan
+    CONTROLLER = "controller"  # filter verify --grafcet/--control: a controller in the loop
+    PROGRESS = "progress"  # filter verify --progress: fair cycles, on the whole product
+
+
+@dataclass(frozen=True)
+class Capability:
+    """One engine's declaration for one command: the needs it serves."""
+
+    command: Command
+    engine: EngineChoice
+    serves: frozenset[Need]
+
+
+_EVERY_NEED = frozenset(Need)
+
+CAPABILITIES: tuple[Capability, ...] = (
+    Capability(Command.VALIDATE, EngineChoice.EXPLICIT, _EVERY_NEED),
+    Capability(Command.VALIDATE, EngineChoice.SYMBOLIC, frozenset()),
+    Capability(Command.SUP, EngineChoice.EXPLICIT, _EVERY_NEED),
+    Capability(Command.SUP, EngineChoice.SYMBOLIC, frozenset()),
+    Capability(Command.FILTER_VERIFY, EngineChoice.EXPLICIT, _EVERY_NEED),
+    Capability(Command.FILTER_VERIFY, EngineChoice.SYMBOLIC, frozenset({Need.READS})),
+)
+"""Every engine of every command, and the needs it serves: the explicit engines every one;
+the symbolic ones the plain run, and the closed loop's a plant whose elements read each
+other (its cycle encodes their guards)."""
+
+
+@dataclass(frozen=True)
+class Threshold:
+    """``auto`` runs the symbolic engine when the estimate exceeds ``size`` and the
+    concurrency reaches ``width``."""
+
+    size: int
+    width: int = 1
+    estimate: str = "plant states"
+
 
 VALIDATE_THRESHOLD = 10**5
 """``validate --engine auto``: symbolic only when plant states × Grafcet steps exceed this."""
@@ -63,11 +124,88 @@ CONCURRENCY_THRESHOLD = 4
 SUP_THRESHOLD = 10**6
 """``sup --engine auto``: symbolic when the plant has more states than this."""
 
+VERIFY_THRESHOLD = 2_000_000
+"""``filter verify --engine auto``: symbolic when the plant has more states than this."""
 
-class EngineChoice(StrEnum):
-    AUTO = "auto"
-    EXPLICIT = "explicit"
-    SYMBOLIC = "symbolic"
+THRESHOLDS: dict[Command, Threshold] = {
+    Command.VALIDATE: Threshold(VALIDATE_THRESHOLD, CONCURRENCY_THRESHOLD, "plant states × Grafcet steps"),
+    Command.SUP: Threshold(SUP_THRESHOLD),
+    Command.FILTER_VERIFY: Threshold(VERIFY_THRESHOLD),
+}
+
+
+@dataclass(frozen=True)
+class Decision:
+    """The engine that runs, and why."""
+
+    engine: EngineChoice
+    reason: str
+
+
+def capability(command: Command, engine: EngineChoice) -> Capability:
+    """The declaration of ``engine`` for ``command`` in :data:`CAPABILITIES`."""
+    return next(c for c in CAPABILITIES if c.command is command and c.engine is engine)
+
+
+_LISTING_OPTIONS = {Command.VALIDATE: "--report/--cor", Command.SUP: "--export/--why"}
+
+
+def refusal(command: Command, need: Need, readers: Sequence[str] = ()) -> SynthError:
+    """The error of an engine asked for a run it does not serve (``readers``: the elements
+    that read others, for :attr:`Need.READS`)."""
+    if need is Need.LISTING:
+        return SynthError(f"{_LISTING_OPTIONS[command]} lists every state: use --engine explicit (or auto)")
+    if need is Need.READS:
+        return SynthError("the symbolic engine does not support elements that read other elements' variables "
+                          f"(`reads` in {', '.join(readers)}); use --engine explicit")
+    if need is Need.SFC:
+        return SynthError("--semantics sfc runs on the explicit engine: use --engine explicit (or auto)")
+    what = "--progress" if need is Need.PROGRESS else "--grafcet and --control"
+    return InputError(f"the symbolic engine of filter verify supports --any-control only, without --progress "
+                      f"({what} need --engine explicit)", None)
+
+
+def refuse(command: Command, asked: EngineChoice | str, needs: Collection[Need], readers: Sequence[str] = ()) -> None:
+    """Raise :func:`refusal` when the engine asked (not ``auto``) does not serve one of
+    ``needs`` (the first in :class:`Need`'s order). The runners call it with the options
+    before any input is read, :func:`decide` with the model's needs too."""
+    asked = EngineChoice(asked)
+    if asked is EngineChoice.AUTO:
+        return
+    missing = [n for n in Need if n in needs and n not in capability(command, asked).serves]
+    if missing:
+        raise refusal(command, missing[0], readers)
+
+
+def decide(command: Command, asked: EngineChoice | str, needs: Collection[Need] = (), *, estimate: int = 0,
+           width: int = 1, readers: Sequence[str] = ()) -> Decision:
+    """The engine that runs ``command`` asked with ``--engine asked`` for a run with
+    ``needs`` (:attr:`Need.READS` added when ``readers`` is not empty) and ``auto``'s
+    ``estimate`` and concurrency ``width`` (see the module docstring)."""
+    asked = EngineChoice(asked)
+    needs = set(needs) | ({Need.READS} if readers else set())
+    refuse(command, asked, needs, readers)
+    if asked is not EngineChoice.AUTO:
+        return Decision(asked, f"--engine {asked}")
+    unserved = sorted(n for n in needs if n not in capability(command, EngineChoice.SYMBOLIC).serves)
+    if unserved:
+        return Decision(EngineChoice.EXPLICIT, f"auto: the symbolic engine does not serve {', '.join(unserved)}")
+    t = THRESHOLDS[command]
+    if estimate <= t.size:
+        return Decision(EngineChoice.EXPLICIT, f"auto: {estimate} {t.estimate}, not above {t.size}")
+    if width < t.width:
+        return Decision(EngineChoice.EXPLICIT,
+                        f"auto: the widest AND divergence starts {width} branches, fewer than {t.width}")
+    return Decision(EngineChoice.SYMBOLIC, f"auto: {estimate} {t.estimate}, above {t.size}")
+
+
+def choose(asked: EngineChoice | str, estimate: int, *, width: int = CONCURRENCY_THRESHOLD) -> EngineChoice:
+    """``validate``'s engine for an estimate and a concurrency alone (:func:`decide`).
+
+    >>> choose(EngineChoice.AUTO, 10**8), choose(EngineChoice.AUTO, 10**8, width=3)
+    (<EngineChoice.SYMBOLIC: 'symbolic'>, <EngineChoice.EXPLICIT: 'explicit'>)
+    """
+    return decide(Command.VALIDATE, asked, estimate=estimate, width=width).engine
 
 
 def concurrency(g: Grafcet) -> int:
@@ -80,21 +218,6 @@ def concurrency(g: Grafcet) -> int:
     1
     """
     return max((len(t.targets) for t in g.transitions), default=1)
-
-
-def choose(asked: EngineChoice | str, estimate: int, *, threshold: int = VALIDATE_THRESHOLD,
-           width: int = CONCURRENCY_THRESHOLD, needs_listing: bool = False,
-           listing_option: str = "--report/--cor") -> EngineChoice:
-    """The engine to run for an estimated size and concurrency ``width`` (see module
-    docstring; ``sup`` passes no width); ``needs_listing``: an option needs every state
-    explicitly (the symbolic engine cannot serve it)."""
-    asked = EngineChoice(asked)
-    if asked == EngineChoice.AUTO:
-        small = estimate <= threshold or width < CONCURRENCY_THRESHOLD
-        return EngineChoice.EXPLICIT if needs_listing or small else EngineChoice.SYMBOLIC
-    if asked == EngineChoice.SYMBOLIC and needs_listing:
-        raise SynthError(f"{listing_option} lists every state: use --engine explicit (or auto)")
-    return asked
 
 
 def validate(
@@ -118,12 +241,14 @@ def validate(
     from synth.grafcet.language import Semantics
     from synth.validation.result import load_model
 
-    asked = choose(engine, 0, needs_listing=True) if needs_listing else EngineChoice(engine)
+    options = {Need.LISTING} if needs_listing else set()
+    if Semantics(semantics) is not Semantics.GRAFCET:
+        options.add(Need.SFC)
+    refuse(Command.VALIDATE, engine, options)
     rs, p, g = load_model(grafcet_path, rules_path, semantics)
-    estimate = p.size * max(1, len(g.steps))
-    if (p.reads or g.semantics is not Semantics.GRAFCET) and asked == EngineChoice.AUTO:  # explicit engine only
-        asked = EngineChoice.EXPLICIT
-    if asked != EngineChoice.EXPLICIT and choose(asked, estimate, width=concurrency(g)) == EngineChoice.SYMBOLIC:
+    chosen = decide(Command.VALIDATE, engine, options, estimate=p.size * max(1, len(g.steps)), width=concurrency(g),
+                    readers=p.readers)
+    if chosen.engine is EngineChoice.SYMBOLIC:
         from synth.grafcet.situation import OutOfRange
         from synth.symbolic.validate import validate_loaded as symbolic
 
@@ -175,15 +300,6 @@ class SupRun:
     def labels(self) -> dict[str, str]:
         return {c.id: c.label for c in self.rules.constraints}
 
-    def summary(self) -> dict[str, Any]:
-        """The JSON of ``synth sup`` (the key ``symbolic`` when the symbolic engine ran)."""
-        from synth.output.summary import sup_summary
-
-        data = sup_summary(self.rules, self.sup, self.path)
-        if self.bdd_nodes is not None:
-            data["symbolic"] = {"bdd_nodes": self.bdd_nodes}
-        return data
-
     def why(self, state: str | None = None) -> Explanation:
         """Why ``state`` (its true variables; default the initial state) is in SUP or not."""
         from synth.sup.explain import explain
@@ -191,13 +307,6 @@ class SupRun:
 
         sup = self.sup if isinstance(self.sup, Supervisor) else Supervisor(self.plant, self.rules.constraints)
         return explain(sup, self.plant.initial if state is None else self.plant.parse_state(state))
-
-    def text(self) -> str:
-        """The terminal listing of :meth:`summary`, with why SUP is empty when it is."""
-        from synth.output.summary import sup_text
-
-        labels = self.labels
-        return sup_text(self.summary(), labels, self.why().text(labels) if self.sup.empty else "")
 
 
 def supervisor(
@@ -221,10 +330,8 @@ def supervisor(
     p = plant(rs)
     if loaded is not None:
         loaded(p)
-    chosen = choose(engine, p.size, threshold=SUP_THRESHOLD, needs_listing=needs_listing, listing_option="--export/--why")
-    if p.reads and EngineChoice(engine) == EngineChoice.AUTO:  # elements read each other: explicit engine only
-        chosen = EngineChoice.EXPLICIT
-    if chosen == EngineChoice.SYMBOLIC:
+    chosen = decide(Command.SUP, engine, {Need.LISTING} if needs_listing else (), estimate=p.size, readers=p.readers)
+    if chosen.engine is EngineChoice.SYMBOLIC:
         from synth.symbolic.encoding import NodeBudget
         from synth.symbolic.supervisor import symbolic_supervisor
 

@@ -4,13 +4,12 @@ test session: blark's Earley parser takes about a second per block."""
 from __future__ import annotations
 
 from functools import lru_cache
-from pathlib import Path
 
 from synth.codegen.filter_st import FilterBlock, filter_block
 from synth.codegen.interpreter.machine import Module, load_st
 from synth.filter.language_check import load_filter
 
-ROOT = Path(__file__).resolve().parent.parent
+from conftest import ROOT
 
 
 @lru_cache(maxsize=None)

@@ -12,7 +12,7 @@ from synth.cli.main import main
 from synth.codegen.grafcet_st import synth_version
 from synth.codegen.plcopen.tc6 import validation_errors
 
-ROOT = Path(__file__).resolve().parent.parent
+from conftest import ROOT
 
 
 @pytest.fixture(autouse=True)

@@ -6,7 +6,6 @@ import json
 import os
 import subprocess
 import sys
-from pathlib import Path
 
 import pytest
 
@@ -16,7 +15,7 @@ from synth.grafcet.ass import stable_situation_automaton
 from synth.grafcet.language_check import load_grafcet
 from synth.grafcet.machine import GrafcetMachine
 
-ROOT = Path(__file__).resolve().parent.parent
+from conftest import ROOT
 
 
 @pytest.fixture(autouse=True)

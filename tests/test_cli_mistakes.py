@@ -132,9 +132,8 @@ def test_sigint_in_a_real_process_exits_130(tmp_path):
 def test_eventually_and_its_alias_progress(cli):
     from synth.cli.main import build_parser
 
-    verify = build_parser()._subparsers._group_actions[0].choices["filter"]._subparsers._group_actions[0].choices["verify"]
-    action = next(a for a in verify._actions if a.dest == "progress")
-    assert action.option_strings == ["--eventually", "--progress"]
+    verify = build_parser().commands.choices["filter"].commands.choices["verify"]
+    assert "--eventually GOAL, --progress GOAL" in verify.format_help()
     ns1 = verify.parse_args(["F.filter", "--plant", "P.rules", "--any-control", "--eventually", "↑x"])
     ns2 = verify.parse_args(["F.filter", "--plant", "P.rules", "--any-control", "--progress", "↑x"])
     assert ns1.progress == ns2.progress == "↑x"

@@ -19,7 +19,8 @@ from synth.grafcet.language_check import load_grafcet, parse_grafcet
 
 from randgrafcet import check_seed, random_grafcet
 
-ROOT = Path(__file__).resolve().parent.parent
+from conftest import ROOT
+
 BUNDLED = [p for p in sorted(ROOT.glob("grafcets/*.g7")) + sorted(ROOT.glob("tests/data/**/*.g7"))
            if "codegen" not in p.parts]
 DEPTH = {"tri.g7": 3, "tri_missing_order.g7": 3, "tri_boxes.g7": 3}  # 11 inputs: 1 335 sequences at depth 3

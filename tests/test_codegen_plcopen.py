@@ -17,7 +17,8 @@ from synth.grafcet.language_check import load_grafcet, parse_grafcet
 from synth.grafcet.machine import GrafcetMachine
 from synth.output.summary import ass_json
 
-ROOT = Path(__file__).resolve().parent.parent
+from conftest import ROOT
+
 BUNDLED = [p for p in sorted(ROOT.glob("grafcets/*.g7")) + sorted(ROOT.glob("tests/data/**/*.g7"))
            if "codegen" not in p.parts and p.name != "source_sink.g7"]
 DATA = ROOT / "tests/data/codegen"

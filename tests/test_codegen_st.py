@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import hashlib
 
-from pathlib import Path
 
 import pytest
 
@@ -16,7 +15,7 @@ from synth.codegen.grafcet_st import grafcet_program
 from synth.errors import InputError
 from synth.grafcet.language_check import load_grafcet, parse_grafcet
 
-ROOT = Path(__file__).resolve().parent.parent
+from conftest import ROOT
 
 
 def _st(text: str, **kw) -> str:

@@ -3,7 +3,7 @@ filter's page opens with what a user does."""
 import subprocess
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
+from conftest import ROOT
 # spelled in pieces so that this file does not match itself
 OUTSIDE = ("FILTER" + ".md", "METHOD" + ".md", "../" + "shared")
 

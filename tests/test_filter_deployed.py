@@ -17,7 +17,8 @@ from synth.filter.run import Row, run, run_trace
 from synth.filter.solve import synthesis
 from st_blocks import interpreted
 
-ROOT = Path(__file__).resolve().parent.parent
+from conftest import ROOT
+
 CASES = [(p.stem, a, m) for p in sorted((ROOT / "plants").glob("*.filter")) for a in Algorithm for m in Mode]
 CYCLES = 1000
 

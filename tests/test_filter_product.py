@@ -17,7 +17,7 @@ from synth.filter.run import run_trace
 from synth.filter.loop.verification import FindingKind
 from synth.logic.events import Event
 from synth.output.filter_text import FINDINGS, check_text, run_json, skeleton_text, verification_json
-from synth.plant.composition import plant
+from synth.plant.composition import load_plant, plant
 from synth.plant.rules_check import load_rules
 from synth.sup.constraints import CompiledConstraints
 
@@ -27,7 +27,7 @@ TRI = ROOT / "plants" / "tri.rules"
 
 def _product(rules, tmp_path, grafcet=None):
     sk = skeleton(rules, tmp_path / "F.filter")
-    return Product(sk.filter, str(rules), grafcet, Algorithm.ALGEBRAIC, Mode.SUPERVISOR, False)
+    return Product(sk.filter, load_plant(rules), grafcet, Algorithm.ALGEBRAIC, Mode.SUPERVISOR, False)
 
 
 def test_grids_agree_with_the_closed_forms_state_by_state(tmp_path):

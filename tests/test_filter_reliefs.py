@@ -3,13 +3,12 @@ them alike, the algebraic synthesis may not; ``filter check`` warns, located at 
 
 from __future__ import annotations
 
-from pathlib import Path
 
 from synth.cli.main import main
 from synth.filter.language_check import load_filter, parse_filter
 from synth.filter.reliefs import SPELLING_WORK, spelling_warnings
 
-ROOT = Path(__file__).resolve().parent.parent
+from conftest import ROOT
 
 
 WITNESS_NOTE = ("  = note: `synth filter check --all-spellings` compares on every input and names every output it "

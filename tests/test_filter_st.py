@@ -18,7 +18,7 @@ from synth.filter.language_check import load_filter, parse_filter
 from synth.filter.solve import requested, synthesis
 from st_blocks import interpreted
 
-ROOT = Path(__file__).resolve().parent.parent
+from conftest import ROOT
 
 
 def _reference_cycle(s, f, point: dict[str, bool]) -> dict[str, bool]:

@@ -24,7 +24,10 @@ from synth.filter.loop.explorer import Explorer
 from synth.filter.from_rules import skeleton
 from synth.filter.language_check import load_filter
 from synth.filter.loop.product import Product
+from synth.grafcet.language_check import load_grafcet
 from synth.output.filter_text import trace_text
+from synth.plant.composition import load_plant
+from synth.plant.rules_check import load_rules
 
 DATA = ROOT / "tests" / "data" / "filter"
 TRI = ROOT / "plants" / "tri.rules"
@@ -50,6 +53,12 @@ def _parsed(text: str, file: str):
 
 def _st(option) -> StSource:
     return StSource(str(option), _parsed)
+
+
+def _grafcet(path, rules):
+    """The Grafcet of ``path`` checked against the plant of ``rules`` (as verify loads it)."""
+    rs = load_rules(rules)
+    return load_grafcet(path, inputs=rs.inputs, outputs=rs.outputs)
 
 
 def _rows(trace):
@@ -101,10 +110,10 @@ def test_the_programs_states_are_the_grafcets_states(tri):
     at every scan), and its fresh instance (the PLC before the power-up scan) is the
     traces' first row, not a state."""
     f = load_filter(tri / "F.filter")
-    pr = Product(f, str(TRI), None, Algorithm.ALGEBRAIC, Mode.SUPERVISOR, False, _st(tri / "tri.st"))
+    pr = Product(f, load_plant(TRI), None, Algorithm.ALGEBRAIC, Mode.SUPERVISOR, False, _st(tri / "tri.st"))
     ex = Explorer(pr, 10_000)
     ex.run()
-    gr = Product(f, str(TRI), str(ROOT / "grafcets" / "tri.g7"), Algorithm.ALGEBRAIC, Mode.SUPERVISOR, False)
+    gr = Product(f, load_plant(TRI), _grafcet(ROOT / "grafcets" / "tri.g7", TRI), Algorithm.ALGEBRAIC, Mode.SUPERVISOR, False)
     eg = Explorer(gr, 10_000)
     eg.run()
 
@@ -181,7 +190,7 @@ def test_a_ton_elapses_as_an_event_and_fairly(cyl):
     v = verify(load_filter(cyl / "c.filter"), str(cyl / "c.rules"), control=_st(DATA / "timed.st"), progress="↑v11")
     assert (v.safe, v.states, v.plant_states, v.cycles, v.corrected) == (True, 6, 5, 12, 0)
     assert v.progress is not None and v.progress.holds
-    pr = Product(load_filter(cyl / "c.filter"), str(cyl / "c.rules"), None, Algorithm.ALGEBRAIC, Mode.SUPERVISOR,
+    pr = Product(load_filter(cyl / "c.filter"), load_plant(cyl / "c.rules"), None, Algorithm.ALGEBRAIC, Mode.SUPERVISOR,
                  False, _st(DATA / "timed.st"))
     ex = Explorer(pr, 100)
     ex.run()

@@ -22,6 +22,7 @@ from synth.filter.from_rules import skeleton
 from synth.filter.language_check import load_filter, parse_filter
 from synth.filter.loop.symbolic.verify import verify_symbolic
 from synth.filter.loop.verification import FindingKind
+from synth.plant.composition import load_plant
 
 DATA = ROOT / "tests" / "data" / "filter"
 FOUR = ROOT / "plants" / "four_cylinders.filter"
@@ -33,7 +34,7 @@ from verify_scale import ring_filter, ring_rules  # noqa: E402
 def _same(f, rules: str, **kw) -> None:
     """Both engines, the same verification (but the seconds and the engine's name)."""
     a = verify(f, rules, any_control=True, **kw)
-    b = verify_symbolic(f, rules, **kw)
+    b = verify_symbolic(f, load_plant(rules), **kw)
     assert b.engine is EngineChoice.SYMBOLIC and a.engine is EngineChoice.EXPLICIT
     assert dataclasses.replace(a, seconds=0) == dataclasses.replace(b, seconds=0, engine=a.engine)
 
@@ -179,7 +180,8 @@ def test_a_ring_the_explicit_engine_cannot_hold(tmp_path):
 def test_the_ring_generator_gives_the_four_cylinders(tmp_path):
     # bench/verify_scale.py's ring of 4 is plants/four_cylinders.rules / .filter (the same counts)
     (tmp_path / "ring4.rules").write_text(ring_rules(4))
-    v = verify_symbolic(parse_filter(ring_filter(4), str(tmp_path / "ring4.filter")), str(tmp_path / "ring4.rules"))
+    v = verify_symbolic(parse_filter(ring_filter(4), str(tmp_path / "ring4.filter")),
+                        load_plant(tmp_path / "ring4.rules"))
     assert (v.safe, v.states, v.plant_states, v.cycles) == (True, 2160, 1584, 16376)
 
 
@@ -195,8 +197,8 @@ def test_walk_back_traces_are_shortest(name, rules, kw):
     # traces of the same length, the same constraints, the same finding noted last (the
     # requests, hence "requests violate ...", may be another shortest trace's)
     f = load_filter(DATA / name)
-    shown = verify_symbolic(f, str(DATA / rules), **kw)
-    walked = verify_symbolic(f, str(DATA / rules), trace_budget=0, **kw)
+    shown = verify_symbolic(f, load_plant(DATA / rules), **kw)
+    walked = verify_symbolic(f, load_plant(DATA / rules), trace_budget=0, **kw)
     assert list(walked.findings) == list(shown.findings) and walked.findings
     for k, a in shown.findings.items():
         b = walked.findings[k]
@@ -207,7 +209,7 @@ def test_walk_back_traces_are_shortest(name, rules, kw):
 
 def test_walk_back_edge_trace():
     # another shortest trace than the explicit engine's (↑s first, then the drop of A), a real one
-    v = verify_symbolic(load_filter(DATA / "two_assume.filter"), str(DATA / "two.rules"), trace_budget=0)
+    v = verify_symbolic(load_filter(DATA / "two_assume.filter"), load_plant(DATA / "two.rules"), trace_budget=0)
     assert [(r.event, r.state, r.requests, r.orders, r.note) for r in v.findings[FindingKind.EDGE].trace] == [
         ("initial", "{}", (), (), ""),
         ("-", "{A}", ("A",), ("A",), ""),
@@ -216,7 +218,7 @@ def test_walk_back_edge_trace():
 
 @pytest.mark.nightly  # 4 s
 def test_walk_back_four_cylinders_three_events():
-    v = verify_symbolic(load_filter(FOUR), str(FOUR_RULES), events_per_cycle=3, trace_budget=0)
+    v = verify_symbolic(load_filter(FOUR), load_plant(FOUR_RULES), events_per_cycle=3, trace_budget=0)
     rows = [(r.event, r.state, r.orders) for r in v.findings[FindingKind.VIOLATION].trace]
     assert rows == [("initial", "{b1,b2,b3,b4,i1}", ()), ("-", "{b1,b2,b3,b4,i1,Q1}", ("Q1",)),
                     ("↓b1, ↑t2, ↓i1", "{b2,b3,b4,t2,Q1,Q2}", ("Q1", "Q2")),
@@ -240,7 +242,7 @@ def test_held_and_passed_through_orders(held):  # 1 s (the explicit engine on tr
 
 def test_held_order_refused_walk_back(held):
     held, annex = held
-    walked = verify_symbolic(load_filter(held), str(annex), trace_budget=0)
+    walked = verify_symbolic(load_filter(held), load_plant(annex), trace_budget=0)
     assert walked.findings[FindingKind.REFUSED].count == 5184
     assert [(r.event, r.state, r.requests, r.orders, r.note) for r in walked.findings[FindingKind.REFUSED].trace] == [
         ("initial", "{v10,v20,v30,v40,TAPIS}", (), (), ""),

@@ -233,8 +233,9 @@ def test_every_transfer_stays_reachable_under_the_toggle(pallets):
     from synth.filter.loop.explorer import Explorer
     from synth.filter.language_check import load_filter
     from synth.filter.loop.product import Product
+    from synth.plant.composition import load_plant
 
-    pr = Product(load_filter(FILTER), str(PLANTS[pallets]), None, Algorithm.ALGEBRAIC, Mode.SUPERVISOR, False,
+    pr = Product(load_filter(FILTER), load_plant(PLANTS[pallets]), None, Algorithm.ALGEBRAIC, Mode.SUPERVISOR, False,
                  StSource(str(TOGGLE), load_st))
     ex = Explorer(pr, 100_000, edges=True)
     ex.run()

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-from pathlib import Path
 
 import pytest
 
@@ -19,7 +18,8 @@ from synth.grafcet.language import (
 )
 from synth.grafcet.language_check import load_grafcet, parse_grafcet
 
-ROOT = Path(__file__).resolve().parent.parent
+from conftest import ROOT
+
 TRI_INPUTS = ("dcy", "v10", "v11", "v20", "v21", "v30", "v31", "v40", "v41", "cp11", "cp12")
 TRI_OUTPUTS = ("TAPIS", "AVANCER1", "RECULER1", "AVANCER2", "RECULER2", "AVANCER3", "AVANCER4")
 

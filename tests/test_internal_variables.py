@@ -21,7 +21,8 @@ from synth.plant.rules_check import parse_rules
 from synth.symbolic.validate import validate_symbolic
 from synth.validation.validate import validate
 
-ROOT = Path(__file__).resolve().parent.parent
+from conftest import ROOT
+
 sys.path.insert(0, str(ROOT / "tests"))
 from randgrafcet import check_seed  # noqa: E402
 from randrules import random_rules  # noqa: E402

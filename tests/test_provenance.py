@@ -5,14 +5,13 @@
 from __future__ import annotations
 
 import hashlib
-from pathlib import Path
 
 import pytest
 
 from synth.cli.main import main
 from synth.version import version
 
-ROOT = Path(__file__).resolve().parent.parent
+from conftest import ROOT
 
 
 def sha(path: str) -> str:

@@ -12,7 +12,8 @@ import pytest
 from schemas import assert_valid
 from synth.cli.main import main
 
-ROOT = Path(__file__).resolve().parent.parent
+from conftest import ROOT
+
 PLANTS = sorted(p.name for p in (ROOT / "plants").glob("*.rules") if p.name != "tri_wrong_v1.rules")
 GRAFCETS = sorted(p.name for p in (ROOT / "grafcets").glob("*.g7"))
 

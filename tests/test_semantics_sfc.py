@@ -13,7 +13,8 @@ from synth.grafcet.ass import stable_situation_automaton
 from synth.grafcet.language_check import parse_grafcet
 from synth.grafcet.machine import GrafcetMachine
 
-ROOT = Path(__file__).resolve().parent.parent
+from conftest import ROOT
+
 sys.path.insert(0, str(ROOT / "tests"))
 from randgrafcet import check_seed  # noqa: E402
 

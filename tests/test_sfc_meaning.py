@@ -127,3 +127,55 @@ def test_beremiz_cli_builds_the_st_project(tmp_path):
     done = subprocess.run([python, "Beremiz_cli.py", "--project-home", str(tmp_path), "build"], cwd=home,
                           capture_output=True, text=True, timeout=600)
     assert "Successfully built." in done.stdout + done.stderr, (done.stdout + done.stderr)[-2000:]
+
+
+SHARED = """inputs go, a, b, c
+outputs RUN
+grafcet G {
+  initial step 0
+  step 1: RUN
+  step 2: RUN if c
+  step 3
+  step 4
+  transition 0 -> 1, 2 when go
+  transition 1 -> 3 when a
+  transition 2 -> 4 when b
+  transition 3, 4 -> 0 when !go
+}
+"""
+
+
+def test_a_shared_order_is_one_or_of_per_step_flags_and_reads_back():
+    """RUN emitted by steps 1 and 2: each step drives its own flag, an S action on the initial
+    step writes RUN as their OR at every scan; the import reads the .g7 back."""
+    g = parse_grafcet(SHARED, "shared.g7")
+    xml = sfc_project_xml(g, version="test").decode()
+    assert xml.count('<variable name="_N_RUN_S1">') == 1 and xml.count('<variable name="_N_RUN_S2">') == 1
+    assert "RUN := _N_RUN_S1 OR _N_RUN_S2;" in xml and '<reference name="_N_RUN_S1"/>' in xml
+    assert "_N_RUN_S2 := c;" in xml and "_N_RUN_S2 := FALSE;" in xml
+    back = import_sfc(xml.encode(), "shared.xml")
+    assert "  step 1: RUN\n  step 2: RUN if c\n" in back and back.splitlines()[2] == "outputs RUN"
+
+
+@needs_beremiz
+@pytest.mark.skipif(shutil.which("gcc") is None, reason="no gcc")
+def test_on_the_plc_a_shared_order_stays_on_while_one_of_its_steps_is_active(tmp_path):
+    """MATIEC resets an N action's variable for one scan when one of its steps is left while
+    another keeps it; the exported flags and their OR keep RUN on, as synth run does."""
+    g = parse_grafcet(SHARED, "shared.g7")
+    (tmp_path / "plc.xml").write_bytes(sfc_project_xml(g, version="test"))
+    assert beremiz_program(tmp_path / "plc.xml", tmp_path / "generated.st").returncode == 0
+    pou = Pou(PouKind.PROGRAM, "shared", (
+        VarSection(SectionKind.INPUT, tuple(Declaration(n) for n in ("go", "a", "b", "c"))),
+        VarSection(SectionKind.OUTPUT, (Declaration("RUN"),))), ())
+    plc = CompiledProgram(StProgram((tmp_path / "generated.st").read_text(), "shared", (), (pou,)), tmp_path / "c")
+    try:
+        run = []
+        for inputs in ({"go": False, "a": False, "b": False, "c": True}, {"go": True}, {"b": True}, {},
+                       {"c": False}, {"a": True}, {"go": False}, {}):
+            plc.cycle(inputs)
+            run.append(plc.value("RUN"))
+    finally:
+        plc.close()
+    # go: steps 1, 2; b leaves step 2 (step 1 keeps RUN); a leaves step 1
+    assert run == [False, True, True, True, True, False, False, False]

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-from pathlib import Path
 
 import pytest
 
@@ -13,7 +12,7 @@ from synth.grafcet.language_check import load_grafcet
 from synth.grafcet.machine import GrafcetMachine, Situation
 from synth.logic.events import EventKind, parse_event
 
-ROOT = Path(__file__).resolve().parent.parent
+from conftest import ROOT
 
 
 def machine(text: str, **kw) -> GrafcetMachine:

@@ -8,7 +8,6 @@ from __future__ import annotations
 import dataclasses
 import random
 import re
-from pathlib import Path
 
 import pytest
 
@@ -24,7 +23,7 @@ from synth.filter.language_check import load_filter
 from synth.grafcet.language_check import load_grafcet
 
 pytest.importorskip("blark")
-ROOT = Path(__file__).resolve().parent.parent
+from conftest import ROOT
 
 
 @pytest.mark.parametrize("target", list(Target))

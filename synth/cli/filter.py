@@ -283,7 +283,7 @@ def register_verify(commands: "argparse._SubParsersAction") -> None:
 
 def cmd_verify(args: argparse.Namespace) -> int:
     from synth.output.summary import print_json
-    from synth.engines import EngineChoice
+    from synth.choices import EngineChoice
     from synth.filter.loop.verify import DEFAULT_MAX_STATES, verify
     from synth.filter.cycle import Algorithm, Mode
     from synth.output.filter_text import verification_json, verification_text

@@ -19,7 +19,7 @@ from synth.version import version
 TYPE_CHECKING = False  # typing.TYPE_CHECKING, without importing typing
 if TYPE_CHECKING:
     from collections.abc import Callable, Sequence
-    from typing import NoReturn
+    from typing import Any, NoReturn
 
 __all__ = ["main", "entry", "build_parser", "version"]
 
@@ -41,9 +41,22 @@ def did_you_mean(word: str, valid: Sequence[str]) -> str:
 
 
 class _Parser(argparse.ArgumentParser):
+    commands: argparse.Action | None = None  # the subcommands' action, once added
+
     def error(self, message: str) -> NoReturn:  # argparse's own errors: exit 2 as for bad input
         self.print_usage(sys.stderr)
         self.exit(EXIT_INPUT, f"{self.prog}: error: {message}\n")
+
+    def add_subparsers(self, **kwargs: Any) -> Any:
+        """argparse's, kept as :attr:`commands` (the subcommand a command line names)."""
+        self.commands = super().add_subparsers(**kwargs)
+        return self.commands
+
+    def long_options(self) -> list[str]:
+        """Every long option of this (sub)command, as its help lists them."""
+        import re
+
+        return sorted(set(re.findall(r"(?<![\w-])--[A-Za-z][\w-]*", self.format_help())))
 
     def _check_value(self, action: argparse.Action, value: object) -> None:
         """A value outside the choices, named with the closest valid ones."""
@@ -52,7 +65,7 @@ class _Parser(argparse.ArgumentParser):
             return
         names = [str(c) for c in choices]
         hint = did_you_mean(str(value), names)
-        if isinstance(action, argparse._SubParsersAction):
+        if action is self.commands:
             kind = "subcommand" if " " in self.prog else "command"
             raise argparse.ArgumentError(None, f"unknown {kind} '{value}'{hint} ({kind}s: {', '.join(names)})")
         raise argparse.ArgumentError(action, f"invalid choice '{value}'{hint} (choose from {', '.join(names)})")
@@ -66,7 +79,7 @@ class _Version(argparse.Action):
         parser.exit(0)
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser() -> _Parser:
     from synth.cli import codegen as cli_codegen, completion as cli_completion, filter as cli_filter, grafcet as cli_grafcet, lib as cli_lib, plant as cli_plant, validate as cli_validate
 
     p = _Parser(prog="synth", description="Validate a Grafcet against a rule-based plant model and its safety constraints.",
@@ -79,14 +92,10 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
-def _subparsers(parser: argparse.ArgumentParser) -> argparse._SubParsersAction | None:
-    return next((a for a in parser._actions if isinstance(a, argparse._SubParsersAction)), None)
-
-
-def _deepest(parser: argparse.ArgumentParser, args: argparse.Namespace) -> argparse.ArgumentParser:
+def _deepest(parser: _Parser, args: argparse.Namespace) -> _Parser:
     """The (sub)parser of the command the arguments name: ``synth filter verify``'s for
     ``synth filter verify …``."""
-    while (action := _subparsers(parser)) is not None:
+    while (action := parser.commands) is not None and isinstance(action.choices, dict):
         chosen = getattr(args, action.dest, None)
         if chosen not in action.choices:
             break
@@ -94,9 +103,9 @@ def _deepest(parser: argparse.ArgumentParser, args: argparse.Namespace) -> argpa
     return parser
 
 
-def _unknown(parser: argparse.ArgumentParser, extras: Sequence[str]) -> str:
+def _unknown(parser: _Parser, extras: Sequence[str]) -> str:
     """The message for arguments no parser took: each unknown option with the closest valid ones."""
-    options = sorted({o for a in parser._actions for o in a.option_strings if o.startswith("--")})
+    options = parser.long_options()
     parts, after_option = [], False
     for word in extras:
         if word.startswith("-") and len(word) > 1:
@@ -110,7 +119,7 @@ def _unknown(parser: argparse.ArgumentParser, extras: Sequence[str]) -> str:
     return "; ".join(parts)
 
 
-def parse(parser: argparse.ArgumentParser, argv: Sequence[str] | None) -> argparse.Namespace:
+def parse(parser: _Parser, argv: Sequence[str] | None) -> argparse.Namespace:
     """``parser.parse_args``, with an unknown option reported by the command it was given to."""
     args, extras = parser.parse_known_args(argv)
     if extras:

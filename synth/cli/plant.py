@@ -99,7 +99,7 @@ def cmd_sup(args: argparse.Namespace) -> int:
     from synth.output.faudes import supervisor_generator
     from synth.output.files import write_atomic
     from synth.output.progress import clear_progress, tty_progress
-    from synth.output.summary import print_json
+    from synth.output.summary import print_json, sup_run_summary, sup_run_text
 
     show = tty_progress(not args.quiet and sys.stderr.isatty())
     run = supervisor(args.rules, engine=args.engine, needs_listing=bool(args.export or args.why),
@@ -115,9 +115,9 @@ def cmd_sup(args: argparse.Namespace) -> int:
     if args.export:
         write_atomic(args.export, supervisor_generator(run.listed(), "sup"))
     if args.json:
-        print_json(run.summary())
+        print_json(sup_run_summary(run))
     else:
-        sys.stdout.write(run.text())
+        sys.stdout.write(sup_run_text(run))
         if run.bdd_nodes is not None and not args.quiet:
             print(f"symbolic engine: {run.bdd_nodes} BDD nodes", file=sys.stderr)
     _written(("libFAUDES", args.export))

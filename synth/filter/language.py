@@ -23,6 +23,10 @@ from synth.errors import InputError, Location
 from synth.logic.expr import Compare, Expr
 from synth.logic.past import base_name, is_pre, pre_name
 
+TYPE_CHECKING = False  # typing.TYPE_CHECKING
+if TYPE_CHECKING:
+    from synth.plant.rules import RuleSet
+
 __all__ = [
     "REQUEST_PREFIX",
     "request_name",
@@ -228,6 +232,7 @@ class Filter:
     warnings: tuple[InputError, ...] = ()
     declarations: tuple[Declared, ...] = field(default=(), compare=False)  # inputs, outputs, observers, with locations
     integers: tuple[IntegerObserver, ...] = ()  # their bits are among the observers
+    rules: RuleSet | None = field(default=None, compare=False, repr=False)  # the rule set ``plant``, read once
 
     @property
     def integer_observers(self) -> tuple[IntegerObserver, ...]:

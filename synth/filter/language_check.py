@@ -36,6 +36,7 @@ from synth.logic.expr import And, Compare, Edge, Expr, Not, Or, Var, names
 from synth.syntax import Checker, read_source
 
 if TYPE_CHECKING:
+    from synth.plant.rules import RuleSet
     from synth.logic.bdd import Engine
 
 __all__ = ["parse_filter", "load_filter", "output_polarities"]
@@ -72,6 +73,7 @@ class _FilterChecker(Checker):
         self.declared: dict[str, Declared] = {}
         self.warnings: list[InputError] = []
         self.plant: str | None = None
+        self.rules: RuleSet | None = None  # the plant's rule set, read once: verify builds its plant from it
         self.engine: "Engine | None" = None
         self.integers: dict[str, IntegerObserver] = {}
 
@@ -100,7 +102,7 @@ class _FilterChecker(Checker):
             self.errors.append(err)
             return
         rs = parse_rules(source, str(target), target.parent)
-        self.plant = str(target)
+        self.plant, self.rules = str(target), rs
         for kind, vector in ((VarKind.INPUT, rs.inputs), (VarKind.OUTPUT, rs.outputs)):
             for n in vector:
                 if n not in self.declared:
@@ -398,6 +400,7 @@ class _FilterChecker(Checker):
             tuple(self.warnings),
             tuple(d for d in self.declared.values() if d.kind is not VarKind.REQUEST),
             tuple(self.integers.values()),
+            self.rules,
         ))
 
 

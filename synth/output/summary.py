@@ -29,8 +29,10 @@ from typing import TYPE_CHECKING, Any, Mapping, Sequence
 from synth.output.dot import orders_text
 
 if TYPE_CHECKING:  # pragma: no cover
-    from synth.grafcet.ass import ASS
     from pathlib import Path
+
+    from synth.engines import SupRun
+    from synth.grafcet.ass import ASS
 
     from synth.grafcet.simulation import SimulationStep
     from synth.plant.library import LibraryModel
@@ -47,6 +49,8 @@ __all__ = [
     "plant_text",
     "sup_summary",
     "sup_text",
+    "sup_run_summary",
+    "sup_run_text",
     "ass_json",
     "ass_text",
     "run_text",
@@ -143,6 +147,20 @@ def sup_summary(rs: "RuleSet", sup: "Supervisor | SymbolicSupervisor", path: str
         "constraints": [{"id": c.id, "label": c.label, "expr": c.text()} for c in rs.constraints],
         "empty": sup.empty,
     }
+
+
+def sup_run_summary(run: "SupRun") -> dict[str, Any]:
+    """The JSON of ``synth sup`` (the key ``symbolic`` when the symbolic engine ran)."""
+    data = sup_summary(run.rules, run.sup, run.path)
+    if run.bdd_nodes is not None:
+        data["symbolic"] = {"bdd_nodes": run.bdd_nodes}
+    return data
+
+
+def sup_run_text(run: "SupRun") -> str:
+    """The terminal listing of :func:`sup_run_summary`, with why SUP is empty when it is."""
+    labels = run.labels
+    return sup_text(sup_run_summary(run), labels, run.why().text(labels) if run.sup.empty else "")
 
 
 def sup_text(data: Mapping[str, Any], labels: Mapping[str, str], empty_why: str = "") -> str:

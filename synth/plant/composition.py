@@ -133,9 +133,14 @@ class Plant:
 
     # ------------------------------------------------------------------ reads
     @cached_property
+    def readers(self) -> tuple[str, ...]:
+        """The elements that read other elements' variables, in declaration order."""
+        return tuple(e.name for e in self.elements if e.guards is not None and not bool(e.guards.all()))
+
+    @cached_property
     def reads(self) -> bool:
         """Some element reads another's variables: moves depend on the global state."""
-        return any(e.guards is not None and not bool(e.guards.all()) for e in self.elements)
+        return bool(self.readers)
 
     def enabled(self, t: LocalTransition, local: tuple[int, ...]) -> bool:
         """Whether ``t`` may occur in the state ``local`` (its source assumed there)."""
@@ -365,4 +370,12 @@ def asynchronous_composition(elements: tuple[ElementAutomaton, ...], rules: Rule
 def plant(rules: RuleSet) -> Plant:
     """The plant of a rule set: its elements' automata, composed asynchronously."""
     return asynchronous_composition(tuple(element_automaton(e) for e in rules.elements), rules)
+
+
+def load_plant(path: str | Path) -> Plant:
+    """Read, parse and check the ``.rules`` file ``path``, and build its plant (its rule set
+    is ``.rules``)."""
+    from synth.plant.rules_check import load_rules
+
+    return plant(load_rules(path))
 

@@ -139,7 +139,7 @@ class Instance:
         self.type = type_name
         self.values = values
         self._keys = {k.upper(): k for k in values}
-        self._state: dict[str, Any] = {}
+        self.memory: dict[str, Any] = {}  # a standard function block's hidden memory (a timer's start)
 
     def key(self, name: str) -> str:
         try:
@@ -172,4 +172,4 @@ class Instance:
             except BodyReturn:
                 pass
         else:
-            STANDARD_FBS[self.type].step(self.values, self._state, self.module.clock_ms)
+            STANDARD_FBS[self.type].step(self.values, self.memory, self.module.clock_ms)

@@ -25,7 +25,7 @@ from typing import Any, Callable
 
 from synth.errors import InputError, Location, Severity
 
-__all__ = ["duration", "IEC_RANGES", "DataVar", "DataScope", "DATA", "data_scope", "assigned_names", "strip_comments",
+__all__ = ["FLAG_PREFIX", "duration", "IEC_RANGES", "DataVar", "DataScope", "DATA", "data_scope", "assigned_names", "strip_comments",
            "HelperChart"]
 
 HelperChart = tuple[str, list[tuple[str, bool, list[str]]], list[tuple[list[str], list[str], str]]]
@@ -194,7 +194,8 @@ def data_scope(pou: Any, q: Callable[[str], str], at: Callable[[Any], Location],
         kinds = [c for c in (typ if typ is not None else []) if isinstance(c.tag, str)]
         iec = kinds[0].tag.rsplit("}", 1)[-1] if len(kinds) == 1 else ""
         name = str(var.get("name", ""))
-        if iec not in IEC_RANGES or name.upper() in exclude or (var in outputs and iec == "BOOL"):
+        if iec not in IEC_RANGES or name.upper() in exclude or (var in outputs and iec == "BOOL") \
+                or name.upper().startswith(FLAG_PREFIX):
             continue
         doc = " ".join("".join(d.itertext()).split()) if (d := var.find(q("documentation"))) is not None else ""
         m = re.fullmatch(r"internal (-?\d+)\.\.(-?\d+)|internal (Boolean)", doc)
@@ -214,6 +215,11 @@ def data_scope(pou: Any, q: Callable[[str], str], at: Callable[[Any], Location],
         scope.vars[name.upper()] = DataVar(name, iec, low, high, max(low, min(high, initial)), m is not None, var,
                                            var in outputs)
     return scope
+
+
+FLAG_PREFIX = "_N_"
+"""The prefix of a step's flag for an order several steps emit (``_N_RUN_S1``, see
+:mod:`synth.codegen.plcopen.shared`): an order in the making, not data."""
 
 
 _MS = {"ms": 1, "s": 1000, "m": 60_000, "h": 3_600_000, "d": 86_400_000}

@@ -42,6 +42,7 @@ from __future__ import annotations
 
 from typing import Any, Sequence
 
+from synth.codegen.plcopen.data import FLAG_PREFIX
 from synth.codegen.plcopen.tc6 import (
     SYNTH_DATA,
     Qualifier,
@@ -213,6 +214,8 @@ def sfc_project_xml(g: Grafcet, *, name: str | None = None, version: str | None 
             return sim_div[i], str(g.transitions[i].targets.index(s))
         return trans_id[i], None
 
+    shared = shared_orders(g)
+    carrier = next(s.name for s in g.steps if s.initial) if shared else None
     body = element("SFC")
     column: dict[str, int] = {p.name: k for k, p in enumerate(g.grafcets)}
     row: dict[str, int] = {}
@@ -228,7 +231,7 @@ def sfc_project_xml(g: Grafcet, *, name: str | None = None, version: str | None 
         elif incoming[s.name]:
             el.append(_conn_in(producer_of_transition(incoming[s.name][0], s.name)))
         el.append(element("connectionPointOut", {"formalParameter": ""}))
-        if s.actions:
+        if s.actions or s.name == carrier:
             el.append(element("connectionPointOutAction", {"formalParameter": ""}))
         data = element("data", {"name": SYNTH_DATA, "handleUnknown": "discard"}, element("grafcet", {"name": s.grafcet}))
         el.append(element("addData", None, data))
@@ -243,10 +246,17 @@ def sfc_project_xml(g: Grafcet, *, name: str | None = None, version: str | None 
             for k in range(len(outgoing[s.name])):
                 div.append(element("connectionPointOut", {"formalParameter": str(k)}))
             body.append(div)
-        if s.actions:
+        if s.actions or s.name == carrier:
             block = element("actionBlock", {"localId": str(ids())}, position(x + 120, y), _conn_in((step_id[s.name], None)))
             for k, a in enumerate(s.actions):
-                block.extend(_actions(a, ids, k, names))
+                own = a.order in shared and a.kind in (CONTINUOUS, CONDITIONAL)
+                block.extend(_actions(a, ids, k, names, shared_flag(names(a.order), s.name) if own else None))
+            if s.name == carrier:
+                for k, (order, emitters) in enumerate(shared.items(), len(s.actions)):
+                    text = f"{names(order)} := " + " OR ".join(shared_flag(names(order), e) for e in emitters) + ";"
+                    block.append(element("action", {"localId": str(ids()), "qualifier": Qualifier.S},
+                                         position(0, 30 * k, "relPosition"),
+                                         element("inline", None, element("ST", None, xhtml(text)))))
             body.append(block)
     for i, t in enumerate(g.transitions):
         col = column[t.grafcet]
@@ -288,6 +298,13 @@ def sfc_project_xml(g: Grafcet, *, name: str | None = None, version: str | None 
                               element("initialValue", None, element("simpleValue", {"value": str(d.init)})),
                               element("documentation", None, xhtml(d.comment, cdata=False))))
         iface.append(vl)
+    if shared:
+        vl = element("localVars")
+        for order, emitters in shared.items():
+            for e in emitters:
+                vl.append(element("variable", {"name": shared_flag(names(order), e)}, element("type", None, element("BOOL")),
+                                  element("documentation", None, xhtml(f"{order} as step {e} emits it", cdata=False))))
+        iface.append(vl)
     if edges:
         vl = element("localVars")
         for rising, n in edges:
@@ -302,12 +319,44 @@ def sfc_project_xml(g: Grafcet, *, name: str | None = None, version: str | None 
     return project(pou_name, version or synth_version(), comment, [pou])
 
 
-def _actions(a: Action, ids: _Ids, k: int, names: _Names) -> list[Any]:
+def shared_flag(order: str, step: str) -> str:
+    """The local BOOL that step ``step`` drives for the shared order ``order``.
+
+    >>> shared_flag("RUN", "12")
+    '_N_RUN_S12'
+    """
+    return f"{FLAG_PREFIX}{order}_{sfc_step_name(step)}"
+
+
+def shared_orders(g: Grafcet) -> dict[str, list[str]]:
+    """The orders that several steps emit continuously or conditionally (``A``, ``A if c``),
+    and that no stored action writes: order -> its emitting steps, in step order.
+
+    MATIEC (Beremiz, OpenPLC) resets an ``N`` action's variable when one of its steps is left
+    even while another keeps it (measured: the order off for one scan), so each emitting step
+    drives a flag of its own (:func:`shared_flag`, with the action it has in the ``.g7``) and
+    an ``S`` action on an initial step, run at every scan from the first one (as Beremiz runs
+    its function blocks), writes the order as the OR of the flags."""
+    emitters: dict[str, list[str]] = {}
+    stored: set[str] = set()
+    for s in g.steps:
+        for a in s.actions:
+            if a.kind in (CONTINUOUS, CONDITIONAL):
+                emitters.setdefault(a.order, [])
+                if s.name not in emitters[a.order]:
+                    emitters[a.order].append(s.name)
+            else:
+                stored.add(a.order)
+    return {o: steps for o, steps in emitters.items() if len(steps) > 1 and o not in stored}
+
+
+def _actions(a: Action, ids: _Ids, k: int, names: _Names, flag: str | None = None) -> list[Any]:
     """The SFC action(s) of one ``.g7`` action, with its IEC 61131-3 meaning: ``A if c`` is an
     ST body under ``N`` (run while the step is active) and a ``P0`` body ``A := FALSE;`` (run
     once when it is left), since a PLC does not run an action body again after its step is
-    left (MATIEC, hence Beremiz and OpenPLC, run it only while the action is active)."""
-    order = names(a.order)
+    left (MATIEC, hence Beremiz and OpenPLC, run it only while the action is active).
+    ``flag``: the step's own flag of a shared order, written instead of the order."""
+    order = flag or names(a.order)
 
     def new(qualifier: Qualifier, body: Any, row: int = 0) -> Any:
         el = element("action", {"localId": str(ids()), "qualifier": qualifier})

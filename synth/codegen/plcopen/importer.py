@@ -42,6 +42,7 @@ from synth.codegen.plcopen.data import DATA, duration
 from synth.codegen.plcopen.instances import separate_instances
 from synth.codegen.plcopen.project import NAMESPACES, PouSummary, body_language, list_pous, pous_of, read_project
 from synth.codegen.plcopen.sfc import Chart, Source, read_chart
+from synth.codegen.plcopen.shared import MARK, merge_shared, shared_assignment
 from synth.codegen.plcopen.timers import prepare_scope
 from synth.codegen.plcopen.vendor import IecQualifier
 from synth.codegen.plcopen.tc6 import Qualifier
@@ -105,6 +106,8 @@ def import_sfc(data: bytes | str, file: str = "<xml>", pou: str | None = None,
         charts[-1].outputs[:] = [o for o in charts[-1].outputs if o.upper() not in scope.used]
         charts[-1].outputs.extend(n for n in [*scope.action_refs, *scope.globals_out.values(), *scope.inputs_out.values()]
                                   if n not in charts[-1].outputs and n.upper() not in scope.used)
+    for c in charts:
+        merge_shared(c, src.at)
     if several:
         separate_instances(charts, [p for p, _ in sfc_pous], q, src.at)
     _feedback(charts, src)
@@ -360,6 +363,8 @@ def _one_action(a: Any, src: Source, steps: dict[str, str], q: Any, qualifier: s
                                  where(0, len(body.strip())))
             cond = ExprReader(cm[2], lambda o, w: where(off + o, w), steps, "an action body").whole()
             return f"{cm[1]} if {cond}"
+    if qualifier == Qualifier.S and (shared := shared_assignment(body)) is not None:
+        return f"{MARK}{shared[0]} := {' '.join(shared[1])}"
     raise InputError(f"a {qualifier} action body that .g7 cannot represent (expected 'NAME := condition;')",
                      where(0, 1))
 

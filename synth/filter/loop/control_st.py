@@ -83,7 +83,7 @@ class StInstance(Protocol):
     @property
     def values(self) -> dict[str, Any]: ...
     @property
-    def _state(self) -> dict[str, Any]: ...
+    def memory(self) -> dict[str, Any]: ...
     @property
     def module(self) -> StClock: ...
     def __getitem__(self, name: str) -> Any: ...
@@ -132,13 +132,13 @@ def _at(option: str, column: int = 1, width: int = 0) -> Location:
 
 
 def _is_instance(x: Any) -> bool:
-    return hasattr(x, "_state") and hasattr(x, "values")
+    return hasattr(x, "memory") and hasattr(x, "values")
 
 
 def _canon(x: Any) -> Any:
     """A hashable value of an ST value: instances by their variables and hidden memory, arrays by their items."""
     if _is_instance(x):
-        return tuple(_canon(v) for v in x.values.values()), tuple(sorted(x._state.items()))
+        return tuple(_canon(v) for v in x.values.values()), tuple(sorted(x.memory.items()))
     if hasattr(x, "bounds") and hasattr(x, "items"):
         return tuple(x.items)
     return x
@@ -174,8 +174,8 @@ class Snapshot:
                 parts += [v.name] if x else []
             elif isinstance(x, int):
                 parts += [f"{v.name}={x}"] if x else []
-            elif _is_instance(x) and x.type in _TIMERS and _TIMERS[x.type] in x._state:
-                since = inst.module.clock_ms - x._state[_TIMERS[x.type]]
+            elif _is_instance(x) and x.type in _TIMERS and _TIMERS[x.type] in x.memory:
+                since = inst.module.clock_ms - x.memory[_TIMERS[x.type]]
                 parts.append(f"{v.name} {'elapsed' if since >= int(x.values['PT']) else 'running'}")
         return "{" + ", ".join(parts) + "}"
 
@@ -268,7 +268,7 @@ class StControl:
         inst = self.copy(snap)
         if len(events) == 1 and events[0].startswith(TIMER_PREFIX):
             fb = self._timers(inst)[events[0]]
-            fb._state[_TIMERS[fb.type]] = self.module.clock_ms - int(fb.values["PT"])
+            fb.memory[_TIMERS[fb.type]] = self.module.clock_ms - int(fb.values["PT"])
         given = {self.inputs[n]: v for n, v in inputs.items() if n in self.inputs}
         try:
             inst.cycle(given)
@@ -293,7 +293,7 @@ class StControl:
                 key = _TIMERS.get(x.type) if x.pou is None else None
                 if key is None:
                     stack.append((here + ".", x))
-                elif key in x._state and self.module.clock_ms - x._state[key] < int(x.values["PT"]):
+                elif key in x.memory and self.module.clock_ms - x.memory[key] < int(x.values["PT"]):
                     out[f"{TIMER_PREFIX}{here} ({_ms_text(int(x.values['PT']))})"] = x
         return out
 

@@ -4,12 +4,13 @@
 
 Example
 -------
->>> from synth.plant.composition import _plants
+>>> from synth.plant.composition import _plants, load_plant
 >>> from synth.filter.from_rules import skeleton
 >>> from synth.filter.cycle import Algorithm
 >>> from synth.filter.loop.product import Product
 >>> sk = skeleton(_plants("tri.rules"), _plants("F.filter"))  # the text only: nothing is written
->>> ex = Explorer(Product(sk.filter, _plants("tri.rules"), None, Algorithm.ALGEBRAIC, Mode.SUPERVISOR, False), 100)
+>>> pr = Product(sk.filter, load_plant(_plants("tri.rules")), None, Algorithm.ALGEBRAIC, Mode.SUPERVISOR, False)
+>>> ex = Explorer(pr, 100)
 >>> ex.run()
 >>> ex.complete, len(ex.seen_keys)
 (False, 100)

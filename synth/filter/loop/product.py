@@ -10,7 +10,8 @@ Example
 >>> from synth.plant.composition import _plants
 >>> from synth.filter.from_rules import skeleton
 >>> sk = skeleton(_plants("tri.rules"), _plants("F.filter"))  # the text only: nothing is written
->>> pr = Product(sk.filter, _plants("tri.rules"), None, Algorithm.ALGEBRAIC, Mode.SUPERVISOR, False)
+>>> from synth.plant.composition import load_plant
+>>> pr = Product(sk.filter, load_plant(_plants("tri.rules")), None, Algorithm.ALGEBRAIC, Mode.SUPERVISOR, False)
 >>> pr.size == pr.plant.size, bool(pr.illegal[pr.plant.initial_index])
 (True, False)
 """
@@ -31,28 +32,34 @@ if TYPE_CHECKING:
     from synth.grafcet.language import Grafcet
     from synth.grafcet.machine import GrafcetMachine
     from synth.filter.loop.control_st import StControl, StSource
-    from synth.filter.loop.control_st import StControl
+    from synth.plant.composition import Plant
+    from synth.plant.rules import RuleSet
 
-__all__ = ["PLANT_LIMIT", "Product"]
+__all__ = ["PLANT_LIMIT", "Product", "rules_of"]
 
 PLANT_LIMIT = 20_000_000
 """verify keeps flat arrays over the plant's states; above this many it stops."""
 
 
-class Product:
-    """The filter, the plant of ``rules_path`` and the Grafcet of ``grafcet_path`` (or
-    none: any control), checked against each other and laid out as arrays."""
+def rules_of(p: Plant) -> RuleSet:
+    """The rule set ``p`` was built from (:func:`~synth.plant.composition.plant`)."""
+    if p.rules is None:
+        raise AssertionError("the closed loop needs a plant built from a rule set (plant(load_rules(path)))")
+    return p.rules
 
-    def __init__(self, f: Filter, rules_path: str, grafcet_path: str | None, algorithm: Algorithm,
+
+class Product:
+    """The filter, the plant ``p`` (built from its rule set ``p.rules``) and the Grafcet
+    ``g`` (checked against the plant's inputs and outputs; or none: any control), checked
+    against each other and laid out as arrays."""
+
+    def __init__(self, f: Filter, p: Plant, g: Grafcet | None, algorithm: Algorithm,
                  mode: Mode, atomic: bool, control: StSource | None = None) -> None:
-        from synth.plant.composition import plant
-        from synth.plant.rules_check import load_rules
         from synth.sup.supervisor import Supervisor
 
-        rs = load_rules(rules_path)
-        p = plant(rs)
+        rs = rules_of(p)
         if p.size > PLANT_LIMIT:
-            raise LimitExceeded(f"the plant of {rules_path} has {p.size} states; verify keeps arrays over the "
+            raise LimitExceeded(f"the plant of {rs.path} has {p.size} states; verify keeps arrays over the "
                                 f"plant's states and stops above {PLANT_LIMIT}")
         self.plant, self.rules = p, rs
         self.cycle = FilterCycle(f, algorithm, mode)
@@ -61,15 +68,13 @@ class Product:
             missing = [n for n in names if n not in have]
             if missing:
                 raise InputError(f"{f.file}: the filter's {kind} {', '.join(missing)} is not an "
-                                 f"{kind} of the plant {rules_path}", None)
+                                 f"{kind} of the plant {rs.path}", None)
         self.machine: GrafcetMachine | None = None
-        self.grafcet: Grafcet | None = None
-        if grafcet_path is not None:
-            from synth.grafcet.language_check import load_grafcet
+        self.grafcet: Grafcet | None = g
+        if g is not None:
             from synth.grafcet.machine import GrafcetMachine
 
-            self.grafcet = load_grafcet(grafcet_path, inputs=rs.inputs, outputs=rs.outputs)
-            self.machine = GrafcetMachine(self.grafcet)
+            self.machine = GrafcetMachine(g)
         self.control: StControl | None = None
         if control is not None:
             from synth.filter.loop.control_st import StControl

@@ -15,7 +15,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from enum import StrEnum
 
-from synth.engines import EngineChoice
+from synth.choices import EngineChoice
 from synth.filter.cycle import Algorithm, Mode
 
 __all__ = ["ANY_CONTROL", "ControlKind", "Control", "FindingKind", "UNSAFE", "INCOHERENT", "TraceRow", "Finding", "ProgressFailure",

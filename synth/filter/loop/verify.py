@@ -60,24 +60,31 @@ from __future__ import annotations
 import dataclasses
 import time
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Callable
 
 import numpy as np
 
-from synth.engines import EngineChoice
+from synth.choices import EngineChoice
+from synth.engines import Command, Need, decide, refuse
 from synth.errors import InputError, close_names
 from synth.filter.loop.control_st import StSource
 from synth.filter.cycle import Algorithm, Mode
 from synth.filter.loop.explorer import Explorer
 from synth.filter.language import Filter
 from synth.filter.loop.outcomes import trace_row
-from synth.filter.loop.product import Product
+from synth.filter.loop.product import Product, rules_of
 from synth.filter.loop.verification import (ANY_CONTROL, Control, ControlKind, FindingKind, Progress, ProgressFailure,
                                        TraceRow, Verification)
 from synth.logic.events import Event
 from synth.logic.expr import Edge, Expr, evaluate, names
+from synth.plant.composition import Plant, load_plant, plant
 
-__all__ = ["verify", "Goal", "goal_of", "DEFAULT_MAX_STATES"]
+TYPE_CHECKING = False  # typing.TYPE_CHECKING: the Grafcet modules load only with --grafcet
+if TYPE_CHECKING:
+    from synth.grafcet.language import Grafcet
+
+__all__ = ["verify", "verify_explicit", "plant_of", "Goal", "goal_of", "DEFAULT_MAX_STATES"]
 
 DEFAULT_MAX_STATES = 1_000_000
 """The explicit engine's default ``--max-states``."""
@@ -91,10 +98,12 @@ def verify(f: Filter, rules_path: str, grafcet: str | None = None, *, any_contro
            strict: bool = False, require_sup: bool = False, max_states: int | None = DEFAULT_MAX_STATES,
            events_per_cycle: int = 1, progress: str | None = None, control: StSource | None = None,
            engine: EngineChoice = EngineChoice.EXPLICIT, report: Callable[[str], None] | None = None) -> Verification:
-    """Explore the closed loop (see the module docstring); ``control``: ``--control PROG.st[:NAME]``.
-    ``engine``: ``symbolic`` (or ``auto`` on a large plant) runs
+    """``synth filter verify``: read each input once, let :func:`synth.engines.decide`
+    choose the engine, run it on the loaded models. ``control``: ``--control
+    PROG.st[:NAME]``; ``engine``: ``symbolic`` (or ``auto`` on a large plant) runs
     :func:`~synth.filter.loop.symbolic.verify.verify_symbolic` (``--any-control`` only; there
-    ``max_states=None`` is no limit, explicitly it is 1000000). ``report`` receives progress lines."""
+    ``max_states=None`` is no limit, explicitly it is 1000000), otherwise
+    :func:`verify_explicit`. ``report`` receives progress lines."""
     if (grafcet is not None) + any_control + (control is not None) != 1:
         raise InputError("verify needs a request source: --grafcet G.g7, --control PROG.st or --any-control "
                          "(one of them)", None)
@@ -102,20 +111,46 @@ def verify(f: Filter, rules_path: str, grafcet: str | None = None, *, any_contro
         raise InputError(f"--events-per-cycle is a number of plant events, 0 or more, not {events_per_cycle}", None)
     if max_states is not None and max_states < 1:
         raise InputError(f"--max-states is a number of states, 1 or more, not {max_states}", None)
-    engine = EngineChoice(engine)
-    if engine is not EngineChoice.EXPLICIT:
-        from synth.filter.loop.symbolic.verify import choose_engine, plant_size, verify_symbolic
+    options = ({Need.CONTROLLER} if not any_control else set()) | ({Need.PROGRESS} if progress is not None else set())
+    refuse(Command.FILTER_VERIFY, engine, options)  # before any input is read
+    p = plant_of(f, rules_path)
+    chosen = decide(Command.FILTER_VERIFY, engine, options, estimate=p.size, readers=p.readers)
+    if chosen.engine is EngineChoice.SYMBOLIC:
+        from synth.filter.loop.symbolic.verify import verify_symbolic
 
-        size = plant_size(rules_path) if engine is EngineChoice.AUTO and any_control and progress is None else 0
-        if choose_engine(engine, any_control=any_control, progress=progress is not None,
-                         plant_size=size) is EngineChoice.SYMBOLIC:
-            return verify_symbolic(f, rules_path, algorithm=algorithm, mode=mode, atomic=atomic, strict=strict,
-                                   require_sup=require_sup, max_states=max_states, events_per_cycle=events_per_cycle,
-                                   report=report)
+        return verify_symbolic(f, p, algorithm=algorithm, mode=mode, atomic=atomic, strict=strict,
+                               require_sup=require_sup, max_states=max_states, events_per_cycle=events_per_cycle,
+                               report=report)
+    g = None
+    if grafcet is not None:
+        from synth.grafcet.language_check import load_grafcet
+
+        g = load_grafcet(grafcet, inputs=rules_of(p).inputs, outputs=rules_of(p).outputs)
+    return verify_explicit(f, p, g, algorithm=algorithm, mode=mode, atomic=atomic, strict=strict,
+                           require_sup=require_sup, max_states=max_states, events_per_cycle=events_per_cycle,
+                           progress=progress, control=control, report=report)
+
+
+def plant_of(f: Filter, rules_path: str) -> Plant:
+    """The plant of ``rules_path``, read once: from the rule set the filter read for its
+    ``use`` when that is the same file (named as ``rules_path`` names it), else from the file."""
+    if f.rules is not None and f.plant is not None and Path(f.plant).resolve() == Path(rules_path).resolve():
+        return plant(dataclasses.replace(f.rules, path=str(rules_path)))
+    return load_plant(rules_path)
+
+
+def verify_explicit(f: Filter, p: Plant, g: Grafcet | None = None, *, algorithm: Algorithm = Algorithm.ALGEBRAIC,
+                    mode: Mode = Mode.SUPERVISOR, atomic: bool = False, strict: bool = False,
+                    require_sup: bool = False, max_states: int | None = DEFAULT_MAX_STATES, events_per_cycle: int = 1,
+                    progress: str | None = None, control: StSource | None = None,
+                    report: Callable[[str], None] | None = None) -> Verification:
+    """The explicit engine (see the module docstring) on the plant ``p`` and the requests of
+    the Grafcet ``g``, of the ST program ``control``, or of any control (neither); ``report``
+    receives progress lines."""
     if max_states is None:
         max_states = DEFAULT_MAX_STATES
     started = time.perf_counter()
-    pr = Product(f, rules_path, grafcet, Algorithm(algorithm), Mode(mode), atomic, control)
+    pr = Product(f, p, g, Algorithm(algorithm), Mode(mode), atomic, control)
     goal = goal_of(progress, pr) if progress is not None else None
     ex = Explorer(pr, max_states, events_per_cycle, edges=goal is not None)
     ex.report = report
@@ -127,12 +162,12 @@ def verify(f: Filter, rules_path: str, grafcet: str | None = None, *, any_contro
     if pr.control is not None:
         source, how = f"PROGRAM {pr.control.program} of {pr.control.file}", Control(
             ControlKind.ST, pr.control.file, pr.control.program)
-    elif grafcet is not None:
-        source, how = grafcet, Control(ControlKind.GRAFCET, grafcet)
+    elif g is not None:
+        source, how = g.path, Control(ControlKind.GRAFCET, g.path)
     else:
         source, how = ANY_CONTROL, Control(ControlKind.ANY)
     return Verification(
-        f.file, rules_path, source, pr.cycle.algorithm, pr.cycle.mode,
+        f.file, pr.rules.path, source, pr.cycle.algorithm, pr.cycle.mode,
         atomic, strict, ex.states, ex.plant_states,
         ex.loop_cycles[0], ex.complete,
         time.perf_counter() - started, len(ex.outside_sup), findings, ex.loop_cycles[1], ex.max_distance,

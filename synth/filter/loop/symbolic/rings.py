@@ -25,7 +25,8 @@ Example
 >>> from synth.plant.composition import _plants
 >>> from synth.filter.from_rules import skeleton
 >>> sk = skeleton(_plants("tri.rules"), _plants("F.filter"))  # the text only: nothing is written
->>> loop = SymbolicLoop(sk.filter, _plants("tri.rules"), Algorithm.ALGEBRAIC, Mode.SUPERVISOR, False, 1)
+>>> from synth.plant.composition import load_plant
+>>> loop = SymbolicLoop(sk.filter, load_plant(_plants("tri.rules")), Algorithm.ALGEBRAIC, Mode.SUPERVISOR, False, 1)
 >>> loop.run()
 >>> loop.complete, loop.states, loop.cycles, sorted(map(str, loop.first_level))
 (True, 12996, 2357952, ['outside_sup', 'transient'])
@@ -37,10 +38,12 @@ from typing import Callable
 
 from synth.filter.cycle import Algorithm, Mode
 from synth.filter.language import Filter
+from synth.filter.loop.product import rules_of
 from synth.filter.loop.symbolic.cycle import FALLBACK, OUTSIDE, SymbolicCycle, next_name
 from synth.filter.loop.verification import FindingKind
 from synth.logic.bdd import Function
 from synth.logic.counting import count
+from synth.plant.composition import Plant
 from synth.symbolic.encoding import Copy
 from synth.symbolic.relation import image
 
@@ -53,14 +56,10 @@ class SymbolicLoop:
     level whose cycles first show it: 0 for the cycles from the initial node; a violation
     or a node outside SUP counts at the level that reaches it, -1 for the initial node)."""
 
-    def __init__(self, f: Filter, rules_path: str, algorithm: Algorithm, mode: Mode, atomic: bool,
+    def __init__(self, f: Filter, p: Plant, algorithm: Algorithm, mode: Mode, atomic: bool,
                  events_per_cycle: int, max_states: int | None = None) -> None:
-        from synth.plant.composition import plant
-        from synth.plant.rules_check import load_rules
-
         self.report: Callable[[str], None] | None = None  # progress lines, one per level (the CLI's live line)
-        rs = load_rules(rules_path)
-        self.sc = sc = SymbolicCycle(f, rs, plant(rs), algorithm, mode, atomic)
+        self.sc = sc = SymbolicCycle(f, rules_of(p), p, algorithm, mode, atomic)
         self.k, self.max_states = events_per_cycle, max_states
         enc, e = sc.enc, sc.engine
         self.enc, self.engine = enc, e

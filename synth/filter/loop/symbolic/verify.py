@@ -1,22 +1,22 @@
 """``synth filter verify --engine symbolic``: the verdict and the counts of
-:class:`~synth.filter.loop.symbolic.rings.SymbolicLoop`, the shortest traces of the explicit
-engine, and the choice of engine (``--engine auto``).
+:class:`~synth.filter.loop.symbolic.rings.SymbolicLoop`, and the shortest traces of the
+explicit engine (which engine runs is decided by :mod:`synth.engines`).
 
 The symbolic search knows at which level each kind of finding first appears; the
 explicit engine (:class:`~synth.filter.loop.explorer.Explorer`) then runs that many levels
 only, so every trace is exactly the one the explicit engine prints, found in the part
 of the closed loop before the first finding. When that part is larger than
-:data:`TRACE_BUDGET` nodes, or the plant has more than :data:`SYMBOLIC_ABOVE` states
-(the explicit arrays), the traces are walked back through the rings
-(:class:`~synth.filter.loop.symbolic.walk.Walk`): shortest ones, not necessarily the explicit
-engine's choice.
+:data:`TRACE_BUDGET` nodes, or the plant has more states than ``--engine auto`` leaves to
+the explicit engine (:data:`synth.engines.VERIFY_THRESHOLD`, the explicit arrays), the
+traces are walked back through the rings (:class:`~synth.filter.loop.symbolic.walk.Walk`):
+shortest ones, not necessarily the explicit engine's choice.
 
 Example
 -------
->>> from synth.plant.composition import _plants
+>>> from synth.plant.composition import _plants, load_plant
 >>> from synth.filter.from_rules import skeleton
 >>> sk = skeleton(_plants("tri.rules"), _plants("F.filter"))  # the text only: nothing is written
->>> v = verify_symbolic(sk.filter, _plants("tri.rules"))
+>>> v = verify_symbolic(sk.filter, load_plant(_plants("tri.rules")))
 >>> v.safe, v.coherent, v.states > 1000
 (True, True, True)
 """
@@ -28,61 +28,31 @@ from typing import Callable
 
 import numpy as np
 
-from synth.engines import EngineChoice
-from synth.errors import InputError
+from synth.choices import EngineChoice
+from synth.engines import VERIFY_THRESHOLD
 from synth.filter.cycle import Algorithm, Mode
 from synth.filter.language import Filter
+from synth.filter.loop.product import rules_of
 from synth.filter.loop.verification import ANY_CONTROL, Control, ControlKind, Finding, FindingKind, Verification
+from synth.plant.composition import Plant
 
-__all__ = ["verify_symbolic", "choose_engine", "plant_size", "SYMBOLIC_ABOVE", "TRACE_BUDGET"]
-
-SYMBOLIC_ABOVE = 2_000_000
-"""``--engine auto`` runs the symbolic engine when the plant has more states than this."""
+__all__ = ["verify_symbolic", "TRACE_BUDGET"]
 
 TRACE_BUDGET = 1_000_000
 """The nodes the explicit engine may visit to render the symbolic engine's traces."""
 
 
-def choose_engine(engine: EngineChoice, *, any_control: bool, progress: bool, plant_size: int) -> EngineChoice:
-    """The engine that runs: ``auto`` is symbolic for ``--any-control`` without
-    ``--progress`` on a plant of more than :data:`SYMBOLIC_ABOVE` states; ``symbolic``
-    refuses what it does not support (exit 2).
-
-    >>> choose_engine(EngineChoice.AUTO, any_control=True, progress=False, plant_size=10**9)
-    <EngineChoice.SYMBOLIC: 'symbolic'>
-    >>> choose_engine(EngineChoice.AUTO, any_control=False, progress=False, plant_size=10**9)
-    <EngineChoice.EXPLICIT: 'explicit'>
-    """
-    engine = EngineChoice(engine)
-    supported = any_control and not progress
-    if engine is EngineChoice.SYMBOLIC and not supported:
-        what = "--progress" if any_control else "--grafcet and --control"
-        raise InputError(f"the symbolic engine of filter verify supports --any-control only, without --progress "
-                         f"({what} need --engine explicit)", None)
-    if engine is EngineChoice.AUTO:
-        return EngineChoice.SYMBOLIC if supported and plant_size > SYMBOLIC_ABOVE else EngineChoice.EXPLICIT
-    return engine
-
-
-def plant_size(rules_path: str) -> int:
-    """The number of states of the plant's grid (what the explicit engine's arrays cover)."""
-    from synth.plant.composition import plant
-    from synth.plant.rules_check import load_rules
-
-    return int(plant(load_rules(rules_path)).size)
-
-
-def explicit_findings(f: Filter, rules_path: str, algorithm: Algorithm, mode: Mode, atomic: bool, k: int,
+def explicit_findings(f: Filter, p: Plant, algorithm: Algorithm, mode: Mode, atomic: bool, k: int,
                       levels: int, budget: int) -> dict[FindingKind, Finding] | None:
     """The explicit engine's findings after ``levels`` levels of its search (None: the
-    plant has more than :data:`SYMBOLIC_ABOVE` states, or the part explored does not fit
-    the budget)."""
+    plant has more than :data:`~synth.engines.VERIFY_THRESHOLD` states, or the part
+    explored does not fit the budget)."""
     from synth.filter.loop.explorer import Explorer
     from synth.filter.loop.product import Product
 
-    if plant_size(rules_path) > SYMBOLIC_ABOVE:  # its arrays over the plant's grid: GiB at 10^7 states
+    if p.size > VERIFY_THRESHOLD:  # its arrays over the plant's grid: GiB at 10^7 states
         return None
-    pr = Product(f, rules_path, None, algorithm, mode, atomic)
+    pr = Product(f, p, None, algorithm, mode, atomic)
     ex = Explorer(pr, budget, k)
     frontier = np.array([ex.key0], dtype=np.int64)
     for _ in range(levels):
@@ -92,7 +62,7 @@ def explicit_findings(f: Filter, rules_path: str, algorithm: Algorithm, mode: Mo
     return ex.findings()
 
 
-def verify_symbolic(f: Filter, rules_path: str, *, algorithm: Algorithm = Algorithm.ALGEBRAIC,
+def verify_symbolic(f: Filter, p: Plant, *, algorithm: Algorithm = Algorithm.ALGEBRAIC,
                     mode: Mode = Mode.SUPERVISOR, atomic: bool = False, strict: bool = False,
                     require_sup: bool = False, max_states: int | None = None, events_per_cycle: int = 1,
                     trace_budget: int = TRACE_BUDGET, report: Callable[[str], None] | None = None) -> Verification:
@@ -103,7 +73,7 @@ def verify_symbolic(f: Filter, rules_path: str, *, algorithm: Algorithm = Algori
     from synth.filter.loop.symbolic.rings import SymbolicLoop
 
     started = time.perf_counter()
-    loop = SymbolicLoop(f, rules_path, Algorithm(algorithm), Mode(mode), atomic, events_per_cycle, max_states)
+    loop = SymbolicLoop(f, p, Algorithm(algorithm), Mode(mode), atomic, events_per_cycle, max_states)
     loop.report = report
     loop.run()
     counts = loop.counts()
@@ -111,7 +81,7 @@ def verify_symbolic(f: Filter, rules_path: str, *, algorithm: Algorithm = Algori
     findings: dict[FindingKind, Finding] = {}
     if kinds:
         levels = max(loop.first_level[k] for k in kinds) + 1
-        shown = explicit_findings(f, rules_path, algorithm, mode, atomic, events_per_cycle, levels, trace_budget)
+        shown = explicit_findings(f, p, algorithm, mode, atomic, events_per_cycle, levels, trace_budget)
         if shown is None:  # a walk back through the rings instead
             from synth.filter.loop.symbolic.walk import Walk
 
@@ -125,6 +95,6 @@ def verify_symbolic(f: Filter, rules_path: str, *, algorithm: Algorithm = Algori
                     raise AssertionError(f"the explicit engine does not find {k} within {levels} levels")
                 findings[k] = Finding(k, shown[k].constraints, shown[k].trace, counts[k])
     return Verification(
-        f.file, rules_path, ANY_CONTROL, Algorithm(algorithm), Mode(mode), atomic, strict, loop.states,
+        f.file, rules_of(p).path, ANY_CONTROL, Algorithm(algorithm), Mode(mode), atomic, strict, loop.states,
         loop.plant_states, loop.cycles, loop.complete, time.perf_counter() - started, loop.outside_sup, findings,
         0, 0, events_per_cycle, None, Control(ControlKind.ANY), EngineChoice.SYMBOLIC)

@@ -15,9 +15,10 @@ Example
 -------
 >>> from synth.filter.cycle import Algorithm, Mode
 >>> from synth.filter.language_check import load_filter
->>> from synth.plant.composition import _plants
+>>> from synth.plant.composition import _plants, load_plant
 >>> loop = SymbolicLoop(load_filter(_plants("../tests/data/filter/two_no_edge.filter")),
-...                     _plants("../tests/data/filter/two.rules"), Algorithm.ALGEBRAIC, Mode.SUPERVISOR, False, 1)
+...                     load_plant(_plants("../tests/data/filter/two.rules")), Algorithm.ALGEBRAIC, Mode.SUPERVISOR,
+...                     False, 1)
 >>> loop.run()
 >>> ids, rows = Walk(loop).finding(FindingKind.EDGE)
 >>> ids, len(rows), rows[-1].note
