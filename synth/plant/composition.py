@@ -38,7 +38,7 @@ from typing import Callable, Iterator, Mapping
 
 import numpy as np
 
-from synth.errors import InputError, LimitExceeded, SynthError, close_names, location_in
+from synth.errors import InputError, LimitExceeded, Location, SynthError, close_names, location_in
 from synth.logic.events import Event
 from synth.plant.element import ElementAutomaton, element_automaton
 from synth.plant.rules import RuleSet
@@ -136,6 +136,12 @@ class Plant:
     def readers(self) -> tuple[str, ...]:
         """The elements that read other elements' variables, in declaration order."""
         return tuple(e.name for e in self.elements if e.guards is not None and not bool(e.guards.all()))
+
+    @cached_property
+    def reads_at(self) -> Location | None:
+        """Where the rules say the first ``reads`` (for an error that refuses them), if anywhere."""
+        specs = self.rules.elements if self.rules is not None else ()
+        return next((r.loc or s.loc for s in specs for r in s.reads if r.loc or s.loc), None)
 
     @cached_property
     def reads(self) -> bool:

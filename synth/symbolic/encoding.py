@@ -107,11 +107,9 @@ class PlantEncoding:
                  anchored: Mapping[int | None, Sequence[str]] | None = None) -> None:
         if p.reads:  # a move would depend on other elements' variables: not encoded here
             readers = ", ".join(e.name for e in p.elements if e.guards is not None and not e.guards.all())
-            specs = p.rules.elements if p.rules is not None else ()
-            at = next((r.loc or s.loc for s in specs for r in s.reads if r.loc or s.loc), None)
             raise InputError(
                 f"the symbolic engine does not support elements that read other elements' variables "
-                f"(`reads` in {readers})", at, notes=("use --engine explicit",))
+                f"(`reads` in {readers})", p.reads_at, notes=("use --engine explicit",))
         self.plant = p
         self.budget = budget or NodeBudget()
         self.variables: tuple[str, ...] = tuple(v for e in p.elements for v in e.variables)

@@ -114,7 +114,7 @@ def verify(f: Filter, rules_path: str, grafcet: str | None = None, *, any_contro
     options = ({Need.CONTROLLER} if not any_control else set()) | ({Need.PROGRESS} if progress is not None else set())
     refuse(Command.FILTER_VERIFY, engine, options)  # before any input is read
     p = plant_of(f, rules_path)
-    chosen = decide(Command.FILTER_VERIFY, engine, options, estimate=p.size, readers=p.readers)
+    chosen = decide(Command.FILTER_VERIFY, engine, options, estimate=p.size, readers=p.readers, reads_at=p.reads_at)
     if chosen.engine is EngineChoice.SYMBOLIC:
         from synth.filter.loop.symbolic.verify import verify_symbolic
 
