@@ -11,7 +11,7 @@
 #   SYNTH_PYTHON        the Python to build the venv from (default: python3)
 #   SYNTH_VENV          where the venv goes (default: .venv in the repository)
 #   SYNTH_SKIP_APT=1    never call apt-get (tests, machines without root)
-#   SYNTH_SETUP_TESTS=1    also install the test dependencies (.[test,commission]) and setuptools>=77, wheel
+#   SYNTH_SETUP_TESTS=1    also install the test dependencies (.[test,commission])
 #   SYNTH_SETUP_BROWSER=1  also install chromium and libatomic1 (the browser test)
 #   SYNTH_PIP_ARGS      extra pip arguments (e.g. --no-deps for an offline re-install)
 #   SYNTH_VENV_ARGS     extra venv arguments (e.g. --system-site-packages)
@@ -32,8 +32,24 @@ apt_install() {  # apt_install PACKAGE...: Debian packages, as root or through s
   fi
   echo "== installing $* (Debian)" >&2
   export DEBIAN_FRONTEND=noninteractive
-  $sudo apt-get update -qq >&2 || true
-  $sudo apt-get install -y -qq "$@" >/dev/null
+  $sudo apt-get update -qq >&2 || echo "== synth set-up: apt-get update failed (no network, or a proxy: set http_proxy / Acquire::http::Proxy)" >&2
+  if ! $sudo apt-get install -y -qq "$@" >/dev/null; then
+    echo "== synth set-up: apt-get install $* failed: the Debian mirror may be unreachable (no network, or a proxy:" \
+         "set http_proxy / Acquire::http::Proxy), or the package is unknown to this release" >&2
+    return 1
+  fi
+}
+
+pip_install() {  # pip_install WHAT ARG...: into the venv; on failure one line from synth saying what failed
+  local code=0
+  # shellcheck disable=SC2086
+  "$VENV/bin/python" -m pip install --quiet --disable-pip-version-check ${SYNTH_PIP_ARGS:-} "${@:2}" >&2 || code=$?
+  if [ "$code" != 0 ]; then
+    echo "== synth set-up failed: pip could not install $1 into $VENV (exit $code). Is the package index" \
+         "reachable? Behind a proxy set HTTPS_PROXY (and PIP_CERT for its certificate); offline, point pip at" \
+         "local wheels with SYNTH_PIP_ARGS='--no-index --find-links DIR'. Nothing outside $VENV was changed." >&2
+    exit 2
+  fi
 }
 
 if ! command -v dot >/dev/null 2>&1; then
@@ -53,24 +69,23 @@ fi
 if [ ! -x "$VENV/bin/python" ]; then
   if ! "$PYTHON" -m venv --help >/dev/null 2>&1 || ! "$PYTHON" -c "import ensurepip" >/dev/null 2>&1; then
     ver="$("$PYTHON" -c 'import sys; print(f"{sys.version_info[0]}.{sys.version_info[1]}")')"
-    apt_install "python${ver}-venv" || apt_install python3-venv
+    apt_install "python${ver}-venv" || apt_install python3-venv || {
+      echo "== synth set-up failed: $PYTHON cannot make a virtual environment (install python3-venv as root)" >&2; exit 2; }
   fi
   echo "== creating the virtual environment $VENV" >&2
   rm -rf "$VENV"
   # shellcheck disable=SC2086
-  "$PYTHON" -m venv ${SYNTH_VENV_ARGS:-} "$VENV"
+  "$PYTHON" -m venv ${SYNTH_VENV_ARGS:-} "$VENV" || {
+    echo "== synth set-up failed: $PYTHON -m venv $VENV did not make a virtual environment" >&2; exit 2; }
 fi
-pip=("$VENV/bin/python" -m pip install --quiet --disable-pip-version-check)
+# wheel first: dd's dependencies (ply, astutils) are source distributions that need it to build;
+# the wheel test builds without isolation: Debian's venv brings setuptools 66, the SPDX licence field needs 77
+pip_install "the build tools (setuptools, wheel)" "setuptools>=77" wheel
 if [ "${SYNTH_SETUP_TESTS:-0}" = 1 ]; then
-  # the wheel test builds without isolation: Debian's venv brings setuptools 66 and no wheel; the SPDX licence field needs 77
   echo "== installing synth and its test dependencies into $VENV" >&2
-  # shellcheck disable=SC2086
-  "${pip[@]}" ${SYNTH_PIP_ARGS:-} "setuptools>=77" wheel >&2
-  # shellcheck disable=SC2086
-  "${pip[@]}" ${SYNTH_PIP_ARGS:-} -e ".[test,commission]" >&2
+  pip_install "synth and its test dependencies" -e ".[test,commission]"
 else
   echo "== installing synth into $VENV" >&2
-  # shellcheck disable=SC2086
-  "${pip[@]}" ${SYNTH_PIP_ARGS:-} -e . >&2
+  pip_install "synth and its dependencies" -e .
 fi
 echo "== ready: $VENV/bin/synth (or: export PATH=\"$(cd "$VENV" && pwd)/bin:\$PATH\")" >&2

@@ -42,8 +42,6 @@ rm -rf "$home/synth"
 mkdir -p "$home"
 git clone -q "$repo" "$home/synth"
 git -C "$home/synth" checkout -q "$commit"
-shared="$(cd "$repo/../shared" 2>/dev/null && pwd || true)"
-[ -n "$shared" ] && { rm -rf "$home/shared"; cp -r "$shared" "$home/shared"; }
 
 status=0
 for job in "scripts/demo.sh" ".ci/run"; do

@@ -47,7 +47,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Callable, Collection, Sequence
 
 from synth.choices import EngineChoice
-from synth.errors import InputError, LimitExceeded, SynthError
+from synth.errors import InputError, LimitExceeded, Location, SynthError
 
 if TYPE_CHECKING:  # pragma: no cover - the engines are imported once chosen
     from synth.grafcet.language import Grafcet, Semantics
@@ -150,14 +150,16 @@ def capability(command: Command, engine: EngineChoice) -> Capability:
 _LISTING_OPTIONS = {Command.VALIDATE: "--report/--cor", Command.SUP: "--export/--why"}
 
 
-def refusal(command: Command, need: Need, readers: Sequence[str] = ()) -> SynthError:
+def refusal(command: Command, need: Need, readers: Sequence[str] = (), reads_at: Location | None = None) -> SynthError:
     """The error of an engine asked for a run it does not serve (``readers``: the elements
-    that read others, for :attr:`Need.READS`)."""
+    that read others, for :attr:`Need.READS`, located at ``reads_at``, their first ``reads``)."""
     if need is Need.LISTING:
         return SynthError(f"{_LISTING_OPTIONS[command]} lists every state: use --engine explicit (or auto)")
     if need is Need.READS:
-        return SynthError("the symbolic engine does not support elements that read other elements' variables "
-                          f"(`reads` in {', '.join(readers)}); use --engine explicit")
+        what = f"the symbolic engine does not support elements that read other elements' variables (`reads` in {', '.join(readers)})"
+        if reads_at is not None:
+            return InputError(what, reads_at, notes=("use --engine explicit",))
+        return SynthError(f"{what}; use --engine explicit")
     if need is Need.SFC:
         return SynthError("--semantics sfc runs on the explicit engine: use --engine explicit (or auto)")
     what = "--progress" if need is Need.PROGRESS else "--grafcet and --control"
@@ -165,7 +167,8 @@ def refusal(command: Command, need: Need, readers: Sequence[str] = ()) -> SynthE
                       f"({what} need --engine explicit)", None)
 
 
-def refuse(command: Command, asked: EngineChoice | str, needs: Collection[Need], readers: Sequence[str] = ()) -> None:
+def refuse(command: Command, asked: EngineChoice | str, needs: Collection[Need], readers: Sequence[str] = (),
+           reads_at: Location | None = None) -> None:
     """Raise :func:`refusal` when the engine asked (not ``auto``) does not serve one of
     ``needs`` (the first in :class:`Need`'s order). The runners call it with the options
     before any input is read, :func:`decide` with the model's needs too."""
@@ -174,17 +177,17 @@ def refuse(command: Command, asked: EngineChoice | str, needs: Collection[Need],
         return
     missing = [n for n in Need if n in needs and n not in capability(command, asked).serves]
     if missing:
-        raise refusal(command, missing[0], readers)
+        raise refusal(command, missing[0], readers, reads_at)
 
 
 def decide(command: Command, asked: EngineChoice | str, needs: Collection[Need] = (), *, estimate: int = 0,
-           width: int = 1, readers: Sequence[str] = ()) -> Decision:
+           width: int = 1, readers: Sequence[str] = (), reads_at: Location | None = None) -> Decision:
     """The engine that runs ``command`` asked with ``--engine asked`` for a run with
     ``needs`` (:attr:`Need.READS` added when ``readers`` is not empty) and ``auto``'s
     ``estimate`` and concurrency ``width`` (see the module docstring)."""
     asked = EngineChoice(asked)
     needs = set(needs) | ({Need.READS} if readers else set())
-    refuse(command, asked, needs, readers)
+    refuse(command, asked, needs, readers, reads_at)
     if asked is not EngineChoice.AUTO:
         return Decision(asked, f"--engine {asked}")
     unserved = sorted(n for n in needs if n not in capability(command, EngineChoice.SYMBOLIC).serves)
@@ -271,7 +274,7 @@ def validate_models(
     if g.semantics is not Semantics.GRAFCET:
         options.add(Need.SFC)
     chosen = decide(Command.VALIDATE, engine, options, estimate=p.size * max(1, len(g.steps)), width=concurrency(g),
-                    readers=p.readers)
+                    readers=p.readers, reads_at=p.reads_at)
     if chosen.engine is EngineChoice.SYMBOLIC:
         from synth.grafcet.situation import OutOfRange
         from synth.symbolic.validate import validate_loaded as symbolic
@@ -354,7 +357,8 @@ def supervisor(
     p = plant(rs)
     if loaded is not None:
         loaded(p)
-    chosen = decide(Command.SUP, engine, {Need.LISTING} if needs_listing else (), estimate=p.size, readers=p.readers)
+    chosen = decide(Command.SUP, engine, {Need.LISTING} if needs_listing else (), estimate=p.size, readers=p.readers,
+                    reads_at=p.reads_at)
     if chosen.engine is EngineChoice.SYMBOLIC:
         from synth.symbolic.encoding import NodeBudget
         from synth.symbolic.supervisor import symbolic_supervisor

@@ -91,28 +91,53 @@ class InputError(SynthError):
         self.notes = tuple(notes)
 
     def render(self) -> str:
+        """The message, the line quoted with a caret under the column, then what was expected,
+        the close names and the notes. Every part is bounded: a huge line is quoted in a
+        window of :data:`WINDOW` characters around the column, a huge message or name cut."""
         loc = self.location
-        head = f"{loc}: {self.severity}: {self.message}" if loc else f"{self.severity}: {self.message}"
+        message = _bounded(self.message, 20 * WINDOW)
+        head = f"{_bounded(str(loc), 2 * WINDOW)}: {self.severity}: {message}" if loc else f"{self.severity}: {message}"
         lines = [head]
         if loc is not None and loc.text:
             number = str(loc.line)
             pad = " " * len(number)
+            raw = loc.text.rstrip("\n")
+            column, width = max(1, loc.column), max(1, loc.width)
+            start = 0
+            if len(raw) > WINDOW:  # the window around the column, "…" where the line goes on
+                start = max(0, min(column - 1 - WINDOW // 3, len(raw) - WINDOW))
+                raw = ("…" if start else "") + raw[start:start + WINDOW] + ("…" if start + WINDOW < len(raw) else "")
+                column = column - start + (1 if start else 0)
+                width = max(1, min(width, len(raw) - column + 1))
             # one visible character per control character, so the caret stays aligned
-            text = "".join(c if c >= " " or c == "\t" else chr(0x2400 + ord(c)) for c in loc.text.rstrip("\n"))
+            text = "".join(c if c >= " " or c == "\t" else chr(0x2400 + ord(c)) for c in raw)
             text = text.expandtabs(1)
             lines.append(f"  {number} | {text}")
-            width = max(1, loc.width)
-            lines.append(f"  {pad} | " + " " * (loc.column - 1) + "^" + "~" * (width - 1))
+            lines.append(f"  {pad} | " + " " * (column - 1) + "^" + "~" * (width - 1))
         if self.expected:
-            lines.append("  = expected " + ", ".join(self.expected))
+            lines.append("  = expected " + ", ".join(_bounded(e, WINDOW) for e in self.expected[:20]))
         if self.suggestions:
-            lines.append("  = did you mean " + " or ".join(self.suggestions) + "?")
+            lines.append("  = did you mean " + " or ".join(_bounded(s, WINDOW) for s in self.suggestions) + "?")
         for note in self.notes:
-            lines.append("  = note: " + note)
+            lines.append("  = note: " + _bounded(note, 20 * WINDOW))
         return "\n".join(lines)
 
     def __str__(self) -> str:
         return self.render()
+
+
+WINDOW = 120
+"""How many characters of a line an error quotes (around the column), and the unit of the
+other bounds of :meth:`InputError.render`."""
+
+
+def _bounded(text: str, limit: int) -> str:
+    """``text``, cut to ``limit`` characters with "… (N characters)" when longer.
+
+    >>> _bounded("abcdef", 4)
+    'abcd… (6 characters)'
+    """
+    return text if len(text) <= limit else f"{text[:limit]}… ({len(text)} characters)"
 
 
 class ModelFailure(InputError):
@@ -120,15 +145,21 @@ class ModelFailure(InputError):
     its variable's range): reported like an input error, with exit code 1, a failing model."""
 
 
+MAX_SHOWN = 20
+"""How many errors of one pass are shown; a line "… and N more errors" says the rest."""
+
+
 class InputErrors(SynthError):
-    """Several input errors found in one pass, reported together."""
+    """Several input errors found in one pass, reported together (the first :data:`MAX_SHOWN`)."""
 
     def __init__(self, errors: Sequence[InputError]) -> None:
-        super().__init__("\n".join(e.render() for e in errors))
         self.errors = tuple(errors)
+        super().__init__(self.render())
 
     def render(self) -> str:
-        return "\n\n".join(e.render() for e in self.errors)
+        shown = "\n\n".join(e.render() for e in self.errors[:MAX_SHOWN])
+        rest = len(self.errors) - MAX_SHOWN
+        return shown + (f"\n\n… and {rest} more error{'s' if rest > 1 else ''}" if rest > 0 else "")
 
 
 class ModelError(SynthError):

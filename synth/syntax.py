@@ -66,7 +66,7 @@ from synth.logic.expr import And, Const, Edge, Expr, Not, Or, Var  # noqa: E402
 
 # ``Token`` is lark's, re-exported: every module of synth imports lark through this one.
 __all__ = [
-    "grammar_text", "parser", "syntax_error", "read_source", "ExprTransformer", "VectorKind", "Checker", "raise_all",
+    "grammar_text", "parser", "syntax_error", "read_bytes", "read_source", "ExprTransformer", "VectorKind", "Checker", "raise_all",
     "parse_tree", "parse_expression", "Token",
 ]
 
@@ -237,30 +237,39 @@ MAX_SOURCE_BYTES = 64 * 1024 * 1024
 """The largest input file synth reads (a model of a real machine is a few hundred kB)."""
 
 
-def read_source(path: str | Path, at: Location | None = None) -> str:
-    """The text of a user file; an unreadable, non-regular (``/dev/zero``, a folder, a
-    pipe), over-large or non-UTF-8 file is an :class:`InputError`, located at ``at`` (the
-    ``use`` that names it) when given.
+def read_bytes(path: str | Path, at: Location | None = None) -> bytes:
+    """The bytes of a user file; an unreadable, non-regular (``/dev/zero``, a folder, a named
+    pipe: refused before it is opened, which would wait for a writer) or over-large file is an
+    :class:`InputError` "cannot read", located at ``at`` (the ``use`` that names it) when given.
 
-    >>> read_source("/dev/zero")
+    >>> read_bytes("/dev/zero")
     Traceback (most recent call last):
     ...
     synth.errors.InputError: error: cannot read '/dev/zero': not a regular file
     """
     import stat
 
+    shown = str(path) if len(str(path)) <= 200 else str(path)[:200] + "…"
     try:
+        if not stat.S_ISREG(os.stat(path).st_mode):
+            raise InputError(f"cannot read '{shown}': not a regular file", at)
         with open(path, "rb") as fh:
             info = os.fstat(fh.fileno())
             if not stat.S_ISREG(info.st_mode):
-                raise InputError(f"cannot read '{path}': not a regular file", at)
+                raise InputError(f"cannot read '{shown}': not a regular file", at)
             if info.st_size > MAX_SOURCE_BYTES:
-                raise InputError(f"cannot read '{path}': {info.st_size} bytes, more than the {MAX_SOURCE_BYTES} synth reads", at)
-            data = fh.read(MAX_SOURCE_BYTES + 1)
+                raise InputError(f"cannot read '{shown}': {info.st_size} bytes, more than the {MAX_SOURCE_BYTES} synth reads", at)
+            return fh.read(MAX_SOURCE_BYTES + 1)
     except OSError as exc:
-        raise InputError(f"cannot read '{str(path)[:200]}': {exc.strerror or exc}", at) from None
+        raise InputError(f"cannot read '{shown}': {exc.strerror or exc}", at) from None
     except ValueError as exc:  # a NUL byte in the name
-        raise InputError(f"cannot read {str(path)[:200]!r}: {exc}", at) from None
+        raise InputError(f"cannot read {shown!r}: {exc}", at) from None
+
+
+def read_source(path: str | Path, at: Location | None = None) -> str:
+    """The text of a user file (:func:`read_bytes`); a non-UTF-8 file is an
+    :class:`InputError` located at its first bad byte."""
+    data = read_bytes(path, at)
     try:
         return data.decode("utf-8-sig")  # a byte-order mark is dropped
     except UnicodeDecodeError as exc:
@@ -344,6 +353,8 @@ _KINDS = {
     "rules": (".rules", "a plant's rules file (.rules)", ("element ", "free ", "constraint ", "model ")),
     "grafcet": (".g7", "a Grafcet file (.g7)", ("grafcet ",)),
     "filter": (".filter", "a safety filter file (.filter)", ("safety ",)),
+    "xml": (".xml", "a PLCopen XML file (.xml)", ("<?xml", "<project")),
+    "st": (".st", "a Structured Text file (.st)", ("PROGRAM ", "FUNCTION_BLOCK ")),
 }
 
 
@@ -355,6 +366,8 @@ def file_kind_hint(grammar: str, file: str, source: str) -> str | None:
     "tri.g7 is a Grafcet file (.g7), not a plant's rules file (.rules): check the order of the arguments"
     >>> file_kind_hint("grafcet", "tri.g7", "grafcet G {") is None
     True
+    >>> file_kind_hint("xml", "tri.g7", "grafcet G {")
+    'tri.g7 is a Grafcet file (.g7), not a PLCopen XML file (.xml): check the order of the arguments'
     """
     if grammar not in _KINDS:
         return None

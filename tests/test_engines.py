@@ -95,7 +95,8 @@ class TestEveryEngine:
         argv = [str(a).replace("{tmp}", str(tmp_path)) for a in args] + ["--engine", str(cap.engine), *quiet]
         inputs = {Path(a).resolve() for a in argv if Path(a).is_file()}
         assert len(inputs) == (1 if cap.command is Command.SUP else 2 + (need is Need.CONTROLLER))
-        readers = load_plant(next(a for a in argv if a.endswith(".rules"))).readers  # before the count
+        loaded = load_plant(next(a for a in argv if a.endswith(".rules")))  # before the count
+        readers, reads_at = loaded.readers, loaded.reads_at
         reads = count_reads(monkeypatch, inputs)
         got, out, err = cli(*argv)
         if need is None or need in cap.serves:
@@ -104,7 +105,7 @@ class TestEveryEngine:
             assert ("symbolic" in data or data.get("engine") == "symbolic") == (cap.engine is EngineChoice.SYMBOLIC)
             assert reads == Counter({p: 1 for p in inputs})  # each input file read once
         else:
-            refused = refusal(cap.command, need, readers)
+            refused = refusal(cap.command, need, readers, reads_at)
             text = refused.render() if isinstance(refused, InputError) else f"error: {refused}"
             assert (got, out, err) == (2, "", text + "\n")
             assert max(reads.values(), default=0) <= 1

@@ -93,7 +93,7 @@ def test_four_cylinders_edge_rule():
     report = coherence(load_filter(PLANTS / "four_cylinders.filter"))
     assert [_found(report, Property.P1, q).status for q in ("Q1", "Q2", "Q3", "Q4")] == [Status.EDGE_RULE] * 4
     assert _found(report, Property.P2).status is Status.HOLDS
-    # FILTER.md §1.3: read literally, P3 fails (i1 while both cylinders are extending)
+    # docs/filter.md, "The domain of P1–P4": read literally, P3 fails (i1 while both cylinders are extending)
     p3 = _found(report, Property.P3, "Q2")
     assert p3.status is Status.VIOLATED and p3.constraints == ("CSc1", "CSs2_6")
 

@@ -1,4 +1,4 @@
-"""`synth filter from-rules`: the skeleton of plants/tri.rules (FILTER.md §3.5 item 8),
+"""`synth filter from-rules`: the skeleton of plants/tri.rules (the rules' constraints as simple and combined ones),
 edge and `= 1` constraints, constraints without an order, atomic writing, round trip."""
 
 from __future__ import annotations

@@ -1,5 +1,5 @@
 """`synth filter run` and the cycle evaluator (synth/filter/cycle.py): the loop examples
-A, B, C of FILTER.md §1.4 (specified and literal loops), memory and edges, blocking mode,
+A, B, C of docs/filter.md, "The correction loop" (specified and literal loops), memory and edges, blocking mode,
 the care set, the CSV trace's located errors, and the lanes (many cycles at once)
 agreeing with single cycles."""
 

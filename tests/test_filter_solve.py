@@ -44,7 +44,7 @@ def test_seed004_eq22_to_26(cli):
 
 
 def test_sim_order_is_a_priority(cli, tmp_path):
-    """FILTER.md §1.6 remark: without a priority, Sim_O2 first gives O2 = R_O2, O1 = R_O1 & !R_O2;
+    """docs/filter.md, "The algebraic synthesis": without a priority, Sim_O2 first gives O2 = R_O2, O1 = R_O1 & !R_O2;
     with the priority of (24) first, O1 keeps it whatever the Sim order."""
     f = tmp_path / "k.filter"
     f.write_text("outputs O1, O2\nsafety Cc1: O1 & O2\n")

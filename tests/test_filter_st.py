@@ -1,5 +1,5 @@
 """``synth filter st``: run by the ST interpreter, the block computes what ``solve`` computed
-(algebraic) or what FILTER.md §1.4 specifies (loop). That blark parses every bundled filter's
+(algebraic) or the corrected loop of docs/filter.md (loop). That blark parses every bundled filter's
 blocks is the business of ``test_filter_deployed.py``."""
 
 from __future__ import annotations
@@ -94,7 +94,7 @@ def _loop_outputs(name: str, requests: tuple[int, ...], mode: str = "supervisor"
 
 
 def test_loop_examples_give_the_corrected_results() -> None:
-    # FILTER.md §3.5 item 6
+    # docs/filter.md, "The correction loop"
     assert _loop_outputs("loop_a", (1, 1)) == ((1, 0), False)  # the literal published code: (0,0)
     assert _loop_outputs("loop_b", (1, 1, 1)) == ((1, 0, 0), False)  # literal: oscillates, then (0,0,0)
     assert _loop_outputs("loop_c", (1, 1, 1)) == ((0, 0, 0), True)  # a GO cycle: fallback

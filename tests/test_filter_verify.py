@@ -1,4 +1,4 @@
-"""`synth filter verify`: the closed loop of FILTER.md §3.4 — the done-when of issue 11
+"""`synth filter verify`: the closed loop of docs/filter.md — the done-when of issue 11
 (from-rules on plants/tri.rules, then verify --any-control), a filter with a constraint
 dropped and its exact shortest trace, edge constraints, ordered vs atomic writes,
 fallback and care-set findings, a Grafcet as the request source, and the vectorised

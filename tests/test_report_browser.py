@@ -67,7 +67,7 @@ def test_blocking_report_in_a_browser(browser, tmp_path, capsys):
     buttons.nth(0).click()
     text = panel.inner_text()
     assert "X0, X100, X200, X300" in text and "initial" in text
-    fills = page.evaluate("""() => Array.from(document.querySelectorAll('#grafcet-b1 g.node'))
+    fills = page.evaluate("""() => Array.from(document.querySelectorAll('#grafcet g.node'))
         .filter(g => g.querySelector('title').textContent.startsWith('step_'))
         .filter(g => g.querySelector('polygon').getAttribute('fill') === '#f9d71c')
         .map(g => g.querySelector('title').textContent).sort()""")
@@ -141,4 +141,91 @@ def test_passing_report_draws_the_grafcet(browser, tmp_path, capsys):
         .map(t => t.textContent).filter(t => t.startsWith('step_'))""")
     assert "step_0" in steps and "step_103" in steps
     assert page.evaluate(NESTED_SCROLL_BOXES) == []
+    assert errors == []
+
+
+# ---------------------------------------------------------------- issue 38: the report's four points
+
+GRAFCET_DRAWINGS = """() => Array.from(document.querySelectorAll('svg'))
+    .filter(s => Array.from(s.querySelectorAll('g.node title')).some(t => t.textContent === 'step_0')).length"""
+
+NOTHING_CLIPPED = """() => {
+  const fig = document.getElementById('grafcet'), f = fig.getBoundingClientRect();
+  const out = Array.from(fig.querySelectorAll('g.node')).filter(g => {
+    const n = g.getBoundingClientRect();
+    return n.left < f.left - 0.5 || n.right > f.right + 0.5 || n.top < f.top - 0.5 || n.bottom > f.bottom + 0.5;
+  });
+  return [fig.scrollWidth <= fig.clientWidth, fig.scrollHeight <= fig.clientHeight + 1, out.length,
+          fig.querySelectorAll('g.node').length];
+}"""
+
+
+def test_the_grafcet_is_never_clipped_and_the_step_to_fix_is_marked(browser, tmp_path, capsys):
+    """The 1 690 px box-sorting Grafcet is drawn whole, fitted to the page (G3 and G4 were cut
+    at the right edge); step 103, where the order is missing, outlined in red and named in the
+    legend and in the index."""
+    path = _report(tmp_path, "grafcets/tri_missing_order.g7", "plants/tri.rules")
+    capsys.readouterr()
+    errors: list[str] = []
+    page = _open(browser, path, errors)
+    page.screenshot(path=str(tmp_path / "missing_order_after.png"), full_page=True)
+    fits_x, fits_y, outside, nodes = page.evaluate(NOTHING_CLIPPED)
+    assert (fits_x, fits_y, outside) == (True, True, 0) and nodes > 40
+    strokes = page.evaluate("""() => Array.from(document.querySelectorAll('#grafcet g.node'))
+        .filter(g => g.querySelector('polygon').getAttribute('stroke') === '#c0392b')
+        .map(g => g.querySelector('title').textContent)""")
+    assert strokes == ["step_103"]
+    assert page.inner_text("#legend tr.fix").strip() == "red outline\tstep to fix (X103): missing order AVANCER2, blocking 1"
+    assert page.inner_text("#index li:first-child") == ("Blocking 1: situation {X1, X103, X200, X300}, missing_order: "
+                                                       "fix step 103")
+    assert page.evaluate(GRAFCET_DRAWINGS) == 1
+    assert errors == []
+
+
+def test_an_index_of_four_blockings_and_one_grafcet(browser, tmp_path, capsys):
+    """Four blockings (the boxes as workpieces): an index whose links reach each section, one
+    Grafcet drawing (not four), updated by a click on any blocking's trace."""
+    path = _report(tmp_path, "grafcets/tri.g7", "plants/tri_boxes.rules")
+    capsys.readouterr()
+    errors: list[str] = []
+    page = _open(browser, path, errors)
+    links = page.locator("#index a")
+    assert [links.nth(i).get_attribute("href") for i in range(links.count())] == [
+        "#blocking-1", "#blocking-2", "#blocking-3", "#blocking-4", "#chart"]
+    assert page.evaluate(GRAFCET_DRAWINGS) == 1
+    links.nth(3).click()
+    top = page.locator("#blocking-4").bounding_box()
+    assert top is not None and 0 <= top["y"] < 50  # the link brought blocking 4 to the top
+    page.locator("#trace-3 button").first.click()
+    assert page.inner_text("#chart-shows").startswith("Active steps (filled) of blocking 3, trace step 0 (initial)")
+    fills = page.evaluate("""() => Array.from(document.querySelectorAll('#grafcet g.node'))
+        .filter(g => g.querySelector('polygon').getAttribute('fill') === '#f9d71c')
+        .map(g => g.querySelector('title').textContent).sort()""")
+    assert fills == ["step_0", "step_100", "step_200", "step_300"]
+    fits_x, fits_y, outside, _ = page.evaluate(NOTHING_CLIPPED)
+    assert (fits_x, fits_y, outside) == (True, True, 0)
+    page.screenshot(path=str(tmp_path / "four_blockings.png"), full_page=True)
+    assert errors == []
+
+
+def test_the_aggregated_automaton_at_a_readable_scale(browser, tmp_path, capsys):
+    """The 90 states of the passing box sorting: text at 100 % (at least 10 px), no longer a
+    strip 10 900 px wide and 94 % white (left to right): top to bottom, tight."""
+    path = _report(tmp_path, "grafcets/tri.g7", "plants/tri.rules")
+    capsys.readouterr()
+    errors: list[str] = []
+    page = _open(browser, path, errors)
+    page.evaluate("document.querySelectorAll('details').forEach(d => d.open = true)")
+    width, height, nodes, covered, text = page.evaluate("""() => {
+      const s = document.querySelector('#aggregated svg'), r = s.getBoundingClientRect();
+      const g = Array.from(s.querySelectorAll('g.node'));
+      const area = g.map(n => n.getBoundingClientRect()).reduce((a, b) => a + b.width * b.height, 0);
+      const text = Math.min(...Array.from(s.querySelectorAll('text')).map(t => t.getBoundingClientRect().height));
+      return [r.width, r.height, g.length, area / (r.width * r.height), text];
+    }""")
+    assert nodes == 90
+    assert text >= 10
+    assert width < 4000 and width / height < 1.5
+    assert covered > 0.10
+    page.locator("#aggregated").screenshot(path=str(tmp_path / "aggregated.png"))
     assert errors == []

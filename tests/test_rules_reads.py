@@ -158,8 +158,11 @@ def test_symbolic_refuses_and_auto_is_explicit(cli, tmp_path):
     f.write_text(TRANSFER + "constraint K: p1 & p2 & !h1 = 0\n")
     code, out, err = cli("sup", f, "--engine", "symbolic")
     assert code == 2 and out == ""
-    assert err == ("error: the symbolic engine does not support elements that read other elements' variables "
-                   "(`reads` in CELLS); use --engine explicit\n")
+    assert err == (f"{f}:4:11: error: the symbolic engine does not support elements that read other elements' "
+                   "variables (`reads` in CELLS)\n"
+                   "  4 |     reads h1\n"
+                   "    |           ^~\n"
+                   "  = note: use --engine explicit\n")
     code, out, err = cli("sup", f, "--json")
     data = json.loads(out)
     assert code == 0 and "symbolic" not in data

@@ -130,3 +130,36 @@ def test_use_lib_resolves_beside_the_file_first(tmp_path):
     mine.write_text("model double_acting { orders A = 0 }\n")
     assert library_file("lib/double_acting.rules", tmp_path) == mine
     assert library_file("lib/double_acting.rules", tmp_path / "nowhere").parent.name in ("lib", "library")
+
+
+def test_setup_says_what_failed_when_pip_fails(tmp_path):
+    """pip cannot reach its index (here: a venv whose pip always fails as it would offline):
+    the set-up ends on one line from synth saying what failed and what to try, exit 2."""
+    venv = tmp_path / "venv"
+    (venv / "bin").mkdir(parents=True)
+    fake = venv / "bin" / "python"
+    fake.write_text(textwrap.dedent(f"""\
+        #!/bin/sh
+        if [ "$1 $2" = "-m pip" ]; then
+          echo "ERROR: Could not find a version that satisfies the requirement wheel (from versions: none)" >&2
+          exit 1
+        fi
+        exec {sys.executable} "$@"
+        """))
+    fake.chmod(0o755)
+    env = dict(os.environ, SYNTH_VENV=str(venv), SYNTH_SKIP_APT="1")
+    r = _run(["bash", str(ROOT / "scripts/setup.sh")], env=env)
+    assert r.returncode == 2
+    assert r.stderr.splitlines()[-1] == (
+        f"== synth set-up failed: pip could not install the build tools (setuptools, wheel) into {venv} (exit 1). "
+        "Is the package index reachable? Behind a proxy set HTTPS_PROXY (and PIP_CERT for its certificate); "
+        "offline, point pip at local wheels with SYNTH_PIP_ARGS='--no-index --find-links DIR'. "
+        f"Nothing outside {venv} was changed.")
+
+
+def test_ci_installs_chromium_only_on_a_ci_server():
+    """`.ci/run` asks setup.sh for the browser only under CI=true (or SYNTH_SETUP_BROWSER=1)."""
+    text = (ROOT / ".ci/run").read_text()
+    assert 'browser="${SYNTH_SETUP_BROWSER:-0}"' in text
+    assert '[ "${CI:-}" = true ] && browser="${SYNTH_SETUP_BROWSER:-1}"' in text
+    assert 'SYNTH_SETUP_BROWSER="$browser" bash scripts/setup.sh' in text

@@ -278,7 +278,7 @@ def test_report_sections_for_prohibitions_with_the_same_trace(cli, tmp_path):
     code, out, _ = cli("validate", g, "--plant", r, "--report", tmp_path / "rep")
     assert code == 1
     html = (tmp_path / "rep" / "index.html").read_text()
-    first, second = html.split("Prohibited orders 1")[1].split("Prohibited orders 2")
+    first, second = html.split("<h2>Prohibited orders 1")[1].split("<h2>Prohibited orders 2")
     assert "SUP forbids ↑B there" in first and "SUP forbids ↑A there" not in first
     assert "SUP forbids ↑A there" in second and "SUP forbids ↑B there" not in second
 

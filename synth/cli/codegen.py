@@ -24,7 +24,7 @@ if TYPE_CHECKING:  # pragma: no cover - the library is imported by the commands 
     from synth.codegen.targets import Target
     from synth.grafcet.language import Grafcet
 
-__all__ = ["register", "cmd_st", "cmd_sfc", "cmd_import"]
+__all__ = ["register", "cmd_st", "cmd_sfc", "cmd_import", "print_files", "write_target", "target_of"]
 
 
 def _load(args: argparse.Namespace) -> tuple["Grafcet", dict[str, bool], list[str]]:
@@ -47,9 +47,11 @@ def _load(args: argparse.Namespace) -> tuple["Grafcet", dict[str, bool], list[st
 
 
 def _write(args: argparse.Namespace, data: str | bytes) -> None:
+    """To ``-o`` or standard output; with ``--json`` and no ``-o`` the JSON carries it instead."""
     from synth.output.files import write_or_print
 
-    write_or_print(args.output, data)
+    if args.output or not getattr(args, "json", False):
+        write_or_print(args.output, data)
 
 
 def target_of(args: argparse.Namespace) -> "Target":
@@ -62,18 +64,29 @@ def target_of(args: argparse.Namespace) -> "Target":
     return Target(args.target or (Target.PLCOPEN if args.xml else Target.IEC))
 
 
-def write_target(args: argparse.Namespace, files: list[tuple[str, bytes]]) -> None:
+def write_target(args: argparse.Namespace, files: list[tuple[str, bytes]]) -> list[str | None]:
     """One file to ``-o`` (or standard output); several (TwinCAT: one per POU) into ``-o DIR``,
-    as is one into an existing folder or a path ending with ``/``."""
+    as is one into an existing folder or a path ending with ``/``. The paths written (None:
+    printed, or carried by ``--json``)."""
     import os
 
-    from synth.output.files import write_files, write_or_print
+    from synth.output.files import write_files
 
     folder = args.output is not None and (args.output.endswith(("/", os.sep)) or os.path.isdir(args.output))
     if len(files) == 1 and not folder:
-        write_or_print(args.output, files[0][1])
-    else:
-        write_files(args.output, files)
+        _write(args, files[0][1])
+        return [args.output]
+    write_files(args.output, files)
+    return [os.path.join(args.output, name) for name, _ in files]
+
+
+def print_files(args: argparse.Namespace, command: str, pou: str, target: str, sources: list[str],
+                 files: list[tuple[str, bytes]], written: list[str | None]) -> None:
+    if getattr(args, "json", False):
+        from synth.output.codegen_json import files_json
+        from synth.output.summary import print_json
+
+        print_json(files_json(command, pou, target, sources, files, written))
 
 
 def cmd_st(args: argparse.Namespace) -> int:
@@ -100,12 +113,23 @@ def cmd_st(args: argparse.Namespace) -> int:
         header = provenance_lines(f"PROGRAM {program.program}", sources)
         files = render(target, program.pous, text=program.text, name=program.program, header=header)
         text = st_of(target, files, args.file)
-        report = differential_check(grafcet, initial, depth=args.depth, program=dataclasses.replace(program, text=text))
+        from synth.output.progress import clear_progress, live_line, tty_progress
+
+        show = tty_progress(live_line(not args.quiet))
+        report = differential_check(grafcet, initial, depth=args.depth, program=dataclasses.replace(program, text=text),
+                                    report=show)
+        clear_progress(show)
         if args.junit or args.sarif:
             from synth.output.ci import st_check_report, write_ci
 
             write_ci([st_check_report(grafcet, report)], args.junit, args.sarif)
-        sys.stdout.write(report.text())
+        if args.json:
+            from synth.output.codegen_json import st_check_json
+            from synth.output.summary import print_json
+
+            print_json(st_check_json(report))
+        else:
+            sys.stdout.write(report.text())
         return 0 if report.ok else 1
     call = None
     if args.filter:
@@ -123,8 +147,8 @@ def cmd_st(args: argparse.Namespace) -> int:
 
         config = configuration(program.program, args.task)
     header = provenance_lines(f"PROGRAM {program.program}", sources)
-    write_target(args, render(target, program.pous, text=program.text, name=program.program, header=header,
-                              config=config))
+    files = render(target, program.pous, text=program.text, name=program.program, header=header, config=config)
+    print_files(args, "st", program.program, str(target), sources, files, write_target(args, files))
     return 0
 
 
@@ -155,35 +179,57 @@ def cmd_sfc(args: argparse.Namespace) -> int:
 
     grafcet, _, sources = _load(args)
     comment = "\n".join(provenance_lines("SFC " + (args.name or program_name(grafcet.path)), sources))
-    _write(args, sfc_project_xml(grafcet, name=args.name, comment=comment))
+    pou = args.name or program_name(grafcet.path)
+    xml = sfc_project_xml(grafcet, name=args.name, comment=comment)
+    _write(args, xml)
+    print_files(args, "sfc", pou, "plcopen", sources, [(f"{pou}.xml", xml.encode("utf-8") if isinstance(xml, str) else xml)],
+                 [args.output])
     return 0
 
 
 def cmd_import(args: argparse.Namespace) -> int:
     from synth.codegen.plcopen.importer import checked_pous, import_sfc
-    from synth.grafcet.language_check import parse_grafcet
 
-    with open(args.file, "rb") as fh:
-        data = fh.read()
+    from synth.syntax import read_bytes
+
+    data = read_bytes(args.file)
     if args.list:
-        for summary in checked_pous(data, args.file):
+        pous = checked_pous(data, args.file)
+        if args.json:
+            from synth.output.codegen_json import import_list_json
+            from synth.output.summary import print_json
+
+            print_json(import_list_json(args.file, pous))
+            return 0
+        for summary in pous:
             print(summary.text())
         return 0
     notes: list[str] = []
     warnings: list = []
+    from synth.output.progress import clear_progress, live_line, tty_progress
+
+    show = tty_progress(live_line(not args.quiet))
+    show(f"reading the SFC of {args.file}")
     text = import_sfc(data, args.file, pou=args.pou, notes=notes, warnings=warnings)
+    clear_progress(show)
     for n in notes:
         print(f"{args.file}: note: {n}", file=sys.stderr)
     for w in warnings:
         print(w.render(), file=sys.stderr)
-    g = parse_grafcet(text, args.output or "<imported>")  # the result must be a valid .g7
+    g = _imported_grafcet(text, args)  # the result must be a valid .g7
     from synth.errors import LimitExceeded
     from synth.grafcet.semantics import IMPORT_BUDGET, scan_only_steps
 
+    show = tty_progress(live_line(not args.quiet))
+    show("the steps a PLC scan keeps active (IEC 61131-3 against IEC 60848)")
+    over = False
     try:
         steps = scan_only_steps(g)
     except LimitExceeded:
-        steps = None
+        steps, over = None, True
+    finally:
+        clear_progress(show)
+    if over:
         print(f"{args.file}: note: not checked whether some steps stay active for a PLC scan where IEC 60848 passes "
               f"through them (more than {IMPORT_BUDGET} situations to explore): validate with --semantics sfc for "
               "the meaning the program has on the PLC", file=sys.stderr)
@@ -192,7 +238,27 @@ def cmd_import(args: argparse.Namespace) -> int:
               "(IEC 61131-3 SFC, their actions run) where IEC 60848 passes through them in one evolution: validate "
               "with --semantics sfc for the meaning the program has on the PLC", file=sys.stderr)
     _write(args, text)
+    if args.json:
+        from synth.output.codegen_json import import_json
+        from synth.output.summary import print_json
+
+        print_json(import_json(args.file, args.output, text, notes, [w.render() for w in warnings], steps or ()))
     return 0
+
+
+def _imported_grafcet(text: str, args: argparse.Namespace) -> "Grafcet":
+    """The Grafcet ``import`` read, checked as a ``.g7``; an error in it says where it came from."""
+    from synth.errors import InputError, InputErrors
+    from synth.grafcet.language_check import parse_grafcet
+
+    name = args.output or "<imported>"
+    try:
+        return parse_grafcet(text, name)
+    except (InputError, InputErrors) as err:
+        note = f"{name} is the Grafcet read from {args.file}: the chart of the XML file does not make a valid Grafcet"
+        errors = err.errors if isinstance(err, InputErrors) else (err,)
+        raise InputErrors([InputError(e.message, e.location, expected=e.expected, suggestions=e.suggestions,
+                                      notes=(*e.notes, note)) for e in errors]) from None
 
 
 def register(sub: "argparse._SubParsersAction") -> None:
@@ -224,6 +290,8 @@ def register(sub: "argparse._SubParsersAction") -> None:
     p.add_argument("--depth", type=int, default=3, metavar="N", help="--check: events per sequence (default 3)")
     p.add_argument("--junit", metavar="FILE", help="--check: also write the result as JUnit XML (one test case per mismatch)")
     p.add_argument("--sarif", metavar="FILE", help="--check: also write the result as SARIF 2.1.0 (one result per mismatch)")
+    p.add_argument("--json", action="store_true", help="print JSON: the files generated (their text without -o), or --check's result")
+    p.add_argument("--quiet", action="store_true", help="--check: no live progress line on a terminal")
     p.set_defaults(handler=cmd_st)
     p = sub.add_parser("sfc", help="a Grafcet as a PLCopen XML SFC",
                        description="Export the Grafcet as a PLCopen TC6 XML SFC program.")
@@ -231,6 +299,7 @@ def register(sub: "argparse._SubParsersAction") -> None:
     p.add_argument("--plant", metavar="RULES", help="plant .rules file: its inputs and outputs")
     p.add_argument("--name", metavar="NAME", help="the POU's name (default: the file's stem)")
     p.add_argument("-o", "--output", metavar="FILE", help="write to FILE (default: standard output)")
+    p.add_argument("--json", action="store_true", help="print JSON: the file generated (its text without -o)")
     p.set_defaults(handler=cmd_sfc)
     p = sub.add_parser("import", help="a PLCopen XML SFC as a .g7 Grafcet",
                        description="Read the SFC of a PLCopen TC6 XML file into the .g7 language.")
@@ -238,4 +307,6 @@ def register(sub: "argparse._SubParsersAction") -> None:
     p.add_argument("-o", "--output", metavar="FILE", help="write to FILE (default: standard output)")
     p.add_argument("--pou", metavar="NAME", help="import this SFC POU only (default: every SFC POU)")
     p.add_argument("--list", action="store_true", help="list the POUs, their languages and what an import reads")
+    p.add_argument("--json", action="store_true", help="print JSON: the Grafcet read (its text without -o), notes and warnings")
+    p.add_argument("--quiet", action="store_true", help="no live progress line on a terminal")
     p.set_defaults(handler=cmd_import)

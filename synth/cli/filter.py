@@ -33,6 +33,7 @@ def register(sub: "argparse._SubParsersAction") -> None:
     c.add_argument("--all-spellings", action="store_true",
                    help="compare the keep/force spellings of every relief on every input, past the work "
                         "limit, naming every output each drives differently (no witness points)")
+    c.add_argument("--quiet", action="store_true", help="no live progress line on a terminal")
     ci_options(c)
     c.set_defaults(handler=cmd_check)
 
@@ -42,6 +43,7 @@ def register(sub: "argparse._SubParsersAction") -> None:
     s.add_argument("--order", metavar="O1,O2,...", help="the order of the Sim criteria (default: the file's)")
     s.add_argument("--flat", action="store_true",
                    help="print every equation over Y only (flat ISOP; refused past a size limit) instead of chained")
+    s.add_argument("--quiet", action="store_true", help="no live progress line on a terminal")
     s.set_defaults(handler=cmd_solve)
     register_st(commands)
 
@@ -59,6 +61,7 @@ def register_st(commands: "argparse._SubParsersAction") -> None:
     t.add_argument("--order", metavar="O1,O2,...", help="the order of the Sim criteria (algebraic)")
     t.add_argument("--split", action="store_true",
                    help="one FUNCTION_BLOCK per independent cluster of outputs (FB_NAME_<k>_Filter)")
+    t.add_argument("--json", action="store_true", help="print JSON: the files generated (their text without -o)")
     t.set_defaults(handler=cmd_st)
 
     register_run(commands)
@@ -92,17 +95,26 @@ def cmd_check(args: argparse.Namespace) -> int:
     from synth.filter.coherence import check
     from synth.output.filter_text import check_json, check_text
 
+    from synth.output.progress import clear_progress, live_line, tty_progress
+
+    show = tty_progress(live_line(not args.quiet))
+    show(f"reading {args.filter}")
     f = _load(args.filter)
     inv = None
     if args.plant:
         from synth.filter.invariants import assumed, invariants
 
+        show(f"the valuations {args.plant} can reach")
         inv = invariants(f, args.plant)
         f = assumed(f, inv)
+    show("coherence: P1-P4, GO, pair conditions, global consistency")
     c = check(f)
     from synth.filter.reliefs import SPELLING_WORK, spelling_warnings
 
-    for w in spelling_warnings(f, limit=None if args.all_spellings else SPELLING_WORK).reports():
+    show("the keep/force spellings of the reliefs")
+    warnings = spelling_warnings(f, limit=None if args.all_spellings else SPELLING_WORK).reports()
+    clear_progress(show)
+    for w in warnings:
         print(w.render(), file=sys.stderr)
     if args.junit or args.sarif:
         from synth.output.ci import filter_check_report, write_ci
@@ -126,7 +138,12 @@ def cmd_solve(args: argparse.Namespace) -> int:
     from synth.filter.solve import synthesis
     from synth.output.filter_text import synthesis_json, synthesis_text
 
+    from synth.output.progress import clear_progress, live_line, tty_progress
+
+    show = tty_progress(live_line(not args.quiet))
+    show(f"algebraic synthesis of {args.filter}")
     s = synthesis(_load(args.filter), _order(args.order), flat=args.flat)
+    clear_progress(show)
     if args.json:
         print_json(synthesis_json(args.filter, s))
     else:
@@ -158,6 +175,11 @@ def cmd_st(args: argparse.Namespace) -> int:
     text = "\n".join(b.text for b in blocks)
     files = render(target, [b.pou for b in blocks], text=text, name=blocks[0].name,
                    header=provenance_lines(what, [args.filter]))
+    if args.json:
+        from synth.cli.codegen import print_files
+
+        print_files(args, "filter st", blocks[0].name, str(target), [args.filter], files, write_target(args, files))
+        return 0
     if target is Target.IEC and args.output is None:
         sys.stdout.write(text)
         return 0
@@ -170,7 +192,7 @@ def cmd_st(args: argparse.Namespace) -> int:
 
 def _algorithm_mode(p: argparse.ArgumentParser) -> None:
     p.add_argument("--algorithm", choices=("algebraic", "loop"), default="algebraic",
-                   help="the solve equations (default) or the correction loop of FILTER.md §1.4")
+                   help="the solve equations (default) or the correction loop (docs/filter.md)")
     p.add_argument("--mode", choices=("supervisor", "blocking"), default="supervisor",
                    help="supervisor (default): g1 = R; blocking: g1 = 0 after a violation until Ack")
 
@@ -203,6 +225,7 @@ def register_from_rules(commands: "argparse._SubParsersAction") -> None:
     g = commands.add_parser("from-rules", help="write a .filter skeleton from a rules file's constraints")
     g.add_argument("rules", metavar="P.rules", help="the plant's rules file")
     g.add_argument("-o", "--output", metavar="F.filter", required=True, help="the filter file to write")
+    g.add_argument("--json", action="store_true", help="print JSON: the constraints as the skeleton takes them")
     g.set_defaults(handler=cmd_from_rules)
 
 
@@ -213,13 +236,20 @@ def cmd_from_rules(args: argparse.Namespace) -> int:
 
     sk = skeleton(args.rules, args.output)
     write_atomic(args.output, sk.text)
+    if args.json:
+        from synth.output.summary import print_json
+
+        print_json({"rules": args.rules, "output": args.output,
+                    "constraints": [{"id": c.id, "kind": str(c.kind), "outputs": list(c.outputs),
+                                     "expression": c.expression} for c in sk.constraints]})
+        return 0
     sys.stdout.write(skeleton_text(sk))
     print(f"wrote {args.output}")
     return 0
 
 
 def register_verify(commands: "argparse._SubParsersAction") -> None:
-    v = commands.add_parser("verify", help="explore the filter in closed loop with the plant (FILTER.md §3.4)")
+    v = commands.add_parser("verify", help="explore the filter in closed loop with the plant (docs/filter.md)")
     v.add_argument("filter", metavar="F.filter", help="the .filter file")
     v.add_argument("--plant", metavar="P.rules", required=True, help="the plant's rules file")
     source = v.add_mutually_exclusive_group(required=True)
@@ -239,13 +269,14 @@ def register_verify(commands: "argparse._SubParsersAction") -> None:
                         "the first level past N, default no limit)")
     v.add_argument("--engine", choices=("auto", "explicit", "symbolic"), default="auto",
                    help="explicit: node by node; symbolic: BDDs, level by level (--any-control only, without "
-                        "--progress); auto (default): symbolic there on a plant of more than 2000000 states")
+                        "--eventually); auto (default): symbolic there on a plant of more than 2000000 states")
     v.add_argument("--events-per-cycle", type=int, default=1, metavar="K",
                    help="the plant makes 0..K events between two PLC scans (default 1)")
-    v.add_argument("--progress", metavar="GOAL",
-                   help="GOAL (a condition on the plant's variables, or ↑x / ↓x) stays reachable from every state "
-                        "and no fair cycle avoids it")
+    v.add_argument("--eventually", "--progress", dest="progress", metavar="GOAL",
+                   help="a liveness goal: GOAL (a condition on the plant's variables, or ↑x / ↓x) stays reachable "
+                        "from every state and no fair cycle avoids it (--progress: the same, its former name)")
     v.add_argument("--json", action="store_true", help="print JSON instead of text")
+    v.add_argument("--quiet", action="store_true", help="no live progress line on a terminal")
     ci_options(v)
     v.set_defaults(handler=cmd_verify)
 
@@ -267,10 +298,14 @@ def cmd_verify(args: argparse.Namespace) -> int:
         from synth.filter.loop.control_st import StSource
 
         control = StSource(args.control, load_st)
+    from synth.output.progress import clear_progress, live_line, tty_progress
+
+    show = tty_progress(live_line(not args.quiet))
     v = verify(f, args.plant, args.grafcet, any_control=args.any_control, algorithm=Algorithm(args.algorithm),
                mode=Mode(args.mode), atomic=args.atomic_outputs, strict=args.strict, require_sup=args.require_sup,
                max_states=args.max_states, events_per_cycle=args.events_per_cycle, progress=args.progress,
-               control=control, engine=EngineChoice(args.engine))
+               control=control, engine=EngineChoice(args.engine), report=show)
+    clear_progress(show)
     if args.junit or args.sarif:
         from synth.output.ci import filter_verify_report, write_ci
 

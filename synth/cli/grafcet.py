@@ -87,7 +87,13 @@ def cmd_run(args: argparse.Namespace) -> int:
 
     grafcet, inputs, _ = _load(args)
     rows = simulate(grafcet, inputs, parse_events(args.events or "", grafcet))
-    sys.stdout.write(run_text(rows))
+    if args.json:
+        from synth.output.codegen_json import run_json
+        from synth.output.summary import print_json
+
+        print_json(run_json(grafcet.path, rows))
+    else:
+        sys.stdout.write(run_text(rows))
     return 0
 
 
@@ -116,4 +122,5 @@ def register(sub: "argparse._SubParsersAction") -> None:
     _common(p)
     p.add_argument("--events", metavar="EVENTS", default="",
                    help='comma-separated events: "↑dcy,^cp12,2s/X101,↓v10,_v11"')
+    p.add_argument("--json", action="store_true", help="print JSON instead of text")
     p.set_defaults(handler=cmd_run)

@@ -33,6 +33,7 @@ Example
 from __future__ import annotations
 
 import copy
+import time
 from dataclasses import dataclass, field
 from enum import StrEnum
 from typing import Callable, Mapping, Protocol, Sequence
@@ -182,6 +183,8 @@ class _Checker:
         self.sequences = 0
         self.cycles = 0
         self.out_of_range = 0
+        self.report: Callable[[str], None] | None = None  # progress lines (the CLI's live line)
+        self.started = time.monotonic()
         self.ms = {t.id: int(t.seconds * 1000) for t in g.timers}
         self.step_of = {t.id: t.step for t in g.timers}
 
@@ -190,6 +193,10 @@ class _Checker:
         """Compare after a cycle; False when the branch must stop (a mismatch or instability)."""
         run, p = self.runner, self.program
         self.cycles += 1
+        if self.report is not None and self.cycles % 8 == 0:
+            rate = self.cycles / max(time.monotonic() - self.started, 1e-6)
+            self.report(f"ST against synth run: {self.sequences} event sequences, {self.cycles} PLC cycles "
+                        f"({rate:.0f} cycles/s), {len(self.mismatches)} mismatches")
         unstable = run.value("Unstable")
         if side is None:  # the machine found a transient cycle that never stabilises
             if not unstable:
@@ -331,13 +338,15 @@ def differential_check(
     program: StProgram | None = None,
     max_mismatches: int = 10,
     runner: Callable[[StProgram], ProgramRunner] | None = None,
+    report: Callable[[str], None] | None = None,
 ) -> DifferentialReport:
     """Play every event sequence of length ``depth`` on ``synth run``'s machine and on the
     generated program (``program``, else :func:`generate_program` of ``g``), comparing active
     steps, outputs and stability after every cycle. ``initial``: the input values at start
     (missing ones are 0). ``runner`` runs the program (default: :class:`InterpretedProgram`;
-    the tests also plug in the C that MATIEC's ``iec2c`` compiles). Without blark (a test
-    extra), a :class:`~synth.errors.SynthError` that says how to install it."""
+    the tests also plug in the C that MATIEC's ``iec2c`` compiles); ``report`` receives
+    progress lines. Without blark (a test extra), a :class:`~synth.errors.SynthError` that
+    says how to install it."""
     program = program or generate_program(g, version="check")
     if runner is None:
         require_blark("synth st --check")
@@ -345,6 +354,7 @@ def differential_check(
     else:
         side = runner(program)
     checker = _Checker(g, initial or {}, depth, program, side, max_mismatches)
+    checker.report = report
     checker.run()
     return DifferentialReport(g.path, depth, checker.sequences, checker.cycles, tuple(checker.mismatches),
                               checker.out_of_range)

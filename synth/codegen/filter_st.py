@@ -1,4 +1,4 @@
-"""A safety logic filter as one IEC 61131-3 ``FUNCTION_BLOCK`` (FILTER.md §1.7, §3.3).
+"""A safety logic filter as one IEC 61131-3 ``FUNCTION_BLOCK`` (docs/filter.md, "Structured Text").
 
 ``VAR_INPUT``: the requests ``R_<o>`` (the program's orders), the inputs and observers
 (and ``Ack`` in blocking mode), an integer observer as an ``INT`` (compared as written,
@@ -12,7 +12,7 @@ computed first, from the raw requests, as ``filter run`` and ``verify`` compute 
   may use the outputs computed before it, as seed 004's eq. (30) does), from the model
   :mod:`synth.filter.block` that ``filter run`` and ``verify`` evaluate too;
 - *loop*: the detection/correction loop of 000 Fig. 7 with its two defects corrected
-  (FILTER.md §1.4: the reliefs accumulate, and the fallback is decided by ``Flag``, not by
+  (docs/filter.md, "The correction loop": the reliefs accumulate, and the fallback is decided by ``Flag``, not by
   the counter); at most ``Ncsc + 1`` iterations, so the PLC watchdog never fires;
 - *blocking* mode (000 §3.1): once the raw requests violate a constraint, the latch
   ``Blocked`` replaces every request by FALSE until ``Ack``; *supervisor* mode passes the

@@ -41,7 +41,7 @@ def algebraic_equations(s: Synthesis) -> Equations:
 
 @dataclass(frozen=True)
 class LoopModel:
-    """The loop of FILTER.md §1.4 as data: per output (in ``outputs`` order) where a simple
+    """The correction loop (docs/filter.md) as data: per output (in ``outputs`` order) where a simple
     constraint forces it to 0 / 1, the combined constraints (id, expression), and
     ``mc0[k][i]`` / ``mc1[k][i]``: relieving combined constraint i forces output k to 0 / 1."""
 

@@ -19,7 +19,7 @@ Semantics (docs/filter.md, "One PLC cycle"):
   each reading the outputs assigned before it; on the care set they are the synthesis,
   off it they are still exactly what the block computes (``outside_care`` says when the
   cycle's Y is not in it, i.e. breaks an assumption or admits no safe vector);
-- :attr:`Algorithm.LOOP`: the specified loop of FILTER.md §1.4 (fc0/fc1 accumulate, at
+- :attr:`Algorithm.LOOP`: the corrected loop of docs/filter.md (fc0/fc1 accumulate, at
   most Ncsc+1 iterations, ``Fallback`` when a combined constraint is still violated);
   ``literal=True`` runs the published code instead (fc reset at each iteration, final
   test ``Cpt > Ncsc``), to show its two defects.
@@ -30,7 +30,7 @@ whose bit ``j`` is the value in lane ``j``, so :meth:`FilterCycle.lanes` evaluat
 cycle for every valuation of some names at once (``verify --any-control`` uses it for
 the 2^|O| request vectors); :meth:`FilterCycle.step` is one lane.
 
-Example (FILTER.md §1.4, example A)
+Example (docs/filter.md, "The correction loop", example A)
 -------
 >>> from synth.filter.language_check import parse_filter
 >>> f = parse_filter("outputs o1, o2\\nsafety K: o1 & o2 keep o1", "a.filter")

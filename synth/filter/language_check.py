@@ -90,16 +90,18 @@ class _FilterChecker(Checker):
         self.declared[name] = Declared(name, kind, loc, grafcet, definition)
 
     def use(self, u: Use) -> None:
-        from synth.plant.rules_check import load_rules
+        from synth.plant.rules_check import parse_rules
 
         if self.plant is not None:
             self.fail("a filter uses at most one plant", u.loc)
             return
         target = (self.base / u.path) if self.base is not None else Path(u.path)
-        if not target.is_file():
-            self.fail(f"cannot read '{u.path}': no such file", u.loc)
+        try:  # a missing file, a folder, a named pipe, a name too long: located at the `use`
+            source = read_source(target, u.loc)
+        except InputError as err:
+            self.errors.append(err)
             return
-        rs = load_rules(target)
+        rs = parse_rules(source, str(target), target.parent)
         self.plant, self.rules = str(target), rs
         for kind, vector in ((VarKind.INPUT, rs.inputs), (VarKind.OUTPUT, rs.outputs)):
             for n in vector:

@@ -18,9 +18,15 @@ def write_atomic(path: str | Path, data: str | bytes) -> Path:
     'hello'
     """
     target = Path(path)
-    target.parent.mkdir(parents=True, exist_ok=True)
     raw = data.encode("utf-8") if isinstance(data, str) else data
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+    try:
+        blocker = next((d for d in target.parents if d.exists()), None)
+        if blocker is not None and not blocker.is_dir():
+            raise NotADirectoryError(20, f"'{blocker}' is a file, not a folder")
+        target.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+    except (OSError, ValueError) as exc:
+        raise _cannot_write(target, exc) from None
     try:
         with os.fdopen(fd, "wb") as fh:
             fh.write(raw)
@@ -28,13 +34,24 @@ def write_atomic(path: str | Path, data: str | bytes) -> Path:
         os.umask(umask)
         os.chmod(tmp, 0o666 & ~umask)
         os.replace(tmp, target)
-    except BaseException:
+    except BaseException as exc:
         try:
             os.unlink(tmp)
         except OSError:
             pass
+        if isinstance(exc, OSError):
+            raise _cannot_write(target, exc) from None
         raise
     return target
+
+
+def _cannot_write(target: Path, exc: Exception) -> Exception:
+    """``cannot write 'path': reason``, an input error (exit 2) without a location."""
+    from synth.errors import InputError
+
+    shown = str(target) if len(str(target)) <= 200 else str(target)[:200] + "…"
+    reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+    return InputError(f"cannot write '{shown}': {reason}", None)
 
 
 def write_or_print(path: str | Path | None, data: str | bytes) -> None:

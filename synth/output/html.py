@@ -17,6 +17,7 @@ from synth.errors import SynthError
 from synth.output.files import write_atomic
 
 if TYPE_CHECKING:
+    from synth.validation.diagnosis import Diagnosis
     from synth.validation.result import Validation
 
 __all__ = ["svg", "write_svg", "dot_available", "report_html", "write_report", "commission_html"]
@@ -141,7 +142,7 @@ def report_html(v: "Validation") -> str:
             "item": item,
             "steps": steps,
             "diagnosis": d,
-            "grafcet_svg": Markup(_figure(chart, ident=f"grafcet-b{k}")),
+            "fix": step_to_fix(d),
             "trace_svg": Markup(_inline_svg(trace_dot(v.sync, tr.nodes, tr.events, blocking=b), kind="whole")),
             "elements": elements,
             "sup_svg": Markup(_inline_svg(sup_neighbourhood_dot(v.sync, v.sync.nodes[b].plant))),
@@ -168,7 +169,8 @@ def report_html(v: "Validation") -> str:
         blocking=blocking,
         prohibited=prohibited,
         aggregated_svg=aggregated,
-        grafcet_svg=Markup(_figure(chart, ident="grafcet")),
+        grafcet_svg=Markup(_figure(chart, ident="grafcet", kind="fit")),
+        fixes={f"b{k}": list(b["fix"]["steps"]) if b["fix"] else [] for k, b in enumerate(blocking, 1)},
         glossary=GLOSSARY_TERMS,
         aggregated_cut=keep is not None,
         aggregated_states=shown,
@@ -178,6 +180,27 @@ def report_html(v: "Validation") -> str:
         walks=walks,
         state_table=_state_table,
     )
+
+
+def step_to_fix(d: "Diagnosis") -> dict | None:
+    """A missing order's step (the source steps of the awaited transition whose cause is an
+    order not emitted, the one the diagnosis names): its steps, names and why; else None.
+
+    >>> from synth.validation.diagnosis import Diagnosis, Verdict
+    >>> step_to_fix(Diagnosis(Verdict.DEAD_END, "no transition leaves X1")) is None
+    True
+    """
+    from synth.validation.diagnosis import Verdict
+
+    if d.verdict is not Verdict.MISSING_ORDER:
+        return None
+    for a in d.awaited:
+        for c in a.causes:
+            if c.changes and not c.emitted and not c.free and a.sources:
+                ch = c.changes[0]
+                why = f"missing order {ch.name}" if ch.rising else f"order {ch.name} must be released"
+                return {"steps": list(a.sources), "names": [f"X{s}" for s in a.sources], "why": why}
+    return None
 
 
 def _state_table(item: dict):

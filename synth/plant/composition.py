@@ -38,7 +38,7 @@ from typing import Callable, Iterator, Mapping
 
 import numpy as np
 
-from synth.errors import LimitExceeded, SynthError, close_names
+from synth.errors import InputError, LimitExceeded, Location, SynthError, close_names, location_in
 from synth.logic.events import Event
 from synth.plant.element import ElementAutomaton, element_automaton
 from synth.plant.rules import RuleSet
@@ -136,6 +136,12 @@ class Plant:
     def readers(self) -> tuple[str, ...]:
         """The elements that read other elements' variables, in declaration order."""
         return tuple(e.name for e in self.elements if e.guards is not None and not bool(e.guards.all()))
+
+    @cached_property
+    def reads_at(self) -> Location | None:
+        """Where the rules say the first ``reads`` (for an error that refuses them), if anywhere."""
+        specs = self.rules.elements if self.rules is not None else ()
+        return next((r.loc or s.loc for s in specs for r in s.reads if r.loc or s.loc), None)
 
     @cached_property
     def reads(self) -> bool:
@@ -296,14 +302,17 @@ class Plant:
 
         return admissible
 
-    def parse_state(self, text: str) -> tuple[int, ...]:
-        """A state written as its true variables (``"TAPIS,v10,v20"`` or ``{...}``)."""
-        words = [w for w in text.replace("{", " ").replace("}", " ").replace(",", " ").split() if w]
+    def parse_state(self, text: str, where: str = "--why") -> tuple[int, ...]:
+        """A state written as its true variables (``"TAPIS,v10,v20"`` or ``{...}``); errors are
+        located in ``text`` as the option ``where``."""
+        import re
+
         true = set()
-        for w in words:
+        for m in re.finditer(r"[^\s{},]+", text):
+            w = m.group()
             if w not in self.owner:
-                hint = close_names(w, self.owner)
-                raise SynthError(f"unknown variable '{w}' in state" + (f" (did you mean {' or '.join(hint)}?)" if hint else ""))
+                raise InputError(f"unknown variable '{w}' in the state", location_in(where, text, 1, m.start() + 1, len(w)),
+                                 suggestions=close_names(w, self.owner))
             true.add(w)
         local = []
         for e in self.elements:
@@ -311,7 +320,8 @@ class Plant:
             hits = np.nonzero(e.codes == code)[0]
             if hits.size == 0:
                 shown = "{" + ",".join(v for v in e.variables if v in true) + "}"
-                raise SynthError(f"{shown} is not a state of element {e.name}: it is incoherent or unreachable in its rules")
+                raise InputError(f"{shown} is not a state of element {e.name}: it is incoherent or unreachable in its rules",
+                                 location_in(where, text, 1, 1, max(1, len(text))))
             local.append(int(hits[0]))
         return tuple(local)
 

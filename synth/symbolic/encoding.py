@@ -27,7 +27,7 @@ from __future__ import annotations
 from enum import Enum
 from typing import Iterator, Mapping, Sequence
 
-from synth.errors import LimitExceeded, SynthError
+from synth.errors import InputError, LimitExceeded
 from synth.logic.bdd import Engine, Function, interleaved_order
 from synth.logic.counting import count
 from synth.logic.expr import names as expr_names
@@ -107,10 +107,9 @@ class PlantEncoding:
                  anchored: Mapping[int | None, Sequence[str]] | None = None) -> None:
         if p.reads:  # a move would depend on other elements' variables: not encoded here
             readers = ", ".join(e.name for e in p.elements if e.guards is not None and not e.guards.all())
-            raise SynthError(
+            raise InputError(
                 f"the symbolic engine does not support elements that read other elements' variables "
-                f"(`reads` in {readers}); use --engine explicit"
-            )
+                f"(`reads` in {readers})", p.reads_at, notes=("use --engine explicit",))
         self.plant = p
         self.budget = budget or NodeBudget()
         self.variables: tuple[str, ...] = tuple(v for e in p.elements for v in e.variables)

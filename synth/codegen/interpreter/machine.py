@@ -48,7 +48,7 @@ from synth.codegen.interpreter.expressions import Node, name_of
 from synth.codegen.interpreter.runtime import Array, Host, Instance, Pou, Value, Variable, VarSection
 from synth.codegen.interpreter.standard import STANDARD_FBS
 from synth.codegen.interpreter.statements import StatementCompiler
-from synth.errors import InputError, location_in
+from synth.errors import InputError, close_names, location_in
 
 __all__ = ["Module", "load_st"]
 
@@ -92,13 +92,30 @@ def load_st(text: str, file: str = "<st>") -> Module:
     """Parse ``text`` with blark and compile its PROGRAMs and FUNCTION_BLOCKs."""
     from blark.parse import parse_source_code
 
-    result = parse_source_code(text, fn=file)
+    text = text.replace("\r\n", "\n").replace("\r", "\n")  # CRLF (Windows IDEs): the same lines and columns
+    # trailing blanks dropped: blark's scanner is quadratic in a run of blanks (20 000: 15 s)
+    text = "\n".join(line.rstrip(" \t") for line in text.split("\n"))
+    stray = _comment_error(text, file) or _long_blanks(text, file)
+    if stray is not None:
+        raise stray
+    try:
+        result = parse_source_code(text, fn=file)
+    except (IndexError, RuntimeError, ValueError) as failure:  # blark's comment scanner on what _comment_error missed
+        raise InputError(f"not valid IEC 61131-3 Structured Text (blark: {failure})",
+                         location_in(file, text, 1, 1)) from None
     if result.exception is not None:
         exc = result.exception
         line, column = getattr(exc, "line", 1) or 1, getattr(exc, "column", 1) or 1
-        expected = sorted(getattr(exc, "expected", None) or getattr(exc, "allowed", None) or ())
-        raise InputError("not valid IEC 61131-3 Structured Text (blark)", location_in(file, text, line, column),
-                         expected=tuple(expected)[:8])
+        if line < 1 or column < 1:  # lark's "unexpected end of input": the end of the text
+            line = text.rstrip("\n").count("\n") + 1
+            column = len(text.rstrip("\n").rsplit("\n", 1)[-1]) + 1
+        expected = sorted(set(getattr(exc, "expected", None) or getattr(exc, "allowed", None) or ()))
+        what = "unexpected end of the text" if getattr(exc, "line", 1) == -1 else "not valid IEC 61131-3 Structured Text (blark)"
+        from synth.syntax import file_kind_hint
+
+        hint = file_kind_hint("st", file, text)
+        raise InputError(what, location_in(file, text, line, column), expected=tuple(expected)[:8],
+                         notes=(hint,) if hint else ())
     source = result.transform()
     compiler = _Compiler(file, text)
     pous: dict[str, Pou] = {}
@@ -109,7 +126,63 @@ def load_st(text: str, file: str = "<st>") -> Module:
                 item, f"{type(item).__name__} is outside the subset synth executes (PROGRAM, FUNCTION_BLOCK)")
         pou = compiler.pou(item, kind)
         pous[pou.name] = pou
+    known = {n.upper() for n in pous} | set(STANDARD_FBS)
+    for decl, type_name in compiler.instances:
+        if type_name.upper() not in known:
+            names = ["BOOL", "TIME", *sorted(_INT_TYPES), *sorted(STANDARD_FBS), *pous]
+            err = compiler.error(decl, f"unknown type {type_name}")
+            raise InputError(err.message, err.location, suggestions=close_names(type_name, names))
     return Module(file, text, pous)
+
+
+def _comment_error(text: str, file: str) -> InputError | None:
+    """A ``*)`` that closes no comment, or a ``(*`` never closed, located (blark's comment
+    scanner fails on both with an exception of its own). Strings are skipped."""
+    depth, opened, i, quote = 0, 0, 0, ""
+    while i < len(text):
+        pair = text[i:i + 2]
+        if quote:
+            quote = "" if text[i] == quote else quote
+        elif depth == 0 and text[i] in "'\"":
+            quote = text[i]
+        elif depth == 0 and pair == "//":
+            end = text.find("\n", i)
+            i = len(text) if end < 0 else end
+            continue
+        elif pair == "(*":
+            opened = i if depth == 0 else opened
+            depth, i = depth + 1, i + 2
+            continue
+        elif pair == "*)":
+            if depth == 0:
+                return _at_offset(file, text, i, "'*)' closes no comment", "remove it, or open the comment with '(*'")
+            depth, i = depth - 1, i + 2
+            continue
+        i += 1
+    if depth:
+        return _at_offset(file, text, opened, "this comment is never closed", "close it with '*)'")
+    return None
+
+
+MAX_BLANKS = 1000
+"""The longest run of blanks inside a line of ST synth parses (blark's time grows with its square)."""
+
+
+def _long_blanks(text: str, file: str) -> InputError | None:
+    """A run of more than :data:`MAX_BLANKS` spaces or tabs before the end of a line, located."""
+    import re
+
+    found = re.search(r"[ \t]{%d,}" % (MAX_BLANKS + 1), text)
+    if found is None:
+        return None
+    return _at_offset(file, text, found.start(), f"{found.end() - found.start()} blanks in a row: more than the "
+                      f"{MAX_BLANKS} synth parses in a line of Structured Text", "shorten the run of blanks")
+
+
+def _at_offset(file: str, text: str, offset: int, message: str, note: str) -> InputError:
+    line = text.count("\n", 0, offset) + 1
+    column = offset - (text.rfind("\n", 0, offset) + 1) + 1
+    return InputError(message, location_in(file, text, line, column), notes=(note,))
 
 
 def _cast(type_name: str, x: Value) -> Value:
@@ -118,6 +191,10 @@ def _cast(type_name: str, x: Value) -> Value:
 
 class _Compiler(StatementCompiler):
     """Declarations and POUs; the bodies are :class:`StatementCompiler`'s."""
+
+    def __init__(self, file: str, text: str) -> None:
+        super().__init__(file, text)
+        self.instances: list[tuple[Node, str]] = []  # (declaration, type name) of every instance variable
 
     def pou(self, node: Node, kind: str) -> Pou:
         variables: list[Variable] = []
@@ -164,6 +241,7 @@ class _Compiler(StatementCompiler):
         else:
             if value is not None:
                 raise self.error(decl, f"initial values of {type_name} instances are outside the subset")
+            self.instances.append((decl, type_name))  # checked once every POU is known (load_st)
             return lambda module: module.instance(type_name)
         if value is None:
             return lambda module: default

@@ -57,12 +57,45 @@ def read_project(data: bytes | str, file: str) -> tuple[Any, Source, Any]:
         line, col = err.position if hasattr(err, "position") else (err.lineno, 1)
         raw_line = src.lines[line - 1] if 0 < line <= len(src.lines) else ""
         message = re.sub(r", line \d+, column \d+$", "", str(err.msg))
-        raise InputError(f"not well-formed XML: {message}", Location(file, line, max(1, col), raw_line)) from None
+        from synth.syntax import file_kind_hint
+
+        hint = file_kind_hint("xml", file, "\n".join(src.lines[:200]))
+        raise InputError(f"not well-formed XML: {message}", Location(file, line, max(1, col), raw_line),
+                         notes=(hint,) if hint else ()) from None
     ns = etree.QName(root).namespace
     if ns not in NAMESPACES or etree.QName(root).localname != "project":
         raise InputError(f"not a PLCopen TC6 XML project (root element {root.tag})", src.at(root),
                          expected=tuple(f'<project xmlns="{n}">' for n in NAMESPACES))
+    _check_numbers(root, src)
     return root, src, lambda tag: f"{{{ns}}}{tag}"
+
+
+_IDS = ("localId", "refLocalId", "executionOrderId")
+_COORDINATES = ("x", "y", "width", "height")
+
+
+def _check_numbers(root: Any, src: Source) -> None:
+    """Identifiers of at most 18 digits and finite coordinates, before anything reads them
+    as numbers (a 4 300-digit ``localId`` is past what Python converts; ``x="1e400"`` is
+    infinite): a located error at the element otherwise."""
+    for el in root.iter():
+        if not isinstance(el.tag, str):  # comments, processing instructions
+            continue
+        for name in _IDS:
+            value = el.get(name)
+            if value is not None and value.strip().isdigit() and len(value.strip()) > 18:
+                raise InputError(f"{name} of {len(value.strip())} digits: synth reads identifiers of at most 18",
+                                 src.at(el))
+        for name in _COORDINATES:
+            value = el.get(name)
+            if value is None or len(value) <= 24:
+                try:
+                    if value is None or abs(float(value)) < 1e15:
+                        continue
+                except ValueError:
+                    continue  # not a number: left to the reader of that attribute
+            raise InputError(f"{name}=\"{value[:24]}{'…' if len(value) > 24 else ''}\" is not a coordinate "
+                             f"(a finite number below 10^15)", src.at(el))
 
 
 def body_language(pou: Any, q: Any) -> str:

@@ -190,6 +190,10 @@ def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
     from lxml import etree
 
     pou_actions = {str(x.get("name")): x for x in pou.iterfind(f"{q('actions')}/{q('action')}")}
+    for v in pou.iterfind(f"{q('interface')}//{q('variable')}"):
+        if not (v.get("name") or "").strip():
+            raise InputError(f"a variable of POU {pou.get('name', '')}'s interface has no name", src.at(v),
+                             notes=('write it <variable name="...">',))
     inputs = [v.get("name") for v in pou.iterfind(f"{q('interface')}/{q('inputVars')}/{q('variable')}")
               if v.find(f"{q('type')}/{q('derived')}") is None]  # a block instance is no Boolean input
     # synth sfc's edge inputs _RE_x/_FE_x (set by the caller) are the edges ↑x/↓x of the input x

@@ -19,7 +19,8 @@ Example
 from __future__ import annotations
 
 import dataclasses
-from typing import Any
+import time
+from typing import Any, Callable
 
 import numpy as np
 
@@ -55,6 +56,7 @@ class Explorer:
 
     def __init__(self, pr: Product, max_states: int, events_per_cycle: int = 1, edges: bool = False) -> None:
         self.pr, self.max_states, self.k, self.track = pr, max_states, events_per_cycle, edges
+        self.report: Callable[[str], None] | None = None  # progress lines, one per level (the CLI's live line)
         self.size = pr.size
         self.aux_of: dict[tuple, int] = {}
         self.aux_list: list[tuple] = []
@@ -367,8 +369,14 @@ class Explorer:
             frontier = self.level(frontier)
             self.powered = set(frontier.tolist())
             self.k, self.prelude_cycles, self.prelude_corrected = k, self.cycles, self.corrected
+        started, levels = time.monotonic(), 0
         while frontier.size and self.complete:
             frontier = self.level(frontier)
+            levels += 1
+            if self.report is not None:
+                rate = self.cycles / max(time.monotonic() - started, 1e-6)
+                self.report(f"closed loop: {self.states} states, {self.cycles} cycles ({rate:.0f} cycles/s), "
+                            f"level {levels}")
 
     @property
     def states(self) -> int:

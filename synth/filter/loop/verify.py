@@ -1,4 +1,4 @@
-"""``synth filter verify``: the filter in closed loop with synth's plant (FILTER.md §3.4).
+"""``synth filter verify``: the filter in closed loop with synth's plant (docs/filter.md, "The closed loop").
 
 The explored product has one node per (plant state, filter memory, Blocked latch,
 Grafcet situation). One **PLC cycle** from a node:
@@ -61,6 +61,7 @@ import dataclasses
 import time
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 
@@ -96,13 +97,13 @@ def verify(f: Filter, rules_path: str, grafcet: str | None = None, *, any_contro
            algorithm: Algorithm = Algorithm.ALGEBRAIC, mode: Mode = Mode.SUPERVISOR, atomic: bool = False,
            strict: bool = False, require_sup: bool = False, max_states: int | None = DEFAULT_MAX_STATES,
            events_per_cycle: int = 1, progress: str | None = None, control: StSource | None = None,
-           engine: EngineChoice = EngineChoice.EXPLICIT) -> Verification:
+           engine: EngineChoice = EngineChoice.EXPLICIT, report: Callable[[str], None] | None = None) -> Verification:
     """``synth filter verify``: read each input once, let :func:`synth.engines.decide`
     choose the engine, run it on the loaded models. ``control``: ``--control
     PROG.st[:NAME]``; ``engine``: ``symbolic`` (or ``auto`` on a large plant) runs
     :func:`~synth.filter.loop.symbolic.verify.verify_symbolic` (``--any-control`` only; there
     ``max_states=None`` is no limit, explicitly it is 1000000), otherwise
-    :func:`verify_explicit`."""
+    :func:`verify_explicit`. ``report`` receives progress lines."""
     if (grafcet is not None) + any_control + (control is not None) != 1:
         raise InputError("verify needs a request source: --grafcet G.g7, --control PROG.st or --any-control "
                          "(one of them)", None)
@@ -113,12 +114,13 @@ def verify(f: Filter, rules_path: str, grafcet: str | None = None, *, any_contro
     options = ({Need.CONTROLLER} if not any_control else set()) | ({Need.PROGRESS} if progress is not None else set())
     refuse(Command.FILTER_VERIFY, engine, options)  # before any input is read
     p = plant_of(f, rules_path)
-    chosen = decide(Command.FILTER_VERIFY, engine, options, estimate=p.size, readers=p.readers)
+    chosen = decide(Command.FILTER_VERIFY, engine, options, estimate=p.size, readers=p.readers, reads_at=p.reads_at)
     if chosen.engine is EngineChoice.SYMBOLIC:
         from synth.filter.loop.symbolic.verify import verify_symbolic
 
         return verify_symbolic(f, p, algorithm=algorithm, mode=mode, atomic=atomic, strict=strict,
-                               require_sup=require_sup, max_states=max_states, events_per_cycle=events_per_cycle)
+                               require_sup=require_sup, max_states=max_states, events_per_cycle=events_per_cycle,
+                               report=report)
     g = None
     if grafcet is not None:
         from synth.grafcet.language_check import load_grafcet
@@ -126,7 +128,7 @@ def verify(f: Filter, rules_path: str, grafcet: str | None = None, *, any_contro
         g = load_grafcet(grafcet, inputs=rules_of(p).inputs, outputs=rules_of(p).outputs)
     return verify_explicit(f, p, g, algorithm=algorithm, mode=mode, atomic=atomic, strict=strict,
                            require_sup=require_sup, max_states=max_states, events_per_cycle=events_per_cycle,
-                           progress=progress, control=control)
+                           progress=progress, control=control, report=report)
 
 
 def plant_of(f: Filter, rules_path: str) -> Plant:
@@ -140,15 +142,18 @@ def plant_of(f: Filter, rules_path: str) -> Plant:
 def verify_explicit(f: Filter, p: Plant, g: Grafcet | None = None, *, algorithm: Algorithm = Algorithm.ALGEBRAIC,
                     mode: Mode = Mode.SUPERVISOR, atomic: bool = False, strict: bool = False,
                     require_sup: bool = False, max_states: int | None = DEFAULT_MAX_STATES, events_per_cycle: int = 1,
-                    progress: str | None = None, control: StSource | None = None) -> Verification:
+                    progress: str | None = None, control: StSource | None = None,
+                    report: Callable[[str], None] | None = None) -> Verification:
     """The explicit engine (see the module docstring) on the plant ``p`` and the requests of
-    the Grafcet ``g``, of the ST program ``control``, or of any control (neither)."""
+    the Grafcet ``g``, of the ST program ``control``, or of any control (neither); ``report``
+    receives progress lines."""
     if max_states is None:
         max_states = DEFAULT_MAX_STATES
     started = time.perf_counter()
     pr = Product(f, p, g, Algorithm(algorithm), Mode(mode), atomic, control)
     goal = goal_of(progress, pr) if progress is not None else None
     ex = Explorer(pr, max_states, events_per_cycle, edges=goal is not None)
+    ex.report = report
     ex.run()
     prog = progress_of(ex, goal) if goal is not None and ex.complete else None
     findings = ex.findings()

@@ -17,17 +17,26 @@
       return "<tr><th>" + esc(r[0]) + "</th><td class='mono'>" + esc(r[1]) + "</td></tr>";
     }).join("") + "</table>";
   }
-  function mark(problem, steps) {
-    var fig = document.getElementById("grafcet-" + problem);
+  var fixes = JSON.parse(document.getElementById("report-fixes").textContent);
+  function mark(problem, k, steps) {
+    var fig = document.getElementById("grafcet");
     if (!fig) return;
-    var active = {};
+    var active = {}, fix = {};
     steps.forEach(function (x) { active["step_" + x.replace(/^X/, "")] = true; });
+    (fixes[problem] || []).forEach(function (x) { fix["step_" + x] = true; });
     fig.querySelectorAll("g.node").forEach(function (g) {
       var title = g.querySelector("title");
       var shape = g.querySelector("polygon, ellipse");
       if (!title || !shape || title.textContent.indexOf("step_") !== 0) return;
       shape.setAttribute("fill", active[title.textContent] ? "#f9d71c" : "#ffffff");
+      g.querySelectorAll("polygon, ellipse").forEach(function (s) {
+        s.setAttribute("stroke", fix[title.textContent] ? "#c0392b" : "black");
+        s.setAttribute("stroke-width", fix[title.textContent] ? "4" : "1");
+      });
     });
+    var caption = document.getElementById("chart-shows");
+    if (caption) caption.textContent = "Active steps (filled) of blocking " + problem.slice(1) + ", trace step " + k +
+      " (" + walks[problem][k].event + ")" + ((fixes[problem] || []).length ? "; outlined in red: the step to fix." : ".");
   }
   function show(problem, k) {
     var st = walks[problem][k];
@@ -35,10 +44,10 @@
     document.querySelectorAll("button[data-problem='" + problem + "']").forEach(function (b) {
       b.classList.toggle("current", Number(b.dataset.step) === k);
     });
-    mark(problem, st.situation);
+    mark(problem, k, st.situation);
   }
   document.querySelectorAll(".trace button").forEach(function (b) {
     b.addEventListener("click", function () { show(b.dataset.problem, Number(b.dataset.step)); });
   });
-  Object.keys(walks).forEach(function (problem) { show(problem, walks[problem].length - 1); });
+  Object.keys(walks).reverse().forEach(function (problem) { show(problem, walks[problem].length - 1); });
 })();

@@ -243,7 +243,8 @@ class SituationReach:
             def value(name: str, steps: set[str] = steps) -> Function:
                 return engine.var(name) if name in owner else (engine.true if name in steps else engine.false)
 
-            hit = evaluate(condition, value) & r.nodes
+            v = evaluate(condition, value)  # a condition folding to a constant (`1`, `X0 & 0`) is a bool
+            hit = ((engine.true if v else engine.false) if isinstance(v, bool) else v) & r.nodes
             if hit != self.false:
                 out[s] = hit
         return out

@@ -216,7 +216,8 @@ class StepReach:
                 return s.engine.var(name)
             return s.steps.var(variables[name]) if name in variables else s.engine.false
 
-        return evaluate(condition, value) & s.nodes
+        v = evaluate(condition, value)  # a condition folding to a constant (`1`, `X0 & 0`) is a bool
+        return ((s.engine.true if v else s.engine.false) if isinstance(v, bool) else v) & s.nodes
 
     def prohibited(self) -> dict[tuple[Steps, Event], Function]:
         """Per (active steps, refused order event), the nodes where SUP refuses it."""

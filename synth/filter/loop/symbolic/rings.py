@@ -34,6 +34,8 @@ Example
 
 from __future__ import annotations
 
+from typing import Callable
+
 from synth.filter.cycle import Algorithm, Mode
 from synth.filter.language import Filter
 from synth.filter.loop.product import rules_of
@@ -56,6 +58,7 @@ class SymbolicLoop:
 
     def __init__(self, f: Filter, p: Plant, algorithm: Algorithm, mode: Mode, atomic: bool,
                  events_per_cycle: int, max_states: int | None = None) -> None:
+        self.report: Callable[[str], None] | None = None  # progress lines, one per level (the CLI's live line)
         self.sc = sc = SymbolicCycle(f, rules_of(p), p, algorithm, mode, atomic)
         self.k, self.max_states = events_per_cycle, max_states
         enc, e = sc.enc, sc.engine
@@ -149,6 +152,8 @@ class SymbolicLoop:
             frontier = self.level(frontier, depth)
             self.levels.append(frontier)
             depth += 1
+            if self.report is not None:
+                self.report(f"closed loop (symbolic): level {depth}, {e.live_nodes()} BDD nodes")
         if self.levels[-1] == e.false:
             self.levels.pop()
         self.states = self.count(self.reach, self.node_vars)

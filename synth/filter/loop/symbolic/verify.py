@@ -24,6 +24,7 @@ Example
 from __future__ import annotations
 
 import time
+from typing import Callable
 
 import numpy as np
 
@@ -64,7 +65,7 @@ def explicit_findings(f: Filter, p: Plant, algorithm: Algorithm, mode: Mode, ato
 def verify_symbolic(f: Filter, p: Plant, *, algorithm: Algorithm = Algorithm.ALGEBRAIC,
                     mode: Mode = Mode.SUPERVISOR, atomic: bool = False, strict: bool = False,
                     require_sup: bool = False, max_states: int | None = None, events_per_cycle: int = 1,
-                    trace_budget: int = TRACE_BUDGET) -> Verification:
+                    trace_budget: int = TRACE_BUDGET, report: Callable[[str], None] | None = None) -> Verification:
     """The closed loop under any control on the symbolic engine. Every count is the
     explicit engine's; each finding's trace is the explicit engine's shortest one or, when
     the explicit engine cannot render it within ``trace_budget`` nodes (see the module
@@ -73,6 +74,7 @@ def verify_symbolic(f: Filter, p: Plant, *, algorithm: Algorithm = Algorithm.ALG
 
     started = time.perf_counter()
     loop = SymbolicLoop(f, p, Algorithm(algorithm), Mode(mode), atomic, events_per_cycle, max_states)
+    loop.report = report
     loop.run()
     counts = loop.counts()
     kinds = [k for k in FindingKind if k in loop.first_level and (require_sup or k is not FindingKind.OUTSIDE_SUP)]
