@@ -44,7 +44,7 @@ def test_command_typo(capsys):
     code, last = _argparse_error(capsys, "validat", "x.g7")
     assert code == 2
     assert last == ("synth: error: unknown command 'validat'; did you mean 'validate'? (commands: plant, sup, ass, "
-                    "run, validate, filter, st, sfc, import, lib, completion)")
+                    "run, validate, filter, st, sfc, import, commission, check, mutate, lib, completion)")
 
 
 def test_subcommand_typo(capsys):

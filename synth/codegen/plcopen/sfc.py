@@ -22,6 +22,7 @@ from synth.codegen.plcopen.data import DATA
 from synth.codegen.plcopen.ids import number_ids
 from synth.codegen.plcopen.scan import one_scan_steps
 from synth.codegen.plcopen.timers import ton_chart
+from synth.codegen.plcopen.divergence import exclusive_branches, priority
 from synth.codegen.plcopen.vendor import chart_flag_warnings, step_actions
 from synth.codegen.plcopen.fbd import FBD_ELEMENTS, fbd_condition, fbd_transition
 from synth.codegen.plcopen.tc6 import SYNTH_DATA
@@ -160,27 +161,6 @@ def _x(el: Any) -> int:
         return int(float(pos.get("x", "0"))) if pos is not None else 0
     except ValueError:
         return 0
-
-
-MATIEC_DIVERGENCE = ("on MATIEC (the compiler of Beremiz and OpenPLC) every true branch fires, priorities ignored: "
-                     "for a program that runs there, validate the receptivities as written, without this rewrite")
-"""The runtime that reads a selection divergence otherwise than IEC 61131-3 (measured: two
-tokens after a divergence whose branches were both true)."""
-
-NO_PRIORITY = 2 ** 63
-"""The rank of a transition without a ``priority`` attribute: after every written one."""
-
-
-def _priority(el: Any, src: Source) -> int:
-    """The ``priority`` attribute of an SFC ``<transition>`` (TC6: the smaller, the earlier a
-    selection divergence tests it), :data:`NO_PRIORITY` when absent; anything else than a
-    non-negative integer is a located error."""
-    text = el.get("priority")
-    if text is None:
-        return NO_PRIORITY
-    if not text.strip().isdigit() or len(text.strip()) > 18:
-        raise InputError(f"transition priority '{text[:40]}' is not a non-negative integer", src.at(el))
-    return int(text)
 
 
 def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
@@ -370,7 +350,7 @@ def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
         div = [(ref, c) for ref, c in producers(el) if kind(elements[ref]) == "selectionDivergence"]
         if len(div) == 1:
             branch = div[0][1].get("formalParameter", "")
-            key = (_priority(el, src), int(branch) if branch.strip().isdigit() else 10 ** 6, _x(el))
+            key = (priority(el, src), int(branch) if branch.strip().isdigit() else 10 ** 6, _x(el))
             branches.setdefault(div[0][0], []).append((key, len(transitions) - 1))
         if sources and sources == targets and "↑" not in expr and "↓" not in expr:
             warnings.append(InputError(
@@ -388,23 +368,8 @@ def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
     _check_names(pou, q, src, transitions, {st.name for st in [*steps.values(), *helpers]}, inputs, outputs, warnings)
     warnings += chart_flag_warnings(pou, q, src.at)
     written_by_synth = any(st.grafcet for st in steps.values())  # its .g7 is the meaning: no rewriting
-    for d, members in branches.items():  # IEC 61131-3: the first true branch, left to right; .g7: every one
-        if len(members) < 2 or written_by_synth:
-            continue
-        ranked = [i for _, i in sorted(members)]
-        prioritised = any(key[0] < NO_PRIORITY for key, _ in members)
-        rewritten = []
-        for k, i in enumerate(ranked[1:], 1):
-            label, sources, targets, expr, el = transitions[i]
-            before = " & ".join(f"!({transitions[j][3]})" for j in ranked[:k])
-            transitions[i] = (label, sources, targets, f"({expr}) & {before}", el)
-            rewritten.append(f"{' -> '.join([', '.join(sources), ', '.join(targets)])} when {transitions[i][3]}")
-        rule = ("the true branch of highest priority (smallest `priority`, then left to right)" if prioritised
-                 else "the first true branch (left to right)")
-        warnings.append(InputError(
-            f"a selection divergence: IEC 61131-3 SFC fires {rule}, .g7 every true "
-            "branch; the later branches' receptivities are made exclusive", src.at(elements[d]),
-            severity=Severity.WARNING, notes=(*rewritten, MATIEC_DIVERGENCE)))
+    if not written_by_synth:
+        warnings += exclusive_branches(branches, transitions, elements, src)
 
     # actions: CODESYS/TwinCAT step actions (vendor addData), then the action blocks
     if scope is not None:
