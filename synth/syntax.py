@@ -251,8 +251,9 @@ def read_bytes(path: str | Path, at: Location | None = None) -> bytes:
 
     shown = str(path) if len(str(path)) <= 200 else str(path)[:200] + "…"
     try:
-        if not stat.S_ISREG(os.stat(path).st_mode):
-            raise InputError(f"cannot read '{shown}': not a regular file", at)
+        mode = os.stat(path).st_mode
+        if not stat.S_ISREG(mode):
+            raise InputError(f"cannot read '{shown}': {'Is a directory' if stat.S_ISDIR(mode) else 'not a regular file'}", at)
         with open(path, "rb") as fh:
             info = os.fstat(fh.fileno())
             if not stat.S_ISREG(info.st_mode):

@@ -52,7 +52,7 @@ def _random_function(e: Engine, rng: random.Random, names: list[str], terms: int
 
 
 def _both(e: Engine):
-    ranks = e._inner_ranks()
+    ranks = e.inner_ranks()
     return Covers(e.bdd, ranks.__getitem__), PlainCovers(e.bdd, ranks.__getitem__)
 
 
