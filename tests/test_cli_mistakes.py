@@ -69,7 +69,7 @@ def test_missing_input_is_cannot_read(cli):
 
 
 def test_wrong_file_kind_is_cannot_read(cli):
-    assert cli("import", str(ROOT / "plants")) == (2, "", f"error: cannot read '{ROOT / 'plants'}': not a regular file\n")
+    assert cli("import", str(ROOT / "plants")) == (2, "", f"error: cannot read '{ROOT / 'plants'}': Is a directory\n")
 
 
 def test_unwritable_output_is_cannot_write(cli, tmp_path):

@@ -82,17 +82,18 @@ def test_random_grafcets_nightly():
 
 
 def test_random_grafcets_cover_every_construct():
+    """The programs the suite runs cover each construct (the thresholds: two thirds of what 120 seeds gave)."""
     texts = [random_grafcet(seed) for seed in RANDOM_SEEDS]
     gs = [parse_grafcet(t, f"random{i}.g7") for i, t in enumerate(texts)]
-    assert sum(any(len(t.targets) > 1 for t in g.transitions) for g in gs) >= 10  # AND divergences
-    assert sum(any(len(t.sources) > 1 for t in g.transitions) for g in gs) >= 10  # AND convergences
-    assert sum(len({t.sources for t in g.transitions}) < len(g.transitions) for g in gs) >= 20  # OR divergences
-    assert sum(bool(g.timers) for g in gs) >= 70
-    assert sum("↑" in t or "↓" in t for t in texts) >= 100
-    assert sum(" on ↑" in t or " on ↓" in t for t in texts) >= 30  # stored actions on events
-    assert sum(" on deactivation" in t for t in texts) >= 12
-    assert sum(" if " in t for t in texts) >= 35  # conditional actions
-    assert sum(len(g.grafcets) > 1 for g in gs) >= 40  # step variables across partial grafcets
+    assert sum(any(len(t.targets) > 1 for t in g.transitions) for g in gs) >= 6  # AND divergences
+    assert sum(any(len(t.sources) > 1 for t in g.transitions) for g in gs) >= 6  # AND convergences
+    assert sum(len({t.sources for t in g.transitions}) < len(g.transitions) for g in gs) >= 13  # OR divergences
+    assert sum(bool(g.timers) for g in gs) >= 47
+    assert sum("↑" in t or "↓" in t for t in texts) >= 67
+    assert sum(" on ↑" in t or " on ↓" in t for t in texts) >= 20  # stored actions on events
+    assert sum(" on deactivation" in t for t in texts) >= 8
+    assert sum(" if " in t for t in texts) >= 23  # conditional actions
+    assert sum(len(g.grafcets) > 1 for g in gs) >= 27  # step variables across partial grafcets
 
 
 def _flip(monkeypatch, old: str, new: str) -> None:
