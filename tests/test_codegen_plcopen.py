@@ -77,8 +77,10 @@ def test_sfc_mapping_of_divergences_timers_edges_and_actions():
     assert xml.count("<simultaneousDivergence ") == 1 and xml.count("<simultaneousConvergence ") == 1
     assert xml.count("<selectionDivergence ") == 1 and xml.count("<selectionConvergence ") == 1
     assert "<![CDATA[_RE_go]]>" in xml
-    assert "<![CDATA[(S1.T >= T#2s) AND S2.X]]>" in xml
-    assert xml.count('qualifier="N"') == 3  # A, B if !c, set M on ↑p
+    # Beremiz writes the convergence from step 1, before step 2: X2 is read from step 2's mirror
+    assert "<![CDATA[(S1.T >= T#2s) AND _X_S2]]>" in xml
+    assert '<variable name="_X_S2">' in xml and '<reference name="_X_S2"/>' in xml
+    assert xml.count('qualifier="N"') == 4  # A, B if !c, set M on ↑p, the mirror of step 2
     assert "<![CDATA[B := NOT c;]]>" in xml
     assert "<![CDATA[IF _RE_p THEN M := TRUE; END_IF;]]>" in xml
     assert "<![CDATA[M := FALSE;]]>" in xml and 'qualifier="P0"' in xml

@@ -27,7 +27,7 @@ import pytest
 
 from beremiz import beremiz_program, find_beremiz
 from iec2c import CompiledProgram, find_iec2c
-from test_sfc_meaning import GRAFCETS, MATIEC_FORWARD_STEP_FLAGS, SHARED
+from test_sfc_meaning import GRAFCETS, SHARED
 from synth.codegen.plcopen.export import sfc_project_xml
 from synth.codegen.plcopen.tc6 import sfc_step_name
 from synth.codegen.program import StProgram, case_aliases, program_name
@@ -44,7 +44,6 @@ clock moving by exact steps that sum to a whole second, MATIEC's step time is on
 SEQUENCES, SCANS = 12, 150
 """Random sequences per Grafcet and scans per sequence."""
 # GRAFCETS: the bundled ones but source_sink.g7, which synth sfc refuses (not IEC 61131-3 SFC);
-# MATIEC_FORWARD_STEP_FLAGS: those MATIEC does not compile (docs/codegen.md, section 3)
 EDGE = re.compile(r"_(RE|FE)_(\w+)")
 
 needs_plc = pytest.mark.skipif(find_beremiz() is None or find_iec2c() is None or shutil.which("gcc") is None,
@@ -171,17 +170,21 @@ def _text(state: tuple[tuple[str, ...], tuple[str, ...]]) -> str:
     return "steps {" + ", ".join(sorted(state[0])) + "} outputs {" + ", ".join(state[1]) + "}"
 
 
+RANDOM_MISSES = {"tri_counting.g7": ["1->2", "2->0"]}
+"""Transitions random inputs without a plant do not fire within the sequences played: three
+boxes sorted in one cycle take some forty input changes in their order."""
+
+
 @needs_plc
 @pytest.mark.parametrize("path", GRAFCETS, ids=lambda p: p.name)
 def test_the_plc_runs_every_bundled_grafcet_as_synth_run_sfc(path, tmp_path):
-    if path.name in MATIEC_FORWARD_STEP_FLAGS:
-        pytest.skip("MATIEC refuses a step flag read before the step's declaration (docs/codegen.md)")
     g = load_grafcet(path)
     scans = scans_for(g)
     out = run_on_plc(g, tmp_path, range(SEQUENCES), scans)
     assert [d.text() for d in out.differences] == []
     assert out.scans == SEQUENCES * scans
-    assert [t.name for t in g.transitions if t not in out.fired] == []  # every transition fired (the PLC: the same steps)
+    # every transition fired (the PLC: the same steps), but those random inputs do not reach
+    assert [t.name for t in g.transitions if t not in out.fired] == RANDOM_MISSES.get(path.name, [])
 
 
 def scans_for(g: Grafcet) -> int:

@@ -43,6 +43,7 @@ from __future__ import annotations
 from typing import Any, Sequence
 
 from synth.codegen.plcopen.data import FLAG_PREFIX
+from synth.codegen.plcopen.mirrors import mirror_flag, mirrored_steps
 from synth.codegen.plcopen.tc6 import (
     SYNTH_DATA,
     Qualifier,
@@ -115,6 +116,7 @@ class _Names:
 
     def __init__(self, g: Grafcet) -> None:
         self.steps = {s.name for s in g.steps}
+        self.mirrored = mirrored_steps(g)
         self.timers = {t.id: t for t in g.timers}
         self.internals = {v.name: v for v in g.internals}
         self.alias = case_aliases([*g.inputs, *g.outputs, *self.internals], [sfc_step_name(s.name) for s in g.steps])
@@ -138,7 +140,8 @@ def _sfc_expr(e: Expr, names: _Names) -> str:
             t = timers[x.name]
             return f"({sfc_step_name(t.step)}.T >= {timer_literal(t.id, t.seconds, t.loc)})"
         if x.name.startswith("X") and x.name[1:] in steps:
-            return f"{sfc_step_name(x.name[1:])}.X"
+            step = x.name[1:]
+            return mirror_flag(step) if step in names.mirrored else f"{sfc_step_name(step)}.X"
         return names(x.name)
 
     return st_expr(e, ref)
@@ -231,7 +234,7 @@ def sfc_project_xml(g: Grafcet, *, name: str | None = None, version: str | None 
         elif incoming[s.name]:
             el.append(_conn_in(producer_of_transition(incoming[s.name][0], s.name)))
         el.append(element("connectionPointOut", {"formalParameter": ""}))
-        if s.actions or s.name in carriers:
+        if s.actions or s.name in carriers or s.name in names.mirrored:
             el.append(element("connectionPointOutAction", {"formalParameter": ""}))
         data = element("data", {"name": SYNTH_DATA, "handleUnknown": "discard"}, element("grafcet", {"name": s.grafcet}))
         el.append(element("addData", None, data))
@@ -246,7 +249,7 @@ def sfc_project_xml(g: Grafcet, *, name: str | None = None, version: str | None 
             for k in range(len(outgoing[s.name])):
                 div.append(element("connectionPointOut", {"formalParameter": str(k)}))
             body.append(div)
-        if s.actions or s.name in carriers:
+        if s.actions or s.name in carriers or s.name in names.mirrored:
             block = element("actionBlock", {"localId": str(ids())}, position(x + 120, y), _conn_in((step_id[s.name], None)))
             for k, a in enumerate(s.actions):
                 own = a.order in shared and a.kind in (CONTINUOUS, CONDITIONAL)
@@ -258,6 +261,10 @@ def sfc_project_xml(g: Grafcet, *, name: str | None = None, version: str | None 
                     block.append(element("action", {"localId": str(ids()), "qualifier": Qualifier.S},
                                          position(0, 30 * k, "relPosition"),
                                          element("inline", None, element("ST", None, xhtml(text)))))
+            if s.name in names.mirrored:
+                block.append(element("action", {"localId": str(ids()), "qualifier": Qualifier.N},
+                                     position(0, 30 * (len(s.actions) + len(shared) * (s.name in carriers)), "relPosition"),
+                                     element("reference", {"name": mirror_flag(s.name)})))
             body.append(block)
     for i, t in enumerate(g.transitions):
         col = column[t.grafcet]
@@ -307,6 +314,15 @@ def sfc_project_xml(g: Grafcet, *, name: str | None = None, version: str | None 
             for e in emitters:
                 vl.append(element("variable", {"name": shared_flag(names(order), e)}, element("type", None, element("BOOL")),
                                   element("documentation", None, xhtml(f"{order} as step {e} emits it", cdata=False))))
+        iface.append(vl)
+    if names.mirrored:
+        vl = element("localVars")
+        for s in g.steps:
+            if s.name in names.mirrored:
+                vl.append(element("variable", {"name": mirror_flag(s.name)}, element("type", None, element("BOOL")),
+                                  element("initialValue", None, element("simpleValue", {"value": str(s.initial).upper()})),
+                                  element("documentation", None, xhtml(f"the flag of step {s.name}, read before the "
+                                                                       "step's declaration", cdata=False))))
         iface.append(vl)
     pou = element("pou", {"name": pou_name, "pouType": "program"}, iface, element("body", None, body))
     if names.alias:

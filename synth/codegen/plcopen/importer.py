@@ -42,6 +42,7 @@ from synth.codegen.plcopen.data import DATA, duration
 from synth.codegen.plcopen.instances import separate_instances
 from synth.codegen.plcopen.project import NAMESPACES, PouSummary, body_language, list_pous, pous_of, read_project
 from synth.codegen.plcopen.sfc import Chart, Source, read_chart
+from synth.codegen.plcopen.mirrors import merge_mirrors
 from synth.codegen.plcopen.shared import MARK, merge_shared, shared_assignment, without_shared_or
 from synth.codegen.plcopen.timers import prepare_scope
 from synth.codegen.plcopen.vendor import IecQualifier
@@ -108,6 +109,7 @@ def import_sfc(data: bytes | str, file: str = "<xml>", pou: str | None = None,
                                   if n not in charts[-1].outputs and n.upper() not in scope.used)
     for c in charts:
         merge_shared(c, src.at)
+        merge_mirrors(c)
     if several:
         separate_instances(charts, [p for p, _ in sfc_pous], q, src.at)
     _feedback(charts, src)
