@@ -64,18 +64,18 @@ def writing_order(g: Grafcet) -> dict[str, int]:
     def visit(start: str) -> None:
         stack = [start]
         while stack:
-            s = stack.pop()
-            if s in rank:
+            name = stack.pop()
+            if name in rank:
                 continue
-            rank[s] = len(rank)
-            following = [x for i in outgoing[s] for x in g.transitions[i].targets]
+            rank[name] = len(rank)
+            following = [x for i in outgoing[name] for x in g.transitions[i].targets]
             stack.extend(reversed(following))
 
-    for s in g.steps:
-        if s.initial:
-            visit(s.name)
-    for s in g.steps:
-        rank.setdefault(s.name, len(rank))
+    for step in g.steps:
+        if step.initial:
+            visit(step.name)
+    for step in g.steps:
+        rank.setdefault(step.name, len(rank))
     return rank
 
 
