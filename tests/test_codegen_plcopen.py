@@ -10,7 +10,7 @@ import pytest
 from synth.codegen.grafcet_st import generate_program, grafcet_program, synth_version
 from synth.codegen.plcopen.export import sfc_project_xml, st_project_xml
 from synth.codegen.plcopen.importer import import_sfc
-from synth.codegen.plcopen.tc6 import validation_errors
+from tc6schema import validation_errors
 from synth.errors import InputError
 from synth.grafcet.ass import stable_situation_automaton
 from synth.grafcet.language_check import load_grafcet, parse_grafcet

@@ -12,7 +12,7 @@ import pytest
 from conftest import ROOT
 from synth.codegen.grafcet_st import generate_program
 from synth.codegen.interpreter.machine import load_st
-from synth.codegen.plcopen.tc6 import validation_errors
+from tc6schema import validation_errors
 from synth.codegen.program import with_locations
 from synth.commission.iomap import Coupling, Layout, io_map, layout_map, parse_map
 from synth.errors import InputError

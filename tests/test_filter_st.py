@@ -182,7 +182,7 @@ def test_cli_bad_filter_is_exit_2(tmp_path: Path, capsys: pytest.CaptureFixture[
 def test_cli_xml_is_valid_tc6(tmp_path: Path) -> None:
     from lxml import etree
 
-    from synth.codegen.plcopen.tc6 import validation_errors
+    from tc6schema import validation_errors
 
     out = tmp_path / "fb.xml"
     assert main(["filter", "st", str(ROOT / "plants" / "loop_b.filter"), "--algorithm", "loop", "--xml",

@@ -109,7 +109,7 @@ def test_on_the_plc_the_pump_stops_when_its_step_is_left(tmp_path):
 
 def test_st_xml_with_a_task_carries_the_configuration(tmp_path):
     from synth.cli.main import main
-    from synth.codegen.plcopen.tc6 import validation_errors
+    from tc6schema import validation_errors
 
     out = tmp_path / "plc.xml"
     assert main(["st", str(ROOT / "grafcets/tri.g7"), "--xml", "--task", "10ms", "-o", str(out)]) == 0

@@ -15,7 +15,7 @@ from synth.cli.main import main
 from synth.codegen.check import differential_check
 from synth.codegen.filter_st import filter_block
 from synth.codegen.grafcet_st import generate_program
-from synth.codegen.plcopen.tc6 import validation_errors
+from tc6schema import validation_errors
 from synth.codegen.targets import Target, render, st_of
 from synth.codegen.twincat import object_id
 from synth.filter.cycle import FilterCycle

@@ -31,11 +31,10 @@ them (:func:`~synth.codegen.program.case_aliases`); the project's comment lists 
 Example
 -------
 >>> from synth.codegen.st import Declaration, Pou, PouKind, SectionKind, VarSection
->>> from synth.codegen.plcopen.tc6 import validation_errors
 >>> p = Pou(PouKind.PROGRAM, "P", (VarSection(SectionKind.INPUT, (Declaration("a"),)),), ("y := a;",))
 >>> xml = st_project_xml([p], version="0.1.0")
->>> validation_errors(xml), b'<pou name="P" pouType="program">' in xml
-([], True)
+>>> b'<pou name="P" pouType="program">' in xml, b'<variable name="a">' in xml
+(True, True)
 """
 
 from __future__ import annotations

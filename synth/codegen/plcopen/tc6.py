@@ -1,5 +1,5 @@
 """PLCopen TC6 XML v2.01, the common ground of the exporter and the importer: the
-namespace, the schema shipped with synth, element builders, the project frame, variable
+namespace, element builders, the project frame, variable
 types and interfaces, the SFC name of a step.
 
 Nothing written depends on the time of day: ``creationDateTime`` is a fixed date.
@@ -16,12 +16,11 @@ from __future__ import annotations
 
 import re
 from enum import StrEnum
-from functools import lru_cache
 from typing import Any, Sequence
 
 from synth.codegen.st import SectionKind, VarSection
 
-__all__ = ["NS", "XHTML", "CREATION_DATE", "SYNTH_DATA", "Qualifier", "schema", "validation_errors", "element",
+__all__ = ["NS", "XHTML", "CREATION_DATE", "SYNTH_DATA", "Qualifier", "element",
            "xhtml", "position", "project", "plc_type", "interface", "sfc_step_name"]
 
 NS = "http://www.plcopen.org/xml/tc6_0201"
@@ -38,26 +37,6 @@ class Qualifier(StrEnum):
     R = "R"
     P1 = "P1"
     P0 = "P0"
-
-
-@lru_cache(maxsize=1)
-def schema():  # -> lxml.etree.XMLSchema
-    """The PLCopen TC6 XML v2.01 schema shipped with synth (``tc6_xml_v201.xsd``)."""
-    from importlib.resources import files
-
-    from lxml import etree
-
-    with files("synth.codegen.plcopen").joinpath("tc6_xml_v201.xsd").open("rb") as fh:
-        return etree.XMLSchema(etree.parse(fh))
-
-
-def validation_errors(xml: bytes) -> list[str]:
-    """The TC6 schema's complaints about ``xml`` (empty when valid)."""
-    from lxml import etree
-
-    s = schema()
-    s.validate(etree.fromstring(xml))
-    return [f"{e.line}: {e.message}" for e in s.error_log]
 
 
 def element(tag: str, attrib: dict[str, str] | None = None, *children: Any) -> Any:
