@@ -44,14 +44,15 @@ import re
 from dataclasses import dataclass
 from typing import Callable, Iterable
 
-from synth.codegen.plcopen.data import duration
+from synth.codegen.plcopen.data import FLAG_PREFIX, duration
+from synth.codegen.plcopen.shared import shared_assignment
 from synth.codegen.plcopen.meaning import STATELESS, ItemKind, MeaningItem
 from synth.errors import InputError
 from synth.grafcet.language import ASSIGN, CONDITIONAL, CONTINUOUS, ON_DEACTIVATION, ON_EVENT, STORED, Action, \
     Grafcet, Step, Transition, duration_seconds
 from synth.logic.expr import Edge, Expr, Var, evaluate, names
 
-__all__ = ["SilentChange", "silent_changes", "MAX_ATOMS"]
+__all__ = ["SilentChange", "silent_changes", "Accounting", "account_import", "MAX_ATOMS"]
 
 MAX_ATOMS = 16
 """The most atoms two receptivities may read for their exclusivity to be decided by
@@ -73,9 +74,22 @@ class SilentChange:
 
 def _same(g7: str, xml: str) -> bool:
     """Whether the ``.g7`` name ``g7`` stands for the XML variable ``xml`` (ST ignores case; a
-    dotted global is flattened; several POUs prefix their own variables)."""
+    dotted global is flattened; several POUs prefix their own variables; a step's flag of a
+    shared order, ``_N_RUN_S1``, is the order ``RUN``)."""
     a, b = g7.upper(), xml.upper().replace(".", "_")
-    return a == b or a.endswith("_" + b)
+    flag = b.startswith(FLAG_PREFIX) and b[len(FLAG_PREFIX):].startswith(a + "_")
+    return a == b or a.endswith("_" + b) or flag
+
+
+def _shared(item: MeaningItem, g: Grafcet, several: bool) -> bool:
+    """``RUN := _N_RUN_S1 OR _N_RUN_S2`` (what ``synth sfc`` writes for an order several steps
+    emit): each flag's step emits the order in the ``.g7``."""
+    found = shared_assignment(f"{item.names[0]} := {item.value}")
+    if found is None:
+        return False
+    order, flags = found
+    steps = [_step(g, item.pou, f[len(FLAG_PREFIX) + len(order) + 1:], several) for f in flags]
+    return all(any(a.kind in (CONTINUOUS, CONDITIONAL) for a in _actions(s, order)) for s in steps)
 
 
 def _step(g: Grafcet, pou: str, name: str, several: bool) -> Step | None:
@@ -228,7 +242,8 @@ def silent_changes(items: list[MeaningItem], g: Grafcet, warnings: list[InputErr
     several = len({i.pou for i in items}) > 1
     checks: dict[ItemKind, Callable[[MeaningItem], str | None]] = {
         ItemKind.QUALIFIER: lambda i: _qualifier(i, g, _step(g, i.pou, i.step, several)),
-        ItemKind.ASSIGNMENT: lambda i: _assignment(i, items, g, _step(g, i.pou, i.step, several)),
+        ItemKind.ASSIGNMENT: lambda i: None if _shared(i, g, several) else
+        _assignment(i, items, g, _step(g, i.pou, i.step, several)),
         ItemKind.PRIORITY: lambda i: _divergence(i, g, several),
         ItemKind.BLOCK: lambda i: _block(i, g, warnings),
         ItemKind.TIMER: lambda i: None if _timers(g, i.duration) else f"a timer of {i.duration or 'its preset'}",
@@ -240,3 +255,28 @@ def silent_changes(items: list[MeaningItem], g: Grafcet, warnings: list[InputErr
             out.append(SilentChange(item, missing))
     return out
 
+
+
+@dataclass(frozen=True)
+class Accounting:
+    """An import and its accounting: the ``.g7`` text, the import's warnings, the items of the
+    imported POUs and the silent changes among them."""
+
+    text: str
+    warnings: tuple[InputError, ...]
+    items: tuple[MeaningItem, ...]
+    silent: tuple[SilentChange, ...]
+
+
+def account_import(data: bytes | str, file: str = "<xml>", pou: str | None = None) -> Accounting:
+    """Import the SFC POUs of ``data`` (``pou``: that one) and account for every item; a refused
+    import raises its :class:`~synth.errors.InputError`."""
+    from synth.codegen.plcopen.importer import import_sfc
+    from synth.codegen.plcopen.meaning import meaning_items
+    from synth.grafcet.language_check import parse_grafcet
+
+    warnings: list[InputError] = []
+    text = import_sfc(data, file, pou=pou, warnings=warnings)
+    g = parse_grafcet(text, file + ".g7")
+    items = meaning_items(data, file, pou)
+    return Accounting(text, tuple(warnings), tuple(items), tuple(silent_changes(items, g, warnings)))

@@ -233,6 +233,14 @@ class _Pou:
             order = "priorities " + ", ".join(p or "-" for p in priorities) if any(priorities) else "left to right"
             self.add(ItemKind.PRIORITY, ", ".join(sources), f"selection divergence after {', '.join(sources)} "
                      f"({len(branches)} branches, {order})", self.src.at(d), tuple(branches), names=tuple(sources))
+        for s in self.sfc.iterfind(q("step")):  # transitions wired to a step without a divergence
+            lid = str(s.get("localId"))
+            direct = [t for t in self.sfc.iterfind(q("transition"))
+                      if any(c.get("refLocalId") == lid for c in t.iter(q("connection")))]
+            if len(direct) > 1:
+                name = str(s.get("name", ""))
+                self.add(ItemKind.PRIORITY, name, f"{len(direct)} transitions wired to step {name} without a "
+                         "divergence", self.src.at(s), tuple(direct), names=(name,))
 
 
 def meaning_items(data: bytes | str, file: str = "<xml>", pou: str | None = None) -> list[MeaningItem]:
