@@ -81,15 +81,17 @@ def _same(g7: str, xml: str) -> bool:
     return a == b or a.endswith("_" + b) or flag
 
 
-def _shared(item: MeaningItem, g: Grafcet, several: bool) -> bool:
+def _shared(item: MeaningItem, g: Grafcet, several: bool) -> str | None:
     """``RUN := _N_RUN_S1 OR _N_RUN_S2`` (what ``synth sfc`` writes for an order several steps
-    emit): each flag's step emits the order in the ``.g7``."""
+    emit): what is missing for each flag's step to emit the order in the ``.g7``, or None."""
     found = shared_assignment(f"{item.names[0]} := {item.value}")
-    if found is None:
-        return False
+    assert found is not None
     order, flags = found
-    steps = [_step(g, item.pou, f[len(FLAG_PREFIX) + len(order) + 1:], several) for f in flags]
-    return all(any(a.kind in (CONTINUOUS, CONDITIONAL) for a in _actions(s, order)) for s in steps)
+    names = [f[len(FLAG_PREFIX) + len(order) + 1:] for f in flags]
+    silent = [n for n in names if not any(a.kind in (CONTINUOUS, CONDITIONAL)
+                                          for a in _actions(_step(g, item.pou, n, several), order))]
+    return f"the order {order} emitted by step {', '.join(silent)}" if silent else None
+
 
 
 def _step(g: Grafcet, pou: str, name: str, several: bool) -> Step | None:
@@ -242,8 +244,8 @@ def silent_changes(items: list[MeaningItem], g: Grafcet, warnings: list[InputErr
     several = len({i.pou for i in items}) > 1
     checks: dict[ItemKind, Callable[[MeaningItem], str | None]] = {
         ItemKind.QUALIFIER: lambda i: _qualifier(i, g, _step(g, i.pou, i.step, several)),
-        ItemKind.ASSIGNMENT: lambda i: None if _shared(i, g, several) else
-        _assignment(i, items, g, _step(g, i.pou, i.step, several)),
+        ItemKind.ASSIGNMENT: lambda i: _shared(i, g, several) if shared_assignment(f"{i.names[0]} := {i.value}")
+        else _assignment(i, items, g, _step(g, i.pou, i.step, several)),
         ItemKind.PRIORITY: lambda i: _divergence(i, g, several),
         ItemKind.BLOCK: lambda i: _block(i, g, warnings),
         ItemKind.TIMER: lambda i: None if _timers(g, i.duration) else f"a timer of {i.duration or 'its preset'}",
