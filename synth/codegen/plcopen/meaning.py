@@ -216,6 +216,19 @@ class _Pou:
                     self.network(n, "", (t,))
         return self.items
 
+    def upstream(self, el: Any, steps: dict[str, str], by_id: dict[str, Any], seen: frozenset[str] = frozenset()) \
+            -> list[str]:
+        """The steps in front of ``el`` through divergences and convergences (a divergence may
+        follow a branch of another)."""
+        out: list[str] = []
+        for c in el.iterfind(f"{self.q('connectionPointIn')}/{self.q('connection')}"):
+            ref = str(c.get("refLocalId"))
+            if ref in steps:
+                out.append(steps[ref])
+            elif ref in by_id and ref not in seen and re.sub(r"^\{.*\}", "", str(by_id[ref].tag)).startswith("selection"):
+                out += self.upstream(by_id[ref], steps, by_id, seen | {ref})
+        return list(dict.fromkeys(out))
+
     def divergences(self, steps: dict[str, str]) -> None:
         """One item per selection divergence with two branches or more: their order."""
         q = self.q
@@ -226,9 +239,7 @@ class _Pou:
                         if any(c.get("refLocalId") == lid for c in t.iter(q("connection")))]
             if len(branches) < 2:
                 continue
-            sources = [steps.get(str(c.get("refLocalId")), "") for c in d.iter(q("connection"))]
-            sources = [s for s in sources if s] or [str(by_id.get(str(c.get("refLocalId")), d).get("name", ""))
-                                                    for c in d.iter(q("connection"))]
+            sources = self.upstream(d, steps, by_id)
             priorities = [t.get("priority") for t in branches]
             order = "priorities " + ", ".join(p or "-" for p in priorities) if any(priorities) else "left to right"
             self.add(ItemKind.PRIORITY, ", ".join(sources), f"selection divergence after {', '.join(sources)} "
