@@ -6,8 +6,8 @@ PLC, or named by a located warning of the import. An item matched by neither is 
 What "in the ``.g7``" means, per item:
 
 * a qualifier on a variable X of step S: ``N`` a continuous or conditional action on X in S;
-  ``S``/``R`` a stored set/reset of X in S; ``D``/``L`` X under (not) a timer of that
-  duration on S, or that timer read where X was;
+  ``S``/``R`` a stored set/reset of X in S; ``D``/``L`` a conditional action on X in S
+  reading S's timer of that duration;
 * an assignment ``X := v`` of step S: ``TRUE``/``FALSE`` a stored set/reset of X in S on
   activation (``N``, ``P1``, ``S``), deactivation (``P0``) or an event (under ``IF``); an
   expression: an assignment of X in S, or, under ``N``, a conditional action on X when the
@@ -42,14 +42,15 @@ from __future__ import annotations
 import itertools
 import re
 from dataclasses import dataclass
+from fractions import Fraction
 from typing import Callable, Iterable
 
 from synth.codegen.plcopen.data import FLAG_PREFIX, duration
 from synth.codegen.plcopen.shared import shared_assignment
 from synth.codegen.plcopen.meaning import STATELESS, ItemKind, MeaningItem
 from synth.errors import InputError
-from synth.grafcet.language import ASSIGN, CONDITIONAL, CONTINUOUS, ON_DEACTIVATION, ON_EVENT, STORED, Action, \
-    Grafcet, Step, Transition, duration_seconds
+from synth.grafcet.language import ASSIGN, CONDITIONAL, CONTINUOUS, ON_DEACTIVATION, ON_EVENT, STORED, TIMER_RE, \
+    Action, Grafcet, Step, Transition, duration_seconds
 from synth.logic.expr import Edge, Expr, Var, evaluate, names
 
 __all__ = ["SilentChange", "silent_changes", "Accounting", "account_import", "MAX_ATOMS"]
@@ -93,7 +94,6 @@ def _shared(item: MeaningItem, g: Grafcet, several: bool) -> str | None:
     return f"the order {order} emitted by step {', '.join(silent)}" if silent else None
 
 
-
 def _step(g: Grafcet, pou: str, name: str, several: bool) -> Step | None:
     """The ``.g7`` step of the XML step ``name`` of POU ``pou`` (``S12`` is ``12``; with
     ``several`` POUs imported, the names are prefixed by the POU's)."""
@@ -106,14 +106,26 @@ def _actions(step: Step | None, name: str) -> list[Action]:
     return [a for a in step.actions if _same(a.order, name)] if step is not None else []
 
 
-def _timers(g: Grafcet, literal: str, step: Step | None = None) -> bool:
-    """Whether the ``.g7`` reads a timer of the TIME ``literal``'s duration (on ``step``)."""
-    d = duration(literal)
-    m = re.fullmatch(r"([0-9.]+)(ms|s|min|h)", d or "")
-    if m is None:
-        return False
-    seconds = duration_seconds(m[1], m[2])
-    return any(t.seconds == seconds and (step is None or t.step == step.name) for t in g.timers)
+def _seconds(literal: str) -> Fraction | None:
+    """The duration of a TIME literal (``T#2s``), None when it is not one."""
+    m = re.fullmatch(r"([0-9.]+)(ms|s|min|h)", duration(literal) or "")
+    return duration_seconds(m[1], m[2]) if m else None
+
+
+def _timers(g: Grafcet, literal: str) -> bool:
+    """Whether the ``.g7`` reads a timer of the TIME ``literal``'s duration."""
+    seconds = _seconds(literal)
+    return seconds is not None and any(t.seconds == seconds for t in g.timers)
+
+
+def _timed(action: Action, literal: str, step: Step) -> bool:
+    """Whether ``action``'s condition reads the timer of ``literal`` on ``step`` (``2s/X1``)."""
+    seconds = _seconds(literal)
+    for n in names(action.condition) if action.condition is not None else ():
+        m = TIMER_RE.match(n.name)
+        if m and m[3] == step.name and duration_seconds(m[1], m[2]) == seconds:
+            return True
+    return False
 
 
 def _qualifier(item: MeaningItem, g: Grafcet, step: Step | None) -> str | None:
@@ -124,8 +136,9 @@ def _qualifier(item: MeaningItem, g: Grafcet, step: Step | None) -> str | None:
         return f"a continuous action on {name}"
     if q in ("S", "R") and not any(a.kind == STORED and a.value == (q == "S") for a in acts):
         return f"a stored {'set' if q == 'S' else 'reset'} of {name}"
-    if q in ("D", "L") and not (_timers(g, item.duration, step) and (acts or item.duration)):
-        return f"{name} under a timer of {item.duration} on its step"
+    if q in ("D", "L") and not any(a.kind == CONDITIONAL and step is not None and _timed(a, item.duration, step)
+                                   for a in acts):
+        return f"{name} under the timer of {item.duration} on its step"
     if q not in ("N", "S", "R", "D", "L"):
         return f"a {q} action on {name}"
     return None
