@@ -49,7 +49,7 @@ from synth.codegen.plcopen.data import FLAG_PREFIX, duration
 from synth.codegen.plcopen.shared import shared_assignment
 from synth.codegen.plcopen.meaning import STATELESS, ItemKind, MeaningItem
 from synth.errors import InputError
-from synth.grafcet.language import ASSIGN, CONDITIONAL, CONTINUOUS, ON_DEACTIVATION, ON_EVENT, STORED, TIMER_RE, \
+from synth.grafcet.language import ASSIGN, CONDITIONAL, CONTINUOUS, ON_ACTIVATION, ON_DEACTIVATION, ON_EVENT, STORED, TIMER_RE, \
     Action, Grafcet, Step, Transition, duration_seconds
 from synth.logic.expr import Edge, Expr, Var, evaluate, names
 
@@ -152,17 +152,16 @@ def _assignment(item: MeaningItem, items: list[MeaningItem], g: Grafcet, step: S
     name, value, q = item.names[0], item.value.upper(), item.qualifier
     acts = _actions(step, name)
     constant = value in _TRUE | _FALSE
-    when = ON_EVENT if item.conditional else ON_DEACTIVATION if q == "P0" else None
+    when = ON_EVENT if item.conditional else ON_DEACTIVATION if q == "P0" else ON_ACTIVATION
     if constant:
         wanted = value in _TRUE
-        stored = [a for a in acts if a.kind == STORED and a.value == wanted and (when is None and a.when != ON_DEACTIVATION
-                                                                              or a.when == when)]
-        assigned = [a for a in acts if a.kind == ASSIGN and (when is None or a.when == when)]
+        stored = [a for a in acts if a.kind == STORED and a.value == wanted and a.when == when]
+        assigned = [a for a in acts if a.kind == ASSIGN and a.when == when]
         ends = q == "P0" and not wanted and any(a.kind in (CONTINUOUS, CONDITIONAL) for a in acts)
         if stored or assigned or ends:
             return None
         verb = "set" if wanted else "reset"
-        return f"a stored {verb} of {name}" + (f" on {when}" if when else " on activation")
+        return f"a stored {verb} of {name} on {when}"
     if any(a.kind == ASSIGN for a in acts):
         return None
     reset = any(i.kind == ItemKind.ASSIGNMENT and i.step == item.step and i.qualifier == "P0" and _same(i.names[0], name)
