@@ -55,7 +55,7 @@ from synth.logic.expr import Edge, Expr, Var, evaluate, names
 
 __all__ = ["SilentChange", "silent_changes", "Accounting", "account_import", "MAX_ATOMS"]
 
-MAX_ATOMS = 16
+MAX_ATOMS = 12
 """The most atoms two receptivities may read for their exclusivity to be decided by
 enumeration; above, the divergence counts as not shown exclusive."""
 
