@@ -119,3 +119,16 @@ def test_the_corpus_bench_counts_per_repository(tmp_path):
         "total files: 4, SFC POUs: 3, imported: 2, refused: 1, no SFC: 1, TRACEBACK: 0, items: 15, silent changes: 0",
         "refused 1: unexpected … in an ST condition",
         "silent changes: 0"]
+
+
+def test_two_transitions_wired_to_one_step_must_stay_exclusive():
+    """Beremiz's counter: Count -> Full when !go & Cnt >= 3, Count -> Start when !go & Cnt < 3,
+    both wired to step Count without a divergence; exclusive over the counter's values."""
+    done = account_import((DATA / "beremiz_counter.xml").read_bytes(), "c.xml")
+    assert [i.what for i in done.items if i.kind == ItemKind.PRIORITY] == [
+        "2 transitions wired to step Count without a divergence"]
+    assert done.silent == ()
+    overlap = done.text.replace("when !go & Cnt < 3", "when !go & Cnt < 4")
+    assert overlap != done.text
+    assert [c.expected for c in silent_changes(list(done.items), parse_grafcet(overlap, "c.g7"), [])] == [
+        "exclusive branches (!go & Cnt >= 3 and !go & Cnt < 4 may hold together)"]

@@ -43,7 +43,7 @@ import itertools
 import re
 from dataclasses import dataclass
 from fractions import Fraction
-from typing import Callable, Iterable
+from typing import Callable
 
 from synth.codegen.plcopen.data import FLAG_PREFIX, duration
 from synth.codegen.plcopen.shared import shared_assignment
@@ -51,7 +51,7 @@ from synth.codegen.plcopen.meaning import STATELESS, ItemKind, MeaningItem
 from synth.errors import InputError
 from synth.grafcet.language import ASSIGN, CONDITIONAL, CONTINUOUS, ON_ACTIVATION, ON_DEACTIVATION, ON_EVENT, STORED, TIMER_RE, \
     Action, Grafcet, Step, Transition, duration_seconds
-from synth.logic.expr import Edge, Expr, Var, evaluate, names
+from synth.logic.expr import Compare, Edge, Expr, evaluate, names
 
 __all__ = ["SilentChange", "silent_changes", "Accounting", "account_import", "MAX_ATOMS"]
 
@@ -171,27 +171,38 @@ def _assignment(item: MeaningItem, items: list[MeaningItem], g: Grafcet, step: S
     return f"an assignment of {name} kept once the step is left"
 
 
-def _atoms(exprs: Iterable[Expr]) -> list[str]:
-    return list(dict.fromkeys(n.text() for e in exprs for n in names(e)))
-
-
 def _exclusive(a: Expr, b: Expr) -> bool | None:
-    """Whether ``a & b`` never holds (its atoms, variables and edges alike, free); None when
-    they read more than :data:`MAX_ATOMS` atoms."""
-    atoms = _atoms([a, b])
-    if len(atoms) > MAX_ATOMS:
+    """Whether ``a & b`` never holds: Boolean variables and edges free, each integer variable
+    compared (``Cnt >= 3``) taken around every constant it is compared with; None when there are
+    more than :data:`MAX_ATOMS` Boolean atoms or ``2 ** MAX_ATOMS`` cases in all."""
+    atoms = list(dict.fromkeys(n for e in (a, b) for n in names(e)))
+    compares = [n for n in atoms if isinstance(n, Compare)]
+    flags = list(dict.fromkeys(n.text() if isinstance(n, Edge) else n.name for n in atoms if not isinstance(n, Compare)))
+    around: dict[str, set[int]] = {}
+    for c in compares:
+        for x in c.operands():
+            around.setdefault(x, {0})
+        if isinstance(c.right, int):
+            around[c.left] |= {c.right - 1, c.right, c.right + 1}
+    numbers = sorted(around)
+    cases = 2 ** len(flags)
+    for x in numbers:
+        cases *= len(around[x])
+    if len(flags) > MAX_ATOMS or cases > 2 ** MAX_ATOMS:
         return None
-    for bits in itertools.product((False, True), repeat=len(atoms)):
-        values = dict(zip(atoms, bits))
+    by_name = {c.name: c for c in compares}
+    for bits in itertools.product((False, True), repeat=len(flags)):
+        for ints in itertools.product(*(sorted(around[x]) for x in numbers)):
+            v, counts = dict(zip(flags, bits)), dict(zip(numbers, ints))
 
-        def edge(e: Edge, v: dict[str, bool] = values) -> bool:
-            return v[e.text()]
+            def value(n: str, v: dict[str, bool] = v, counts: dict[str, int] = counts) -> bool:
+                return by_name[n].holds(counts) if n in by_name else v.get(n, False)
 
-        def value(n: str, v: dict[str, bool] = values) -> bool:
-            return v[Var(n).text()] if n in v else False
+            def edge(e: Edge, v: dict[str, bool] = v) -> bool:
+                return v[e.text()]
 
-        if evaluate(a, value, edge) and evaluate(b, value, edge):
-            return False
+            if evaluate(a, value, edge) and evaluate(b, value, edge):
+                return False
     return True
 
 
