@@ -148,8 +148,9 @@ def blink_charts(pou: Any, sfc: Any, q: Callable[[str], str], at: Callable[[Any]
         scope.warnings.append(InputError(
             f"the LD action {name} (run while {enable} holds) blinks {light}: {ton_set.get('instanceName')} "
             f"(IN:=NOT {light}, PT:={pt_set}) sets it{_through(trig_set)}, {ton_reset.get('instanceName')} "
-            f"(IN:={light}, PT:={pt_reset}) resets it{_through(trig_reset)}; read as the partial grafcet {name}, whose steps {off} and {on} ({light} set on its "
-            f"activation, reset on its deactivation) alternate after {d_set} and {d_reset} while {enable} holds (the "
+            f"(IN:={light}, PT:={pt_reset}) resets it{_through(trig_reset)}; read as the partial grafcet {name}, "
+            f"whose steps {off} and {on} ({light} set on its activation, reset on its deactivation) alternate after "
+            f"{d_set} and {d_reset} while {enable} holds (the "
             f"PLC's phase is {light} itself, which other steps may set or reset; the grafcet's phase is its step, and "
             "its timers run while the action is not called, as a TON called again with IN still TRUE counts from "
             "when IN rose)", at(ton_set), severity=Severity.WARNING))
