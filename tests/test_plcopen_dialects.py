@@ -613,7 +613,8 @@ grafcet ASKED_SR {
         "timer 5s/XRun: IEC 61131-3 makes it TRUE from 5s after the step's activation until its deactivation, as the "
         "timer",
         "l.xml:47:17: warning: the LD action BLINK (run while XIdle holds) blinks LAMP: T_OFF (IN:=NOT LAMP, "
-        "PT:=T#700ms) sets it, T_ON (IN:=LAMP, PT:=T#300ms) resets it; read as the partial grafcet BLINK, whose steps "
+        "PT:=T#700ms) sets it on the rising edge of its Q (R_TRIG UP), T_ON (IN:=LAMP, PT:=T#300ms) resets it on the "
+        "rising edge of its Q (R_TRIG DOWN); read as the partial grafcet BLINK, whose steps "
         "BLINK_off and BLINK_on (LAMP set on its activation, reset on its deactivation) alternate after 700ms and "
         "300ms while XIdle holds (the PLC's phase is LAMP itself, which other steps may set or reset; the grafcet's "
         "phase is its step, and its timers run while the action is not called, as a TON called again with IN still "

@@ -30,7 +30,7 @@ from iec2c import CompiledProgram, find_iec2c
 from test_sfc_meaning import GRAFCETS, SHARED
 from synth.codegen.plcopen.export import sfc_project_xml
 from synth.codegen.plcopen.tc6 import sfc_step_name
-from synth.codegen.program import StProgram, case_aliases, program_name
+from synth.codegen.program import StProgram, case_aliases
 from synth.codegen.st import Declaration, Pou, PouKind, SectionKind, VarSection
 from synth.grafcet.language import Grafcet, Semantics, Transition
 from synth.grafcet.language_check import load_grafcet, parse_grafcet
@@ -112,7 +112,9 @@ def run_on_plc(g: Grafcet, folder: Path, seeds: range, scans: int, period: int =
     difference of each sequence ends it."""
     g = replace(g, semantics=Semantics.SFC)
     folder.mkdir(parents=True, exist_ok=True)
-    (folder / "plc.xml").write_bytes(sfc_project_xml(g, version="test"))
+    xml = sfc_project_xml(g, version="test")
+    (folder / "plc.xml").write_bytes(xml)
+    name = re.search(rb'<pou name="([^"]+)"', xml)[1].decode()  # type: ignore[index]  # clamp.g7: clamp_1
     done = beremiz_program(folder / "plc.xml", folder / "generated.st")
     assert done.returncode == 0, done.stderr
     text = (folder / "generated.st").read_text()
@@ -120,7 +122,7 @@ def run_on_plc(g: Grafcet, folder: Path, seeds: range, scans: int, period: int =
     st = {n: alias.get(n, n) for n in (*g.inputs, *g.outputs)}
     declared = program_inputs(text)
     edges = {n: (m[1] == "RE", next(x for x in g.inputs if st[x] == m[2])) for n in declared if (m := EDGE.fullmatch(n))}
-    pou = Pou(PouKind.PROGRAM, program_name(g.path), (
+    pou = Pou(PouKind.PROGRAM, name, (
         VarSection(SectionKind.INPUT, tuple(Declaration(n) for n in declared)),
         VarSection(SectionKind.OUTPUT, tuple(Declaration(st[o]) for o in g.outputs)),
         VarSection(SectionKind.LOCAL, tuple(Declaration(f"{sfc_step_name(s.name)}.X") for s in g.steps))), ())

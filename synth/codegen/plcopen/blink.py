@@ -40,9 +40,14 @@ from synth.errors import InputError, Location, Severity
 __all__ = ["blinker", "blink_charts"]
 
 
-def blinker(ld: Any, q: Callable[[str], str]) -> tuple[str, tuple[Any, str, str], tuple[Any, str, str]] | None:
-    """``(V, (TON, PT text, duration) setting V, (TON, PT text, duration) resetting V)`` when the
-    LD body ``ld`` is a blinker of ``V`` (see the module doc), else None."""
+Rung = tuple[Any, str, str, str]
+"""One rung of a blinker: its TON, the PT text, the duration, the R_TRIG between the TON and
+the coil (its instance name, or ``""`` when the TON drives the coil directly)."""
+
+
+def blinker(ld: Any, q: Callable[[str], str]) -> tuple[str, Rung, Rung] | None:
+    """``(V, rung setting V, rung resetting V)`` when the LD body ``ld`` is a blinker of ``V``
+    (see the module doc), else None."""
     from lxml import etree
 
     elements = {int(str(el.get("localId"))): el for el in ld
@@ -68,11 +73,13 @@ def blinker(ld: Any, q: Callable[[str], str]) -> tuple[str, tuple[Any, str, str]
     light = names.pop()
     used: set[int] = set()
 
-    def rung(coil: Any) -> tuple[Any, str, str] | None:
+    def rung(coil: Any) -> Rung | None:
         used.add(id(coil))
         x = feed(coil)
+        trig = ""
         if x is not None and kind(x) == "block" and str(x.get("typeName", "")).upper() == "R_TRIG":
             used.add(id(x))
+            trig = str(x.get("instanceName", "") or "R_TRIG")
             x = block_input(x, "CLK")
         if x is None or kind(x) != "block" or str(x.get("typeName", "")).upper() != "TON":
             return None
@@ -90,12 +97,18 @@ def blinker(ld: Any, q: Callable[[str], str]) -> tuple[str, tuple[Any, str, str]
         if d is None:
             return None
         used.update({id(x), id(contact), id(pt), id(rail)})
-        return x, text, d
+        return x, text, d, trig
 
     by_storage = {c.get("storage"): rung(c) for c in coils}
     on, off = by_storage["set"], by_storage["reset"]
     left = [el for el in elements.values() if id(el) not in used and kind(el) not in ("rightPowerRail", "comment")]
     return (light, on, off) if on is not None and off is not None and not left else None
+
+
+def _through(trig: str) -> str:
+    """How a rung's TON reaches its coil, for the warning: through an R_TRIG (on the rising
+    edge of its Q, as the step's activation does), or directly."""
+    return f" on the rising edge of its Q (R_TRIG {trig})" if trig else ""
 
 
 def blink_charts(pou: Any, sfc: Any, q: Callable[[str], str], at: Callable[[Any], Location], prefix: str,
@@ -122,7 +135,7 @@ def blink_charts(pou: Any, sfc: Any, q: Callable[[str], str], at: Callable[[Any]
         found = blinker(bodies[name], q)
         if found is None:
             continue
-        light, (ton_set, pt_set, d_set), (ton_reset, pt_reset, d_reset) = found
+        light, (ton_set, pt_set, d_set, trig_set), (ton_reset, pt_reset, d_reset, trig_reset) = found
         off, on = f"{prefix}{name}_off", f"{prefix}{name}_on"
         enable = f"X{steps[0]}" if len(steps) == 1 else "(" + " | ".join(f"X{s}" for s in steps) + ")"
         scope.extra_charts.append((name, [(off, True, []), (on, False, [f"set {light} on activation",
@@ -134,9 +147,10 @@ def blink_charts(pou: Any, sfc: Any, q: Callable[[str], str], at: Callable[[Any]
             scope.action_refs.append(light)
         scope.warnings.append(InputError(
             f"the LD action {name} (run while {enable} holds) blinks {light}: {ton_set.get('instanceName')} "
-            f"(IN:=NOT {light}, PT:={pt_set}) sets it, {ton_reset.get('instanceName')} (IN:={light}, PT:={pt_reset}) "
-            f"resets it; read as the partial grafcet {name}, whose steps {off} and {on} ({light} set on its "
-            f"activation, reset on its deactivation) alternate after {d_set} and {d_reset} while {enable} holds (the "
+            f"(IN:=NOT {light}, PT:={pt_set}) sets it{_through(trig_set)}, {ton_reset.get('instanceName')} "
+            f"(IN:={light}, PT:={pt_reset}) resets it{_through(trig_reset)}; read as the partial grafcet {name}, "
+            f"whose steps {off} and {on} ({light} set on its activation, reset on its deactivation) alternate after "
+            f"{d_set} and {d_reset} while {enable} holds (the "
             f"PLC's phase is {light} itself, which other steps may set or reset; the grafcet's phase is its step, and "
             "its timers run while the action is not called, as a TON called again with IN still TRUE counts from "
             "when IN rose)", at(ton_set), severity=Severity.WARNING))

@@ -10,10 +10,8 @@
 
 Mapping (:mod:`synth.codegen.plcopen.importer` reads it back):
 
-=====================================  ==========================================
-``.g7``                                SFC
-=====================================  ==========================================
-step ``12`` / ``wait``                  ``<step name="S12">`` / ``name="wait"``
+=====================================  ===================================``.g7``                                SFC
+=====================================  ===================================step ``12`` / ``wait``                  ``<step name="S12">`` / ``name="wait"``
 ``X12``                                 ``S12.X``
 ``2s/X12``                              ``(S12.T >= T#2s)`` (the TIME literal of ``synth st``)
 ``↑x`` / ``↓x``                         inputs ``_RE_x`` / ``_FE_x`` (set by the caller, see docs/codegen.md)
@@ -23,8 +21,7 @@ step ``12`` / ``wait``                  ``<step name="S12">`` / ``name="wait"``
 ``set A`` / ``reset A`` on activation   qualifier ``S`` / ``R``, reference ``A``
 ``set A on deactivation``               qualifier ``P0``, inline ST ``A := TRUE;``
 ``set A on ↑p``                         qualifier ``N``, inline ``IF _RE_p THEN A := TRUE; END_IF;``
-=====================================  ==========================================
-
+=====================================  ===================================
 Plant names differing only in case (``a`` and ``A``) are renamed as ``synth st`` renames
 them (:func:`~synth.codegen.program.case_aliases`); the project's comment lists the renames.
 
@@ -56,7 +53,7 @@ from synth.codegen.plcopen.tc6 import (
 from synth.codegen.program import Configuration, case_aliases, check_variable_name, first_location, program_name, renamed_note
 from synth.codegen.st import Pou, PouKind, st_expr, timer_literal
 from synth.codegen.twincat import object_id
-from synth.errors import InputError
+from synth.errors import InputError, Location
 from synth.codegen.st_internals import compare_text, declarations as internal_declarations, sum_text
 from synth.grafcet.language import (
     ASSIGN,
@@ -108,6 +105,23 @@ def st_project_xml(pous: Sequence[Pou], *, name: str = "synth", version: str | N
         configs.append(element("configuration", {"name": config.name},
                                element("resource", {"name": config.resource}, task)))
     return project(name, version or synth_version(), comment, out, configs, extra)
+
+
+def _program_name(name: str, default: bool, declared: Sequence[str]) -> str:
+    """The ``PROGRAM``'s name, distinct from every name it declares (IEC 61131-3 ignores case:
+    ``PROGRAM clamp`` cannot declare ``CLAMP``, MATIEC refuses it): a default name (the file's
+    stem) gets ``_1``, ``_2``, ...; a name the user gave is a located error."""
+    taken = {n.upper() for n in declared}
+    if name.upper() not in taken:
+        return name
+    if not default:
+        raise InputError(f"the program name {name} is also the name of a variable or step of the chart (IEC 61131-3 "
+                         "ignores case)", Location("--name", 1, 1, name, max(1, len(name))),
+                         notes=("choose another --name",))
+    k = 1
+    while f"{name}_{k}".upper() in taken:
+        k += 1
+    return f"{name}_{k}"
 
 
 class _Names:
@@ -323,6 +337,8 @@ def sfc_project_xml(g: Grafcet, *, name: str | None = None, version: str | None 
                                   element("documentation", None, xhtml(f"the flag of step {s.name}, read before the "
                                                                        "step's declaration", cdata=False))))
         iface.append(vl)
+    pou_name = _program_name(pou_name, name is None, [*(str(v.get("name")) for v in iface.iter() if v.get("name")),
+                                                      *(sfc_step_name(s.name) for s in g.steps)])
     pou = element("pou", {"name": pou_name, "pouType": "program"}, iface, element("body", None, body))
     if names.alias:
         comment = "\n".join(c for c in (comment, renamed_note(names.alias)) if c)
