@@ -94,7 +94,7 @@ def test_what_synth_sfc_writes_comes_back_without_a_silent_change(name):
         changes = silent_changes(list(done.items), parse_grafcet(lost, "t.g7"), list(done.warnings))
         assert len(changes) == 10  # the shared assignment on each of the 9 initial steps, and step S112's flag
         assert changes[0].expected == "the order AVANCER1 emitted by step S112"
-        assert changes[5].text() == ("tri.g7.xml:478: N action on _N_AVANCER1_S112 (step S112): not in the .g7 as a "
+        assert changes[5].text() == ("tri.g7.xml:572: N action on _N_AVANCER1_S112 (step S112): not in the .g7 as a "
                                      "continuous action on _N_AVANCER1_S112, and no warning names it")
 
 

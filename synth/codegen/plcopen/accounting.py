@@ -46,6 +46,7 @@ from fractions import Fraction
 from typing import Callable
 
 from synth.codegen.plcopen.data import FLAG_PREFIX, duration
+from synth.codegen.plcopen.mirrors import MIRROR_PREFIX
 from synth.codegen.plcopen.shared import shared_assignment
 from synth.codegen.plcopen.meaning import STATELESS, ItemKind, MeaningItem
 from synth.errors import InputError
@@ -131,6 +132,8 @@ def _timed(action: Action, literal: str, step: Step) -> bool:
 def _qualifier(item: MeaningItem, g: Grafcet, step: Step | None) -> str | None:
     """What is missing for a qualifier item, or None."""
     name, q = item.names[0], item.qualifier
+    if q == "N" and name.upper() == f"{MIRROR_PREFIX}{item.step}".upper():
+        return None  # the step's own mirror (synth sfc): its flag, which every .g7 step has
     acts = _actions(step, name)
     if q == "N" and not any(a.kind in (CONTINUOUS, CONDITIONAL) for a in acts):
         return f"a continuous action on {name}"
