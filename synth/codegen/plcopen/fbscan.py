@@ -96,42 +96,53 @@ def _top(x: str) -> str:
 
 
 def negation(x: str) -> str:
+    if x in ("0", "1"):
+        return "1" if x == "0" else "0"
     return x[1:] if re.fullmatch(r"![\w/.↑↓]+", x) else "!" + _atom(x)
 
 
 def _and(*xs: str) -> str:
-    return " & ".join(f"({x})" if "|" in _top(x) else x for x in xs)
+    if "0" in xs:
+        return "0"
+    return " & ".join(f"({x})" if "|" in _top(x) else x for x in xs if x != "1") or "1"
 
 
 def _or(*xs: str) -> str:
-    return " | ".join(xs)
+    if "1" in xs:
+        return "1"
+    return " | ".join(x for x in xs if x != "0") or "0"
+
+
+def _chart(name: str, steps: list[str], moves: list[tuple[str, str, str]]) -> HelperChart:
+    """A partial grafcet: ``steps`` (the first initial), ``moves`` (source, target, receptivity)
+    but those that never fire (receptivity 0)."""
+    return (name, [(s, i == 0, []) for i, s in enumerate(steps)], [([a], [b], r) for a, b, r in moves if r != "0"])
 
 
 def two_step(name: str, off: str, on: str, up: str, down: str) -> HelperChart:
-    return (name, [(off, True, []), (on, False, [])], [([off], [on], up), ([on], [off], down)])
+    return _chart(name, [off, on], [(off, on, up), (on, off, down)])
 
 
 def rising_chart(name: str, clk: str) -> HelperChart:
     """The partial grafcet of ``R_TRIG`` ``name`` of ``clk``: ``Q := CLK AND NOT M; M := CLK``."""
     off, q, held = f"{name}_off", f"{name}_q", f"{name}_held"
-    return (f"{name}_R_TRIG", [(off, True, []), (q, False, []), (held, False, [])],
-            [([off], [q], clk), ([q], [held], clk), ([q], [off], negation(clk)), ([held], [off], negation(clk))])
+    return _chart(f"{name}_R_TRIG", [off, q, held],
+                  [(off, q, clk), (q, held, clk), (q, off, negation(clk)), (held, off, negation(clk))])
 
 
 def _falling_chart(name: str, clk: str) -> HelperChart:
     """``F_TRIG``: ``Q := NOT CLK AND M; M := CLK`` (M FALSE at the first call)."""
     off, hi, q = f"{name}_off", f"{name}_hi", f"{name}_q"
-    return (f"{name}_F_TRIG", [(off, True, []), (hi, False, []), (q, False, [])],
-            [([off], [hi], clk), ([hi], [q], negation(clk)), ([q], [hi], clk), ([q], [off], negation(clk))])
+    return _chart(f"{name}_F_TRIG", [off, hi, q],
+                  [(off, hi, clk), (hi, q, negation(clk)), (q, hi, clk), (q, off, negation(clk))])
 
 
 def _ton_chart(name: str, on: str, pt: str) -> HelperChart:
     """MATIEC's ``TON``: STATE 0 -> 1 when IN rises (START_TIME := now), 1 -> 2 (Q) when IN and
     START_TIME + PT <= now, any -> 0 when IN is FALSE."""
     off, timing, q = f"{name}_off", f"{name}_timing", f"{name}_q"
-    return (f"{name}_TON", [(off, True, []), (timing, False, []), (q, False, [])],
-            [([off], [timing], on), ([timing], [off], negation(on)), ([timing], [q], _and(on, f"{pt}/X{timing}")),
-             ([q], [off], negation(on))])
+    return _chart(f"{name}_TON", [off, timing, q], [(off, timing, on), (timing, off, negation(on)),
+                                                    (timing, q, _and(on, f"{pt}/X{timing}")), (q, off, negation(on))])
 
 
 def scan_block(el: Any, params: dict[str, tuple[Callable[[], str], Any]], by_block: bool, where: Location,
