@@ -24,6 +24,8 @@ from synth.codegen.plcopen.vendor import Dialect, dialect_of
 from synth.errors import InputError
 from synth.grafcet.language_check import parse_grafcet
 
+DATA = Path(__file__).resolve().parent / "data" / "plcopen"
+
 HEAD = """<?xml version='1.0' encoding='utf-8'?>
 <project xmlns:ns1="http://www.plcopen.org/xml/tc6_0201" xmlns:xhtml="http://www.w3.org/1999/xhtml" xmlns:xsd="http://www.w3.org/2001/XMLSchema" xmlns="http://www.plcopen.org/xml/tc6_0201">
   <fileHeader companyName="Unknown" productName="Unnamed" productVersion="1" creationDateTime="2024-05-02T10:00:00"/>
@@ -296,7 +298,24 @@ def test_a_transition_leaving_the_initial_step_at_the_first_scan_is_warned():
 
 needs_plc = pytest.mark.skipif(find_beremiz() is None or find_iec2c() is None or shutil.which("gcc") is None,
                                reason="Beremiz (SYNTH_BEREMIZ, SYNTH_BEREMIZ_PYTHON), iec2c and gcc are not here")
-FIXTURES = {"R_TRIG": R_TRIG, "SR": SR, "TON": TON}
+LD = (DATA / "beremiz_ld_fbd.xml").read_text().replace('<contact localId="21" height="15" width="21" negated="false">',
+                                                      '<contact localId="21" height="15" width="21" negated="false" '
+                                                      'edge="rising">').replace('name="On"', 'name="Lit"').replace(
+    '<pou name="lamp"', '<pou name="lamps"')
+"""LD contacts ↑a and NOT b (Beremiz adds an R_TRIG for the edge), a NOT in a named FBD transition (step On
+renamed Lit: ON is a word of MATIEC's; the POU lamps: LAMP is its output and MATIEC's names ignore case)."""
+FIXTURES = {"R_TRIG": R_TRIG, "SR": SR, "TON": TON, "LD": LD}
+
+
+def test_an_edge_contact_is_the_r_trig_beremiz_adds():
+    text, warnings = imported(LD)
+    assert text.split("grafcet R_TRIG21_R_TRIG {")[0].endswith(
+        "  transition Idle -> Lit when (XR_TRIG21_q) & !b\n  transition Lit -> Idle when XNOT42_on\n}\n")
+    assert "  transition R_TRIG21_off -> R_TRIG21_q when a\n" in text
+    assert warnings[0].startswith("b.xml:75:13: warning: the rising edge of a (an R_TRIG Beremiz adds) in a transition "
+                                  "network of a file written by Beremiz")
+    negated = LD.replace('negated="false" edge="rising"', 'negated="true" edge="rising"')
+    assert "  transition Idle -> Lit when (!(a)) & !b\n" in imported(negated)[0]  # Beremiz: NOT(a), the edge ignored
 
 
 def on_plc(xml: str, g7: str, folder: Path) -> Outcome:
@@ -307,7 +326,8 @@ def on_plc(xml: str, g7: str, folder: Path) -> Outcome:
     text = beremiz_text(folder / "b.xml", folder / "generated.st")
     assert "COMPUTE_FUNCTION_BLOCKS(S);" in text
     names = {n: n for n in (*g.inputs, *g.outputs)}
-    return play(g, PlcProgram(text, "cell", PouKind.PROGRAM, names, {"Idle": "Idle", "Busy": "Busy"}), folder,
+    steps = {s.name: s.name for s in g.steps if "_" not in s.name}  # the chart's, not the blocks'
+    return play(g, PlcProgram(text, re.findall(r'<pou name="(\w+)"', xml)[0], PouKind.PROGRAM, names, steps), folder,
                 range(SEQUENCES), SCANS)
 
 

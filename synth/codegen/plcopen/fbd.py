@@ -70,6 +70,9 @@ def fbd_condition(cond: Any, elements: dict[int, Any], q: Callable[[str], str], 
         name = (ex.text or "").strip() if ex is not None and by_block else ""
         flag = step_flag(name, elements, steps) if re.fullmatch(r"[A-Za-z_]\w*", name) else None
         arg = flag or node(int(fed.get("localId")), inner, by_block)
+        if every_scan() and var.get("edge", "none") in ("rising", "falling") and not _negated(var):
+            arg = scan_block(var, {"CLK": ((lambda x=arg: x), fed)}, by_block, src.at(var), lambda: ("", None),
+                             lambda x: lagging(x, steps), var.get("edge"))
         if not wrap:
             return negation(arg) if _negated(var) else arg
         return f"!({arg})" if _negated(var) else f"({arg})"
@@ -143,7 +146,10 @@ def fbd_condition(cond: Any, elements: dict[int, Any], q: Callable[[str], str], 
             reader = ExprReader(name, lambda off, w, h=var, t=name: src.text_at(h, t, off, w), steps)
             literal = reader.whole()
             edge = el.get("edge", "none")
-            if edge in ("rising", "falling"):
+            if edge in ("rising", "falling") and every_scan() and not _negated(el):  # Beremiz: an R_TRIG/F_TRIG
+                literal = scan_block(el, {"CLK": ((lambda x=literal: x), var)}, False, src.at(el), lambda: ("", None),
+                                     lambda x: lagging(x, steps), edge)
+            elif edge in ("rising", "falling") and not every_scan():
                 literal = ("↑" if edge == "rising" else "↓") + literal
             if _negated(el):
                 literal = f"!{literal}" if edge == "none" else f"!({literal})"

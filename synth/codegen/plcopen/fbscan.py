@@ -146,21 +146,24 @@ def _ton_chart(name: str, on: str, pt: str) -> HelperChart:
 
 
 def scan_block(el: Any, params: dict[str, tuple[Callable[[], str], Any]], by_block: bool, where: Location,
-               pt_text: Callable[[], tuple[str, Location]], lag: Callable[[str], str | None]) -> str:
+               pt_text: Callable[[], tuple[str, Location]], lag: Callable[[str], str | None],
+               edge: str = "") -> str:
     """The value of block ``el`` read by a transition (its output of the previous scan) or, when
     ``by_block``, by the input of a block Beremiz calls after it (of this scan, unless in a loop).
-    ``params``: each input's reader (called in file order, as Beremiz does) and element."""
+    ``params``: each input's reader (called in file order, as Beremiz does) and element. With
+    ``edge`` (``rising``/``falling``), ``el`` is a contact or a block input with that edge, which
+    Beremiz writes as an ``R_TRIG``/``F_TRIG`` of its variable (``params``: its ``CLK``)."""
     scope = DATA.get()
     assert scope is not None
-    kind = str(el.get("typeName") or "").upper()
+    kind = ("R_TRIG" if edge == "rising" else "F_TRIG") if edge else str(el.get("typeName") or "").upper()
     path = el.getroottree().getpath(el)
     call = scope.scan_calls.get(path)
     if call is None:
-        name = str(el.get("instanceName") or "") or f"{kind}{el.get('localId')}"
+        name = str(el.get("instanceName") or "") or f"{kind}{el.get('localId') or len(scope.scan_calls)}"
         full = f"{scope.prefix}{name}"
         state = f"X{full}_on" if kind in LATCH_BLOCKS else f"X{full}_q" if kind in ("R_TRIG", "F_TRIG", "TON") else ""
         call = scope.scan_calls[path] = Call(full, kind, before=state)  # its state: read in a loop
-        _run(call, el, params, where, pt_text, lag, scope)
+        _run(call, params, where, pt_text, lag, scope, f"the {edge} edge of {{}} (an {kind} Beremiz adds)" if edge else "")
     if by_block and call.now is not None:
         return call.now
     if not call.before:  # a function: its register
@@ -182,9 +185,11 @@ def _who(scope: DataScope) -> str:
     return f"{scope.dialect[0].value} ({scope.dialect[1]})"
 
 
-def _run(call: Call, el: Any, params: dict[str, tuple[Callable[[], str], Any]], where: Location,
-         pt_text: Callable[[], tuple[str, Location]], lag: Callable[[str], str | None], scope: DataScope) -> None:
-    """Call ``el`` once: read its inputs, make its partial grafcet, set ``call.now``."""
+def _run(call: Call, params: dict[str, tuple[Callable[[], str], Any]], where: Location,
+         pt_text: Callable[[], tuple[str, Location]], lag: Callable[[str], str | None], scope: DataScope,
+         label: str) -> None:
+    """Call the block once: read its inputs, make its partial grafcet, set ``call.now``
+    (``label``: how to name it, ``{}`` standing for CLK, when it is an edge Beremiz adds)."""
     kind, name = call.kind, call.name
     missing = [p for p in SCAN_BLOCKS[kind] if p not in params]
     if missing:
@@ -194,7 +199,8 @@ def _run(call: Call, el: Any, params: dict[str, tuple[Callable[[], str], Any]], 
     values = {p: read() for p, (read, _) in params.items() if p != "PT"}
     late = sorted({x for v in values.values() if (x := lag(v)) is not None})
     short = name.removeprefix(scope.prefix)
-    what = f"the {kind} {short} in a transition network of a file written by {_who(scope)}: {COMPUTE}"
+    named = label.format(values.get("CLK", "")) if label else f"the {kind} {short}"
+    what = f"{named} in a transition network of a file written by {_who(scope)}: {COMPUTE}"
     if kind in ("AND", "OR", "NOT", "SEL"):
         args = list(values.values())
         call.now = (_and(*args) if kind == "AND" else _or(*args) if kind == "OR" else negation(args[0]) if kind == "NOT"
@@ -232,7 +238,7 @@ def _run(call: Call, el: Any, params: dict[str, tuple[Callable[[], str], Any]], 
                    f"({on}) rises, step {name}_q ({short}.Q) once {pt} have elapsed, both left when IN falls", where)
     for x in late:
         scope.warnings.append(InputError(
-            f"the {kind} {short} reads {x}, which the PLC's scan sets before it calls the block (steps updated, "
+            f"{named} reads {x}, which the PLC's scan sets before it calls the block (steps updated, "
             f"actions run): the block sees this scan's value, the .g7 partial grafcet the previous scan's (one scan "
             "later)", where, severity=Severity.WARNING))
 
