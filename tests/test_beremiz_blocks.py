@@ -282,18 +282,39 @@ def test_the_tool_that_wrote_the_file_is_read_from_its_file_header(header, diale
     assert found == (dialect, f"fileHeader {header}")
 
 
-def test_a_transition_leaving_the_initial_step_at_the_first_scan_is_warned():
-    """Beremiz sets COMPUTE_FUNCTION_BLOCKS (S) after the first scan only if the initial step is
-    still active: Idle -> Busy on go (an inVariable, not a block) may leave it at once."""
-    xml = project({"R_TRIG0": "R_TRIG"}, "12", "20.Q", invar(10, "btn"), invar(12, "go"),
-                  block(20, "R_TRIG", "R_TRIG0", [("CLK", "10")], "Q"))
-    text, warnings = imported(xml)
-    assert "  transition Idle -> Busy when go\n  transition Busy -> Idle when XR_TRIG0_q\n" in text
+FIRST = project({"R_TRIG0": "R_TRIG"}, "12", "20.Q", invar(10, "btn"), invar(12, "go"),
+                block(20, "R_TRIG", "R_TRIG0", [("CLK", "10")], "Q"))
+"""Idle -> Busy on go (an inVariable: it may fire at the first scan), Busy -> Idle on R_TRIG0(btn)."""
+
+
+def test_blocks_wait_for_the_initial_step_to_stay_active_after_a_scan():
+    """Beremiz's S action COMPUTE_FUNCTION_BLOCKS is stored at the end of a scan after which its
+    initial step is active: when Idle is left at the first scan, no block runs until Idle is
+    active again after a scan."""
+    text, warnings = imported(FIRST)
+    guard = "(XCOMPUTE_FUNCTION_BLOCKS_on | XIdle & !(XIdle & go) | XBusy & XR_TRIG0_q)"
+    assert text == CHART % ("go", "XR_TRIG0_q") + f"""grafcet R_TRIG0_R_TRIG {{
+  initial step R_TRIG0_off
+  step R_TRIG0_q
+  step R_TRIG0_held
+  transition R_TRIG0_off -> R_TRIG0_q when {guard} & btn
+  transition R_TRIG0_q -> R_TRIG0_held when {guard} & btn
+  transition R_TRIG0_q -> R_TRIG0_off when {guard} & !btn
+  transition R_TRIG0_held -> R_TRIG0_off when {guard} & !btn
+}}
+grafcet COMPUTE_FUNCTION_BLOCKS {{
+  initial step COMPUTE_FUNCTION_BLOCKS_off
+  step COMPUTE_FUNCTION_BLOCKS_on
+  transition COMPUTE_FUNCTION_BLOCKS_off -> COMPUTE_FUNCTION_BLOCKS_on when XIdle & !(XIdle & go) | XBusy & XR_TRIG0_q
+}}
+"""
     assert warnings[0] == (
         "b.xml:29:13: warning: Beremiz stores COMPUTE_FUNCTION_BLOCKS (the blocks of the transition networks) on "
-        "initial step Idle: it calls them from the first scan after which Idle is active; when a transition leaving "
-        "Idle fires at the first scan (go), the PLC calls no block until Idle is active again after a scan, while the "
-        ".g7 evaluates them from the first scan")
+        "initial step Idle: the PLC calls them at the end of each scan after which Idle is active, then at every scan; "
+        "a transition leaving Idle may fire at the first scan (go), so the blocks' partial grafcets move only when step "
+        "COMPUTE_FUNCTION_BLOCKS_on of the partial grafcet COMPUTE_FUNCTION_BLOCKS (the action stored) is active or "
+        "Idle is active after the scan")
+    assert not any("COMPUTE_FUNCTION_BLOCKS (the blocks" in w for w in imported(R_TRIG)[1])  # Idle waits for a block
 
 
 needs_plc = pytest.mark.skipif(find_beremiz() is None or find_iec2c() is None or shutil.which("gcc") is None,
@@ -304,7 +325,7 @@ LD = (DATA / "beremiz_ld_fbd.xml").read_text().replace('<contact localId="21" he
     '<pou name="lamp"', '<pou name="lamps"')
 """LD contacts ↑a and NOT b (Beremiz adds an R_TRIG for the edge), a NOT in a named FBD transition (step On
 renamed Lit: ON is a word of MATIEC's; the POU lamps: LAMP is its output and MATIEC's names ignore case)."""
-FIXTURES = {"R_TRIG": R_TRIG, "SR": SR, "TON": TON, "LD": LD}
+FIXTURES = {"R_TRIG": R_TRIG, "SR": SR, "TON": TON, "LD": LD, "FIRST": FIRST}
 
 
 def test_an_edge_contact_is_the_r_trig_beremiz_adds():
@@ -339,7 +360,10 @@ def test_on_the_plc_the_blocks_evolve_as_their_partial_grafcets(name, tmp_path):
     out = on_plc(xml, g7, tmp_path)
     assert [d.text() for d in out.differences] == [] and out.scans == SEQUENCES * SCANS
     g = parse_grafcet(g7, "b.g7")
-    first_scan = ["TON0_off->TON0_timing"] if name == "TON" else []  # fired by the first scan, before those counted
+    # fired by the first scan, before the scans counted (FIRST: seeds 1, 3, 4 and 8 start with go, leave Idle at
+    # once and stay in Busy, the blocks never called, on the PLC as in the .g7)
+    first_scan = {"TON": ["TON0_off->TON0_timing"],
+                  "FIRST": ["COMPUTE_FUNCTION_BLOCKS_off->COMPUTE_FUNCTION_BLOCKS_on"]}.get(name, [])
     assert [t.name for t in g.transitions if t not in out.fired] == first_scan
 
 
@@ -349,3 +373,14 @@ def test_on_the_plc_the_reading_called_while_the_transition_is_evaluated_differs
     for name in ("R_TRIG", "SR"):
         out = on_plc(FIXTURES[name], import_sfc(as_codesys(FIXTURES[name]).encode(), "b.xml"), tmp_path / name)
         assert len(out.differences) >= SEQUENCES // 2, name
+
+
+@needs_plc
+def test_on_the_plc_blocks_called_from_the_first_scan_would_differ(tmp_path):
+    """FIRST without its guard (the blocks' moves from the first scan): the 4 sequences that start
+    with go (seeds 1, 3, 4, 8) leave Idle at once; the PLC then never calls R_TRIG0, the .g7 would."""
+    g7 = import_sfc(FIRST.encode(), "b.xml")
+    plain = g7.replace("(XCOMPUTE_FUNCTION_BLOCKS_on | XIdle & !(XIdle & go) | XBusy & XR_TRIG0_q) & ", "")
+    assert plain.count("XCOMPUTE_FUNCTION_BLOCKS_on") == 0
+    out = on_plc(FIRST, plain, tmp_path)
+    assert [d.seed for d in out.differences] == [1, 3, 4, 8]

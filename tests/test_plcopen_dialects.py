@@ -81,7 +81,9 @@ def as_codesys(xml: str) -> str:
 
 def test_beremiz_ld_contacts_and_an_fbd_named_transition():
     """The NOT of the named transition's FBD body: Beremiz computes it after the transitions
-    (its output of the previous scan, a register grafcet); CODESYS while evaluating the transition."""
+    (its output of the previous scan, a register grafcet), from the end of the first scan after
+    which Idle is active (Idle may be left at the first scan); CODESYS while evaluating the
+    transition."""
     for name in ("beremiz_ld_fbd.xml", "beremiz_tc6_1_0.xml"):  # TC6 2.01, and the same chart in the 1.0 namespace
         text = import_sfc((DATA / name).read_bytes(), name)
         assert text.split("\n", 1)[1] == """inputs a, b, c
@@ -96,8 +98,13 @@ grafcet G1 {
 grafcet NOT42 {
   initial step NOT42_off
   step NOT42_on
-  transition NOT42_off -> NOT42_on when !c
-  transition NOT42_on -> NOT42_off when c
+  transition NOT42_off -> NOT42_on when (XCOMPUTE_FUNCTION_BLOCKS_on | XIdle & !(XIdle & (a) & !b) | XOn & XNOT42_on) & !c
+  transition NOT42_on -> NOT42_off when (XCOMPUTE_FUNCTION_BLOCKS_on | XIdle & !(XIdle & (a) & !b) | XOn & XNOT42_on) & c
+}
+grafcet COMPUTE_FUNCTION_BLOCKS {
+  initial step COMPUTE_FUNCTION_BLOCKS_off
+  step COMPUTE_FUNCTION_BLOCKS_on
+  transition COMPUTE_FUNCTION_BLOCKS_off -> COMPUTE_FUNCTION_BLOCKS_on when XIdle & !(XIdle & (a) & !b) | XOn & XNOT42_on
 }
 """
         text = import_sfc(as_codesys((DATA / name).read_text()).encode(), name)

@@ -44,7 +44,7 @@ from synth.errors import InputError, Location, Severity
 from synth.grafcet.language_reader import parse_receptivity
 from synth.logic.expr import Var, evaluate, names
 
-__all__ = ["SCAN_BLOCKS", "every_scan", "scan_block", "lagging", "rising_chart", "first_scan_warning", "negation"]
+__all__ = ["SCAN_BLOCKS", "every_scan", "scan_block", "lagging", "rising_chart", "first_scan_guard", "negation"]
 
 SCAN_BLOCKS = {"AND": (), "OR": (), "NOT": ("IN",), "SEL": ("G", "IN0", "IN1"), "R_TRIG": ("CLK",),
                "F_TRIG": ("CLK",), "TON": ("IN", "PT"), **LATCH_BLOCKS}
@@ -243,24 +243,38 @@ def _run(call: Call, params: dict[str, tuple[Callable[[], str], Any]], where: Lo
             "later)", where, severity=Severity.WARNING))
 
 
-def first_scan_warning(transitions: list[tuple[str, list[str], list[str], str, Any]], initial: str, at: Location,
-                       helper_steps: dict[str, bool]) -> list[InputError]:
-    """A warning when a transition leaving ``initial`` (the step that stores
-    COMPUTE_FUNCTION_BLOCKS) may fire at the first scan (``helper_steps``: the blocks' steps, each
-    with whether it is initial; timers not elapsed then): the PLC then calls no block until the
-    step is active again after a scan, the ``.g7`` calls them from the first scan."""
+def first_scan_guard(transitions: list[tuple[str, list[str], list[str], str, Any]], initial: str, at: Location,
+                     helper_steps: dict[str, bool]) -> list[InputError]:
+    """When a transition leaving ``initial`` (the step that stores COMPUTE_FUNCTION_BLOCKS) may
+    fire at the first scan (``helper_steps``: the blocks' steps, each with whether it is initial;
+    timers not elapsed then), the PLC calls no block until ``initial`` is active after a scan:
+    the partial grafcet ``COMPUTE_FUNCTION_BLOCKS`` (its step ``_on``: the action stored) and
+    each block's moves guarded by it, with a located warning."""
     scope = DATA.get()
     if scope is None or not scope.scan_calls:
         return []
-    for _, sources, _, expr, _ in transitions:
-        if initial not in sources or not _may_hold(expr, helper_steps):
-            continue
-        return [InputError(
-            f"Beremiz stores COMPUTE_FUNCTION_BLOCKS (the blocks of the transition networks) on initial step {initial}: "
-            f"it calls them from the first scan after which {initial} is active; when a transition leaving {initial} "
-            f"fires at the first scan ({expr}), the PLC calls no block until {initial} is active again after a scan, "
-            "while the .g7 evaluates them from the first scan", at, severity=Severity.WARNING)]
-    return []
+    leaving = [(sources, expr) for _, sources, _, expr, _ in transitions if initial in sources]
+    may = next((expr for _, expr in leaving if _may_hold(expr, helper_steps)), None)
+    if may is None:
+        return []
+
+    def fires(sources: list[str], expr: str) -> str:
+        return _and(*(f"X{s}" for s in sources), expr)
+
+    after = _or(_and(f"X{initial}", negation(_or(*(fires(s, e) for s, e in leaving)))),
+                *(fires(s, e) for _, s, t, e, _ in transitions if initial in t))
+    name = f"{scope.prefix}COMPUTE_FUNCTION_BLOCKS"
+    guard = f"X{name}_on | {after}"
+    firsts = {f"{c.name}_off" for c in scope.scan_calls.values()}
+    scope.extra_charts[:] = [(c[0], c[1], [(a, b, _and(f"({guard})", r)) for a, b, r in c[2]])
+                             if c[1][0][0] in firsts else c for c in scope.extra_charts]
+    scope.extra_charts.append(_chart(name, [f"{name}_off", f"{name}_on"], [(f"{name}_off", f"{name}_on", after)]))
+    return [InputError(
+        f"Beremiz stores COMPUTE_FUNCTION_BLOCKS (the blocks of the transition networks) on initial step {initial}: "
+        f"the PLC calls them at the end of each scan after which {initial} is active, then at every scan; a transition "
+        f"leaving {initial} may fire at the first scan ({may}), so the blocks' partial grafcets move only when step "
+        f"{name}_on of the partial grafcet {name} (the action stored) is active or {initial} is active after the scan",
+        at, severity=Severity.WARNING)]
 
 
 def _may_hold(expr: str, helper_steps: dict[str, bool]) -> bool:
