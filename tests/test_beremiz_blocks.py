@@ -325,7 +325,27 @@ LD = (DATA / "beremiz_ld_fbd.xml").read_text().replace('<contact localId="21" he
     '<pou name="lamp"', '<pou name="lamps"')
 """LD contacts ↑a and NOT b (Beremiz adds an R_TRIG for the edge), a NOT in a named FBD transition (step On
 renamed Lit: ON is a word of MATIEC's; the POU lamps: LAMP is its output and MATIEC's names ignore case)."""
-FIXTURES = {"R_TRIG": R_TRIG, "SR": SR, "TON": TON, "LD": LD, "FIRST": FIRST}
+F_TRIG = R_TRIG.replace("R_TRIG", "F_TRIG")
+RS = SR.replace('typeName="SR"', 'typeName="RS"').replace('<derived name="SR"/>', '<derived name="RS"/>').replace(
+    'formalParameter="S1"', 'formalParameter="S"').replace('formalParameter="R"', 'formalParameter="R1"')
+FIXTURES = {"R_TRIG": R_TRIG, "SR": SR, "TON": TON, "LD": LD, "FIRST": FIRST, "F_TRIG": F_TRIG, "RS": RS}
+
+
+def test_an_f_trig_and_an_rs_latch():
+    text, _ = imported(F_TRIG)
+    assert text == CHART % ("XF_TRIG0_q", "!go") + """grafcet F_TRIG0_F_TRIG {
+  initial step F_TRIG0_off
+  step F_TRIG0_hi
+  step F_TRIG0_q
+  transition F_TRIG0_off -> F_TRIG0_hi when btn
+  transition F_TRIG0_hi -> F_TRIG0_q when !btn
+  transition F_TRIG0_q -> F_TRIG0_hi when btn
+  transition F_TRIG0_q -> F_TRIG0_off when !btn
+}
+"""
+    text, warnings = imported(RS)
+    assert text.endswith("  transition SR0_off -> SR0_on when btn & !go\n  transition SR0_on -> SR0_off when go\n}\n")
+    assert warnings[0].endswith("(SR0.Q1 is XSR0_on: set when btn & !go, reset when go, reset dominant)")
 
 
 def test_an_edge_contact_is_the_r_trig_beremiz_adds():
