@@ -15,13 +15,14 @@ Example
 from __future__ import annotations
 
 import re
+from functools import partial
 from typing import Any, Callable
 
 from synth.codegen.plcopen.blocks import FBD_FUNCTION_BLOCKS, sel, step_flag, ton_output, trigger
 from synth.codegen.plcopen.fbscan import SCAN_BLOCKS, every_scan, lagging, negation, scan_block
 from synth.codegen.plcopen.latch import LATCH_BLOCKS, latch_chart, latch_step
 from synth.codegen.plcopen.st_condition import ExprReader
-from synth.errors import InputError
+from synth.errors import InputError, Location
 
 __all__ = ["FBD_ELEMENTS", "fbd_condition", "fbd_transition"]
 
@@ -71,13 +72,13 @@ def fbd_condition(cond: Any, elements: dict[int, Any], q: Callable[[str], str], 
         flag = step_flag(name, elements, steps) if re.fullmatch(r"[A-Za-z_]\w*", name) else None
         arg = flag or node(int(fed.get("localId")), inner, by_block)
         if every_scan() and var.get("edge", "none") in ("rising", "falling") and not _negated(var):
-            arg = scan_block(var, {"CLK": ((lambda x=arg: x), fed)}, by_block, src.at(var), lambda: ("", None),
-                             lambda x: lagging(x, steps), var.get("edge"))
+            arg = scan_block(var, {"CLK": (partial(str, arg), fed)}, by_block, src.at(var), None,
+                             partial(lagging, steps=steps), str(var.get("edge")))
         if not wrap:
             return negation(arg) if _negated(var) else arg
         return f"!({arg})" if _negated(var) else f"({arg})"
 
-    def pt_of(block: Any) -> tuple[str, Any]:
+    def pt_of(block: Any) -> tuple[str, Location]:
         """The text of the inVariable wired to the ``PT`` of ``block``, and where it is."""
         var = next((v for v in block.iterfind(f"{q('inputVariables')}/{q('variable')}")
                     if str(v.get("formalParameter", "")).upper() == "PT"), None)
@@ -110,9 +111,10 @@ def fbd_condition(cond: Any, elements: dict[int, Any], q: Callable[[str], str], 
                                      expected=tuple(SCAN_BLOCKS))
                 outs = el.find(f"{q('outputVariables')}/{q('variable')}")
                 ins = list(el.iterfind(f"{q('inputVariables')}/{q('variable')}"))
-                params = {str(v.get("formalParameter", "")).upper() or f"IN{i + 1}":
-                          ((lambda v=v: argument(v, frozenset(), True, False)), v) for i, v in enumerate(ins)}
-                value = scan_block(el, params, by_block, src.at(el), lambda: pt_of(el), lambda x: lagging(x, steps))
+                readers: dict[str, tuple[Callable[[], str], Any]] = {
+                    str(v.get("formalParameter", "")).upper() or f"IN{i + 1}":
+                    (partial(argument, v, frozenset(), True, False), v) for i, v in enumerate(ins)}
+                value = scan_block(el, readers, by_block, src.at(el), partial(pt_of, el), partial(lagging, steps=steps))
                 return f"!({value})" if _negated(outs) else value
             if name not in _BLOCKS and name not in FBD_FUNCTION_BLOCKS and name not in LATCH_BLOCKS:
                 raise InputError(f"an FBD block {el.get('typeName')} in a transition condition: only AND, OR, NOT, "
@@ -147,8 +149,8 @@ def fbd_condition(cond: Any, elements: dict[int, Any], q: Callable[[str], str], 
             literal = reader.whole()
             edge = el.get("edge", "none")
             if edge in ("rising", "falling") and every_scan() and not _negated(el):  # Beremiz: an R_TRIG/F_TRIG
-                literal = scan_block(el, {"CLK": ((lambda x=literal: x), var)}, False, src.at(el), lambda: ("", None),
-                                     lambda x: lagging(x, steps), edge)
+                literal = scan_block(el, {"CLK": (partial(str, literal), var)}, False, src.at(el), None,
+                                     partial(lagging, steps=steps), edge)
             elif edge in ("rising", "falling") and not every_scan():
                 literal = ("↑" if edge == "rising" else "↓") + literal
             if _negated(el):

@@ -146,7 +146,7 @@ def _ton_chart(name: str, on: str, pt: str) -> HelperChart:
 
 
 def scan_block(el: Any, params: dict[str, tuple[Callable[[], str], Any]], by_block: bool, where: Location,
-               pt_text: Callable[[], tuple[str, Location]], lag: Callable[[str], str | None],
+               pt_text: Callable[[], tuple[str, Location]] | None, lag: Callable[[str], str | None],
                edge: str = "") -> str:
     """The value of block ``el`` read by a transition (its output of the previous scan) or, when
     ``by_block``, by the input of a block Beremiz calls after it (of this scan, unless in a loop).
@@ -186,7 +186,7 @@ def _who(scope: DataScope) -> str:
 
 
 def _run(call: Call, params: dict[str, tuple[Callable[[], str], Any]], where: Location,
-         pt_text: Callable[[], tuple[str, Location]], lag: Callable[[str], str | None], scope: DataScope,
+         pt_text: Callable[[], tuple[str, Location]] | None, lag: Callable[[str], str | None], scope: DataScope,
          label: str) -> None:
     """Call the block once: read its inputs, make its partial grafcet, set ``call.now``
     (``label``: how to name it, ``{}`` standing for CLK, when it is an edge Beremiz adds)."""
@@ -224,6 +224,7 @@ def _run(call: Call, params: dict[str, tuple[Callable[[], str], Any]], where: Lo
                    + (" (the PLC's first call sees CLK TRUE as a rising edge, so does the grafcet)"
                       if kind == "R_TRIG" else ""), where)
     else:  # TON
+        assert pt_text is not None  # a TON block, never an edge
         text, pt_at = pt_text()
         pt = duration(text) or scope.constant_durations.get(text.strip().upper())
         if pt is None:
