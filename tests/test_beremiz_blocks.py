@@ -54,38 +54,7 @@ HEAD = """<?xml version='1.0' encoding='utf-8'?>
         </interface>
         <body>
           <SFC>
-            <step localId="1" height="30" width="80" name="Idle" initialStep="true">
-              <position x="500" y="10"/>
-              <connectionPointIn><relPosition x="40" y="0"/><connection refLocalId="8"/></connectionPointIn>
-              <connectionPointOut formalParameter=""><relPosition x="40" y="30"/></connectionPointOut>
-            </step>
-            <transition localId="2" height="2" width="20">
-              <position x="560" y="60"/>
-              <connectionPointIn><relPosition x="10" y="0"/><connection refLocalId="1"/></connectionPointIn>
-              <connectionPointOut><relPosition x="10" y="2"/></connectionPointOut>
-              <condition>
-                <connectionPointIn><connection refLocalId="%s"/></connectionPointIn>
-              </condition>
-            </transition>
-            <step localId="3" height="30" width="80" name="Busy">
-              <position x="500" y="100"/>
-              <connectionPointIn><relPosition x="40" y="0"/><connection refLocalId="2"/></connectionPointIn>
-              <connectionPointOut formalParameter=""><relPosition x="40" y="30"/></connectionPointOut>
-              <connectionPointOutAction formalParameter=""><relPosition x="80" y="15"/></connectionPointOutAction>
-            </step>
-            <actionBlock localId="4" height="30" width="100">
-              <position x="650" y="100"/>
-              <connectionPointIn><relPosition x="0" y="15"/><connection refLocalId="3"/></connectionPointIn>
-              <action localId="0"><relPosition x="0" y="0"/><reference name="RUN"/></action>
-            </actionBlock>
-            <transition localId="5" height="2" width="20">
-              <position x="560" y="160"/>
-              <connectionPointIn><relPosition x="10" y="0"/><connection refLocalId="3"/></connectionPointIn>
-              <connectionPointOut><relPosition x="10" y="2"/></connectionPointOut>
-              <condition>
-                <connectionPointIn><connection refLocalId="%s"/></connectionPointIn>
-              </condition>
-            </transition>
+%%STEPS%%
             <jumpStep localId="8" height="13" width="12" targetName="Idle">
               <position x="563" y="200"/>
               <connectionPointIn><relPosition x="6" y="0"/><connection refLocalId="5"/></connectionPointIn>
@@ -109,6 +78,39 @@ HEAD = """<?xml version='1.0' encoding='utf-8'?>
   </instances>
 </project>
 """
+
+
+def step(lid: int, name: str, source: int, y: int, initial: bool = False, actions: bool = False) -> str:
+    first = ' initialStep="true"' if initial else ""
+    more = ('\n              <connectionPointOutAction formalParameter=""><relPosition x="80" y="15"/>'
+            "</connectionPointOutAction>") if actions else ""
+    return (f'            <step localId="{lid}" height="30" width="80" name="{name}"{first}>\n'
+            f'              <position x="500" y="{y}"/>\n'
+            f'              <connectionPointIn><relPosition x="40" y="0"/><connection refLocalId="{source}"/>'
+            "</connectionPointIn>\n"
+            '              <connectionPointOut formalParameter=""><relPosition x="40" y="30"/></connectionPointOut>'
+            f"{more}\n            </step>")
+
+
+def transition(lid: int, source: int, y: int) -> str:
+    """A transition whose condition is wired to the network (``%s``: the element it reads)."""
+    return (f'            <transition localId="{lid}" height="2" width="20">\n              <position x="560" y="{y}"/>\n'
+            f'              <connectionPointIn><relPosition x="10" y="0"/><connection refLocalId="{source}"/>'
+            "</connectionPointIn>\n"
+            '              <connectionPointOut><relPosition x="10" y="2"/></connectionPointOut>\n'
+            "              <condition>\n"
+            '                <connectionPointIn><connection refLocalId="%s"/></connectionPointIn>\n'
+            "              </condition>\n            </transition>")
+
+
+ACTIONS = """            <actionBlock localId="4" height="30" width="100">
+              <position x="650" y="100"/>
+              <connectionPointIn><relPosition x="0" y="15"/><connection refLocalId="3"/></connectionPointIn>
+              <action localId="0"><relPosition x="0" y="0"/><reference name="RUN"/></action>
+            </actionBlock>"""
+HEAD = HEAD.replace("%%STEPS%%", "\n".join(
+    (step(1, "Idle", 8, 10, initial=True), transition(2, 1, 60), step(3, "Busy", 2, 100, actions=True), ACTIONS,
+     transition(5, 3, 160))))
 
 
 def invar(lid: int, expression: str) -> str:

@@ -4,7 +4,9 @@ SFC example and every CODESYS V3.5 export connect the condition of a transition 
 over such variables; Beremiz draws LD contacts from a power rail (in series: AND, in
 parallel: OR). :func:`fbd_condition` reads that network back into one ``.g7``
 receptivity; any other construct (an LD contact, another block, a loop) is an
-:class:`~synth.errors.InputError` at its element.
+:class:`~synth.errors.InputError` at its element. In a file written by Beremiz or the OpenPLC
+editor, the blocks are read as Beremiz calls them, at every scan after the transitions
+(:mod:`synth.codegen.plcopen.fbscan`).
 
 Example
 -------

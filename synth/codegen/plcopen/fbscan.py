@@ -40,7 +40,7 @@ from synth.codegen.plcopen.blocks import sel, warn_block
 from synth.codegen.plcopen.data import DATA, DataScope, HelperChart, duration
 from synth.codegen.plcopen.latch import LATCH_BLOCKS
 from synth.codegen.plcopen.vendor import Dialect
-from synth.errors import InputError, Location, Severity
+from synth.errors import InputError, Location, Severity, SynthError
 from synth.grafcet.language_reader import parse_receptivity
 from synth.logic.expr import Var, evaluate, names
 
@@ -77,7 +77,7 @@ def lagging(text: str, steps: dict[str, str]) -> str | None:
     """The step flag or step timer of the chart that the block input ``text`` reads, if any:
     the PLC sets it before it calls the block (this scan's value), .g7 reads it before the scan."""
     chart = set(steps.values())
-    found = [m[0] for m in re.finditer(r"(?:\w+/)?X(\w+)", text) if m[1] in chart]
+    found = [m[0] for m in re.finditer(r"(?<!\w)(?:\w+/)?X(\w+)", text) if m[1] in chart]
     return found[0] if found else None
 
 
@@ -283,7 +283,7 @@ def _may_hold(expr: str, helper_steps: dict[str, bool]) -> bool:
     activity, timers not elapsed, edges possible, at most 12 other names tried every way (more: it may)."""
     try:
         e = parse_receptivity(expr, "<receptivity>")
-    except Exception:  # noqa: BLE001  (a receptivity the grafcet checks later: assume it may hold)
+    except SynthError:  # a receptivity the grafcet checks later: assume it may hold
         return True
     free = sorted({a.name for a in names(e) if isinstance(a, Var) and not _fixed(a.name, helper_steps)})
     if len(free) > 12:
