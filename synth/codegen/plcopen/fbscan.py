@@ -44,7 +44,8 @@ from synth.errors import InputError, Location, Severity, SynthError
 from synth.grafcet.language_reader import parse_receptivity
 from synth.logic.expr import Var, evaluate, names
 
-__all__ = ["SCAN_BLOCKS", "every_scan", "scan_block", "lagging", "rising_chart", "first_scan_guard", "negation"]
+__all__ = ["SCAN_BLOCKS", "every_scan", "scan_block", "lagging", "rising_chart", "first_scan_guard", "negation",
+           "settle_step_reads", "after_scan"]
 
 SCAN_BLOCKS = {"AND": (), "OR": (), "NOT": ("IN",), "SEL": ("G", "IN0", "IN1"), "R_TRIG": ("CLK",),
                "F_TRIG": ("CLK",), "TON": ("IN", "PT"), **LATCH_BLOCKS}
@@ -62,9 +63,11 @@ class Call:
 
     name: str
     kind: str
+    where: Location
     now: str | None = None
     before: str = ""
     register: bool = False  # a function whose previous output is read: its register grafcet is due
+    label: str = ""  # how the warnings name it
 
 
 def every_scan() -> bool:
@@ -74,10 +77,11 @@ def every_scan() -> bool:
 
 
 def lagging(text: str, steps: dict[str, str]) -> str | None:
-    """The step flag or step timer of the chart that the block input ``text`` reads, if any:
-    the PLC sets it before it calls the block (this scan's value), .g7 reads it before the scan."""
+    """The step timer of the chart that the block input ``text`` reads, if any: the PLC updates
+    it before it calls the block (this scan's value), .g7 reads it before the scan. (A step flag
+    is read as the PLC reads it: :func:`settle_step_reads`.)"""
     chart = set(steps.values())
-    found = [m[0] for m in re.finditer(r"(?<!\w)(?:\w+/)?X(\w+)", text) if m[1] in chart]
+    found = [m[0] for m in re.finditer(r"(?<!\w)\w+/X(\w+)", text) if m[1] in chart]
     return found[0] if found else None
 
 
@@ -162,7 +166,7 @@ def scan_block(el: Any, params: dict[str, tuple[Callable[[], str], Any]], by_blo
         name = str(el.get("instanceName") or "") or f"{kind}{el.get('localId') or len(scope.scan_calls)}"
         full = f"{scope.prefix}{name}"
         state = f"X{full}_on" if kind in LATCH_BLOCKS else f"X{full}_q" if kind in ("R_TRIG", "F_TRIG", "TON") else ""
-        call = scope.scan_calls[path] = Call(full, kind, before=state)  # its state: read in a loop
+        call = scope.scan_calls[path] = Call(full, kind, where, before=state)  # its state: read in a loop
         _run(call, params, where, pt_text, lag, scope, f"the {edge} edge of {{}} (an {kind} Beremiz adds)" if edge else "")
     if by_block and call.now is not None:
         return call.now
@@ -199,7 +203,7 @@ def _run(call: Call, params: dict[str, tuple[Callable[[], str], Any]], where: Lo
     values = {p: read() for p, (read, _) in params.items() if p != "PT"}
     late = sorted({x for v in values.values() if (x := lag(v)) is not None})
     short = name.removeprefix(scope.prefix)
-    named = label.format(values.get("CLK", "")) if label else f"the {kind} {short}"
+    named = call.label = label.format(values.get("CLK", "")) if label else f"the {kind} {short}"
     what = f"{named} in a transition network of a file written by {_who(scope)}: {COMPUTE}"
     if kind in ("AND", "OR", "NOT", "SEL"):
         args = list(values.values())
@@ -239,9 +243,46 @@ def _run(call: Call, params: dict[str, tuple[Callable[[], str], Any]], where: Lo
                    f"({on}) rises, step {name}_q ({short}.Q) once {pt} have elapsed, both left when IN falls", where)
     for x in late:
         scope.warnings.append(InputError(
-            f"{named} reads {x}, which the PLC's scan sets before it calls the block (steps updated, "
-            f"actions run): the block sees this scan's value, the .g7 partial grafcet the previous scan's (one scan "
-            "later)", where, severity=Severity.WARNING))
+            f"{named} reads the step timer {x}, which the PLC's scan updates before it calls the block: the block "
+            "sees this scan's value, the .g7 partial grafcet the previous scan's (one scan later)", where,
+            severity=Severity.WARNING))
+
+
+def after_scan(step: str, transitions: list[tuple[str, list[str], list[str], str, Any]]) -> str:
+    """Whether ``step`` is active once this scan's transitions have fired: active and left by none
+    of the transitions leaving it, or entered by one (each fires when its sources are active and
+    its receptivity holds, every true one, as MATIEC fires them)."""
+    def fires(sources: list[str], expr: str) -> str:
+        return _and(*(f"X{s}" for s in sources), expr)
+
+    leaving = [fires(s, e) for _, s, _, e, _ in transitions if step in s]
+    return _or(_and(f"X{step}", negation(_or(*leaving))), *(fires(s, e) for _, s, t, e, _ in transitions if step in t))
+
+
+def _moves(scope: DataScope, change: Callable[[str], str]) -> None:
+    """Every move of the blocks' partial grafcets with its receptivity changed by ``change``."""
+    firsts = {f"{c.name}_off" for c in scope.scan_calls.values()}
+    scope.extra_charts[:] = [(c[0], c[1], [(a, b, change(r)) for a, b, r in c[2]]) if c[1][0][0] in firsts else c
+                             for c in scope.extra_charts]
+
+
+def settle_step_reads(transitions: list[tuple[str, list[str], list[str], str, Any]], chart: set[str]) -> None:
+    """A block input reading the flag ``XS`` of a step of the chart reads it as the PLC does, once
+    the scan's transitions have fired (MATIEC updates the steps before it runs the actions): each
+    such flag in the blocks' moves becomes :func:`after_scan` of ``S``."""
+    scope = DATA.get()
+    if scope is None or not scope.scan_calls:
+        return
+    flag = re.compile(r"(?<![\w/])X(\w+)")
+    for call in scope.scan_calls.values():
+        read = sorted({m[1] for c in scope.extra_charts if c[1][0][0] == f"{call.name}_off"
+                       for _, _, r in c[2] for m in flag.finditer(r) if m[1] in chart})
+        for step in read:
+            scope.warnings.append(InputError(
+                f"{call.label} reads X{step}, which MATIEC updates before it calls the block: read as step {step} once "
+                f"the scan's transitions have fired, {after_scan(step, transitions)}", call.where,
+                severity=Severity.WARNING))
+    _moves(scope, lambda r: flag.sub(lambda m: f"({after_scan(m[1], transitions)})" if m[1] in chart else m[0], r))
 
 
 def first_scan_guard(transitions: list[tuple[str, list[str], list[str], str, Any]], initial: str, at: Location,
@@ -254,21 +295,12 @@ def first_scan_guard(transitions: list[tuple[str, list[str], list[str], str, Any
     scope = DATA.get()
     if scope is None or not scope.scan_calls:
         return []
-    leaving = [(sources, expr) for _, sources, _, expr, _ in transitions if initial in sources]
-    may = next((expr for _, expr in leaving if _may_hold(expr, helper_steps)), None)
+    may = next((e for _, s, _, e, _ in transitions if initial in s and _may_hold(e, helper_steps)), None)
     if may is None:
         return []
-
-    def fires(sources: list[str], expr: str) -> str:
-        return _and(*(f"X{s}" for s in sources), expr)
-
-    after = _or(_and(f"X{initial}", negation(_or(*(fires(s, e) for s, e in leaving)))),
-                *(fires(s, e) for _, s, t, e, _ in transitions if initial in t))
+    after = after_scan(initial, transitions)
     name = f"{scope.prefix}COMPUTE_FUNCTION_BLOCKS"
-    guard = f"X{name}_on | {after}"
-    firsts = {f"{c.name}_off" for c in scope.scan_calls.values()}
-    scope.extra_charts[:] = [(c[0], c[1], [(a, b, _and(f"({guard})", r)) for a, b, r in c[2]])
-                             if c[1][0][0] in firsts else c for c in scope.extra_charts]
+    _moves(scope, lambda r: _and(f"(X{name}_on | {after})", r))
     scope.extra_charts.append(_chart(name, [f"{name}_off", f"{name}_on"], [(f"{name}_off", f"{name}_on", after)]))
     return [InputError(
         f"Beremiz stores COMPUTE_FUNCTION_BLOCKS (the blocks of the transition networks) on initial step {initial}: "
