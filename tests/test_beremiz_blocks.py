@@ -327,10 +327,34 @@ LD = (DATA / "beremiz_ld_fbd.xml").read_text().replace('<contact localId="21" he
     '<pou name="lamp"', '<pou name="lamps"')
 """LD contacts ↑a and NOT b (Beremiz adds an R_TRIG for the edge), a NOT in a named FBD transition (step On
 renamed Lit: ON is a word of MATIEC's; the POU lamps: LAMP is its output and MATIEC's names ignore case)."""
+STEP_FLAG = project({"R_TRIG0": "R_TRIG", "TON0": "TON"}, "21.Q", "20.Q", invar(10, "btn"), invar(11, "Idle.X"),
+                    invar(12, "T#30ms"), block(20, "R_TRIG", "R_TRIG0", [("CLK", "10")], "Q"),
+                    block(21, "TON", "TON0", [("IN", "11"), ("PT", "12")], "Q"))
+"""Idle -> Busy once TON0 (IN := Idle.X) has run 30 ms, Busy -> Idle on a rising edge of btn (a
+flag of a later step does not compile: MATIEC reads a step flag only after the step's declaration,
+and Beremiz writes COMPUTE_FUNCTION_BLOCKS right after the initial step)."""
+
+
+def test_a_block_reads_a_step_flag_once_the_scans_transitions_have_fired():
+    text, warnings = imported(STEP_FLAG)
+    idle = "XIdle & !(XIdle & XTON0_q) | XBusy & XR_TRIG0_q"
+    assert text.split("grafcet TON0_TON {\n")[1].split("}")[0] == f"""  initial step TON0_off
+  step TON0_timing
+  step TON0_q
+  transition TON0_off -> TON0_timing when ({idle})
+  transition TON0_timing -> TON0_off when !({idle})
+  transition TON0_timing -> TON0_q when ({idle}) & 30ms/XTON0_timing
+  transition TON0_q -> TON0_off when !({idle})
+"""
+    assert warnings[2] == ("b.xml:93:13: warning: the TON TON0 reads XIdle, which MATIEC updates before it calls the "
+                           f"block: read as step Idle once the scan's transitions have fired, {idle}")
+
+
 F_TRIG = R_TRIG.replace("R_TRIG", "F_TRIG")
 RS = SR.replace('typeName="SR"', 'typeName="RS"').replace('<derived name="SR"/>', '<derived name="RS"/>').replace(
     'formalParameter="S1"', 'formalParameter="S"').replace('formalParameter="R"', 'formalParameter="R1"')
-FIXTURES = {"R_TRIG": R_TRIG, "SR": SR, "TON": TON, "LD": LD, "FIRST": FIRST, "F_TRIG": F_TRIG, "RS": RS}
+FIXTURES = {"R_TRIG": R_TRIG, "SR": SR, "TON": TON, "LD": LD, "FIRST": FIRST, "F_TRIG": F_TRIG, "RS": RS,
+            "STEP_FLAG": STEP_FLAG}
 
 
 def test_an_f_trig_and_an_rs_latch():
@@ -385,7 +409,8 @@ def test_on_the_plc_the_blocks_evolve_as_their_partial_grafcets(name, tmp_path):
     # fired by the first scan, before the scans counted (FIRST: seeds 1, 3, 4 and 8 start with go, leave Idle at
     # once and stay in Busy, the blocks never called, on the PLC as in the .g7)
     first_scan = {"TON": ["TON0_off->TON0_timing"],
-                  "FIRST": ["COMPUTE_FUNCTION_BLOCKS_off->COMPUTE_FUNCTION_BLOCKS_on"]}.get(name, [])
+                  "FIRST": ["COMPUTE_FUNCTION_BLOCKS_off->COMPUTE_FUNCTION_BLOCKS_on"],
+                  "STEP_FLAG": ["TON0_timing->TON0_off"]}.get(name, [])  # STEP_FLAG: Idle is left once TON0 is out
     assert [t.name for t in g.transitions if t not in out.fired] == first_scan
 
 
@@ -398,11 +423,15 @@ def test_on_the_plc_the_reading_called_while_the_transition_is_evaluated_differs
 
 
 @needs_plc
-def test_on_the_plc_blocks_called_from_the_first_scan_would_differ(tmp_path):
-    """FIRST without its guard (the blocks' moves from the first scan): the 4 sequences that start
-    with go (seeds 1, 3, 4, 8) leave Idle at once; the PLC then never calls R_TRIG0, the .g7 would."""
-    g7 = import_sfc(FIRST.encode(), "b.xml")
-    plain = g7.replace("(XCOMPUTE_FUNCTION_BLOCKS_on | XIdle & !(XIdle & go) | XBusy & XR_TRIG0_q) & ", "")
-    assert plain.count("XCOMPUTE_FUNCTION_BLOCKS_on") == 0
-    out = on_plc(FIRST, plain, tmp_path)
-    assert [d.seed for d in out.differences] == [1, 3, 4, 8]
+@pytest.mark.parametrize("name, exact, plain, seeds", [
+    # the blocks' moves from the first scan: the 4 sequences that start with go (seeds 1, 3, 4, 8) leave Idle at
+    # once; the PLC then never calls R_TRIG0, the .g7 would
+    ("FIRST", "(XCOMPUTE_FUNCTION_BLOCKS_on | XIdle & !(XIdle & go) | XBusy & XR_TRIG0_q) & ", "", [1, 3, 4, 8]),
+    # Idle.X read before the scan's transitions fire: TON0 starts a scan late after each return to Idle
+    ("STEP_FLAG", "(XIdle & !(XIdle & XTON0_q) | XBusy & XR_TRIG0_q)", "XIdle", list(range(SEQUENCES))),
+])
+def test_on_the_plc_each_correction_is_needed(name, exact, plain, seeds, tmp_path):
+    g7 = import_sfc(FIXTURES[name].encode(), "b.xml")
+    assert exact in g7
+    out = on_plc(FIXTURES[name], g7.replace(exact, plain), tmp_path)
+    assert [d.seed for d in out.differences] == seeds
