@@ -359,16 +359,10 @@ FIXTURES = {"R_TRIG": R_TRIG, "SR": SR, "TON": TON, "LD": LD, "FIRST": FIRST, "F
 
 def test_an_f_trig_and_an_rs_latch():
     text, _ = imported(F_TRIG)
-    assert text == CHART % ("XF_TRIG0_q", "!go") + """grafcet F_TRIG0_F_TRIG {
-  initial step F_TRIG0_off
-  step F_TRIG0_hi
-  step F_TRIG0_q
-  transition F_TRIG0_off -> F_TRIG0_hi when btn
-  transition F_TRIG0_hi -> F_TRIG0_q when !btn
-  transition F_TRIG0_q -> F_TRIG0_hi when btn
-  transition F_TRIG0_q -> F_TRIG0_off when !btn
-}
-"""
+    assert text.startswith(CHART % ("XF_TRIG0_q", "!go") + "grafcet F_TRIG0_F_TRIG {\n  initial step F_TRIG0_off\n")
+    assert [line.split(" -> ") for line in text.splitlines() if line.startswith("  transition F_")] == [
+        ["  transition F_TRIG0_off", "F_TRIG0_hi when btn"], ["  transition F_TRIG0_hi", "F_TRIG0_q when !btn"],
+        ["  transition F_TRIG0_q", "F_TRIG0_hi when btn"], ["  transition F_TRIG0_q", "F_TRIG0_off when !btn"]]
     text, warnings = imported(RS)
     assert text.endswith("  transition SR0_off -> SR0_on when btn & !go\n  transition SR0_on -> SR0_off when go\n}\n")
     assert warnings[0].endswith("(SR0.Q1 is XSR0_on: set when btn & !go, reset when go, reset dominant)")
