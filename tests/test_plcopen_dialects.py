@@ -889,8 +889,21 @@ def test_the_scan_note_says_when_it_is_not_computed(cli, tmp_path):
     code, _, err = cli("import", tmp_path / "wide.xml", "-o", tmp_path / "back.g7")
     assert code == 0 and err == (
         f"{tmp_path / 'wide.xml'}: note: not checked whether some steps stay active for a PLC scan where IEC 60848 "
-        "passes through them (more than 2000 situations to explore): validate with --semantics sfc for the meaning "
-        "the program has on the PLC\n")
+        "passes through them (more than 2000 situations or 20000 reactions to explore): validate with --semantics sfc "
+        "for the meaning the program has on the PLC\n")
+
+
+def test_the_scan_note_has_a_budget_of_reactions_too():
+    """Partial grafcets over many inputs (the blocks of a Beremiz chart) make each situation
+    costly: the note also stops after IMPORT_REACTIONS runs of the machine per reading."""
+    from synth.errors import LimitExceeded
+    from synth.grafcet.semantics import scan_only_steps
+
+    g = parse_grafcet("inputs a, b\ngrafcet G { initial step 0 step 1 transition 0 -> 1 when a & b "
+                      "transition 1 -> 0 when !a }\n", "n.g7")
+    assert scan_only_steps(g) == ()
+    with pytest.raises(LimitExceeded, match="more than 3 reactions while building the ASS"):
+        scan_only_steps(g, max_reactions=3)
 
 
 def test_import_list_says_refused_for_a_pou_the_import_refuses(cli, tmp_path):
