@@ -6,6 +6,7 @@ dialect's shape (the public files measured by ``bench/import_corpus.py`` stay ou
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import pytest
@@ -68,9 +69,45 @@ def test_list_and_select_pous(capsys):
     assert capsys.readouterr().err == f"{path}: note: POU PLC_PRG not imported: an ST body: .g7 holds SFC charts only\n"
 
 
+CODESYS_HEADER = '<fileHeader companyName="" productName="CODESYS" productVersion="CODESYS V3.5 SP16"/>'
+
+
+def as_codesys(xml: str) -> str:
+    """``xml`` (a Beremiz file) with a CODESYS ``fileHeader``: its blocks read as CODESYS calls them."""
+    header = re.search(r"<fileHeader [^>]*/>", xml)
+    assert header is not None
+    return xml.replace(header[0], CODESYS_HEADER, 1)
+
+
 def test_beremiz_ld_contacts_and_an_fbd_named_transition():
+    """The NOT of the named transition's FBD body: Beremiz computes it after the transitions
+    (its output of the previous scan, a register grafcet), from the end of the first scan after
+    which Idle is active (Idle may be left at the first scan); CODESYS while evaluating the
+    transition."""
     for name in ("beremiz_ld_fbd.xml", "beremiz_tc6_1_0.xml"):  # TC6 2.01, and the same chart in the 1.0 namespace
         text = import_sfc((DATA / name).read_bytes(), name)
+        assert text.split("\n", 1)[1] == """inputs a, b, c
+outputs LAMP
+
+grafcet G1 {
+  initial step Idle
+  step On: LAMP
+  transition Idle -> On when (a) & !b
+  transition On -> Idle when XNOT42_on
+}
+grafcet NOT42 {
+  initial step NOT42_off
+  step NOT42_on
+  transition NOT42_off -> NOT42_on when (XCOMPUTE_FUNCTION_BLOCKS_on | XIdle & !(XIdle & (a) & !b) | XOn & XNOT42_on) & !c
+  transition NOT42_on -> NOT42_off when (XCOMPUTE_FUNCTION_BLOCKS_on | XIdle & !(XIdle & (a) & !b) | XOn & XNOT42_on) & c
+}
+grafcet COMPUTE_FUNCTION_BLOCKS {
+  initial step COMPUTE_FUNCTION_BLOCKS_off
+  step COMPUTE_FUNCTION_BLOCKS_on
+  transition COMPUTE_FUNCTION_BLOCKS_off -> COMPUTE_FUNCTION_BLOCKS_on when XIdle & !(XIdle & (a) & !b) | XOn & XNOT42_on
+}
+"""
+        text = import_sfc(as_codesys((DATA / name).read_text()).encode(), name)
         assert text.split("\n", 1)[1] == """inputs a, b, c
 outputs LAMP
 
@@ -133,7 +170,7 @@ def test_a_selection_divergence_keeps_its_sfc_priority_with_a_warning():
 
 
 def test_a_level_self_loop_jump_is_imported_with_a_warning():
-    xml = (DATA / "beremiz_ld_fbd.xml").read_text().replace('targetName="Idle"', 'targetName="On"')
+    xml = as_codesys((DATA / "beremiz_ld_fbd.xml").read_text().replace('targetName="Idle"', 'targetName="On"'))
     warnings: list[InputError] = []
     text = import_sfc(xml.encode(), "loop.xml", warnings=warnings)
     assert "  transition On -> On when !(c)\n" in text
@@ -434,10 +471,11 @@ def test_what_a_codesys_data_body_cannot_be_is_located(old, new, first):
 
 
 def test_sel_r_trig_and_ton_blocks_wired_in_fbd_transitions():
-    """Beremiz FBD: SEL(auto, R_TRIG(step_btn).Q, go); TON(IN:=PRESSING, PT:=T#1500ms).Q with PRESSING only
-    the continuous action of step Press: the step timer of Press."""
+    """FBD read as CODESYS calls it (while the transition is evaluated): SEL(auto, R_TRIG(step_btn).Q, go);
+    TON(IN:=PRESSING, PT:=T#1500ms).Q with PRESSING only the continuous action of step Press: the step
+    timer of Press (test_beremiz_blocks: the same file as Beremiz runs it)."""
     warnings: list[InputError] = []
-    text = import_sfc((DATA / "beremiz_fbd_blocks.xml").read_bytes(), "b.xml", warnings=warnings)
+    text = import_sfc(as_codesys((DATA / "beremiz_fbd_blocks.xml").read_text()).encode(), "b.xml", warnings=warnings)
     assert text.split("\n", 1)[1] == """inputs auto, go, step_btn
 outputs PRESS, PRESSING
 
@@ -455,8 +493,8 @@ grafcet G1 {
         "b.xml:124:13: warning: the TON TON0 wired with IN:=PRESSING (only the continuous action of step Press: "
         "XPress) to the condition of a transition leaving step Press: TON0.Q is read as the step timer 1500ms/XPress "
         "(a TON keeps Q until it is called with IN FALSE; a .g7 timer restarts at each activation of its step)"]
-    xml = (DATA / "beremiz_fbd_blocks.xml").read_text().replace("<expression>PRESSING</expression>",
-                                                                 "<expression>go</expression>")
+    xml = as_codesys((DATA / "beremiz_fbd_blocks.xml").read_text()).replace("<expression>PRESSING</expression>",
+                                                                             "<expression>go</expression>")
     text = import_sfc(xml.encode(), "b.xml")
     assert "  transition Press -> Wait when 1500ms/XTON0_on\n" in text
     assert "  transition TON0_off -> TON0_on when XPress & go\n  transition TON0_on -> TON0_off when !(XPress & go)\n" in text
@@ -575,11 +613,12 @@ def test_a_ton_in_if_then_and_one_alias_timing_two_steps():
 
 
 def test_an_sr_latch_an_ld_blinker_and_d_flags_are_helper_grafcets_and_step_timers():
-    """Beremiz traffic-light shape: SR(S1:=btn, R:=HOLD.Q) feeding TON HOLD(IN:=SR.Q1) in an FBD
-    transition (a loop through the latch), an LD action that blinks LAMP with two TONs and two
-    R_TRIGs, a local Boolean that is only a D action, and a P action LAMP := 1."""
+    """Beremiz traffic-light shape, read as CODESYS calls the blocks (while the transition is
+    evaluated): SR(S1:=btn, R:=HOLD.Q) feeding TON HOLD(IN:=SR.Q1) in an FBD transition (a loop
+    through the latch), an LD action that blinks LAMP with two TONs and two R_TRIGs, a local
+    Boolean that is only a D action, and a P action LAMP := 1."""
     warnings: list[InputError] = []
-    text = import_sfc((DATA / "beremiz_latch_blink.xml").read_bytes(), "l.xml", warnings=warnings)
+    text = import_sfc(as_codesys((DATA / "beremiz_latch_blink.xml").read_text()).encode(), "l.xml", warnings=warnings)
     assert text.split("\n", 1)[1] == """inputs go, btn
 outputs LAMP
 
@@ -639,7 +678,7 @@ grafcet ASKED_SR {
 
 
 def test_an_rs_latch_is_reset_dominant():
-    xml = (DATA / "beremiz_latch_blink.xml").read_text()
+    xml = as_codesys((DATA / "beremiz_latch_blink.xml").read_text())
     rs = xml.replace('typeName="SR"', 'typeName="RS"').replace('formalParameter="S1"', 'formalParameter="S"') \
         .replace('<variable formalParameter="R">', '<variable formalParameter="R1">')
     warnings: list[InputError] = []
@@ -851,8 +890,21 @@ def test_the_scan_note_says_when_it_is_not_computed(cli, tmp_path):
     code, _, err = cli("import", tmp_path / "wide.xml", "-o", tmp_path / "back.g7")
     assert code == 0 and err == (
         f"{tmp_path / 'wide.xml'}: note: not checked whether some steps stay active for a PLC scan where IEC 60848 "
-        "passes through them (more than 2000 situations to explore): validate with --semantics sfc for the meaning "
-        "the program has on the PLC\n")
+        "passes through them (more than 2000 situations or 20000 reactions to explore): validate with --semantics sfc "
+        "for the meaning the program has on the PLC\n")
+
+
+def test_the_scan_note_has_a_budget_of_reactions_too():
+    """Partial grafcets over many inputs (the blocks of a Beremiz chart) make each situation
+    costly: the note also stops after IMPORT_REACTIONS runs of the machine per reading."""
+    from synth.errors import LimitExceeded
+    from synth.grafcet.semantics import scan_only_steps
+
+    g = parse_grafcet("inputs a, b\ngrafcet G { initial step 0 step 1 transition 0 -> 1 when a & b "
+                      "transition 1 -> 0 when !a }\n", "n.g7")
+    assert scan_only_steps(g) == ()
+    with pytest.raises(LimitExceeded, match="more than 3 reactions while building the ASS"):
+        scan_only_steps(g, max_reactions=3)
 
 
 def test_import_list_says_refused_for_a_pou_the_import_refuses(cli, tmp_path):

@@ -108,27 +108,56 @@ class Outcome:
 
 
 def run_on_plc(g: Grafcet, folder: Path, seeds: range, scans: int, period: int = PERIOD) -> Outcome:
-    """``g`` on the PLC and on the machine, one sequence of ``scans`` scans per seed; the first
-    difference of each sequence ends it."""
+    """``g`` exported by ``synth sfc``, on the PLC and on the machine, one sequence of ``scans``
+    scans per seed; the first difference of each sequence ends it."""
     g = replace(g, semantics=Semantics.SFC)
     folder.mkdir(parents=True, exist_ok=True)
     xml = sfc_project_xml(g, version="test")
     (folder / "plc.xml").write_bytes(xml)
     name = re.search(rb'<pou name="([^"]+)"', xml)[1].decode()  # type: ignore[index]  # clamp.g7: clamp_1
-    done = beremiz_program(folder / "plc.xml", folder / "generated.st")
-    assert done.returncode == 0, done.stderr
-    text = (folder / "generated.st").read_text()
+    text = beremiz_text(folder / "plc.xml", folder / "generated.st")
     alias = case_aliases([*g.inputs, *g.outputs, *(v.name for v in g.internals)], [sfc_step_name(s.name) for s in g.steps])
     st = {n: alias.get(n, n) for n in (*g.inputs, *g.outputs)}
+    steps = {s.name: sfc_step_name(s.name) for s in g.steps}
+    return play(g, PlcProgram(text, name, PouKind.PROGRAM, st, steps), folder, seeds, scans, period)
+
+
+def beremiz_text(xml: Path, out: Path) -> str:
+    """The program Beremiz's generator writes for the project ``xml``."""
+    done = beremiz_program(xml, out)
+    assert done.returncode == 0, done.stderr
+    return out.read_text()
+
+
+@dataclass(frozen=True)
+class PlcProgram:
+    """A program Beremiz generated (``text``), the POU that runs it, and the PLC's names of the
+    Grafcet's inputs and outputs (``names``) and of the steps compared (``steps``); ``outputs``:
+    those compared (None: every output)."""
+
+    text: str
+    pou: str
+    kind: PouKind
+    names: dict[str, str]
+    steps: dict[str, str]
+    outputs: tuple[str, ...] | None = None
+
+
+def play(g: Grafcet, program: PlcProgram, folder: Path, seeds: range, scans: int, period: int = PERIOD) -> Outcome:
+    """``program`` compiled by MATIEC against ``synth run --semantics sfc`` of ``g``, one sequence
+    of ``scans`` scans per seed; the first difference of each sequence ends it."""
+    g = replace(g, semantics=Semantics.SFC)
+    text, st = program.text, program.names
+    outputs = g.outputs if program.outputs is None else program.outputs
     declared = program_inputs(text)
     edges = {n: (m[1] == "RE", next(x for x in g.inputs if st[x] == m[2])) for n in declared if (m := EDGE.fullmatch(n))}
-    pou = Pou(PouKind.PROGRAM, name, (
+    pou = Pou(program.kind, program.pou, (
         VarSection(SectionKind.INPUT, tuple(Declaration(n) for n in declared)),
-        VarSection(SectionKind.OUTPUT, tuple(Declaration(st[o]) for o in g.outputs)),
-        VarSection(SectionKind.LOCAL, tuple(Declaration(f"{sfc_step_name(s.name)}.X") for s in g.steps))), ())
+        VarSection(SectionKind.OUTPUT, tuple(Declaration(st[o]) for o in outputs)),
+        VarSection(SectionKind.LOCAL, tuple(Declaration(f"{s}.X") for s in program.steps.values()))), ())
     machine = GrafcetMachine(g)
     played, differences, fired = 0, [], set()
-    plc = CompiledProgram(StProgram(text, pou.name, (), (pou,)), folder / "c")
+    plc = CompiledProgram(StProgram(text, pou.name, (), (pou,)), folder / "c", pou=pou.name)
     start = plc.save()  # the program as loaded: each sequence starts from it
     try:
         for seed in seeds:
@@ -155,9 +184,10 @@ def run_on_plc(g: Grafcet, folder: Path, seeds: range, scans: int, period: int =
                 plc.advance(period)
                 plc.cycle(cells)
                 played += 1
-                want = (tuple(side.sit.steps), tuple(o for o in g.outputs if o in machine.orders(side.sit, inputs)))
-                got = (tuple(s.name for s in g.steps if plc.value(f"{sfc_step_name(s.name)}.X")),
-                       tuple(o for o in g.outputs if plc.value(st[o])))
+                want = (tuple(s for s in side.sit.steps if s in program.steps),
+                        tuple(o for o in outputs if o in machine.orders(side.sit, inputs)))
+                got = (tuple(s for s, name in program.steps.items() if plc.value(f"{name}.X")),
+                       tuple(o for o in outputs if plc.value(st[o])))
                 if sorted(want[0]) != sorted(got[0]) or want[1] != got[1]:
                     values = " ".join(f"{n}={int(v)}" for n, v in inputs.items())
                     differences.append(Difference(Path(g.path).name, seed, k, values, _text(want), _text(got)))

@@ -218,7 +218,7 @@ def cmd_import(args: argparse.Namespace) -> int:
         print(w.render(), file=sys.stderr)
     g = _imported_grafcet(text, args)  # the result must be a valid .g7
     from synth.errors import LimitExceeded
-    from synth.grafcet.semantics import IMPORT_BUDGET, scan_only_steps
+    from synth.grafcet.semantics import IMPORT_BUDGET, IMPORT_REACTIONS, scan_only_steps
 
     show = tty_progress(live_line(not args.quiet))
     show("the steps a PLC scan keeps active (IEC 61131-3 against IEC 60848)")
@@ -231,7 +231,8 @@ def cmd_import(args: argparse.Namespace) -> int:
         clear_progress(show)
     if over:
         print(f"{args.file}: note: not checked whether some steps stay active for a PLC scan where IEC 60848 passes "
-              f"through them (more than {IMPORT_BUDGET} situations to explore): validate with --semantics sfc for "
+              f"through them (more than {IMPORT_BUDGET} situations or {IMPORT_REACTIONS} reactions to explore): validate "
+              "with --semantics sfc for "
               "the meaning the program has on the PLC", file=sys.stderr)
     if steps:
         print(f"{args.file}: note: step{'s' if len(steps) > 1 else ''} {', '.join(steps)} stay active for a PLC scan "

@@ -77,6 +77,7 @@ def stable_situation_automaton(
     initial_inputs: Mapping[str, bool] | None = None,
     max_states: int = 100_000,
     admissible: Callable[[Mapping[str, bool]], bool] | None = None,
+    max_reactions: int | None = None,
 ) -> ASS:
     """The ASS of ``machine``, explored from its initial situation.
 
@@ -128,6 +129,7 @@ def stable_situation_automaton(
     moves: dict[tuple[int, Event], dict[int, int]] = {}
     queue: deque[int] = deque([0])
     queued = {0}
+    runs = [0]  # the machine's runs so far
 
     def known(sit: Situation) -> int:
         k = sid.get(sit)
@@ -157,6 +159,9 @@ def stable_situation_automaton(
                 out[target] = out.get(target, 0) | hit
                 rest &= ~covered
         while rest:
+            runs[0] += 1
+            if max_reactions is not None and runs[0] > max_reactions:
+                raise LimitExceeded(f"more than {max_reactions} reactions while building the ASS")
             v = (rest & -rest).bit_length() - 1
             reader = InputRecorder(partial(valuation, v))
             if event.kind is EventKind.TIMER:

@@ -22,7 +22,7 @@ from synth.grafcet.ass import stable_situation_automaton
 from synth.grafcet.language import Grafcet, Semantics, step_key
 from synth.grafcet.machine import GrafcetMachine
 
-__all__ = ["IMPORT_BUDGET", "scan_only_steps"]
+__all__ = ["IMPORT_BUDGET", "IMPORT_REACTIONS", "scan_only_steps"]
 
 
 IMPORT_BUDGET = 2_000
@@ -30,15 +30,22 @@ IMPORT_BUDGET = 2_000
 it stays well under a second on a chart of 200 steps and says so when it is not computed."""
 
 
-def scan_only_steps(g: Grafcet, max_states: int = IMPORT_BUDGET) -> tuple[str, ...] | None:
+IMPORT_REACTIONS = 20_000
+"""Runs of the machine each reading may make for that note (about a CPU second): many inputs
+and partial grafcets (the blocks of a Beremiz chart) make each situation costly."""
+
+
+def scan_only_steps(g: Grafcet, max_states: int = IMPORT_BUDGET,
+                    max_reactions: int = IMPORT_REACTIONS) -> tuple[str, ...] | None:
     """The steps active in some situation of the SFC reading and in no stable situation of the
     IEC 60848 one (inputs free); None when the Grafcet never stabilises in IEC 60848.
     :class:`~synth.errors.LimitExceeded` when either reading has more than ``max_states``
-    situations."""
+    situations or needs more than ``max_reactions`` runs of the machine."""
     try:
         stable = stable_situation_automaton(GrafcetMachine(replace(g, semantics=Semantics.GRAFCET)),
-                                            max_states=max_states)
-        scans = stable_situation_automaton(GrafcetMachine(replace(g, semantics=Semantics.SFC)), max_states=max_states)
+                                            max_states=max_states, max_reactions=max_reactions)
+        scans = stable_situation_automaton(GrafcetMachine(replace(g, semantics=Semantics.SFC)), max_states=max_states,
+                                           max_reactions=max_reactions)
     except InputError:
         return None
     seen = {s for st in stable.states for s in st.situation.steps}

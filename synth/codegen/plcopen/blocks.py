@@ -26,7 +26,7 @@ from synth.codegen.plcopen.actions import rising
 from synth.codegen.plcopen.data import DATA, duration
 from synth.errors import InputError, Location, Severity
 
-__all__ = ["FBD_FUNCTION_BLOCKS", "sel", "trigger", "ton_output", "warn_block"]
+__all__ = ["FBD_FUNCTION_BLOCKS", "sel", "trigger", "ton_output", "warn_block", "step_flag"]
 
 FBD_FUNCTION_BLOCKS = ("SEL", "R_TRIG", "F_TRIG", "TON")
 """The blocks other than AND/OR/NOT read in an FBD transition condition."""
@@ -69,7 +69,7 @@ def trigger(kind: str, instance: str, clk: str, where: Location) -> str:
     return edge
 
 
-def _step_flag(name: str, sfc_elements: dict[int, Any], steps: dict[str, str]) -> str | None:
+def step_flag(name: str, sfc_elements: dict[int, Any], steps: dict[str, str]) -> str | None:
     """``XS`` when the Boolean ``name`` is only the continuous (N) action of the one step ``S``."""
     from lxml import etree
 
@@ -108,7 +108,7 @@ def ton_output(instance: str, c: str, pt_text: str, sources: list[str], where: L
         raise InputError(f"the PT of TON {instance} is '{pt_text.strip()}': a step timer needs a constant duration "
                          "such as T#2s", pt_at)
     c = given = _bare(c)
-    if re.fullmatch(r"[A-Za-z_]\w*", c) and (flag := _step_flag(c, sfc_elements, steps)) is not None:
+    if re.fullmatch(r"[A-Za-z_]\w*", c) and (flag := step_flag(c, sfc_elements, steps)) is not None:
         c, given = flag, f"{c} (only the continuous action of step {flag[1:]}: {flag})"
     if scope is None or len(sources) != 1:
         raise InputError(f"TON {instance} in the condition of a transition with {len(sources)} source steps: a .g7 "

@@ -23,6 +23,7 @@ import re
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
+from synth.codegen.plcopen.vendor import Dialect
 from synth.errors import InputError, Location, Severity
 
 __all__ = ["FLAG_PREFIX", "duration", "IEC_RANGES", "DataVar", "DataScope", "DATA", "data_scope", "assigned_names", "strip_comments",
@@ -99,6 +100,8 @@ class DataScope:
     action_refs: list[str] = field(default_factory=list)  # names an action block references (outputs)
     extra_charts: list[HelperChart] = field(default_factory=list)  # SR/RS latches, LD blinkers
     blink_actions: set[str] = field(default_factory=set)  # upper-case LD actions read as a blinker
+    dialect: tuple[Dialect, str] = (Dialect.OTHER, "")  # the tool that wrote the file, and how it says so
+    scan_calls: dict[str, Any] = field(default_factory=dict)  # Beremiz: a block's path -> its call (fbscan.py)
 
     def every_scan(self, statement: str, action: str, where: Location) -> None:
         """``statement`` (data read) runs at every PLC scan while its step is active: an error,

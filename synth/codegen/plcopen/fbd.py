@@ -4,7 +4,9 @@ SFC example and every CODESYS V3.5 export connect the condition of a transition 
 over such variables; Beremiz draws LD contacts from a power rail (in series: AND, in
 parallel: OR). :func:`fbd_condition` reads that network back into one ``.g7``
 receptivity; any other construct (an LD contact, another block, a loop) is an
-:class:`~synth.errors.InputError` at its element.
+:class:`~synth.errors.InputError` at its element. In a file written by Beremiz or the OpenPLC
+editor, the blocks are read as Beremiz calls them, at every scan after the transitions
+(:mod:`synth.codegen.plcopen.fbscan`).
 
 Example
 -------
@@ -14,12 +16,15 @@ Example
 
 from __future__ import annotations
 
+import re
+from functools import partial
 from typing import Any, Callable
 
-from synth.codegen.plcopen.blocks import FBD_FUNCTION_BLOCKS, sel, ton_output, trigger
+from synth.codegen.plcopen.blocks import FBD_FUNCTION_BLOCKS, sel, step_flag, ton_output, trigger
+from synth.codegen.plcopen.fbscan import SCAN_BLOCKS, every_scan, lagging, negation, scan_block
 from synth.codegen.plcopen.latch import LATCH_BLOCKS, latch_chart, latch_step
 from synth.codegen.plcopen.st_condition import ExprReader
-from synth.errors import InputError
+from synth.errors import InputError, Location
 
 __all__ = ["FBD_ELEMENTS", "fbd_condition", "fbd_transition"]
 
@@ -49,7 +54,42 @@ def fbd_condition(cond: Any, elements: dict[int, Any], q: Callable[[str], str], 
             raise InputError(f"connection to unknown localId {text}", src.at(conns[0]))
         return node(int(text), frozenset())
 
-    def node(lid: int, seen: frozenset[int]) -> str:
+    def source(var: Any) -> Any:
+        """The element wired to the block input ``var``."""
+        cp = var.find(q("connectionPointIn"))
+        if cp is None:
+            raise InputError("an unconnected block input", src.at(var))
+        conns = cp.findall(q("connection"))
+        if len(conns) != 1 or not conns[0].get("refLocalId", "").strip().isdigit():
+            raise InputError("a block input must be connected to one element", src.at(var))
+        ref = int(conns[0].get("refLocalId"))
+        if ref not in elements:
+            raise InputError(f"connection to unknown localId {ref}", src.at(conns[0]))
+        return elements[ref]
+
+    def argument(var: Any, inner: frozenset[int], by_block: bool, wrap: bool = True) -> str:
+        fed = source(var)
+        ex = fed.find(q("expression"))
+        name = (ex.text or "").strip() if ex is not None and by_block else ""
+        flag = step_flag(name, elements, steps) if re.fullmatch(r"[A-Za-z_]\w*", name) else None
+        arg = flag or node(int(fed.get("localId")), inner, by_block)
+        if every_scan() and var.get("edge", "none") in ("rising", "falling") and not _negated(var):
+            arg = scan_block(var, {"CLK": (partial(str, arg), fed)}, by_block, src.at(var), None,
+                             partial(lagging, steps=steps), str(var.get("edge")))
+        if not wrap:
+            return negation(arg) if _negated(var) else arg
+        return f"!({arg})" if _negated(var) else f"({arg})"
+
+    def pt_of(block: Any) -> tuple[str, Location]:
+        """The text of the inVariable wired to the ``PT`` of ``block``, and where it is."""
+        var = next((v for v in block.iterfind(f"{q('inputVariables')}/{q('variable')}")
+                    if str(v.get("formalParameter", "")).upper() == "PT"), None)
+        if var is None:
+            raise InputError("an FBD TON block without its input PT", src.at(block))
+        ex = source(var).find(q("expression"))
+        return (ex.text or "") if ex is not None else "", src.at(source(var))
+
+    def node(lid: int, seen: frozenset[int], by_block: bool = False) -> str:
         el = elements[lid]
         kind = etree.QName(el).localname
         if lid in latches:
@@ -66,6 +106,18 @@ def fbd_condition(cond: Any, elements: dict[int, Any], q: Callable[[str], str], 
             return f"!({expr})" if _negated(el) else expr
         if kind == "block":
             name = (el.get("typeName") or "").upper()
+            if every_scan():
+                if name not in SCAN_BLOCKS:
+                    raise InputError(f"an FBD block {el.get('typeName')} in a transition condition: only "
+                                     f"{', '.join(SCAN_BLOCKS)} have a Boolean or timer meaning in .g7", src.at(el),
+                                     expected=tuple(SCAN_BLOCKS))
+                outs = el.find(f"{q('outputVariables')}/{q('variable')}")
+                ins = list(el.iterfind(f"{q('inputVariables')}/{q('variable')}"))
+                readers: dict[str, tuple[Callable[[], str], Any]] = {
+                    str(v.get("formalParameter", "")).upper() or f"IN{i + 1}":
+                    (partial(argument, v, frozenset(), True, False), v) for i, v in enumerate(ins)}
+                value = scan_block(el, readers, by_block, src.at(el), partial(pt_of, el), partial(lagging, steps=steps))
+                return f"!({value})" if _negated(outs) else value
             if name not in _BLOCKS and name not in FBD_FUNCTION_BLOCKS and name not in LATCH_BLOCKS:
                 raise InputError(f"an FBD block {el.get('typeName')} in a transition condition: only AND, OR, NOT, "
                                  "SEL, R_TRIG, F_TRIG, TON, SR and RS have a Boolean or step-timer meaning in .g7",
@@ -79,21 +131,10 @@ def fbd_condition(cond: Any, elements: dict[int, Any], q: Callable[[str], str], 
             args: list[str] = []
             params: dict[str, tuple[str, Any]] = {}
             for var in el.iterfind(f"{q('inputVariables')}/{q('variable')}"):
-                cp = var.find(q("connectionPointIn"))
-                if cp is None:
-                    raise InputError("an unconnected block input", src.at(var))
-                conns = cp.findall(q("connection"))
-                if len(conns) != 1 or not conns[0].get("refLocalId", "").strip().isdigit():
-                    raise InputError("a block input must be connected to one element", src.at(var))
-                ref = int(conns[0].get("refLocalId"))
-                if ref not in elements:
-                    raise InputError(f"connection to unknown localId {ref}", src.at(conns[0]))
                 if name == "TON" and str(var.get("formalParameter", "")).upper() == "PT":
-                    ex = elements[ref].find(q("expression"))
-                    params["PT"] = ((ex.text or "") if ex is not None else "", elements[ref])
+                    params["PT"] = pt_of(el)
                     continue
-                arg = node(ref, inner)
-                args.append(f"!({arg})" if _negated(var) else f"({arg})")
+                args.append(argument(var, inner, False))
                 params[str(var.get("formalParameter", "")).upper()] = (args[-1], var)
             out = _function_block(name, el, args, params)
             if name in LATCH_BLOCKS:
@@ -109,7 +150,10 @@ def fbd_condition(cond: Any, elements: dict[int, Any], q: Callable[[str], str], 
             reader = ExprReader(name, lambda off, w, h=var, t=name: src.text_at(h, t, off, w), steps)
             literal = reader.whole()
             edge = el.get("edge", "none")
-            if edge in ("rising", "falling"):
+            if edge in ("rising", "falling") and every_scan() and not _negated(el):  # Beremiz: an R_TRIG/F_TRIG
+                literal = scan_block(el, {"CLK": (partial(str, literal), var)}, False, src.at(el), None,
+                                     partial(lagging, steps=steps), edge)
+            elif edge in ("rising", "falling") and not every_scan():
                 literal = ("↑" if edge == "rising" else "↓") + literal
             if _negated(el):
                 literal = f"!{literal}" if edge == "none" else f"!({literal})"
@@ -149,7 +193,7 @@ def fbd_condition(cond: Any, elements: dict[int, Any], q: Callable[[str], str], 
             return ""
         if name == "TON":
             return ton_output(instance, params["IN"][0], params["PT"][0], list(sources), src.at(el), elements,
-                              steps, src.at(params["PT"][1]))
+                              steps, params["PT"][1])
         return trigger(name, instance, params["CLK"][0], src.at(el))
 
     cp = cond.find(q("connectionPointIn"))

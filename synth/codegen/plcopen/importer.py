@@ -45,7 +45,7 @@ from synth.codegen.plcopen.sfc import Chart, Source, read_chart
 from synth.codegen.plcopen.mirrors import merge_mirrors
 from synth.codegen.plcopen.shared import MARK, merge_shared, shared_assignment, without_shared_or
 from synth.codegen.plcopen.timers import prepare_scope
-from synth.codegen.plcopen.vendor import IecQualifier
+from synth.codegen.plcopen.vendor import IecQualifier, dialect_of
 from synth.codegen.plcopen.tc6 import Qualifier
 from synth.codegen.plcopen.st_condition import PREDICATES, ExprReader, st_text
 from synth.errors import InputError, Location, Severity
@@ -94,6 +94,7 @@ def import_sfc(data: bytes | str, file: str = "<xml>", pou: str | None = None,
         token4 = HELD.set(held)
         prefix = f"{p.get('name')}_" if several else ""
         scope = prepare_scope(p, s, q, src.at, prefix, src.text_at)
+        scope.dialect = dialect_of(root, q)
         token3 = DATA.set(scope)
         try:
             charts.append(read_chart(p, s, q, src, _read_action, prefix))

@@ -25,6 +25,7 @@ from synth.codegen.plcopen.timers import ton_chart
 from synth.codegen.plcopen.divergence import exclusive_branches, priority
 from synth.codegen.plcopen.vendor import chart_flag_warnings, step_actions
 from synth.codegen.plcopen.fbd import FBD_ELEMENTS, fbd_condition, fbd_transition
+from synth.codegen.plcopen.fbscan import first_scan_guard, settle_step_reads
 from synth.codegen.plcopen.tc6 import SYNTH_DATA
 from synth.codegen.plcopen.st_condition import PREDICATES, ExprReader, st_text
 from synth.errors import InputError, Location, Severity, close_names
@@ -361,6 +362,11 @@ def read_chart(pou: Any, sfc: Any, q: Callable[[str], str], src: Source,
                        "condition an edge, or add a step",)))
     helpers: list[_ImportedStep] = []
     scope = DATA.get()
+    first = next((st for st in steps.values() if st.initial), None)
+    if scope is not None and first is not None:
+        settle_step_reads(transitions, {st.name for st in steps.values()})
+        starts = {n: initial for c in scope.extra_charts for n, initial, _ in c[1]}
+        warnings += first_scan_guard(transitions, first.name, src.at(first.el), starts)
     for gname, hsteps, htrans in ton_chart(scope, by_sfc_name, src.text_at) if scope is not None else []:
         helpers += [_ImportedStep(n, initial, list(acts), gname, pou) for n, initial, acts in hsteps]
         transitions += [("", a, b, expr, pou) for a, b, expr in htrans]

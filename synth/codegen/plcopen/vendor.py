@@ -20,7 +20,8 @@ from typing import Any, Callable
 
 from synth.errors import InputError, Location, Severity
 
-__all__ = ["IecQualifier", "StepAction", "SFC_ELEMENT_DATA", "step_actions", "CHART_FLAGS", "chart_flag_warnings"]
+__all__ = ["IecQualifier", "StepAction", "SFC_ELEMENT_DATA", "step_actions", "CHART_FLAGS", "chart_flag_warnings",
+           "Dialect", "dialect_of"]
 
 
 class IecQualifier(StrEnum):
@@ -37,6 +38,35 @@ class IecQualifier(StrEnum):
     SD = "SD"
     DS = "DS"
     SL = "SL"
+
+class Dialect(Enum):
+    """The tool that wrote a PLCopen file, as far as the meaning of its SFC bodies differs: when
+    the blocks wired in a transition network are called (docs/codegen.md)."""
+
+    BEREMIZ = "Beremiz or the OpenPLC editor"  # called at every scan, after the transitions
+    CODESYS = "CODESYS or TwinCAT"  # called while the transition is evaluated
+    OTHER = "another tool"  # read as CODESYS does
+
+
+_BEREMIZ_DEFAULTS = ("Unknown", "Unnamed")
+"""The ``fileHeader`` companyName and productName of a new project in Beremiz and in the OpenPLC
+editor (its fork)."""
+
+
+def dialect_of(root: Any, q: Callable[[str], str]) -> tuple[Dialect, str]:
+    """The tool that wrote the project ``root`` and the ``fileHeader`` words that say so."""
+    header = root.find(q("fileHeader"))
+    company = str(header.get("companyName", "")) if header is not None else ""
+    product = str(header.get("productName", "")) if header is not None else ""
+    said = f'fileHeader companyName="{company}" productName="{product}"'
+    words = f"{company} {product}".lower()
+    if any(w in words for w in ("codesys", "twincat", "beckhoff", "3s-smart")) or \
+            any(str(d.get("name", "")).startswith("http://www.3s-software.com") for d in root.iter(q("data"))):
+        return Dialect.CODESYS, said
+    if "beremiz" in words or "openplc" in words or (company, product) == _BEREMIZ_DEFAULTS:
+        return Dialect.BEREMIZ, said
+    return Dialect.OTHER, said
+
 
 SFC_ELEMENT_DATA = "/plcopenxml/sfc/element"
 """How the name of a CODESYS (``http://www.3s-software.com``) or TwinCAT SFC element's
