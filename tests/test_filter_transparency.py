@@ -45,9 +45,10 @@ def _node_by_node(ex: Explorer) -> tuple[int, int, int]:
 
 
 @pytest.mark.parametrize("pallets, k, states, cycles, corrected",
-                         [(p, k, s, c, r) for p, k, s, _, c, r, _ in GRAFCET_RUNS if (p, k) in {(1, 1), (2, 1), (3, 2)}])
+                         [(p, k, s, c, r) for p, k, s, _, c, r, _ in GRAFCET_RUNS if (p, k) in {(1, 1), (3, 2)}])
 def test_correcting_cycles_equal_a_count_node_by_node(pallets, k, states, cycles, corrected):
     """What ``filter verify`` prints (``tests/test_four_cylinders.py`` checks the CLI prints
     these numbers) equals the count node by node. Counted after the merge, 1 pallet gives
-    457, 2 pallets 666 corrections."""
+    457 corrections (2 pallets: 666 of 753, three pallets and two events
+    per cycle: 113 of 113 either way)."""
     assert _node_by_node(_explorer(pallets, k)) == (states, cycles, corrected)

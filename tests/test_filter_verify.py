@@ -56,7 +56,6 @@ def test_done_when_tri_any_control(cli, tri_filter):
         ("-", "{v10,v20,v30,v40,TAPIS,AVANCER2}", ("TAPIS", "AVANCER2"), ("TAPIS", "AVANCER2"), ""),
         ("↑cp11", "{v10,v20,v30,v40,cp11,TAPIS,AVANCER2}", (), (), "before the PLC writes"),
     ]
-    assert v.seconds < 30
     code, out, err = cli("filter", "verify", tri_filter, "--plant", TRI, "--any-control")
     assert code == 0
     assert "safe: no constraint is violated once the outputs are written" in out
