@@ -49,6 +49,5 @@ def _node_by_node(ex: Explorer) -> tuple[int, int, int]:
 def test_correcting_cycles_equal_a_count_node_by_node(pallets, k, states, cycles, corrected):
     """What ``filter verify`` prints (``tests/test_four_cylinders.py`` checks the CLI prints
     these numbers) equals the count node by node. Counted after the merge, 1 pallet gives
-    457 corrections (2 pallets: 666 of 753, three pallets and two events
-    per cycle: 113 of 113 either way)."""
+    457 corrections (2 pallets: 666 of 753)."""
     assert _node_by_node(_explorer(pallets, k)) == (states, cycles, corrected)
