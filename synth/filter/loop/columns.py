@@ -73,9 +73,9 @@ class PlantColumns:
             for t in self.level_terms]
         by_event: dict[str, list[LocalTransition]] = {}  # per event, its local transitions, first-seen order
         controllable: dict[str, bool] = {}
-        for t in p.transitions:
-            by_event.setdefault(t.event, []).append(t)
-            controllable[t.event] = t.controllable
+        for move in p.transitions:
+            by_event.setdefault(move.event, []).append(move)
+            controllable[move.event] = move.controllable
         self.uncontrollable: tuple[tuple[str, tuple[LocalTransition, ...]], ...] = tuple(
             (e, tuple(ts)) for e, ts in by_event.items() if not controllable[e])
         self.val = {v: self._value(v) for v in p.variables}
@@ -83,8 +83,8 @@ class PlantColumns:
         for z in p.outputs:
             for edge in (Event.rise(z), Event.fall(z)):
                 self.toggle.setdefault(edge, self._move(()))
-        self.illegal = Column(lambda c: self.holds(self.level_terms, c))
-        self.forbid = {e: Column(lambda c, ts=ts: self.holds(ts, c)) for e, ts in self.edge_terms.items()}
+        self.illegal = self._terms(self.level_terms)
+        self.forbid = {e: self._terms(ts) for e, ts in self.edge_terms.items()}
         self.outside_sup = Column(self._removed)
 
     # ------------------------------------------------------------------ digits and moves
@@ -96,6 +96,9 @@ class PlantColumns:
         axis = self.plant.owner[name]
         vec = self.plant.elements[axis].value(name)
         return Column(lambda c: vec[self.digit(c, axis)])
+
+    def _terms(self, terms: Sequence[Term]) -> Column:
+        return Column(lambda c: self.holds(terms, c))
 
     def _move(self, transitions: tuple[LocalTransition, ...]) -> Column:
         return Column(lambda c: self.step(transitions, c, {}))
