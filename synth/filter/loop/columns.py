@@ -23,17 +23,27 @@ Example
 
 from __future__ import annotations
 
-from typing import Any, Callable, Iterator, Sequence
+from typing import Any, Callable, Iterator, NamedTuple, Sequence
 
 import numpy as np
 
 from synth.errors import LimitExceeded
 from synth.logic.events import Event
-from synth.plant.composition import LocalTransition, Plant
+from synth.plant.composition import Plant
 from synth.plant.rules import Constraint
 from synth.sup.constraints import Term, split_terms
 
 __all__ = ["Column", "PlantColumns"]
+
+
+class Move(NamedTuple):
+    """A local transition on codes: from local index ``src`` of element ``axis``, the code
+    moves by ``shift``; ``guard`` over the codes of what the element reads (None: always)."""
+
+    axis: int
+    src: int
+    shift: int
+    guard: np.ndarray | None
 
 
 class Column:
@@ -71,13 +81,17 @@ class PlantColumns:
         self.level_reach: list[Term] | None = None if p.reads else [
             Term(t.constraint, tuple((a, p.elements[a].can_reach(v)) for a, v in t.factors), None)
             for t in self.level_terms]
-        by_event: dict[str, list[LocalTransition]] = {}  # per event, its local transitions, first-seen order
+        by_event: dict[str, list[Move]] = {}  # per event, its local transitions, first-seen order
         controllable: dict[str, bool] = {}
-        for move in p.transitions:
-            by_event.setdefault(move.event, []).append(move)
-            controllable[move.event] = move.controllable
-        self.uncontrollable: tuple[tuple[str, tuple[LocalTransition, ...]], ...] = tuple(
+        for lt in p.transitions:
+            guard = None if lt.guard is None else np.asarray(lt.guard, dtype=bool)
+            shift = (lt.dst - lt.src) * p.strides[lt.axis]
+            by_event.setdefault(lt.event, []).append(Move(lt.axis, lt.src, shift, guard))
+            controllable[lt.event] = lt.controllable
+        self.uncontrollable: tuple[tuple[str, tuple[Move, ...]], ...] = tuple(
             (e, tuple(ts)) for e, ts in by_event.items() if not controllable[e])
+        # per element, the (element, values) of each variable it reads; per guarded move, its guard
+        self.reads = [[(p.owner[r], p.elements[p.owner[r]].value(r)) for r in e.reads] for e in p.elements]
         self.val = {v: self._value(v) for v in p.variables}
         self.toggle = {e: self._move(tuple(ts)) for e, ts in by_event.items() if controllable[e]}
         for z in p.outputs:
@@ -100,16 +114,14 @@ class PlantColumns:
     def _terms(self, terms: Sequence[Term]) -> Column:
         return Column(lambda c: self.holds(terms, c))
 
-    def _move(self, transitions: tuple[LocalTransition, ...]) -> Column:
+    def _move(self, transitions: tuple[Move, ...]) -> Column:
         return Column(lambda c: self.step(transitions, c, {}))
 
-    def step(self, transitions: Sequence[LocalTransition], codes: np.ndarray, digits: dict[int, np.ndarray]
+    def step(self, transitions: Sequence[Move], codes: np.ndarray, digits: dict[int, np.ndarray]
              ) -> np.ndarray:
         """The successor of each code by one of ``transitions`` (one event's; the last one
         that applies, as an array filled transition by transition would hold), -1 where
         none does; ``digits`` caches the codes' digits per element."""
-        p = self.plant
-
         def dig(a: int) -> np.ndarray:
             if a not in digits:
                 digits[a] = self.digit(codes, a)
@@ -120,11 +132,10 @@ class PlantColumns:
             sel = dig(t.axis) == t.src
             if t.guard is not None:
                 read = np.zeros(codes.size, dtype=np.int64)
-                for j, r in enumerate(p.elements[t.axis].reads):
-                    a = p.owner[r]
-                    read |= p.elements[a].value(r)[dig(a)].astype(np.int64) << j
-                sel &= np.asarray(t.guard, dtype=bool)[read]
-            out[sel] = codes[sel] + (t.dst - t.src) * p.strides[t.axis]
+                for j, (a, vec) in enumerate(self.reads[t.axis]):
+                    read |= vec[dig(a)].astype(np.int64) << j
+                sel &= t.guard[read]
+            out[sel] = codes[sel] + t.shift
         return out
 
     def moves(self, codes: np.ndarray) -> Iterator[tuple[str, np.ndarray]]:

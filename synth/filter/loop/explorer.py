@@ -197,14 +197,15 @@ class Explorer:
             def bit(m: int) -> bool:
                 return bool((m >> j) & 1)
 
-            req = dict(zip(cyc.outputs, map(bit, lanes.requests)))
-            req.update((o, bit(out[o])) for o in pr.passthrough)
             oc = Outcome(tuple(bit(out[o]) for o in pr.orders),
                          self.intern((tuple(map(bit, memory_after)), bit(lanes.blocked), sit)),
-                         bit(lanes.fallback), bit(lanes.outside_care), tuple(req[o] for o in pr.orders),
-                         tuple(i for i, m in lanes.violated.items() if bit(m)))
-            g = self.outcome_of.get(oc)
+                         bit(lanes.fallback), bit(lanes.outside_care), (), ())
+            g = self.outcome_of.get(oc)  # the witness (requests, violated) is not compared
             if g is None:
+                req = dict(zip(cyc.outputs, map(bit, lanes.requests)))
+                req.update((o, bit(out[o])) for o in pr.passthrough)
+                oc = dataclasses.replace(oc, requests=tuple(req[o] for o in pr.orders),
+                                         violated=tuple(i for i, m in lanes.violated.items() if bit(m)))
                 g = self.outcome_of[oc] = len(self.outcomes)
                 self.outcomes.append(oc)
             found.append(g)
