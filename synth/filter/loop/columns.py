@@ -90,7 +90,7 @@ class PlantColumns:
             controllable[lt.event] = lt.controllable
         self.uncontrollable: tuple[tuple[str, tuple[Move, ...]], ...] = tuple(
             (e, tuple(ts)) for e, ts in by_event.items() if not controllable[e])
-        # per element, the (element, values) of each variable it reads; per guarded move, its guard
+        # per element, the (element, values) of each variable it reads (its moves' guards read them)
         self.reads = [[(p.owner[r], p.elements[p.owner[r]].value(r)) for r in e.reads] for e in p.elements]
         self.val = {v: self._value(v) for v in p.variables}
         self.toggle = {e: self._move(tuple(ts)) for e, ts in by_event.items() if controllable[e]}
