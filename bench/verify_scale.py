@@ -11,8 +11,9 @@ states, CPU seconds and peak MiB of each engine side by side.
 - ``ring_filter(n)``: plants/four_cylinders.filter by analogy: six simple constraints per
   cylinder, one combined ``ik & Qk & Qk+1 keep Qk``, the observers X3k.
 
-The plant's grid has 24^N states (6 per cylinder, 4 per cell): the explicit engine keeps
-arrays over it and stops above 2·10^7 (N ≥ 6). Each (N, engine) runs in a fresh process
+The plant's grid has 24^N states (6 per cylinder, 4 per cell): neither engine holds an
+array over it (the explicit one computes what it needs for the states it reaches,
+synth/filter/loop/columns.py). Each (N, engine) runs in a fresh process
 (``synth filter verify ... --engine E --json``); its CPU seconds and peak RSS come from
 ``resource.getrusage`` of the child; a run past ``--limit`` seconds is killed.
 """

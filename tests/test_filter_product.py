@@ -6,6 +6,9 @@ output layer prints (from-rules writes nothing, check and run are one call each)
 from __future__ import annotations
 
 import json
+import sys
+
+import numpy as np
 
 from conftest import ROOT
 from synth.filter.coherence import check
@@ -21,6 +24,9 @@ from synth.plant.composition import load_plant, plant
 from synth.plant.rules_check import load_rules
 from synth.sup.constraints import CompiledConstraints
 
+sys.path.insert(0, str(ROOT / "bench"))
+from verify_scale import ring_rules  # noqa: E402
+
 DATA = ROOT / "tests" / "data" / "filter"
 TRI = ROOT / "plants" / "tri.rules"
 
@@ -30,23 +36,47 @@ def _product(rules, tmp_path, grafcet=None):
     return Product(sk.filter, load_plant(rules), grafcet, Algorithm.ALGEBRAIC, Mode.SUPERVISOR, False)
 
 
-def test_grids_agree_with_the_closed_forms_state_by_state(tmp_path):
-    """illegal, outside SUP and the forbidden edges of every state, from the Supervisor's
-    grids, equal CompiledConstraints' answers for that one state."""
+def test_columns_agree_with_the_supervisor_state_by_state(tmp_path):
+    """illegal, outside SUP and the forbidden edges of every state, computed by the
+    product's columns for the codes asked (all of them at once, and one by one), equal the
+    Supervisor's grids and CompiledConstraints' answers for that one state."""
+    from synth.sup.supervisor import Supervisor
+
     seen = set()
-    for rules in (DATA / "two.rules", TRI):
+    ring = tmp_path / "ring3.rules"  # cells that read the cylinders
+    ring.write_text(ring_rules(3))
+    for rules in (DATA / "two.rules", TRI, ring):
         pr = _product(rules, tmp_path)
         rs = load_rules(rules)
         cc = CompiledConstraints(plant(rs), rs.constraints)
+        sup = Supervisor(pr.plant, rs.constraints)
+        codes = np.arange(pr.size, dtype=np.int64)
+        illegal, outside = pr.illegal[codes], pr.outside_sup[codes]
+        assert (illegal == sup.illegal.ravel()).all() and (outside == sup.removed.ravel()).all(), rules
+        assert set(pr.forbid) == set(sup.forbid), rules
+        for ev, col in pr.forbid.items():
+            assert (col[codes] == sup.forbid[ev].ravel()).all(), (rules, ev)
         seen |= {"edge"} if pr.forbid else set()
-        seen |= {"weakly"} if (pr.outside_sup & ~pr.illegal).any() else set()
-        for code in range(pr.size):
+        seen |= {"weakly"} if (outside & ~illegal).any() else set()
+        seen |= {"reads"} if pr.plant.reads and (outside & ~illegal).any() else set()  # the forward search
+        for code in codes.tolist()[:: max(1, pr.size // 300)]:
             local = pr.plant.local(code)
-            assert pr.illegal[code] == bool(cc.violated(local)), (rules, code)
-            assert pr.outside_sup[code] == (not cc.kept(local)), (rules, code)
-            for ev, grid in pr.forbid.items():
-                assert grid[code] == bool(cc.forbidding(ev, local)), (rules, code, ev)
-    assert seen == {"edge", "weakly"}  # not vacuous
+            assert bool(pr.illegal[code]) == bool(cc.violated(local)), (rules, code)
+            assert pr.violated(code) == tuple(cc.violated(local)), (rules, code)
+            assert pr.columns.threatened(code) == tuple(cc.threatened(local)), (rules, code)
+            for ev in pr.forbid:
+                assert pr.columns.forbidding(ev, code) == tuple(cc.forbidding(ev, local)), (rules, code, ev)
+        # every event's successor column equals the plant's transitions
+        dense: dict[str, np.ndarray] = {}
+        for t, src, dst in pr.plant.transition_arrays():
+            dense.setdefault(t.event, np.full(pr.size, -1, dtype=np.int64))[src] = dst
+        moves = dict(pr.moves(codes))
+        assert list(moves) == list(pr.uncontrollable) == [e for e in dense if e not in pr.toggle], rules
+        for ev, col in pr.toggle.items():
+            assert (col[codes] == dense.get(ev, -1)).all(), (rules, ev)
+        for ev, succ in moves.items():
+            assert (succ == dense[ev]).all(), (rules, ev)
+    assert seen == {"edge", "weakly", "reads"}  # not vacuous
     # every order has both edges in the toggle table (-1 where the plant has no such move)
     assert all(Event.edge(z, r) in pr.toggle for z in pr.orders for r in (False, True))
 

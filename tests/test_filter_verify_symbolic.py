@@ -1,7 +1,8 @@
 """`synth filter verify --engine symbolic` (issue 23, build 2): the closed loop under any
 control on BDDs gives the explicit engine's report exactly (counts, cycles, findings,
-shortest traces) on the bundled filters; what it refuses; ``--engine auto``; a ring of
-cylinders whose plant the explicit engine cannot hold (bench/verify_scale.py)."""
+shortest traces) on the bundled filters; what it refuses; ``--engine auto``; rings of
+cylinders (bench/verify_scale.py): both engines equal on small ones, the explicit one
+without arrays over a grid of 24^6 states (issue 37)."""
 
 from __future__ import annotations
 
@@ -15,7 +16,6 @@ import pytest
 from conftest import ROOT
 from schemas import assert_valid
 from synth.engines import EngineChoice
-from synth.errors import LimitExceeded
 from synth.filter.loop.verify import verify
 from synth.filter.cycle import Algorithm, Mode
 from synth.filter.from_rules import skeleton
@@ -156,18 +156,37 @@ def test_max_states_on_the_symbolic_engine(cli):
     assert "--max-states 100" in err
 
 
-def test_the_explicit_engine_cannot_hold_a_ring_of_6(tmp_path):
-    # 6 cylinders, one pallet: a plant grid of 24^6 states; the explicit engine keeps arrays
-    # over it and stops (exit 2)
+def test_the_explicit_engine_holds_a_ring_of_6(tmp_path):
+    # 6 cylinders, one pallet: a plant grid of 24^6 states; the explicit engine holds no
+    # array over it (synth/filter/loop/columns.py) and explores until its state limit
     (tmp_path / "ring6.rules").write_text(ring_rules(6))
     f = parse_filter(ring_filter(6), str(tmp_path / "ring6.filter"))
-    with pytest.raises(LimitExceeded, match="191102976 states"):
-        verify(f, str(tmp_path / "ring6.rules"), any_control=True)
+    v = verify(f, str(tmp_path / "ring6.rules"), any_control=True, max_states=300)
+    assert v.engine is EngineChoice.EXPLICIT and not v.complete and v.states == 300
+
+
+@pytest.mark.parametrize("n, k", [(3, 1), (3, 2), (4, 1)])
+def test_both_engines_agree_on_small_rings(tmp_path, n, k):
+    # the differential of issue 37: the explicit engine (columns over state codes) and the
+    # symbolic one (observers placed by their reads) on the bench's rings
+    (tmp_path / "ring.rules").write_text(ring_rules(n))
+    _same(parse_filter(ring_filter(n), str(tmp_path / "ring.filter")), str(tmp_path / "ring.rules"),
+          events_per_cycle=k)
+
+
+@pytest.mark.nightly  # 70 s
+def test_the_explicit_engine_explores_a_ring_of_6(tmp_path):
+    (tmp_path / "ring6.rules").write_text(ring_rules(6))
+    f = parse_filter(ring_filter(6), str(tmp_path / "ring6.filter"))
+    v = verify(f, str(tmp_path / "ring6.rules"), any_control=True)
+    assert v.engine is EngineChoice.EXPLICIT
+    assert (v.safe, v.coherent, v.complete, v.states, v.plant_states, v.cycles, v.outside_sup) == (
+        True, True, True, 116640, 85536, 2277120, 0)
 
 
 @pytest.mark.nightly  # 3 s (10 s on a loaded machine)
-def test_a_ring_the_explicit_engine_cannot_hold(tmp_path):
-    # ... the symbolic one (chosen by auto) explores the 116640 nodes of the closed loop
+def test_auto_takes_the_symbolic_engine_on_a_ring_of_6(tmp_path):
+    # the symbolic one (chosen by auto) explores the 116640 nodes of the closed loop
     (tmp_path / "ring6.rules").write_text(ring_rules(6))
     f = parse_filter(ring_filter(6), str(tmp_path / "ring6.filter"))
     rules = str(tmp_path / "ring6.rules")

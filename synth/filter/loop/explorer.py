@@ -27,7 +27,8 @@ import numpy as np
 from synth.filter.loop.control_st import TIMER_PREFIX
 from synth.filter.cycle import ACK, Memory, Mode
 from synth.errors import LimitExceeded
-from synth.filter.loop.outcomes import Outcome, OutcomeArrays, lane_bits, react, situation_text, trace_row, unpack
+from synth.filter.loop.outcomes import (Outcome, OutcomeArrays, first_lanes, lane_bits, react, situation_text,
+                                       trace_row)
 from synth.filter.loop.product import Product
 from synth.filter.loop.writes import merge_events, write
 from synth.filter.loop.verification import Finding, FindingKind, TraceRow
@@ -70,16 +71,15 @@ class Explorer:
         self.events: list[str] = []
         self.seqs: list[tuple[str, ...]] = []
         self.seq_of: dict[tuple[str, ...], int] = {}
-        for seq in [(), *((e,) for e, _ in pr.uncontrollable)]:  # ids in the plant's event order
+        for seq in [(), *((e,) for e in pr.uncontrollable)]:  # ids in the plant's event order
             self.intern_seq(seq)
         # the events the plant (and the Grafcet's timers) may not postpone forever: one bit each
-        self.fair: dict[str, int] = {e: i for i, (e, _) in enumerate(pr.uncontrollable)}
+        self.fair: dict[str, int] = {e: i for i, e in enumerate(pr.uncontrollable)}
         self.order: list[int] = []  # the nodes in the order they were found (breadth-first)
         # (source, target, fairness bits of the events taken, events id, outcome): with --progress
         self.edge_parts: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
         self.parent: dict[int, tuple[int, str, int]] = {}  # node -> (parent node, event, outcome)
         self.seen_keys: set[int] = set()
-        self.seen_arrays: dict[int, np.ndarray] = {}
         # kind -> (node, event, outcome, code, ids)
         self.first: dict[FindingKind, tuple[int, str, int, int, tuple[str, ...]]] = {}
         self.counts: dict[FindingKind, set[int]] = {k: set() for k in FindingKind}
@@ -94,6 +94,7 @@ class Explorer:
         self.key0 = self.intern((tuple(memory.previous[i] for i in pr.used_index), False, sit0)) * self.size \
             + p.initial_index
         self.admit_one(self.key0)
+        self.note_outside(np.array([self.key0], dtype=np.int64))
         # a program's fresh instance: the PLC before its power-up scan (see run)
         self.prelude: int | None = self.key0 if pr.control is not None else None
         self.prelude_cycles = self.prelude_corrected = 0
@@ -106,6 +107,9 @@ class Explorer:
     def intern(self, a: tuple) -> int:
         k = self.aux_of.get(a)
         if k is None:
+            if (len(self.aux_list) + 1) * self.size >= 2**63:
+                raise LimitExceeded(f"{len(self.aux_list) + 1} filter memories and controller states by "
+                                    f"{self.size} plant states: a node no longer fits in 63 bits")
             k = self.aux_of[a] = len(self.aux_list)
             self.aux_list.append(a)
         return k
@@ -125,20 +129,19 @@ class Explorer:
             raise LimitExceeded("--progress tracks at most 64 plant events and Grafcet timers in this closed loop")
         return 1 << b if b < 64 else 0
 
-    def seen_array(self, aux: int) -> np.ndarray:
-        arr = self.seen_arrays.get(aux)
-        if arr is None:
-            arr = self.seen_arrays[aux] = np.zeros(self.size, dtype=bool)
-        return arr
-
     def admit_one(self, key: int) -> None:
-        code = key % self.size
         self.seen_keys.add(key)
         self.order.append(key)
-        self.seen_array(key // self.size)[code] = True
-        if self.pr.outside_sup[code]:
-            self.outside_sup.add(code)
-            self.first_outside_sup = key if self.first_outside_sup is None else self.first_outside_sup
+
+    def note_outside(self, keys: np.ndarray) -> None:
+        """Count the plant states outside SUP among the nodes ``keys`` just admitted (in
+        their order of admission); keep the first such node."""
+        codes = keys % self.size
+        out = self.pr.outside_sup[codes]
+        if out.any():
+            self.outside_sup.update(codes[out].tolist())
+            if self.first_outside_sup is None:
+                self.first_outside_sup = int(keys[int(np.argmax(out))])
 
     def record(self, kind: FindingKind, mask: np.ndarray, where: np.ndarray, node: np.ndarray, event: np.ndarray,
                oid: np.ndarray | None, shown: np.ndarray, ids: Any = ()) -> None:
@@ -183,24 +186,26 @@ class Explorer:
             previous[i] = v
         lanes = cyc.lanes(Memory(tuple(previous), blocked), fixed, free)
         n = lanes.count
-        out = {o: unpack(m, n) for o, m in zip(cyc.outputs, lanes.outputs)}
+        out = dict(zip(cyc.outputs, lanes.outputs))  # lane masks
         for o in pr.passthrough:
-            out[o] = np.full(n, passed[o]) if o in passed else unpack(lane_bits(free.index(o), n), n)
-        columns = [out[o] for o in pr.orders] + [unpack(lanes.previous[i], n) for i in pr.used_index]
-        columns += [unpack(m, n) for m in (lanes.blocked, lanes.fallback, lanes.outside_care)]
-        _, firsts = np.unique(np.stack(columns, axis=1), axis=0, return_index=True)
+            out[o] = ((1 << n) - 1 if passed[o] else 0) if o in passed else lane_bits(free.index(o), n)
+        memory_after = [lanes.previous[i] for i in pr.used_index]
+        masks = [*(out[o] for o in pr.orders), *memory_after, lanes.blocked, lanes.fallback, lanes.outside_care]
         found: list[int] = []
-        for j in sorted(firsts.tolist()):  # one witness lane per distinct outcome, the first
-            result, memory = lanes.lane(j)
-            targets = dict(zip(cyc.outputs, result.outputs))
-            req = dict(zip(cyc.outputs, result.requests))
-            for o in pr.passthrough:
-                targets[o] = req[o] = bool(out[o][j])
-            mem = tuple(memory.previous[i] for i in pr.used_index)
-            oc = Outcome(tuple(targets[o] for o in pr.orders), self.intern((mem, memory.blocked, sit)),
-                          result.fallback, result.outside_care, tuple(req[o] for o in pr.orders), result.violated)
-            g = self.outcome_of.get(oc)
+        for j in first_lanes(masks, n):  # one witness lane per distinct outcome, the first
+
+            def bit(m: int) -> bool:
+                return bool((m >> j) & 1)
+
+            oc = Outcome(tuple(bit(out[o]) for o in pr.orders),
+                         self.intern((tuple(map(bit, memory_after)), bit(lanes.blocked), sit)),
+                         bit(lanes.fallback), bit(lanes.outside_care), (), ())
+            g = self.outcome_of.get(oc)  # the witness (requests, violated) is not compared
             if g is None:
+                req = dict(zip(cyc.outputs, map(bit, lanes.requests)))
+                req.update((o, bit(out[o])) for o in pr.passthrough)
+                oc = dataclasses.replace(oc, requests=tuple(req[o] for o in pr.orders),
+                                         violated=tuple(i for i, m in lanes.violated.items() if bit(m)))
                 g = self.outcome_of[oc] = len(self.outcomes)
                 self.outcomes.append(oc)
             found.append(g)
@@ -224,8 +229,7 @@ class Explorer:
         by_events = pr.machine is not None  # a Grafcet reacts to each event; a program scans once
         for _ in range(self.k):
             found = []
-            for ev, nxt in pr.uncontrollable:
-                dst = nxt[post]
+            for ev, dst in pr.moves(post):
                 ok = dst >= 0
                 if not ok.any():
                     continue
@@ -308,7 +312,7 @@ class Explorer:
         shown = np.where(ok, final, post)
 
         def edge_ids(i: int) -> tuple[str, ...]:
-            return tuple(dict.fromkeys(c for ev in edge_events for c in pr.sup.forbidding(ev, pr.plant.local(int(post[i])))))
+            return tuple(dict.fromkeys(c for ev in edge_events for c in pr.columns.forbidding(ev, int(post[i]))))
 
         self.record(FindingKind.VIOLATION, violation, final, node, event, oid, shown,
                     lambda i: pr.violated(int(final[i])))
@@ -342,17 +346,14 @@ class Explorer:
 
     def admit(self, keys: np.ndarray, node: np.ndarray, event: np.ndarray, oid: np.ndarray) -> np.ndarray:
         """The nodes of ``keys`` not seen before (their first occurrence is the parent)."""
-        size = self.size
         uk, first = np.unique(keys, return_index=True)
-        fresh = np.ones(uk.size, dtype=bool)
-        uk_aux = uk // size
-        for a in np.unique(uk_aux).tolist():
-            sel = uk_aux == a
-            fresh[sel] = ~self.seen_array(a)[uk[sel] % size]
+        seen = self.seen_keys
+        fresh = np.fromiter((k not in seen for k in uk.tolist()), dtype=bool, count=uk.size)
         new: list[int] = []
         if self.prelude is not None and not self.reentered and self.prelude in uk:
             self.reentered = True  # a scan gives the fresh instance back: a state like any other
             new.append(self.prelude)
+        admitted = len(new)
         for k, i in zip(uk[fresh].tolist(), first[fresh].tolist()):
             if self.states >= self.max_states:
                 self.complete = False
@@ -360,7 +361,9 @@ class Explorer:
             self.admit_one(k)
             self.parent[k] = (int(node[i]), self.events[int(event[i])], int(oid[i]))
             new.append(k)
-        return np.array(new, dtype=np.int64)
+        out = np.array(new, dtype=np.int64)
+        self.note_outside(out[admitted:])
+        return out
 
     def run(self) -> None:
         frontier = np.array([self.key0], dtype=np.int64)
@@ -429,7 +432,7 @@ class Explorer:
         if self.first_outside_sup is not None:
             key = self.first_outside_sup
             rows = self.trace(key)
-            ids = tuple(self.pr.sup.threatened(self.pr.plant.local(key % self.size)))
+            ids = self.pr.columns.threatened(key % self.size)
             rows[-1] = dataclasses.replace(rows[-1], note="; ".join(
                 n for n in (rows[-1].note, "outside SUP: uncontrollable events can lead to " + ", ".join(ids)) if n))
             out[FindingKind.OUTSIDE_SUP] = Finding(FindingKind.OUTSIDE_SUP, ids, tuple(rows), len(self.outside_sup))

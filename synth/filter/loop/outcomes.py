@@ -1,12 +1,12 @@
 """The outcomes of one PLC cycle in ``synth filter verify``'s exploration: an outcome
 (the orders written, the memory after the cycle, the flags), the arrays over every
-outcome found so far, the lane masks of :meth:`~synth.filter.cycle.FilterCycle.lanes`
-as numpy arrays, the Grafcet's reaction to a cycle's events and a trace row.
+outcome found so far, the distinct outcomes among the lanes of
+:meth:`~synth.filter.cycle.FilterCycle.lanes` (:func:`first_lanes`), the Grafcet's reaction to a cycle's events and a trace row.
 
 Example
 -------
->>> unpack(0b0110, 4).tolist(), lane_bits(1, 4)
-([False, True, True, False], 12)
+>>> first_lanes([0b0110, 0b0100], 4), lane_bits(1, 4)
+([0, 1, 2], 12)
 >>> arrays = OutcomeArrays(2)
 >>> oc = Outcome((True, False), 0, False, False, (True, True), ("K",))
 >>> targets, fallback, outside, aux, requests = arrays.update([oc])
@@ -28,7 +28,7 @@ TYPE_CHECKING = False
 if TYPE_CHECKING:
     from synth.filter.loop.product import Product
 
-__all__ = ["Outcome", "OutcomeArrays", "unpack", "lane_bits", "react", "situation_text", "trace_row"]
+__all__ = ["Outcome", "OutcomeArrays", "first_lanes", "lane_bits", "react", "situation_text", "trace_row"]
 
 
 @dataclass(frozen=True)
@@ -44,10 +44,19 @@ class Outcome:
     violated: tuple[str, ...] = field(compare=False)  # filter constraints the requests violate
 
 
-def unpack(mask: int, count: int) -> np.ndarray:
-    """A lane mask as a bool array (lane j at index j)."""
-    raw = np.frombuffer(mask.to_bytes((count + 7) // 8, "little"), dtype=np.uint8)
-    return np.unpackbits(raw, bitorder="little")[:count].astype(bool)
+def first_lanes(masks: Sequence[int], count: int) -> list[int]:
+    """The first lane (ascending) of each distinct column of ``masks``' bits over ``count`` lanes."""
+    if not masks:
+        return [0] if count else []
+    size = (count + 7) // 8
+    raw = np.frombuffer(b"".join(m.to_bytes(size, "little") for m in masks), dtype=np.uint8)
+    bits = np.unpackbits(raw.reshape(len(masks), size), axis=1, bitorder="little")[:, :count]
+    if len(masks) < 63:  # each lane's column as one integer
+        keys = (bits.astype(np.int64) << np.arange(len(masks), dtype=np.int64)[:, None]).sum(axis=0)
+        _, firsts = np.unique(keys, return_index=True)
+    else:
+        _, firsts = np.unique(bits.T, axis=0, return_index=True)
+    return sorted(firsts.tolist())
 
 
 def lane_bits(i: int, count: int) -> int:

@@ -1,9 +1,8 @@
-"""The closed loop's parts for ``synth filter verify``: the plant of a rules file as flat
-arrays over its state codes (variables, controllable and uncontrollable moves), the
-filter cycle, the controller that makes the requests (a Grafcet, an ST program of
-:mod:`~synth.filter.loop.control_st`, or none: any control), and the constraints' grids
-from :class:`~synth.sup.supervisor.Supervisor` (illegal states, states outside SUP,
-edge events forbidden).
+"""The closed loop's parts for ``synth filter verify``: the plant of a rules file as
+functions of its state codes (:mod:`~synth.filter.loop.columns`: variables, controllable
+and uncontrollable moves, illegal states, states outside SUP, edge events forbidden),
+the filter cycle and the controller that makes the requests (a Grafcet, an ST program of
+:mod:`~synth.filter.loop.control_st`, or none: any control).
 
 Example
 -------
@@ -18,14 +17,14 @@ Example
 
 from __future__ import annotations
 
-from typing import Any, Mapping
+from typing import Any, Iterator, Mapping
 
 import numpy as np
 
 from synth.errors import InputError, LimitExceeded
 from synth.filter.cycle import Algorithm, FilterCycle, Mode
 from synth.filter.language import Filter
-from synth.logic.events import Event
+from synth.filter.loop.columns import Column, PlantColumns
 
 TYPE_CHECKING = False  # typing.TYPE_CHECKING: the Grafcet modules load only with --grafcet
 if TYPE_CHECKING:
@@ -35,10 +34,7 @@ if TYPE_CHECKING:
     from synth.plant.composition import Plant
     from synth.plant.rules import RuleSet
 
-__all__ = ["PLANT_LIMIT", "Product", "rules_of"]
-
-PLANT_LIMIT = 20_000_000
-"""verify keeps flat arrays over the plant's states; above this many it stops."""
+__all__ = ["Product", "rules_of"]
 
 
 def rules_of(p: Plant) -> RuleSet:
@@ -51,16 +47,12 @@ def rules_of(p: Plant) -> RuleSet:
 class Product:
     """The filter, the plant ``p`` (built from its rule set ``p.rules``) and the Grafcet
     ``g`` (checked against the plant's inputs and outputs; or none: any control), checked
-    against each other and laid out as arrays."""
+    against each other; the plant's parts are :class:`~synth.filter.loop.columns.Column`
+    objects, indexed by state codes like arrays over the plant's grid."""
 
     def __init__(self, f: Filter, p: Plant, g: Grafcet | None, algorithm: Algorithm,
                  mode: Mode, atomic: bool, control: StSource | None = None) -> None:
-        from synth.sup.supervisor import Supervisor
-
         rs = rules_of(p)
-        if p.size > PLANT_LIMIT:
-            raise LimitExceeded(f"the plant of {rs.path} has {p.size} states; verify keeps arrays over the "
-                                f"plant's states and stops above {PLANT_LIMIT}")
         self.plant, self.rules = p, rs
         self.cycle = FilterCycle(f, algorithm, mode)
         self.filter, self.atomic = f, atomic
@@ -94,32 +86,20 @@ class Product:
             if self.control is None and d.name not in observable and d.definition is None:
                 raise InputError(f"observer {d.name} has no value in verify: define it (`observer {d.name} := "
                                  "EXPR`) or make it a step variable of the --grafcet Grafcet", d.loc)
-        size, shape = p.size, p.shape
-        self.size = size
-        self.val = {v: np.broadcast_to(p.values(v), shape).ravel().copy() for v in p.variables}
+        self.size = p.size
+        self.columns = cols = PlantColumns(p, rs.constraints)  # functions of state codes: nothing per plant state
+        self.val: dict[str, Column] = cols.val
         self.orders = p.outputs
         self.passthrough = tuple(o for o in p.outputs if o not in f.outputs)
         self.held = {v.name: v.initial for v in rs.variables if v.held}  # requested at their held value
         self.ynames = tuple(dict.fromkeys([*f.inputs, *self.grafcet_inputs]))
         if len(self.ynames) > 40:
             raise LimitExceeded(f"{len(self.ynames)} inputs are read; verify codes an input vector in 40 bits")
-        self.toggle: dict[str, np.ndarray] = {}
-        self.uncontrollable: list[tuple[str, np.ndarray]] = []
-        moves: dict[str, np.ndarray] = {}  # uncontrollable event -> its successor array, in first-seen order
-        for t, src, dst in p.transition_arrays():
-            table = self.toggle if t.controllable else moves
-            arr = table.get(t.event)
-            if arr is None:  # one array per event (not one per local transition)
-                arr = table[t.event] = np.full(size, -1, dtype=np.int64)
-            arr[src] = dst
-        self.uncontrollable.extend(moves.items())
-        for z in self.orders:
-            for edge in (Event.rise(z), Event.fall(z)):
-                self.toggle.setdefault(edge, np.full(size, -1, dtype=np.int64))
-        self.sup = Supervisor(p, rs.constraints)  # its grids: no SUP exploration
-        self.illegal: np.ndarray = self.sup.illegal.ravel()
-        self.outside_sup: np.ndarray = self.sup.removed.ravel()
-        self.forbid: dict[str, np.ndarray] = {ev: g.ravel() for ev, g in self.sup.forbid.items()}
+        self.toggle: dict[str, Column] = cols.toggle
+        self.uncontrollable: tuple[str, ...] = tuple(e for e, _ in cols.uncontrollable)  # in first-seen order
+        self.illegal: Column = cols.illegal
+        self.outside_sup: Column = cols.outside_sup
+        self.forbid: dict[str, Column] = cols.forbid
         self.used_index = [self.cycle.remembered.index(n) for n in self.cycle.used]
 
     @property
@@ -153,8 +133,12 @@ class Product:
         orders = self.machine.orders(sit, {n: values[n] for n in self.grafcet_inputs})
         return {f"X{s}": s in sit.steps for s in self.steps}, {o: self.held.get(o, o in orders) for o in self.orders}
 
+    def moves(self, codes: np.ndarray) -> Iterator[tuple[str, np.ndarray]]:
+        """Every uncontrollable event and its successor of each code (-1: it cannot occur)."""
+        return self.columns.moves(codes)
+
     def label(self, code: int) -> str:
         return self.plant.label(self.plant.local(code))
 
     def violated(self, code: int) -> tuple[str, ...]:
-        return tuple(self.sup.violated(self.plant.local(code)))
+        return self.columns.violated(code)

@@ -39,9 +39,10 @@ step of the product is a PLC scan; fair: the plant does not keep an event enable
 without making it, nor the Grafcet a running timer) -- :class:`~synth.filter.loop.verification.Progress`.
 
 Every finding comes with a shortest trace (breadth-first, in cycles). The exploration is
-explicit (numpy arrays over the plant's state codes, one level of the breadth-first
-search at a time) and stops after ``max_states`` nodes. The parts: the product's arrays
-(:mod:`~synth.filter.loop.product`), the search (:mod:`~synth.filter.loop.explorer`, one cycle's
+explicit (numpy arrays of the reached nodes' integer codes, one level of the
+breadth-first search at a time; nothing held per plant state) and stops after
+``max_states`` nodes. The parts: the product (:mod:`~synth.filter.loop.product`, the plant
+as functions of state codes in :mod:`~synth.filter.loop.columns`), the search (:mod:`~synth.filter.loop.explorer`, one cycle's
 outcomes in :mod:`~synth.filter.loop.outcomes`) and what it finds
 (:mod:`~synth.filter.loop.verification`); :mod:`synth.output.filter_text` prints it.
 
@@ -275,8 +276,8 @@ def _enabled(ex: Explorer, keys: np.ndarray) -> np.ndarray:
     pr, size = ex.pr, ex.size
     codes = keys % size
     out = np.zeros(keys.size, dtype=np.uint64)
-    for e, nxt in pr.uncontrollable:
-        out |= (nxt[codes] >= 0).astype(np.uint64) << np.uint64(ex.fair[e])
+    for e, nxt in pr.moves(codes):
+        out |= (nxt >= 0).astype(np.uint64) << np.uint64(ex.fair[e])
     if pr.controlled:
         auxes = keys // size
         for aux in np.unique(auxes).tolist():

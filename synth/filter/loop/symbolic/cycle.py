@@ -41,7 +41,7 @@ from synth.filter.cycle import Algorithm, Cover, FilterCycle, Mode
 from synth.filter.language import Filter
 from synth.logic.bdd import Function
 from synth.logic.events import Event
-from synth.logic.past import pre_name
+from synth.logic.past import base_name, is_pre, pre_name
 from synth.plant.composition import Plant
 from synth.plant.rules import RuleSet
 from synth.sup.constraints import split_terms
@@ -134,13 +134,17 @@ class SymbolicCycle:
     # ------------------------------------------------------------------ variables
     def _order_variables(self) -> None:
         """Declare the memory and request variables next to the plant variable they copy
-        (a previous input beside the input), then reorder the manager once."""
+        (a previous input beside the input; an observer's previous value beside the last
+        plant variable its definition reads: :meth:`_observer_places`), then reorder the
+        manager once."""
         e, cyc = self.engine, self.cycle
         beside: dict[str, list[str]] = {}
         loose: list[str] = []
         request_of = dict(zip(cyc.requests, cyc.outputs))
+        place = self._observer_places()
         for n, m in zip(cyc.used, self.memory):
             base = request_of.get(n, n)
+            base = place.get(base, base)
             (beside.setdefault(base, []) if base in self.plant.owner else loose).extend([m, next_name(m)])
         for r in self.free:
             base = request_of.get(r, r[3:] if r.startswith("?R_") else "")
@@ -159,6 +163,27 @@ class SymbolicCycle:
             from dd import cudd
 
             cudd.reorder(e.bdd, {e.declare(n): i for i, n in enumerate(order)})
+
+    def _observer_places(self) -> dict[str, str]:
+        """Per observer defined from the plant's variables (directly, through their past
+        values or through other observers): the one of them last in the variable order.
+        Its memory goes there rather than after every plant variable, so that a ring of
+        cylinders keeps each cylinder's observer with the cylinder (the ring of 10: 272 s
+        grouped at the end, 12 s placed; docs/performance.md, session 27)."""
+        position = {n: i for i, n in enumerate(self.engine.variable_order)}
+        defined = dict(self.cycle.defined)
+
+        def reads(n: str, seen: set[str]) -> set[str]:
+            n = base_name(n) if is_pre(n) else n
+            if n in self.plant.owner:
+                return {n}
+            if n in seen or n not in defined:
+                return set()
+            seen.add(n)
+            return {v for cube in defined[n] for m, _ in cube for v in reads(m, seen)}
+
+        places = {n: reads(n, set()) for n in defined}
+        return {n: max(r, key=position.__getitem__) for n, r in places.items() if r}
 
     def _terms(self, terms: Iterable[Iterable[tuple[int, np.ndarray]]]) -> Function:
         """The union of product terms, each a tuple of (element, local states it allows)."""

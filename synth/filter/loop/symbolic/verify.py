@@ -7,7 +7,7 @@ explicit engine (:class:`~synth.filter.loop.explorer.Explorer`) then runs that m
 only, so every trace is exactly the one the explicit engine prints, found in the part
 of the closed loop before the first finding. When that part is larger than
 :data:`TRACE_BUDGET` nodes, or the plant has more states than ``--engine auto`` leaves to
-the explicit engine (:data:`synth.engines.VERIFY_THRESHOLD`, the explicit arrays), the
+the explicit engine (:data:`synth.engines.VERIFY_THRESHOLD`), the
 traces are walked back through the rings (:class:`~synth.filter.loop.symbolic.walk.Walk`):
 shortest ones, not necessarily the explicit engine's choice.
 
@@ -50,7 +50,7 @@ def explicit_findings(f: Filter, p: Plant, algorithm: Algorithm, mode: Mode, ato
     from synth.filter.loop.explorer import Explorer
     from synth.filter.loop.product import Product
 
-    if p.size > VERIFY_THRESHOLD:  # its arrays over the plant's grid: GiB at 10^7 states
+    if p.size > VERIFY_THRESHOLD:  # where auto runs this engine: the traces walked back, as they always were
         return None
     pr = Product(f, p, None, algorithm, mode, atomic)
     ex = Explorer(pr, budget, k)

@@ -1,0 +1,221 @@
+"""The plant of ``synth filter verify``'s explicit closed loop as functions of plant state
+codes: a variable's value, an event's successor, illegal, outside SUP, an edge forbidden,
+each computed for the codes the search asks about and indexed like the array over the
+plant's grid it stands for (:class:`Column`). Nothing is held per plant state, so the
+loop's memory follows the states it reaches, not the grid (24^N states for N cylinders).
+
+A code's local indices are its digits (mixed radices: the plant's strides); a move of one
+element changes one digit, its guard reads the digits of the elements it reads. *Outside
+SUP* (a violation reachable by uncontrollable moves) is SUP's closed form when no element
+reads another (a product of each element's own closures); otherwise, guards read where
+the moves occur, a search forward from the codes asked through the uncontrollable moves
+and back from the violating states it meets: the fixpoint SUP computes on the grid,
+restricted to what the codes can reach.
+
+Example
+-------
+>>> from synth.plant.composition import _plants, load_plant
+>>> p = load_plant(_plants("tri.rules"))
+>>> cols = PlantColumns(p, p.rules.constraints)
+>>> bool(cols.illegal[p.initial_index]), cols.val["TAPIS"][np.array([p.initial_index])].tolist()
+(False, [False])
+"""
+
+from __future__ import annotations
+
+from typing import Any, Callable, Iterator, NamedTuple, Sequence
+
+import numpy as np
+
+from synth.errors import LimitExceeded
+from synth.logic.events import Event
+from synth.plant.composition import Plant
+from synth.plant.rules import Constraint
+from synth.sup.constraints import Term, split_terms
+
+__all__ = ["Column", "PlantColumns"]
+
+
+class Move(NamedTuple):
+    """A local transition on codes: from local index ``src`` of element ``axis``, the code
+    moves by ``shift``; ``guard`` over the codes of what the element reads (None: always)."""
+
+    axis: int
+    src: int
+    shift: int
+    guard: np.ndarray | None
+
+
+class Column:
+    """A value per plant state code, computed for the codes asked: ``column[codes]`` as
+    ``array[codes]`` would be (an array of codes, or one code)."""
+
+    def __init__(self, fn: Callable[[np.ndarray], np.ndarray]) -> None:
+        self.fn = fn
+
+    def __getitem__(self, codes: Any) -> Any:
+        arr = np.asarray(codes, dtype=np.int64)
+        out = self.fn(arr.reshape(-1))
+        return out.reshape(arr.shape) if arr.ndim else out[0]
+
+
+class PlantColumns:
+    """The plant ``p`` and its ``constraints`` as :class:`Column` objects (module docstring):
+    ``val[v]``, ``toggle[event]`` (a controllable event's successor, -1 where it cannot
+    occur; both edges of every order), ``illegal``, ``outside_sup``, ``forbid[event]``;
+    :meth:`moves` gives every uncontrollable event's successors at once."""
+
+    def __init__(self, p: Plant, constraints: Sequence[Constraint]) -> None:
+        if p.size >= 2**62:
+            raise LimitExceeded(f"the plant has {p.size} states; verify's state codes must fit in 62 bits")
+        self.plant = p
+        terms = split_terms(p, constraints)
+        self.level_terms = [t for t in terms if t.event is None]
+        self.edge_terms: dict[str, list[Term]] = {}
+        for t in terms:
+            if t.event is not None:
+                self.edge_terms.setdefault(t.event, []).append(t)
+        # without reads, the moves of one element never depend on another's state: what the
+        # uncontrollable moves reach is the product of each element's own closure, and a
+        # term is reachable when each of its factors is (SUP's closed form)
+        self.level_reach: list[Term] | None = None if p.reads else [
+            Term(t.constraint, tuple((a, p.elements[a].can_reach(v)) for a, v in t.factors), None)
+            for t in self.level_terms]
+        by_event: dict[str, list[Move]] = {}  # per event, its local transitions, first-seen order
+        controllable: dict[str, bool] = {}
+        for lt in p.transitions:
+            guard = None if lt.guard is None else np.asarray(lt.guard, dtype=bool)
+            shift = (lt.dst - lt.src) * p.strides[lt.axis]
+            by_event.setdefault(lt.event, []).append(Move(lt.axis, lt.src, shift, guard))
+            controllable[lt.event] = lt.controllable
+        self.uncontrollable: tuple[tuple[str, tuple[Move, ...]], ...] = tuple(
+            (e, tuple(ts)) for e, ts in by_event.items() if not controllable[e])
+        # per element, the (element, values) of each variable it reads (its moves' guards read them)
+        self.reads = [[(p.owner[r], p.elements[p.owner[r]].value(r)) for r in e.reads] for e in p.elements]
+        self.val = {v: self._value(v) for v in p.variables}
+        self.toggle = {e: self._move(tuple(ts)) for e, ts in by_event.items() if controllable[e]}
+        for z in p.outputs:
+            for edge in (Event.rise(z), Event.fall(z)):
+                self.toggle.setdefault(edge, self._move(()))
+        self.illegal = self._terms(self.level_terms)
+        self.forbid = {e: self._terms(ts) for e, ts in self.edge_terms.items()}
+        self.outside_sup = Column(self._removed)
+
+    # ------------------------------------------------------------------ digits and moves
+    def digit(self, codes: np.ndarray, axis: int) -> np.ndarray:
+        """The local index of element ``axis`` in each code."""
+        return (codes // self.plant.strides[axis]) % self.plant.shape[axis]
+
+    def _value(self, name: str) -> Column:
+        axis = self.plant.owner[name]
+        vec = self.plant.elements[axis].value(name)
+        return Column(lambda c: vec[self.digit(c, axis)])
+
+    def _terms(self, terms: Sequence[Term]) -> Column:
+        return Column(lambda c: self.holds(terms, c))
+
+    def _move(self, transitions: tuple[Move, ...]) -> Column:
+        return Column(lambda c: self.step(transitions, c, {}))
+
+    def step(self, transitions: Sequence[Move], codes: np.ndarray, digits: dict[int, np.ndarray]
+             ) -> np.ndarray:
+        """The successor of each code by one of ``transitions`` (one event's; the last one
+        that applies, as an array filled transition by transition would hold), -1 where
+        none does; ``digits`` caches the codes' digits per element."""
+        def dig(a: int) -> np.ndarray:
+            if a not in digits:
+                digits[a] = self.digit(codes, a)
+            return digits[a]
+
+        out = np.full(codes.size, -1, dtype=np.int64)
+        for t in transitions:
+            sel = dig(t.axis) == t.src
+            if t.guard is not None:
+                read = np.zeros(codes.size, dtype=np.int64)
+                for j, (a, vec) in enumerate(self.reads[t.axis]):
+                    read |= vec[dig(a)].astype(np.int64) << j
+                sel &= t.guard[read]
+            out[sel] = codes[sel] + t.shift
+        return out
+
+    def moves(self, codes: np.ndarray) -> Iterator[tuple[str, np.ndarray]]:
+        """Every uncontrollable event (the plant's first-seen order) and its successor of
+        each code (-1 where it cannot occur)."""
+        digits: dict[int, np.ndarray] = {}
+        for e, ts in self.uncontrollable:
+            yield e, self.step(ts, codes, digits)
+
+    # ------------------------------------------------------------------ constraints
+    def holds(self, terms: Sequence[Term], codes: np.ndarray) -> np.ndarray:
+        """Whether some product term of ``terms`` holds at each code."""
+        out = np.zeros(codes.size, dtype=bool)
+        digits: dict[int, np.ndarray] = {}
+        for t in terms:
+            here = np.ones(codes.size, dtype=bool)
+            for a, vec in t.factors:
+                if a not in digits:
+                    digits[a] = self.digit(codes, a)
+                here &= vec[digits[a]]
+            out |= here
+        return out
+
+    def closure(self, codes: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The states reachable from ``codes`` by uncontrollable moves (sorted, ``codes``
+        included) and those moves, as positions in it (sources, targets)."""
+        nodes = np.unique(codes)
+        src: list[np.ndarray] = [np.zeros(0, dtype=np.int64)]
+        dst: list[np.ndarray] = [np.zeros(0, dtype=np.int64)]
+        frontier = nodes
+        while frontier.size:
+            found = []
+            for _, nxt in self.moves(frontier):
+                ok = nxt >= 0
+                src.append(frontier[ok])
+                dst.append(nxt[ok])
+                found.append(nxt[ok])
+            reached = np.unique(np.concatenate([np.zeros(0, dtype=np.int64), *found]))
+            frontier = reached[~_member(reached, nodes)]
+            nodes = np.union1d(nodes, frontier)
+        s, d = np.concatenate(src), np.concatenate(dst)
+        return nodes, np.searchsorted(nodes, s), np.searchsorted(nodes, d)
+
+    def _removed(self, codes: np.ndarray) -> np.ndarray:
+        """Outside SUP: a violating state is reachable from the code by uncontrollable moves."""
+        if not codes.size:
+            return np.zeros(0, dtype=bool)
+        if self.level_reach is not None:
+            return self.holds(self.level_reach, codes)
+        nodes, s, d = self.closure(codes)
+        bad = self.holds(self.level_terms, nodes)
+        while True:  # back along the moves, until nothing is added
+            more = bad[d] & ~bad[s]
+            if not more.any():
+                break
+            bad[s[more]] = True
+        return bad[np.searchsorted(nodes, codes)]
+
+    def _ids(self, terms: Sequence[Term], codes: np.ndarray) -> tuple[str, ...]:
+        """The constraints (first-seen order, no repeats) of the terms holding at one of ``codes``."""
+        return tuple(dict.fromkeys(t.constraint for t in terms if self.holds([t], codes).any()))
+
+    def violated(self, code: int) -> tuple[str, ...]:
+        """The constraints the state violates (levels)."""
+        return self._ids(self.level_terms, np.array([code], dtype=np.int64))
+
+    def forbidding(self, event: str, code: int) -> tuple[str, ...]:
+        """The edge constraints that forbid controllable ``event`` in the state."""
+        return self._ids(self.edge_terms.get(event, ()), np.array([code], dtype=np.int64))
+
+    def threatened(self, code: int) -> tuple[str, ...]:
+        """The constraints whose violation uncontrollable moves can reach from the state."""
+        if self.level_reach is not None:
+            return self._ids(self.level_reach, np.array([code], dtype=np.int64))
+        return self._ids(self.level_terms, self.closure(np.array([code], dtype=np.int64))[0])
+
+
+def _member(values: np.ndarray, sorted_set: np.ndarray) -> np.ndarray:
+    """Whether each of ``values`` is in the sorted array ``sorted_set``."""
+    if not sorted_set.size:
+        return np.zeros(values.size, dtype=bool)
+    pos = np.minimum(np.searchsorted(sorted_set, values), sorted_set.size - 1)
+    return sorted_set[pos] == values
