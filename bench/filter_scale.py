@@ -141,7 +141,29 @@ def grid_filter(n: int) -> str:
     return "\n".join(lines) + "\n"
 
 
-FAMILIES = {"ring": ring_filter, "chain": chain_filter, "grid": grid_filter}
+def grid_edges_filter(n: int, stations: int = 8) -> str:
+    """``stations`` stations of ``n // stations`` cylinders with edge constraints on their end
+    sensors and interlocks between neighbours both ways, as a ``.filter`` text."""
+    width = max(1, n // stations)
+    cells = [(s, k) for s in range(1, stations + 1) for k in range(1, width + 1)]
+
+    def o(s: int, k: int) -> str:
+        return f"o{s}_{k}"
+
+    lines = [f"# bench/filter_scale.py: a grid of {stations} stations x {width} cylinders, edges on the end sensors",
+             "inputs " + ", ".join(f"b{s}_{k}, h{s}_{k}" for s, k in cells),
+             "outputs " + ", ".join(o(s, k) for s, k in cells)]
+    for s, k in cells:
+        lines.append(f"safety A{s}_{k}: ↑{o(s, k)} & !b{s}_{k}")  # extend only from the retracted end
+        lines.append(f"safety B{s}_{k}: {o(s, k)} & ↑h{s}_{k}")  # stop driving when the extended end is reached
+        if k < width:  # in a station: the cylinder before has the priority
+            lines.append(f"safety H{s}_{k}: {o(s, k)} & {o(s, k + 1)}   keep {o(s, k)}")
+        if s < stations:  # between stations: the later station has the priority
+            lines.append(f"safety V{s}_{k}: {o(s, k)} & {o(s + 1, k)}   keep {o(s + 1, k)}")
+    return "\n".join(lines) + "\n"
+
+
+FAMILIES = {"ring": ring_filter, "chain": chain_filter, "grid": grid_filter, "grid_edges": grid_edges_filter}
 
 
 def _env() -> dict[str, str]:
