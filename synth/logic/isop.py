@@ -58,16 +58,26 @@ def expanded(bdd: Any, cube: Cube, upper: Function, leq: Callable[[Function, Fun
     its order, while it still implies ``upper``: a prime implicant of ``upper``. ``leq``:
     CUDD's containment test (:meth:`synth.logic.native.Native.leq`), which tells whether a
     cube implies ``upper`` without building its cofactor."""
-    kept = dict(cube)
-    for n in list(cube):
-        trial = {m: v for m, v in kept.items() if m != n}
-        if leq is not None:
-            implies = leq(bdd.cube(trial), upper)
-        else:
-            implies = (bdd.let(trial, upper) if trial else upper) == bdd.true
-        if implies:
-            kept = trial
-    return kept
+    if leq is None:
+        kept = dict(cube)
+        for n in list(cube):
+            trial = {m: v for m, v in kept.items() if m != n}
+            if (bdd.let(trial, upper) if trial else upper) == bdd.true:  # the cube implies upper
+                kept = trial
+        return kept
+    # the literal at j is tested with the kept ones before it and all after it: the cubes of
+    # the literals after each j built once, those kept before it grown one literal at a time
+    names = list(cube)
+    literals = [bdd.var(n) if cube[n] else ~bdd.var(n) for n in names]
+    after = [bdd.true] * (len(names) + 1)
+    for j in range(len(names) - 1, -1, -1):
+        after[j] = literals[j] & after[j + 1]
+    before, out = bdd.true, {}
+    for j, n in enumerate(names):
+        if not leq(before & after[j + 1], upper):  # needed: kept
+            out[n] = cube[n]
+            before &= literals[j]
+    return out
 
 
 class Covers:
