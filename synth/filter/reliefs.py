@@ -241,11 +241,7 @@ class _Chain:
         i, g = alternative
         base = self.base  # before the mark: the chain's messages are kept
         mark = self.p.mark()
-        k = self.p.position(g)
-        s, best = self._step(self.states[i], k, g)
-        if self._rejoined(i, s, k, g.equiv(best)):  # the same relation as the chain's S_i+1: the same filter
-            self.p.forget(mark)
-            return None
+        s, _ = self._step(self.states[i], self.p.position(g), g)
         for j in range(i + 1, len(self.goods) + 1):
             if s.domains == self.states[j].domains:  # the chain rejoined: the same filter from here
                 self.p.forget(mark)
@@ -258,16 +254,6 @@ class _Chain:
         if not differ and care == base[0]:
             return None
         return differ or list(self.m.outputs)
-
-
-    def _rejoined(self, i: int, s: State, k: int, narrowed: Function) -> bool:
-        """Whether ``s``, the chain's ``S_i`` narrowed by ``narrowed`` in bag ``k``, is the same
-        relation as the chain's ``S_i+1`` (``S_i`` narrowed by the file's criterion ``i``),
-        however their domains are written: each implies the other's narrowing, i.e.
-        ``∃O.(s ∧ ¬d_i)`` and ``∃O.(S_i+1 ∧ ¬narrowed)`` are false (two projections)."""
-        p, false = self.p, self.m.engine.false
-        mine = self.goods[i].equiv(self.bests[i])
-        return p.project(s, self.where[i], ~mine) == false and p.project(self.states[i + 1], k, ~narrowed) == false
 
 
 @dataclasses.dataclass(frozen=True)
