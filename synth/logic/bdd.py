@@ -358,7 +358,8 @@ class Engine:
     def expanded(self, cube: Cube, upper: Function) -> Cube:
         """``cube`` (implying ``upper``) with literals dropped, in text order, while it
         still implies ``upper``: a prime implicant of ``upper``."""
-        kept = expanded(self.bdd, {self.declare(n): v for n, v in cube.items()}, upper)
+        leq = None if self._native is None else self._native.leq
+        kept = expanded(self.bdd, {self.declare(n): v for n, v in cube.items()}, upper, leq)
         return {self._outer[v]: x for v, x in kept.items()}
 
     def minimal_cube(self, u: Function) -> Cube | None:
