@@ -104,8 +104,8 @@ class _Chain:
         for s, t in swapped:  # its position and its good, where the criterion differs
             i = None if stated else index[id(s)]
             other = None if i is None else priority_criterion(t, outputs)
-            good = None if i is None or other == written[i] else self._good(other)
-            self.alternatives.append(None if i is None or good == self.goods[i] else (i, good))
+            good = None if i is None or other is None or other == written[i] else self._good(other)
+            self.alternatives.append(None if i is None or good is None or good == self.goods[i] else (i, good))
         self.p = layout(m, self.goods + [a[1] for a in self.alternatives if a is not None])
         self.where = [self.p.position(g) for g in self.goods]
         self.states: list[State] = [self.p.initial]
