@@ -1,7 +1,7 @@
 """How the safety logic filter scales with the number of outputs: ``check``, ``solve`` and
 ``st`` on three families of N outputs, with a truth-table oracle side by side at small N.
 
-    python3 bench/filter_scale.py [--family ring|chain|grid] [--sizes 2,3,4,6,8] [--limit 60]
+    python3 bench/filter_scale.py [--family ring|chain|grid|grid_edges] [--sizes 2,3,4,6,8] [--limit 60]
                                   [--oracle-max 3] [--json FILE]
 
 - ``ring`` (``ring_filter(N)``): cylinders ``Q1..QN`` on a ring, each with ``bk`` (retracted),
@@ -16,6 +16,13 @@
   stop ``o & stop<s>`` on its first three outputs, interlocks between neighbours in a
   station ``o<s>_<k> & o<s>_<k+1>`` and between stations ``o<s>_<k> & o<s+1>_<k>`` (keep the
   first); 64 outputs give 200 constraints.
+- ``grid_edges`` (``grid_edges_filter(N)``, N a multiple of 8; issue 37): 8 stations of N/8
+  cylinders ``o<s>_<k>`` with end sensors ``b<s>_<k>`` (retracted) and ``h<s>_<k>`` (extended);
+  per cylinder ``↑o & !b`` (extend only from the retracted end) and ``o & ↑h`` (stop driving
+  when the extended end is reached, an edge on the sensor), interlocks between neighbours in
+  a station ``o<s>_<k> & o<s>_<k+1>`` (keep the first) and between stations
+  ``o<s>_<k> & o<s+1>_<k>`` (keep the *second*: the priorities run both ways across the grid);
+  64 outputs give 240 constraints.
 
 Per N, one fresh process runs the stages (``check``: P1–P4 and consistency, then the
 keep/force spelling comparison ``synth filter check`` prints; ``st``: the algebraic and the
