@@ -1,7 +1,7 @@
 """How the safety logic filter scales with the number of outputs: ``check``, ``solve`` and
 ``st`` on three families of N outputs, with a truth-table oracle side by side at small N.
 
-    python3 bench/filter_scale.py [--family ring|chain|grid] [--sizes 2,3,4,6,8] [--limit 60]
+    python3 bench/filter_scale.py [--family ring|chain|grid|grid_edges] [--sizes 2,3,4,6,8] [--limit 60]
                                   [--oracle-max 3] [--json FILE]
 
 - ``ring`` (``ring_filter(N)``): cylinders ``Q1..QN`` on a ring, each with ``bk`` (retracted),
@@ -16,6 +16,13 @@
   stop ``o & stop<s>`` on its first three outputs, interlocks between neighbours in a
   station ``o<s>_<k> & o<s>_<k+1>`` and between stations ``o<s>_<k> & o<s+1>_<k>`` (keep the
   first); 64 outputs give 200 constraints.
+- ``grid_edges`` (``grid_edges_filter(N)``, N a multiple of 8; issue 37): 8 stations of N/8
+  cylinders ``o<s>_<k>`` with end sensors ``b<s>_<k>`` (retracted) and ``h<s>_<k>`` (extended);
+  per cylinder ``↑o & !b`` (extend only from the retracted end) and ``o & ↑h`` (stop driving
+  when the extended end is reached, an edge on the sensor), interlocks between neighbours in
+  a station ``o<s>_<k> & o<s>_<k+1>`` (keep the first) and between stations
+  ``o<s>_<k> & o<s+1>_<k>`` (keep the *second*: the priorities run both ways across the grid);
+  64 outputs give 240 constraints.
 
 Per N, one fresh process runs the stages (``check``: P1–P4 and consistency, then the
 keep/force spelling comparison ``synth filter check`` prints; ``st``: the algebraic and the
@@ -141,7 +148,29 @@ def grid_filter(n: int) -> str:
     return "\n".join(lines) + "\n"
 
 
-FAMILIES = {"ring": ring_filter, "chain": chain_filter, "grid": grid_filter}
+def grid_edges_filter(n: int, stations: int = 8) -> str:
+    """``stations`` stations of ``n // stations`` cylinders with edge constraints on their end
+    sensors and interlocks between neighbours both ways, as a ``.filter`` text."""
+    width = max(1, n // stations)
+    cells = [(s, k) for s in range(1, stations + 1) for k in range(1, width + 1)]
+
+    def o(s: int, k: int) -> str:
+        return f"o{s}_{k}"
+
+    lines = [f"# bench/filter_scale.py: a grid of {stations} stations x {width} cylinders, edges on the end sensors",
+             "inputs " + ", ".join(f"b{s}_{k}, h{s}_{k}" for s, k in cells),
+             "outputs " + ", ".join(o(s, k) for s, k in cells)]
+    for s, k in cells:
+        lines.append(f"safety A{s}_{k}: ↑{o(s, k)} & !b{s}_{k}")  # extend only from the retracted end
+        lines.append(f"safety B{s}_{k}: {o(s, k)} & ↑h{s}_{k}")  # stop driving when the extended end is reached
+        if k < width:  # in a station: the cylinder before has the priority
+            lines.append(f"safety H{s}_{k}: {o(s, k)} & {o(s, k + 1)}   keep {o(s, k)}")
+        if s < stations:  # between stations: the later station has the priority
+            lines.append(f"safety V{s}_{k}: {o(s, k)} & {o(s + 1, k)}   keep {o(s + 1, k)}")
+    return "\n".join(lines) + "\n"
+
+
+FAMILIES = {"ring": ring_filter, "chain": chain_filter, "grid": grid_filter, "grid_edges": grid_edges_filter}
 
 
 def _env() -> dict[str, str]:

@@ -96,3 +96,40 @@ def test_an_interval_with_a_run_of_eliminations() -> None:
     mine, plain = _both(e)
     assert [{e.name_of(v): b for v, b in c.items()} for c in mine.cover(lower, upper)] == [{"x5": True, "x8": False}]
     assert mine.cover(lower, upper) == plain.cover(lower, upper)
+
+
+def _factored_recursive(terms: list, top: bool = False) -> str:
+    """The greedy factoring as it was written before session 27 (recounting at each level)."""
+    if any(not t for t in terms):
+        return "1"
+    counts: dict = {}
+    for t in terms:
+        for lit in t:
+            counts[lit] = counts.get(lit, 0) + 1
+    best = min(counts, key=lambda lit: (-counts[lit], lit)) if counts else None
+    if best is None or counts[best] < 2:
+        out = " | ".join(" & ".join(text for _, text in t) for t in terms)
+        return out if top or len(terms) == 1 else f"({out})"
+    inner = [[lit for lit in t if lit != best] for t in terms if best in t]
+    rest = [t for t in terms if best not in t]
+    if any(not t for t in inner):
+        head = best[1]
+    else:
+        sub = _factored_recursive(inner)
+        head = f"{best[1]} & {sub}" if len(inner) > 1 else best[1] + " & " + sub
+    if not rest:
+        return head
+    out = head + " | " + _factored_recursive(rest, top=True)
+    return out if top else f"({out})"
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_one_pass_factoring_is_the_recursive_one(seed: int) -> None:
+    from synth.logic.factoring import factored
+
+    rng = random.Random(seed)
+    lits = [(k, ("!" if k % 2 else "") + f"x{k // 2}") for k in range(12)]
+    for _ in range(300):
+        terms = [sorted(rng.sample(lits, rng.randint(1, 6))) for _ in range(rng.randint(1, 12))]
+        for top in (True, False):
+            assert factored(terms, top) == _factored_recursive(terms, top)

@@ -208,14 +208,18 @@ def go_graph(m: FilterFunctions) -> tuple[tuple[GoEdge, ...], tuple[Cycle, ...]]
     does not point at ``↓A4·…``, which needs A4^-1 = 1."""
     e = m.engine
     combined = m.filter.combined
+    touching: dict[str, list[str]] = {}  # output -> the combined constraints that read it at t, in file order
+    for t in combined:
+        for o in e.support(m.constraint[t.id]):
+            touching.setdefault(o, []).append(t.id)
     edges: list[GoEdge] = []
     for s in combined:
         for f in s.forced:
             was = e.let({f.output: not f.value}, m.constraint[s.id]) & m.assumed
-            for t in combined:
-                c = m.constraint[t.id]
+            for t_id in touching.get(f.output, []):  # a constraint that does not read o is not set off by o:=v
+                c = m.constraint[t_id]
                 if (was & e.let({f.output: f.value}, c) & ~e.let({f.output: not f.value}, c)) != e.false:
-                    edges.append(GoEdge(s.id, f.output, f.value, t.id))
+                    edges.append(GoEdge(s.id, f.output, f.value, t_id))
     ids = [s.id for s in combined]
     succ = {i: [g for g in edges if g.source == i] for i in ids}
     cycles: list[Cycle] = []

@@ -12,11 +12,12 @@ Example
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
 from typing import Iterable, Mapping, Sequence
 
 from synth.logic.bdd import Cube, Engine, Function, factored, cube_literals, interleaved_order
-from synth.filter.language import Comparison, Criterion, Filter, IntegerObserver
+from synth.filter.language import Comparison, Criterion, Filter, IntegerObserver, Safety
 from synth.logic.past import base_name, is_pre, pre_name
 from synth.logic.expr import Compare, Edge, Expr, Var, names
 
@@ -213,6 +214,7 @@ class FilterFunctions:
     fc0: dict[str, Function] = field(default_factory=dict)  # o -> (O, Y) where a CSc relief forces o to 0
     fc1: dict[str, Function] = field(default_factory=dict)
     forcing: dict[tuple[str, bool], list[tuple[str, Function]]] = field(default_factory=dict)
+    reliefs: dict[tuple[str, bool], list[tuple[str, Function]]] = field(default_factory=dict)  # (o, v) -> relief_parts
 
     @property
     def outputs(self) -> tuple[str, ...]:
@@ -223,9 +225,9 @@ class FilterFunctions:
         """F(O, Y): some constraint is violated."""
         return self.engine.disjunction(self.constraint.values())
 
-    @property
+    @functools.cached_property
     def simple_forbidden(self) -> Function:
-        """ΣCSs(O, Y)."""
+        """ΣCSs(O, Y) (built once: P3 and P4 read it for every output)."""
         return self.engine.disjunction(self.constraint[s.id] for s in self.filter.simple)
 
     def forcing_parts(self, output: str, value: bool) -> list[tuple[str, Function]]:
@@ -234,11 +236,7 @@ class FilterFunctions:
 
     def relief_parts(self, output: str, value: bool) -> list[tuple[str, Function]]:
         """(id, CSc) for each combined constraint whose relief sets ``output`` to ``value``."""
-        return [
-            (s.id, self.constraint[s.id])
-            for s in self.filter.combined
-            if any(c.output == output and c.value == value for c in s.forced)
-        ]
+        return self.reliefs.get((output, value), [])
 
 
 def functions(f: Filter) -> FilterFunctions:
@@ -252,10 +250,16 @@ def functions(f: Filter) -> FilterFunctions:
             if any(pre_name(b) in read for b in i.bits):
                 assumed &= e.domain(pre_name(i.name))
     m = FilterFunctions(f, e, {s.id: e.expr(s.expr) for s in f.safeties}, assumed)
+    simple: dict[str, list[Safety]] = {}  # each output's simple constraints, in file order
+    for s in f.simple:
+        simple.setdefault(s.outputs[0], []).append(s)
+    for s in f.combined:  # each relief's (output, value) pairs, in file order
+        for key in dict.fromkeys((c.output, c.value) for c in s.forced):
+            m.reliefs.setdefault(key, []).append((s.id, m.constraint[s.id]))
     for o in f.outputs:
         for value in (False, True):
             parts = []
-            for s in f.simple:
+            for s in simple.get(o, []):
                 if s.outputs == (o,):
                     # o·h0 + !o·h1: the constraint forces 0 where h0 = c|o=1, 1 where h1 = c|o=0
                     where = e.let({o: not value}, m.constraint[s.id])

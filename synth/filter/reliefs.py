@@ -87,19 +87,25 @@ class _Chain:
     it and their messages are shared): its care set and each output's function (None
     where the output is not determined), what ``solve`` prints its equations from."""
 
-    def __init__(self, f: Filter, swapped: Sequence[tuple[Safety, Filter]]) -> None:
+    def __init__(self, f: Filter, swapped: Sequence[tuple[Safety, Safety]]) -> None:
         from synth.filter.model import functions
-        from synth.filter.solve import criteria
+        from synth.filter.solve import criteria, priority_criterion
 
         self.m = m = functions(f)
         written = criteria(f)
         self.goods = [self._good(c) for c in written]
         self.alternatives: list[tuple[int, Function] | None] = []
-        for _, alt in swapped:  # at most one priority criterion differs: its position and its good
-            other = criteria(alt)
-            i = next((i for i, (a, b) in enumerate(zip(written, other)) if a != b), None)
-            good = None if i is None else self._good(other[i])
-            self.alternatives.append(None if i is None or good == self.goods[i] else (i, good))
+        # the priority criteria come first, one per relief in file order, unless the file states
+        # its criteria (then no spelling changes them): a relief written the other way changes its
+        # own criterion only
+        stated = any(isinstance(c, Criterion) for c in f.criteria)
+        index = {id(s): i for i, s in enumerate(s for s in f.combined if s.has_priority)}
+        outputs = frozenset(f.outputs)
+        for s, t in swapped:  # its position and its good, where the criterion differs
+            i = None if stated else index[id(s)]
+            other = None if i is None else priority_criterion(t, outputs)
+            good = None if i is None or other is None or other == written[i] else self._good(other)
+            self.alternatives.append(None if i is None or good is None or good == self.goods[i] else (i, good))
         self.p = layout(m, self.goods + [a[1] for a in self.alternatives if a is not None])
         self.where = [self.p.position(g) for g in self.goods]
         self.states: list[State] = [self.p.initial]
@@ -324,12 +330,11 @@ def spelling_warnings(f: Filter, safeties: Sequence[Safety] | None = None,
     those left tried at the other points (free variables 1, random), and the rest listed,
     not compared. ``limit`` None: every relief compared on every input, each warning
     naming every output it drives differently."""
-    swapped: list[tuple[Safety, Filter]] = []
+    swapped: list[tuple[Safety, Safety]] = []  # each relief and the same constraint written the other way
     for s in (safeties if safeties is not None else f.combined):
         other = _other(s) if s.has_priority else None
         if other is not None:
-            t = dataclasses.replace(s, keep=other.keep, force=other.force)
-            swapped.append((s, dataclasses.replace(f, safeties=tuple(t if u is s else u for u in f.safeties))))
+            swapped.append((s, dataclasses.replace(s, keep=other.keep, force=other.force)))
     if not swapped:
         return Spellings([])
     chain = _Chain(f, swapped)

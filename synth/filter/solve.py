@@ -26,17 +26,17 @@ Example (004 eqs. 4-13)
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Callable, Mapping, Sequence
+from typing import Callable, Collection, Mapping, Sequence
 
 from synth.errors import InputError, LimitExceeded
 from synth.logic.bdd import CoverTooLarge, Cube, Function, cube_text
-from synth.filter.language import Criterion, Filter, Sense, SimCriterion, request_name
+from synth.filter.language import Criterion, Filter, Safety, Sense, SimCriterion, request_name
 from synth.logic.past import pre_name
 from synth.filter import narrowing
 from synth.filter.model import FilterFunctions, equation_functions, functions
 from synth.logic.expr import And, Const, Edge, Expr, Not, Or, Var
 
-__all__ = ["IMPLICIT", "FLAT_PROBE", "FLAT_LIMIT", "Applied", "Synthesis", "synthesis", "chained_equations", "criteria", "priority_criteria", "requested", "sim_expr",
+__all__ = ["IMPLICIT", "FLAT_PROBE", "FLAT_LIMIT", "Applied", "Synthesis", "synthesis", "chained_equations", "criteria", "priority_criteria", "priority_criterion", "requested", "sim_expr",
            "differences", "printed"]
 
 
@@ -53,7 +53,7 @@ def sim_expr(output: str) -> Expr:
     return Or((And((r, o)), And((Not(r), Not(o)))))
 
 
-def requested(e: Expr, outputs: Sequence[str]) -> Expr:
+def requested(e: Expr, outputs: Collection[str]) -> Expr:
     """``e`` with each output at t replaced by its request (past values kept), e.g.
     ``↑A4`` becomes ``!A4^-1 & R_A4``: the condition under which the request violates ``e``.
 
@@ -81,18 +81,19 @@ def requested(e: Expr, outputs: Sequence[str]) -> Expr:
 def priority_criteria(f: Filter) -> list[Criterion]:
     """One ``Min`` per CSc with a priority (004 eq. 24): when the requests violate it,
     minimise ``!L`` for ``keep L``, or the forced outputs being off their values."""
-    found = []
-    for s in f.combined:
-        if not s.has_priority:
-            continue
-        when = requested(s.expr, f.outputs)
-        if s.keep is not None:
-            bad: Expr = s.keep.arg if isinstance(s.keep, Not) else Not(s.keep)
-        else:
-            offs = tuple(Not(Var(c.output)) if c.value else Var(c.output) for c in s.forced)
-            bad = offs[0] if len(offs) == 1 else Or(offs)
-        found.append(Criterion(Sense.MIN, And((when, bad)), s.loc, f"priority of {s.id}"))
-    return found
+    outputs = frozenset(f.outputs)
+    return [priority_criterion(s, outputs) for s in f.combined if s.has_priority]
+
+
+def priority_criterion(s: Safety, outputs: Collection[str]) -> Criterion:
+    """The criterion of one CSc with a priority (:func:`priority_criteria`)."""
+    when = requested(s.expr, outputs)
+    if s.keep is not None:
+        bad: Expr = s.keep.arg if isinstance(s.keep, Not) else Not(s.keep)
+    else:
+        offs = tuple(Not(Var(c.output)) if c.value else Var(c.output) for c in s.forced)
+        bad = offs[0] if len(offs) == 1 else Or(offs)
+    return Criterion(Sense.MIN, And((when, bad)), s.loc, f"priority of {s.id}")
 
 
 def criteria(f: Filter, order: Sequence[str] | None = None) -> list[Criterion]:

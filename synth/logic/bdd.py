@@ -31,8 +31,9 @@ from functools import reduce
 from typing import Any, Iterable, Mapping, Sequence
 
 from synth.logic.native import native
-from synth.logic.past import PRE_SUFFIX, pre_name
+from synth.logic.past import pre_name
 from synth.logic.expr import And, Const, Edge, Expr, Not, Var
+from synth.logic.factoring import cube_literals, factored
 from synth.logic.isop import CoverTooLarge, Covers, Cube, expanded
 
 
@@ -143,6 +144,7 @@ class Engine:
         self._rank: dict[str, int] | None = None if text_order is None else {
             n: i for i, n in enumerate(dict.fromkeys(text_order))}
         self._ranks_by_inner: dict[str, int] = {}
+        self._ranks_by_name: dict[str, int] = {}  # the same, by the caller's names (the printed literals' order)
         self._covers: Covers | None = None
         self._cubes: dict[frozenset[str], Function] = {}
         self._native = native(self.bdd) if self.cudd else None
@@ -237,6 +239,7 @@ class Engine:
         """Internal name -> rank in the text order, rebuilt when variables were declared."""
         if len(self._ranks_by_inner) != len(self._outer):
             self._ranks_by_inner = {i: self.rank(n) for i, n in self._outer.items()}
+            self._ranks_by_name = {n: self._ranks_by_inner[i] for i, n in self._outer.items()}
         return self._ranks_by_inner
 
     # ---- translation
@@ -355,7 +358,8 @@ class Engine:
     def expanded(self, cube: Cube, upper: Function) -> Cube:
         """``cube`` (implying ``upper``) with literals dropped, in text order, while it
         still implies ``upper``: a prime implicant of ``upper``."""
-        kept = expanded(self.bdd, {self.declare(n): v for n, v in cube.items()}, upper)
+        leq = None if self._native is None else self._native.leq
+        kept = expanded(self.bdd, {self.declare(n): v for n, v in cube.items()}, upper, leq)
         return {self._outer[v]: x for v, x in kept.items()}
 
     def minimal_cube(self, u: Function) -> Cube | None:
@@ -392,55 +396,5 @@ class Engine:
         cubes = self.cover(lower, upper, limit)
         if cubes == [{}]:
             return "1"
-        order = {n: self.rank(n) for n in self.names}
-        return factored([cube_literals(c, order) for c in cubes], top=True)
-
-
-# ---- printing a cover: literals with edges recognised, then greedy factoring
-_Lit = tuple[int, str]  # (sort key, text)
-
-
-def cube_literals(cube: Cube, order: Mapping[str, int]) -> list[_Lit]:
-    lits: list[_Lit] = []
-    done: set[str] = set()
-    for n, v in cube.items():
-        if n in done:
-            continue
-        if n.endswith(PRE_SUFFIX):
-            now = n[: -len(PRE_SUFFIX)]
-            if now in cube and cube[now] != v:  # !x^-1 & x is ↑x, x^-1 & !x is ↓x
-                done.update((n, now))
-                lits.append((order.get(now, 0), ("↓" if v else "↑") + now))
-                continue
-        elif pre_name(n) in cube and cube[pre_name(n)] != v:
-            continue  # printed with its past value above
-        done.add(n)
-        lits.append((order.get(n, 0), n if v else "!" + n))
-    return sorted(lits)
-
-
-def factored(terms: Sequence[list[_Lit]], top: bool = False) -> str:
-    """Greedy algebraic factoring: take out the literal common to most terms."""
-    terms = [t for t in terms]
-    if any(not t for t in terms):
-        return "1"
-    counts: dict[_Lit, int] = {}
-    for t in terms:
-        for lit in t:
-            counts[lit] = counts.get(lit, 0) + 1
-    best = min(counts, key=lambda lit: (-counts[lit], lit)) if counts else None
-    if best is None or counts[best] < 2:
-        texts = [" & ".join(text for _, text in t) for t in terms]
-        out = " | ".join(texts)
-        return out if top or len(terms) == 1 else f"({out})"
-    inner = [[lit for lit in t if lit != best] for t in terms if best in t]
-    rest = [t for t in terms if best not in t]
-    if any(not t for t in inner):  # x | x & y: cannot happen in an irredundant cover
-        head = best[1]
-    else:
-        sub = factored(inner)
-        head = f"{best[1]} & {sub}" if len(inner) > 1 else best[1] + " & " + sub
-    if not rest:
-        return head
-    out = head + " | " + factored(rest, top=True)
-    return out if top else f"({out})"
+        self.inner_ranks()  # built once per set of declared variables, not per equation
+        return factored([cube_literals(c, self._ranks_by_name) for c in cubes], top=True)

@@ -26,8 +26,9 @@ Example
 
 from __future__ import annotations
 
-import sys
 from typing import Any, Callable, Mapping
+
+from synth.logic.native import native
 
 __all__ = ["Covers", "CoverTooLarge", "Cube", "expanded"]
 
@@ -52,15 +53,31 @@ class CoverTooLarge(Exception):
         self.limit = limit
 
 
-def expanded(bdd: Any, cube: Cube, upper: Function) -> Cube:
+def expanded(bdd: Any, cube: Cube, upper: Function, leq: Callable[[Function, Function], bool] | None = None) -> Cube:
     """``cube`` (implying ``upper``, over ``bdd``'s variables) with literals dropped, in
-    its order, while it still implies ``upper``: a prime implicant of ``upper``."""
-    kept = dict(cube)
-    for n in list(cube):
-        trial = {m: v for m, v in kept.items() if m != n}
-        if (bdd.let(trial, upper) if trial else upper) == bdd.true:  # the cube implies upper
-            kept = trial
-    return kept
+    its order, while it still implies ``upper``: a prime implicant of ``upper``. ``leq``:
+    CUDD's containment test (:meth:`synth.logic.native.Native.leq`), which tells whether a
+    cube implies ``upper`` without building its cofactor."""
+    if leq is None:
+        kept = dict(cube)
+        for n in list(cube):
+            trial = {m: v for m, v in kept.items() if m != n}
+            if (bdd.let(trial, upper) if trial else upper) == bdd.true:  # the cube implies upper
+                kept = trial
+        return kept
+    # the literal at j is tested with the kept ones before it and all after it: the cubes of
+    # the literals after each j built once, those kept before it grown one literal at a time
+    names = list(cube)
+    literals = [bdd.var(n) if cube[n] else ~bdd.var(n) for n in names]
+    after = [bdd.true] * (len(names) + 1)
+    for j in range(len(names) - 1, -1, -1):
+        after[j] = literals[j] & after[j + 1]
+    before, out = bdd.true, {}
+    for j, n in enumerate(names):
+        if not leq(before & after[j + 1], upper):  # needed: kept
+            out[n] = cube[n]
+            before &= literals[j]
+    return out
 
 
 class Covers:
@@ -71,8 +88,8 @@ class Covers:
         self.source = source
         self.rank = rank
         self.native = type(source).__module__ == "dd.cudd"  # complemented edges, low and high of the regular node
-        # dd.cudd's module: its conjunction-abstraction ∃V.(u ∧ v), which stops at the first common point
-        self._backend = sys.modules[type(source).__module__] if self.native else None
+        # CUDD's containment test u ≤ v in the cover's manager (no BDD built; None: dd's operations)
+        self._leq: Callable[[Function, Function], bool] | None = None
         # the manager of the cover being computed: dd.autoref's, the engine's; CUDD's, one per cover (:meth:`_opened`)
         self.bdd = source
         self._firsts: dict[Function, str] = {}  # during one cover: no function outlives it
@@ -95,6 +112,8 @@ class Covers:
         bdd = self.bdd = type(source)(memory_estimate=MEMORY, initial_cache_size=CACHE)
         bdd.configure(reordering=False, loose_up_to=LOOSE)
         bdd.declare(*sorted(names, key=source.level_of_var))
+        calls = native(bdd)
+        self._leq = None if calls is None else calls.leq
         lower_here = source.copy(lower, bdd)
         return lower_here, lower_here if upper == lower else source.copy(upper, bdd)
 
@@ -107,7 +126,7 @@ class Covers:
             kept = self._covered(*self._opened(lower, lower if upper is None else upper), limit)
         finally:
             self._firsts.clear()
-            self.bdd = self.source  # the cover's own manager goes with its last function
+            self.bdd, self._leq = self.source, None  # the cover's own manager goes with its last function
         if kept is None:
             raise CoverTooLarge(limit or 0)  # from a frame without the cover's BDDs
         return kept
@@ -121,7 +140,7 @@ class Covers:
         if limit is not None and len(cubes) > limit:
             return None
         primes: list[Cube] = []
-        for c in (expanded(self.bdd, self._ordered(c), upper) for c in cubes):
+        for c in (expanded(self.bdd, self._ordered(c), upper, self._leq) for c in cubes):
             if c not in primes:
                 primes.append(c)
         # drop, in order, each cube the others (the kept ones before it, all after it) cover
@@ -133,7 +152,7 @@ class Covers:
         kept: list[Cube] = []
         before = bdd.false
         for i, c in enumerate(primes):
-            if (lower & ~(before | after[i + 1])) != bdd.false:
+            if not self._below(lower, before | after[i + 1]):
                 kept.append(c)
                 before |= functions[i]
         return kept
@@ -176,7 +195,7 @@ class Covers:
         while failed - done > 1 and upper != bdd.true:  # lower is not false, nor is ∃V.lower
             size = (done + failed) // 2
             every = bdd.forall(names[done:size], upper)
-            if self._below(lower, every, names):
+            if self._below(lower, every):
                 upper, done = every, size
             else:
                 failed = size
@@ -184,12 +203,12 @@ class Covers:
             return lower, upper
         return bdd.exist(names[:done], lower), upper
 
-    def _below(self, lower: Function, upper: Function, names: list[str]) -> bool:
-        """``lower ≤ upper``, ``names`` their supports: ``∃.lower ∧ ¬upper`` false, which CUDD's
-        conjunction-abstraction finds as soon as it meets a common point (no BDD built)."""
-        if self._backend is None:
+    def _below(self, lower: Function, upper: Function) -> bool:
+        """``lower ≤ upper``: with CUDD its containment test, which builds nothing and stops at
+        the first point of ``lower`` outside ``upper``."""
+        if self._leq is None:
             return (lower & ~upper) == self.bdd.false
-        return self._backend.and_exists(lower, ~upper, names) == self.bdd.false
+        return self._leq(lower, upper)
 
     def _isop(self, lower: Function, upper: Function, memo: dict, limit: int | None,
               after: bool = False) -> tuple[list[Cube], Function]:
@@ -212,8 +231,11 @@ class Covers:
         if v == b:
             l0, l1 = self._cofactors(lower, v) if v == a else (lower, lower)
             u0, u1 = self._cofactors(upper, v)
-            x0, x1 = l0 & ~u1, l1 & ~u0
-            empty = x0 == bdd.false and x1 == bdd.false
+            if self._leq is not None and self._leq(l0, u1) and self._leq(l1, u0):
+                empty = True  # both halves empty, found without building them
+            else:
+                x0, x1 = l0 & ~u1, l1 & ~u0
+                empty = x0 == bdd.false and x1 == bdd.false
         else:  # lower ≤ upper at either value of v: both halves are empty
             empty = True
         if empty:  # v appears in no cube: the cover of [∃v.lower, ∀v.upper]
