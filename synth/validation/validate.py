@@ -23,7 +23,8 @@ from synth.plant.composition import Plant
 from synth.plant.rules import RuleSet
 from synth.validation.analysis import analyse
 from synth.validation.result import Validation, home_conditions, load_model
-from synth.validation.sync import Sync, synchronous_product
+from synth.validation.frontier import explore
+from synth.validation.sync import Sync
 
 __all__ = ["validate", "validate_loaded", "home_states"]
 
@@ -76,7 +77,7 @@ def validate_loaded(
     ``progress(aggregated states, states to visit)`` is called now and then."""
     conditions = home_conditions(homes, p, g)
     machine = GrafcetMachine(g)
-    sync = synchronous_product(p, rs.constraints, machine, max_states=max_states, progress=progress)
+    sync = explore(p, rs.constraints, machine, max_states=max_states, progress=progress)
     sup_empty = not sync.oracle.kept(p.initial)  # the constraints compiled once
     analysis = analyse(sync, home_states(sync, conditions))
     if not (analysis.blocking or analysis.never_starts or analysis.prohibited):  # a passing run imports no diagnosis

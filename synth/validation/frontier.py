@@ -1,0 +1,326 @@
+"""SYNC explored a frontier at a time: the explicit engine's fast path.
+
+The same aggregated automaton as :func:`synth.validation.sync.synchronous_product`, node
+for node, edge for edge and in the same order, built by numpy passes over the whole
+breadth-first frontier instead of one interpreted step per state: a node is a pair of
+integers (situation number, flat plant code); the frontier's uncontrollable moves come
+from the element-local transition tables (:class:`~synth.validation.regions.PlantCodes`);
+the Grafcet reacts on rows of bits (:class:`~synth.grafcet.vector.VectorMachine`); the
+regions entered are searched many at once (:func:`~synth.validation.regions.regions`),
+and nodes, regions and situations are found again through sorted integer keys.
+
+The machine itself still runs what the rows do not carry: the timers' events (per
+node), a reaction that fires an OR divergence's conflict (its rounds are noted) or evolves
+longer than :data:`~synth.grafcet.vector.ROUNDS` rounds. A Grafcet the rows cannot carry
+at all (:func:`reason` says why), or anything unusual met on the way (a transient cycle,
+an event that changes several inputs, keys past 64 bits), is explored by the machine's
+path from the start, which also gives the same error at the same place.
+
+Example
+-------
+>>> from synth.plant.composition import _plants
+>>> from synth.validation.result import load_model
+>>> from synth.validation.sync import synchronous_product
+>>> rs, p, g = load_model(_plants("../grafcets/tri_missing_order.g7"), _plants("tri.rules"))
+>>> fast, slow = explore(p, rs.constraints, GrafcetMachine(g)), synchronous_product(p, rs.constraints, GrafcetMachine(g))
+>>> fast.nodes == slow.nodes, fast.edges == slow.edges, fast.sync_states == slow.sync_states
+(True, True, True)
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Callable, Sequence
+
+import numpy as np
+
+from synth.errors import InputError, LimitExceeded
+from synth.grafcet.machine import GrafcetMachine, Situation
+from synth.grafcet.vector import VectorMachine, unsupported
+from synth.logic.events import Event
+from synth.plant.composition import Plant
+from synth.plant.rules import Constraint
+from synth.sup.constraints import CompiledConstraints
+from synth.validation.conflicts import Conflict, ConflictLog
+from synth.validation.regions import PlantCodes, Regions, SortedKeys, first_occurrences, regions
+from synth.validation.sync import Edge, Node, Sync, synchronous_product
+
+__all__ = ["explore", "reason", "explore_frontier", "Unsupported"]
+
+Rounds = tuple[tuple, ...]
+
+
+class Unsupported(Exception):
+    """The frontier path met what it leaves to the machine's path (the message says what)."""
+
+
+def reason(p: Plant, machine: GrafcetMachine) -> str | None:
+    """Why SYNC of ``machine`` against ``p`` is explored by the machine state by state
+    rather than a frontier at a time; None when the frontier path runs."""
+    why = unsupported(machine)
+    if why is not None:
+        return why
+    missing = [n for n in machine.inputs if n not in p.owner]
+    if missing:
+        return f"input {missing[0]} is not a plant variable"
+    if p.size >= 1 << 40:
+        return f"{p.size} plant states: past the frontier path's 40-bit codes"
+    return None
+
+
+def explore(
+    p: Plant,
+    constraints: Sequence[Constraint],
+    machine: GrafcetMachine,
+    *,
+    max_states: int | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> Sync:
+    """SYNC, a frontier at a time when :func:`reason` allows it, else (or when the frontier
+    path meets what it leaves to the machine) by the machine's path."""
+    if reason(p, machine) is None:
+        try:
+            return explore_frontier(p, constraints, machine, max_states=max_states, progress=progress)
+        except Unsupported:
+            pass
+    return synchronous_product(p, constraints, machine, max_states=max_states, progress=progress)
+
+
+class _Situations:
+    """The situations met, numbered; their bits for the rows."""
+
+    def __init__(self, vm: VectorMachine, size: int) -> None:
+        self.vm, self.size = vm, size
+        self.items: list[Situation] = []
+        self.timers: list[tuple[Event, ...]] = []
+        self._ids: dict[bytes, int] = {}
+        self.A = np.zeros((0, len(vm.step_names)), dtype=bool)
+        self.T = np.zeros((0, len(vm.timer_names)), dtype=bool)
+
+    def number(self, A: np.ndarray, T: np.ndarray, given: list[Situation] | None = None) -> np.ndarray:
+        """The numbers of the rows' situations (new ones numbered in row order)."""
+        packed = np.packbits(np.hstack([A, T]), axis=1)
+        out = np.empty(len(A), dtype=np.int64)
+        fresh = []
+        for r, key in enumerate(packed):
+            b = key.tobytes()
+            hit = self._ids.get(b)
+            if hit is None:
+                hit = self._ids[b] = len(self.items)
+                sit = given[r] if given is not None else self.vm.situation(A[r], T[r])
+                self.items.append(sit)
+                self.timers.append(self.vm.machine.timers(sit))
+                fresh.append(r)
+            out[r] = hit
+        if fresh:
+            self.A = np.vstack([self.A, A[fresh]])
+            self.T = np.vstack([self.T, T[fresh]])
+            if len(self.items) * self.size >= 1 << 62:
+                raise Unsupported("node keys past 64 bits")
+        return out
+
+    def of(self, sits: list[Situation]) -> np.ndarray:
+        A, T = self.vm.rows(sits)
+        return self.number(A, T, sits)
+
+
+def explore_frontier(
+    p: Plant,
+    constraints: Sequence[Constraint],
+    machine: GrafcetMachine,
+    *,
+    max_states: int | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> Sync:
+    """SYNC a frontier at a time (see module doc); :class:`Unsupported` when it meets
+    what it leaves to the machine's path."""
+    oracle = CompiledConstraints(p, constraints)
+    if not oracle.kept(p.initial):
+        return Sync(p, oracle, machine)
+    return _Explorer(p, oracle, machine, max_states).run(progress)
+
+
+def _slices(starts: np.ndarray, groups: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The sizes of the slices ``starts[g]:starts[g + 1]`` of ``groups`` and their
+    positions, concatenated in order."""
+    counts = starts[groups + 1] - starts[groups]
+    at = np.repeat(starts[groups] - np.cumsum(counts) + counts, counts) + np.arange(int(counts.sum()))
+    return counts, at
+
+
+class _Explorer:
+    def __init__(self, p: Plant, oracle: CompiledConstraints, machine: GrafcetMachine, max_states: int | None) -> None:
+        self.p, self.oracle, self.machine, self.max_states = p, oracle, machine, max_states
+        self.vm = VectorMachine(machine)
+        self.pc = PlantCodes(p, oracle)
+        self.P = p.size
+        self.sits = _Situations(self.vm, self.P)
+        self.regions = Regions()
+        self.entered = SortedKeys()  # (situation, entry) -> region
+        self.by_wanted = SortedKeys()  # (wanted orders, entry) -> region
+        self._wanted: dict[bytes, int] = {}
+        self.index = SortedKeys()  # (situation, plant) -> node
+        self.nodes: list[Node] = []
+        self.node_sit = np.empty(0, dtype=np.int64)
+        self.node_code = np.empty(0, dtype=np.int64)
+        self.edges: list[Edge] = []
+        self.conflicts: list[Conflict] = []
+        self.log = ConflictLog()
+        self.pairs: list[np.ndarray] = []  # (situation, member) keys of the regions entered
+        # the Grafcet's order columns in the regions' order of the plant's orders
+        self._order_cols = [self.vm.order_names.index(o) if o in self.vm.order_names else -1 for o in self.pc.orders]
+
+    # ------------------------------------------------------------------ helpers
+    def inputs(self, codes: np.ndarray) -> np.ndarray:
+        return self.pc.values(self.machine.inputs, self.pc.digits(codes))
+
+    def as_dict(self, bits: np.ndarray) -> dict[str, bool]:
+        return dict(zip(self.machine.inputs, bits.tolist()))
+
+    def orders(self, sid: np.ndarray, codes: np.ndarray) -> np.ndarray:
+        return self.vm.orders(self.sits.A[sid], self.sits.T[sid], self.inputs(codes))
+
+    def region_of(self, sid: np.ndarray, entry: np.ndarray) -> np.ndarray:
+        """The region entered at each (situation, entry), searched when new."""
+        keys = sid * self.P + entry
+        found = self.entered.find(keys)
+        if (found < 0).any():
+            miss = np.flatnonzero(found < 0)
+            first = miss[first_occurrences(keys[miss])]
+            emitted = self.orders(sid[first], entry[first])
+            wanted = np.zeros((len(first), len(self._order_cols)), dtype=bool)
+            for j, c in enumerate(self._order_cols):
+                if c >= 0:
+                    wanted[:, j] = emitted[:, c]
+            wid = np.array([self._wanted.setdefault(w.tobytes(), len(self._wanted))
+                            for w in np.packbits(wanted, axis=1)], dtype=np.int64)
+            if len(self._wanted) * self.P >= 1 << 62:
+                raise Unsupported("region keys past 64 bits")
+            wkeys = wid * self.P + entry[first]
+            gid = self.by_wanted.find(wkeys)
+            new = np.flatnonzero(gid < 0)
+            if new.size:
+                new = new[first_occurrences(wkeys[new])]
+                base = self.regions.count
+                try:
+                    regions(self.pc, self.regions, entry[first][new], wanted[new])
+                except OverflowError as err:
+                    raise Unsupported(str(err)) from None
+                self.by_wanted.add(wkeys[new], base + np.arange(new.size))
+                gid = self.by_wanted.find(wkeys)
+            self.entered.add(keys[first], gid)
+            counts, at = _slices(self.regions.member_starts, gid)
+            self.pairs.append(np.repeat(sid[first], counts) * self.P + self.regions.members[at])
+            found = self.entered.find(keys)
+        return found
+
+    def enter(self, sid: np.ndarray, entry: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The nodes of the settled states of each region entered (new ones made), and for
+        each of them the candidate it comes from."""
+        gid = self.region_of(sid, entry)
+        counts, at = _slices(self.regions.settled_starts, gid)
+        src = np.repeat(np.arange(len(gid)), counts)
+        q, proh = self.regions.settled[at], self.regions.settled_proh[at]
+        tsid = sid[src]
+        keys = tsid * self.P + q
+        node = self.index.find(keys)
+        miss = np.flatnonzero(node < 0)
+        if miss.size:
+            first = miss[first_occurrences(keys[miss])]
+            ids = len(self.nodes) + np.arange(first.size)
+            self.make_nodes(tsid[first], q[first], proh[first])
+            self.index.add(keys[first], ids)
+            node = self.index.find(keys)
+        return node, src
+
+    def make_nodes(self, sid: np.ndarray, q: np.ndarray, proh: np.ndarray) -> None:
+        emitted = self.orders(sid, q)
+        digits = self.pc.digits(q)
+        set_ = emitted & self.pc.values(self.vm.order_names, digits)
+        names = self.vm.order_names
+        items, prohs = self.sits.items, self.regions.prohibitions
+        for s, local, em, on, pr in zip(sid.tolist(), digits.T.tolist(), emitted, set_, proh.tolist()):
+            self.nodes.append(Node(items[s], tuple(local), frozenset(names[i] for i in np.flatnonzero(em)),
+                                   tuple(names[i] for i in np.flatnonzero(on)), prohs[pr]))
+        self.node_sit = np.concatenate([self.node_sit, sid])
+        self.node_code = np.concatenate([self.node_code, q])
+        if self.max_states is not None and len(self.nodes) > self.max_states:
+            raise LimitExceeded(
+                f"more than {self.max_states} aggregated states; raise --max-states or simplify the model"
+            )
+
+    # ------------------------------------------------------------------ the search
+    def run(self, progress: Callable[[int, int], None] | None) -> Sync:
+        init = np.array([self.p.initial_index], dtype=np.int64)
+        sit0 = self.machine.initial(self.as_dict(self.inputs(init)[0]))
+        node, _ = self.enter(self.sits.of([sit0]), init)
+        initial = tuple(node.tolist())
+        lo, last = 0, time.monotonic()
+        while lo < len(self.nodes):
+            hi = len(self.nodes)
+            self.expand(lo, hi)
+            lo = hi
+            if progress is not None and time.monotonic() - last > 0.5:
+                progress(len(self.nodes), len(self.nodes) - lo)
+                last = time.monotonic()
+        states = int(np.unique(np.concatenate(self.pairs)).size) if self.pairs else 0
+        return Sync(self.p, self.oracle, self.machine, tuple(self.nodes), tuple(self.edges), initial,
+                    tuple(self.conflicts), states)
+
+    def expand(self, lo: int, hi: int) -> None:
+        """Every event from the nodes ``lo:hi``, in the machine's path's order."""
+        sid, codes = self.node_sit[lo:hi], self.node_code[lo:hi]
+        row, rank, entry = self.pc.successors(codes)
+        before = self.inputs(codes)
+        after = self.inputs(entry)
+        changed = before[row] ^ after
+        count = changed.sum(axis=1)
+        if (count > 1).any():
+            raise Unsupported("an event that changes several inputs")
+        col = changed.argmax(axis=1)
+        E = np.where(count == 1, 2 * col + after[np.arange(len(row)), col], -1)
+        A2, T2, pending = self.vm.react(self.sits.A[sid[row]], self.sits.T[sid[row]], after, E)
+        nsid = np.zeros(len(row), dtype=np.int64)
+        nsid[~pending] = self.sits.number(A2[~pending], T2[~pending])
+        events: list[Event] = [self.pc.uncontrollable[k].event for k in rank.tolist()]
+        traced: dict[int, Rounds] = {}  # candidate -> rounds fired, where the machine reacted
+        items = self.sits.items
+        for c in np.flatnonzero(pending).tolist():
+            sit, traced[c] = self._machine(lambda: self.machine.react_with_trace(
+                items[sid[row[c]]], self.as_dict(before[row[c]]), self.as_dict(after[c])))
+            nsid[c] = self.sits.of([sit])[0]
+        rows, ranks, entries, sids = [row], [rank], [entry], [nsid]
+        first_timer = len(self.pc.uncontrollable)
+        for r in np.flatnonzero(self.has_timers()[sid]).tolist():
+            for j, timer in enumerate(self.sits.timers[sid[r]]):
+                sit, rounds = self._machine(lambda: self.machine.fire_timer_with_trace(
+                    items[sid[r]], timer, self.as_dict(before[r])))
+                traced[len(events)] = rounds
+                events.append(timer)
+                rows.append(np.array([r]))
+                ranks.append(np.array([first_timer + j]))
+                entries.append(codes[r:r + 1])
+                sids.append(self.sits.of([sit]))
+        row, rank, entry, nsid = (np.concatenate(x) for x in (rows, ranks, entries, sids))
+        order = np.lexsort((rank, row))
+        where = np.empty(len(order), dtype=np.int64)
+        where[order] = np.arange(len(order))
+        for c in sorted(traced, key=lambda c: where[c]):
+            i = lo + int(row[c])
+            self.conflicts.extend(Conflict(i, events[c], st, names) for st, names in self.log.fresh(traced[c]))
+        row, entry, nsid = row[order], entry[order], nsid[order]
+        events = [events[c] for c in order.tolist()]
+        node, src = self.enter(nsid, entry)
+        source = (lo + row[src]).tolist()
+        self.edges.extend(Edge(a, events[c], b) for a, c, b in zip(source, src.tolist(), node.tolist()))
+
+    def has_timers(self) -> np.ndarray:
+        return np.array([bool(t) for t in self.sits.timers], dtype=bool)
+
+    @staticmethod
+    def _machine(call: Callable[[], tuple[Situation, Rounds]]) -> tuple[Situation, Rounds]:
+        """One evolution by the machine; a transient cycle is for the machine's path to report."""
+        try:
+            return call()
+        except InputError:
+            raise Unsupported("a transient cycle") from None

@@ -1,0 +1,247 @@
+"""Plant states as integer codes, and many regions searched at once: the plant's side of
+the frontier explorer (:mod:`synth.validation.frontier`).
+
+A plant state is its flat code (mixed radices, :meth:`~synth.plant.composition.Plant.index`);
+:class:`PlantCodes` reads the element-local digits, the Grafcet's inputs and the orders'
+values of whole arrays of codes, follows the uncontrollable moves of a frontier, and
+decides SUP membership and SUP's refusals with the compiled constraints' factors (the
+same terms :class:`~synth.sup.constraints.CompiledConstraints` asks one state at a time).
+:func:`regions` runs :func:`synth.validation.sync.region` for many (entry, wanted orders)
+at once, layer by layer: the members of each region in the same breadth-first order, its
+settled states with the same prohibitions (computed by the oracle itself, only where a
+move was refused).
+
+Example
+-------
+>>> from synth.plant.composition import _plants, load_plant
+>>> from synth.sup.constraints import CompiledConstraints
+>>> from synth.plant.rules_check import load_rules
+>>> rs = load_rules(_plants("tri.rules"))
+>>> p = load_plant(_plants("tri.rules"))
+>>> pc = PlantCodes(p, CompiledConstraints(p, rs.constraints))
+>>> pc.kept(np.array([p.initial_index])).tolist()
+[True]
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from synth.plant.composition import LocalTransition, Plant
+from synth.sup.constraints import CompiledConstraints, term_holds
+from synth.validation.sync import Prohibition, moves_by_order
+
+__all__ = ["PlantCodes", "Regions", "regions", "SortedKeys"]
+
+
+class SortedKeys:
+    """Integer keys kept sorted, each with an integer value: a lookup table without a
+    dictionary entry per key (insertions are merges of sorted arrays)."""
+
+    def __init__(self) -> None:
+        self.keys = np.empty(0, dtype=np.int64)
+        self.values = np.empty(0, dtype=np.int64)
+
+    def find(self, keys: np.ndarray) -> np.ndarray:
+        """The value of each key, -1 where absent."""
+        if not self.keys.size:
+            return np.full(len(keys), -1, dtype=np.int64)
+        pos = np.minimum(np.searchsorted(self.keys, keys), self.keys.size - 1)
+        return np.where(self.keys[pos] == keys, self.values[pos], -1)
+
+    def add(self, keys: np.ndarray, values: np.ndarray) -> None:
+        """Insert absent, distinct ``keys``."""
+        order = np.argsort(keys, kind="stable")
+        keys, values = keys[order], values[order]
+        pos = np.searchsorted(self.keys, keys)
+        self.keys = np.insert(self.keys, pos, keys)
+        self.values = np.insert(self.values, pos, values)
+
+
+def first_occurrences(keys: np.ndarray) -> np.ndarray:
+    """Positions of the first occurrence of each distinct key, in the order they occur."""
+    _, first = np.unique(keys, return_index=True)
+    return np.sort(first)
+
+
+class PlantCodes:
+    """Array reads of a plant's states given as flat codes (see module doc)."""
+
+    def __init__(self, p: Plant, oracle: CompiledConstraints) -> None:
+        self.plant, self.oracle = p, oracle
+        self.size = p.size
+        self.strides = np.array(p.strides, dtype=np.int64)
+        self.shape = np.array(p.shape, dtype=np.int64)
+        self.uncontrollable = [t for t in p.transitions if not t.controllable]
+        self.moves = moves_by_order(p)
+        self.orders = sorted(self.moves)  # the region's order of the orders
+        self._reach = [g.ravel() for g in oracle.reach_grids] if oracle.reach_grids is not None else None
+
+    def digits(self, codes: np.ndarray) -> np.ndarray:
+        """Element-local indices, ndim × n."""
+        return (codes[None, :] // self.strides[:, None]) % self.shape[:, None]
+
+    def values(self, names: tuple[str, ...] | list[str], digits: np.ndarray) -> np.ndarray:
+        """The plant variables ``names`` at each state (n × len(names)); False for a name
+        the plant does not have."""
+        out = np.zeros((digits.shape[1], len(names)), dtype=bool)
+        for j, n in enumerate(names):
+            axis = self.plant.owner.get(n)
+            if axis is not None:
+                out[:, j] = self.plant.elements[axis].value(n)[digits[axis]]
+        return out
+
+    def kept(self, codes: np.ndarray) -> np.ndarray:
+        """SUP membership of each state: no violation reachable by uncontrollable events."""
+        bad = np.zeros(len(codes), dtype=bool)
+        if self._reach is not None:
+            for g in self._reach:
+                bad |= g[codes]
+            return ~bad
+        digits = self.digits(codes)
+        for factors in self.oracle.level_reach:
+            bad |= term_holds(factors, digits)
+        return ~bad
+
+    def forbidden(self, t: LocalTransition, digits: np.ndarray) -> np.ndarray:
+        """Where an edge constraint forbids the controllable ``t``."""
+        out = np.zeros(digits.shape[1], dtype=bool)
+        for term in self.oracle.edge_terms.get(t.event, ()):
+            out |= term_holds(term.factors, digits)
+        return out
+
+    def successors(self, codes: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The uncontrollable moves from ``codes`` into SUP: (row, move rank, target code),
+        sorted by row then rank (the explicit engine's order)."""
+        digits = self.digits(codes)
+        rows, ranks, targets = [], [], []
+        for k, t in enumerate(self.uncontrollable):
+            ok = digits[t.axis] == t.src
+            if t.guard is not None:
+                ok &= self.plant.enabled_digits(t, digits)
+            r = np.flatnonzero(ok)
+            if r.size:
+                rows.append(r)
+                ranks.append(np.full(r.size, k))
+                targets.append(codes[r] + (t.dst - t.src) * int(self.strides[t.axis]))
+        if not rows:
+            empty = np.empty(0, dtype=np.int64)
+            return empty, empty, empty
+        row, rank, target = np.concatenate(rows), np.concatenate(ranks), np.concatenate(targets)
+        keep = self.kept(target)  # cannot fail from a SUP state; kept for safety, as the machine's path
+        order = np.lexsort((rank[keep], row[keep]))
+        return row[keep][order], rank[keep][order], target[keep][order]
+
+    def refusals(self, code: int, wanted: np.ndarray) -> tuple[Prohibition, ...]:
+        """The order changes SUP refuses in state ``code`` towards ``wanted`` (one bit per
+        :attr:`orders`), as :func:`~synth.validation.sync.region` lists them."""
+        cur = self.plant.local(code)
+        val = self.plant.valuation(cur)
+        refused: list[Prohibition] = []
+        for j, order in enumerate(self.orders):
+            if val[order] == bool(wanted[j]):
+                continue
+            for t in self.moves[order]:
+                if t.src == cur[t.axis]:
+                    ok, why = self.oracle.move(t, cur)
+                    if not ok:
+                        refused.append(Prohibition(t.event, tuple(why)))
+        return tuple(sorted(refused))
+
+
+class Regions:
+    """Regions searched so far, numbered in order: members and settled states as slices
+    of flat arrays (``starts[g]:starts[g + 1]``), prohibitions as indices into
+    :attr:`prohibitions`."""
+
+    def __init__(self) -> None:
+        self.member_starts = np.zeros(1, dtype=np.int64)
+        self.members = np.empty(0, dtype=np.int64)
+        self.settled_starts = np.zeros(1, dtype=np.int64)
+        self.settled = np.empty(0, dtype=np.int64)
+        self.settled_proh = np.empty(0, dtype=np.int64)
+        self.prohibitions: list[tuple[Prohibition, ...]] = [()]
+        self._proh_ids: dict[tuple[Prohibition, ...], int] = {(): 0}
+
+    @property
+    def count(self) -> int:
+        return len(self.member_starts) - 1
+
+    def proh_id(self, proh: tuple[Prohibition, ...]) -> int:
+        hit = self._proh_ids.get(proh)
+        if hit is None:
+            hit = self._proh_ids[proh] = len(self.prohibitions)
+            self.prohibitions.append(proh)
+        return hit
+
+    def append(self, members: np.ndarray, member_counts: np.ndarray, settled: np.ndarray, proh: np.ndarray,
+               settled_counts: np.ndarray) -> None:
+        self.member_starts = np.concatenate([self.member_starts, self.members.size + np.cumsum(member_counts)])
+        self.members = np.concatenate([self.members, members])
+        self.settled_starts = np.concatenate([self.settled_starts, self.settled.size + np.cumsum(settled_counts)])
+        self.settled = np.concatenate([self.settled, settled])
+        self.settled_proh = np.concatenate([self.settled_proh, proh])
+
+
+def regions(pc: PlantCodes, store: Regions, entries: np.ndarray, wanted: np.ndarray) -> None:
+    """Search the regions entered at ``entries`` under ``wanted`` (one row of bits over
+    ``pc.orders`` per entry) and append them to ``store``, in the order given."""
+    R = len(entries)
+    if R * pc.size >= 1 << 62:
+        raise OverflowError("region keys")
+    reg, cur = np.arange(R, dtype=np.int64), entries.astype(np.int64)
+    seen = SortedKeys()
+    seen.add(reg * pc.size + cur, reg)
+    member_parts, settled_parts = [(reg, cur)], []
+    while cur.size:
+        digits = pc.digits(cur)
+        values = pc.values(pc.orders, digits)
+        progressed = np.zeros(cur.size, dtype=bool)
+        refused = np.zeros(cur.size, dtype=bool)
+        rows, ranks, targets = [], [], []
+        rank = 0
+        for j, order in enumerate(pc.orders):
+            active = values[:, j] != wanted[reg, j]
+            for t in pc.moves[order]:
+                app = np.flatnonzero(active & (digits[t.axis] == t.src))
+                rank += 1
+                if not app.size:
+                    continue
+                target = cur[app] + (t.dst - t.src) * int(pc.strides[t.axis])
+                ok = pc.kept(target) & ~pc.forbidden(t, digits[:, app])
+                refused[app[~ok]] = True
+                progressed[app[ok]] = True
+                rows.append(app[ok])
+                ranks.append(np.full(int(ok.sum()), rank))
+                targets.append(target[ok])
+        still = ~progressed
+        settled_parts.append((reg[still], cur[still], refused[still]))
+        if not rows:
+            break
+        row, rnk, target = np.concatenate(rows), np.concatenate(ranks), np.concatenate(targets)
+        order = np.lexsort((rnk, row))
+        nreg, target = reg[row[order]], target[order]
+        keys = nreg * pc.size + target
+        first = first_occurrences(keys)
+        first = first[seen.find(keys[first]) < 0]
+        reg, cur = nreg[first], target[first]
+        seen.add(reg * pc.size + cur, reg)
+        member_parts.append((reg, cur))
+    _store(pc, store, R, member_parts, settled_parts, wanted)
+
+
+def _store(pc: PlantCodes, store: Regions, R: int, member_parts: list[tuple[np.ndarray, np.ndarray]],
+           settled_parts: list[tuple[np.ndarray, np.ndarray, np.ndarray]], wanted: np.ndarray) -> None:
+    """Group the layers' members and settled states by region (breadth-first order kept)."""
+    mreg = np.concatenate([r for r, _ in member_parts])
+    mcode = np.concatenate([c for _, c in member_parts])
+    order = np.argsort(mreg, kind="stable")
+    sreg = np.concatenate([r for r, _, _ in settled_parts])
+    scode = np.concatenate([c for _, c, _ in settled_parts])
+    sref = np.concatenate([f for _, _, f in settled_parts])
+    sorder = np.argsort(sreg, kind="stable")
+    sreg, scode, sref = sreg[sorder], scode[sorder], sref[sorder]
+    proh = np.zeros(len(scode), dtype=np.int64)
+    for i in np.flatnonzero(sref).tolist():
+        proh[i] = store.proh_id(pc.refusals(int(scode[i]), wanted[sreg[i]]))
+    store.append(mcode[order], np.bincount(mreg, minlength=R), scode, proh, np.bincount(sreg, minlength=R))
