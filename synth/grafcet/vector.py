@@ -23,9 +23,9 @@ Example
 >>> v = VectorMachine(GrafcetMachine(g))
 >>> A, T = v.rows([v.machine.initial({"a": False, "b": False})] * 2)
 >>> I = np.array([[True, False], [True, True]])
->>> A2, T2, pending = v.react(A, T, I, np.array([1, 1]))
->>> [v.situation(a, t).text() for a, t in zip(A2, T2)], pending.tolist()
-(['{X1}', '{X0}'], [False, False])
+>>> A2, T2, moved, pending = v.react(A, T, I, np.array([1, 1]))
+>>> [v.situation(a, t).text() for a, t in zip(A2, T2)], moved.tolist(), pending.tolist()
+(['{X1}', '{X0}'], [True, True], [False, False])
 >>> v.orders(A2, T2, I)[:, v.order_names.index("A")].tolist()
 [True, False]
 """
@@ -173,22 +173,24 @@ class VectorMachine:
         return enabled
 
     def react(self, A: np.ndarray, T: np.ndarray, I: np.ndarray, E: np.ndarray
-              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """The stable situations after the input events ``E`` (inputs ``I`` once they
-        happened) from the rows (A, T); and the rows left to the machine (``pending``:
-        a conflict, or still evolving after :data:`ROUNDS` rounds), whose bits are
-        meaningless."""
-        A, T = A.copy(), T.copy()
+        happened) from the rows (A, T); the rows where a transition fired (``moved``); and
+        the rows left to the machine (``pending``: a conflict, or still evolving after
+        :data:`ROUNDS` rounds), whose bits are meaningless."""
+        A, T, I = np.asfortranarray(A), np.asfortranarray(T), np.asfortranarray(I)
         pending = np.zeros(len(A), dtype=bool)
+        moved = np.zeros(len(A), dtype=bool)
         live = np.arange(len(A))
         ev = E
         for _ in range(ROUNDS):
             if not live.size:
-                return A, T, pending
+                return A, T, moved, pending
             a, t = A[live], T[live]
             fire = self._fireable(a, t, I[live], ev)
-            moving = fire.any(axis=1)
-            live, a, t, fire = live[moving], a[moving], t[moving], fire[moving].astype(np.int32)
+            firing = fire.any(axis=1)
+            live, a, t, fire = live[firing], a[firing], t[firing], fire[firing].astype(np.int32)
+            moved[live] = True
             leaving = fire @ self._src
             conflict = (leaving > 1).any(axis=1)
             pending[live[conflict]] = True
@@ -199,7 +201,7 @@ class VectorMachine:
             live = live[~conflict]
             ev = np.full(len(live), -1)
         pending[live] = True
-        return A, T, pending
+        return A, T, moved, pending
 
     def orders(self, A: np.ndarray, T: np.ndarray, I: np.ndarray) -> np.ndarray:
         """The orders each row emits (columns :attr:`order_names`) on the input levels ``I``."""

@@ -30,7 +30,7 @@ Example
 from __future__ import annotations
 
 import time
-from typing import Callable, Sequence
+from typing import Callable, Sequence, TypeVar
 
 import numpy as np
 
@@ -100,10 +100,11 @@ class _Situations:
     def number(self, A: np.ndarray, T: np.ndarray, given: list[Situation] | None = None) -> np.ndarray:
         """The numbers of the rows' situations (new ones numbered in row order)."""
         packed = np.packbits(np.hstack([A, T]), axis=1)
-        out = np.empty(len(A), dtype=np.int64)
+        _, first, inverse = np.unique(packed, axis=0, return_index=True, return_inverse=True)
+        ids = np.empty(len(first), dtype=np.int64)
         fresh = []
-        for r, key in enumerate(packed):
-            b = key.tobytes()
+        for u, r in enumerate(first.tolist()):
+            b = packed[r].tobytes()
             hit = self._ids.get(b)
             if hit is None:
                 hit = self._ids[b] = len(self.items)
@@ -111,7 +112,8 @@ class _Situations:
                 self.items.append(sit)
                 self.timers.append(self.vm.machine.timers(sit))
                 fresh.append(r)
-            out[r] = hit
+            ids[u] = hit
+        out = ids[inverse.ravel()]
         if fresh:
             self.A = np.vstack([self.A, A[fresh]])
             self.T = np.vstack([self.T, T[fresh]])
@@ -138,6 +140,18 @@ def explore_frontier(
     if not oracle.kept(p.initial):
         return Sync(p, oracle, machine)
     return _Explorer(p, oracle, machine, max_states).run(progress)
+
+
+T_ = TypeVar("T_")
+
+
+def _per_row(bits: np.ndarray, make: Callable[[np.ndarray], T_]) -> list[T_]:
+    """``make`` of each row of ``bits``, called once per distinct row."""
+    if not bits.shape[1]:
+        return [make(np.zeros(0, dtype=bool))] * len(bits)
+    uniq, inverse = np.unique(bits, axis=0, return_inverse=True)
+    made = [make(row) for row in uniq]
+    return [made[i] for i in inverse.ravel().tolist()]
 
 
 def _slices(starts: np.ndarray, groups: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -236,12 +250,12 @@ class _Explorer:
     def make_nodes(self, sid: np.ndarray, q: np.ndarray, proh: np.ndarray) -> None:
         emitted = self.orders(sid, q)
         digits = self.pc.digits(q)
-        set_ = emitted & self.pc.values(self.vm.order_names, digits)
         names = self.vm.order_names
+        wanted = _per_row(emitted, lambda row: frozenset(names[i] for i in np.flatnonzero(row)))
+        set_ = _per_row(emitted & self.pc.values(names, digits), lambda row: tuple(names[i] for i in np.flatnonzero(row)))
         items, prohs = self.sits.items, self.regions.prohibitions
-        for s, local, em, on, pr in zip(sid.tolist(), digits.T.tolist(), emitted, set_, proh.tolist()):
-            self.nodes.append(Node(items[s], tuple(local), frozenset(names[i] for i in np.flatnonzero(em)),
-                                   tuple(names[i] for i in np.flatnonzero(on)), prohs[pr]))
+        self.nodes.extend(Node(items[s], tuple(local), w, o, prohs[pr])
+                          for s, local, w, o, pr in zip(sid.tolist(), digits.full().T.tolist(), wanted, set_, proh.tolist()))
         self.node_sit = np.concatenate([self.node_sit, sid])
         self.node_code = np.concatenate([self.node_code, q])
         if self.max_states is not None and len(self.nodes) > self.max_states:
@@ -279,9 +293,10 @@ class _Explorer:
             raise Unsupported("an event that changes several inputs")
         col = changed.argmax(axis=1)
         E = np.where(count == 1, 2 * col + after[np.arange(len(row)), col], -1)
-        A2, T2, pending = self.vm.react(self.sits.A[sid[row]], self.sits.T[sid[row]], after, E)
-        nsid = np.zeros(len(row), dtype=np.int64)
-        nsid[~pending] = self.sits.number(A2[~pending], T2[~pending])
+        A2, T2, moved, pending = self.vm.react(self.sits.A[sid[row]], self.sits.T[sid[row]], after, E)
+        nsid = sid[row]
+        moved &= ~pending
+        nsid[moved] = self.sits.number(A2[moved], T2[moved])
         events: list[Event] = [self.pc.uncontrollable[k].event for k in rank.tolist()]
         traced: dict[int, Rounds] = {}  # candidate -> rounds fired, where the machine reacted
         items = self.sits.items

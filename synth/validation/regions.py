@@ -25,13 +25,15 @@ Example
 
 from __future__ import annotations
 
+from typing import Iterable
+
 import numpy as np
 
 from synth.plant.composition import LocalTransition, Plant
-from synth.sup.constraints import CompiledConstraints, term_holds
+from synth.sup.constraints import CompiledConstraints
 from synth.validation.sync import Prohibition, moves_by_order
 
-__all__ = ["PlantCodes", "Regions", "regions", "SortedKeys"]
+__all__ = ["Digits", "PlantCodes", "Regions", "regions", "SortedKeys"]
 
 
 class SortedKeys:
@@ -64,31 +66,57 @@ def first_occurrences(keys: np.ndarray) -> np.ndarray:
     return np.sort(first)
 
 
+class Digits:
+    """The element-local indices of an array of plant codes, each element's computed when
+    first read (``digits[axis]``)."""
+
+    def __init__(self, pc: PlantCodes, codes: np.ndarray) -> None:
+        self.codes, self.n = codes, len(codes)
+        self._pc = pc
+        self._axes: dict[int, np.ndarray] = {}
+
+    def __getitem__(self, axis: int) -> np.ndarray:
+        hit = self._axes.get(axis)
+        if hit is None:
+            hit = self._axes[axis] = (self.codes // self._pc.stride[axis]) % self._pc.radix[axis]
+        return hit
+
+    def full(self) -> np.ndarray:
+        """Every element's indices, ndim × n."""
+        return np.array([self[a] for a in range(len(self._pc.stride))]).reshape(len(self._pc.stride), self.n)
+
+
 class PlantCodes:
     """Array reads of a plant's states given as flat codes (see module doc)."""
 
     def __init__(self, p: Plant, oracle: CompiledConstraints) -> None:
         self.plant, self.oracle = p, oracle
         self.size = p.size
-        self.strides = np.array(p.strides, dtype=np.int64)
-        self.shape = np.array(p.shape, dtype=np.int64)
+        self.stride, self.radix = p.strides, p.shape
         self.uncontrollable = [t for t in p.transitions if not t.controllable]
         self.moves = moves_by_order(p)
         self.orders = sorted(self.moves)  # the region's order of the orders
         self._reach = [g.ravel() for g in oracle.reach_grids] if oracle.reach_grids is not None else None
 
-    def digits(self, codes: np.ndarray) -> np.ndarray:
-        """Element-local indices, ndim × n."""
-        return (codes[None, :] // self.strides[:, None]) % self.shape[:, None]
+    def digits(self, codes: np.ndarray) -> Digits:
+        return Digits(self, codes)
 
-    def values(self, names: tuple[str, ...] | list[str], digits: np.ndarray) -> np.ndarray:
+    def values(self, names: tuple[str, ...] | list[str], digits: Digits) -> np.ndarray:
         """The plant variables ``names`` at each state (n × len(names)); False for a name
         the plant does not have."""
-        out = np.zeros((digits.shape[1], len(names)), dtype=bool)
+        out = np.zeros((digits.n, len(names)), dtype=bool)
         for j, n in enumerate(names):
             axis = self.plant.owner.get(n)
             if axis is not None:
                 out[:, j] = self.plant.elements[axis].value(n)[digits[axis]]
+        return out
+
+    @staticmethod
+    def holds(factors: Iterable[tuple[int, np.ndarray]], digits: Digits, rows: np.ndarray | None = None) -> np.ndarray:
+        """Whether a product term holds at each state (of ``rows`` only, when given)."""
+        out = np.ones(digits.n if rows is None else len(rows), dtype=bool)
+        for a, vec in factors:
+            out &= vec[digits[a] if rows is None else digits[a][rows]]
         return out
 
     def kept(self, codes: np.ndarray) -> np.ndarray:
@@ -100,14 +128,14 @@ class PlantCodes:
             return ~bad
         digits = self.digits(codes)
         for factors in self.oracle.level_reach:
-            bad |= term_holds(factors, digits)
+            bad |= self.holds(factors, digits)
         return ~bad
 
-    def forbidden(self, t: LocalTransition, digits: np.ndarray) -> np.ndarray:
-        """Where an edge constraint forbids the controllable ``t``."""
-        out = np.zeros(digits.shape[1], dtype=bool)
+    def forbidden(self, t: LocalTransition, digits: Digits, rows: np.ndarray) -> np.ndarray:
+        """Where an edge constraint forbids the controllable ``t``, at ``rows``."""
+        out = np.zeros(len(rows), dtype=bool)
         for term in self.oracle.edge_terms.get(t.event, ()):
-            out |= term_holds(term.factors, digits)
+            out |= self.holds(term.factors, digits, rows)
         return out
 
     def successors(self, codes: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -118,19 +146,20 @@ class PlantCodes:
         for k, t in enumerate(self.uncontrollable):
             ok = digits[t.axis] == t.src
             if t.guard is not None:
-                ok &= self.plant.enabled_digits(t, digits)
+                ok &= self.plant.enabled_digits(t, digits.full())
             r = np.flatnonzero(ok)
             if r.size:
                 rows.append(r)
                 ranks.append(np.full(r.size, k))
-                targets.append(codes[r] + (t.dst - t.src) * int(self.strides[t.axis]))
+                targets.append(codes[r] + (t.dst - t.src) * self.stride[t.axis])
         if not rows:
             empty = np.empty(0, dtype=np.int64)
             return empty, empty, empty
         row, rank, target = np.concatenate(rows), np.concatenate(ranks), np.concatenate(targets)
         keep = self.kept(target)  # cannot fail from a SUP state; kept for safety, as the machine's path
-        order = np.lexsort((rank[keep], row[keep]))
-        return row[keep][order], rank[keep][order], target[keep][order]
+        row, rank, target = row[keep], rank[keep], target[keep]
+        order = np.lexsort((rank, row))
+        return row[order], rank[order], target[order]
 
     def refusals(self, code: int, wanted: np.ndarray) -> tuple[Prohibition, ...]:
         """The order changes SUP refuses in state ``code`` towards ``wanted`` (one bit per
@@ -207,8 +236,8 @@ def regions(pc: PlantCodes, store: Regions, entries: np.ndarray, wanted: np.ndar
                 rank += 1
                 if not app.size:
                     continue
-                target = cur[app] + (t.dst - t.src) * int(pc.strides[t.axis])
-                ok = pc.kept(target) & ~pc.forbidden(t, digits[:, app])
+                target = cur[app] + (t.dst - t.src) * pc.stride[t.axis]
+                ok = pc.kept(target) & ~pc.forbidden(t, digits, app)
                 refused[app[~ok]] = True
                 progressed[app[ok]] = True
                 rows.append(app[ok])
