@@ -74,6 +74,7 @@ class Digits:
         self.codes, self.n = codes, len(codes)
         self._pc = pc
         self._axes: dict[int, np.ndarray] = {}
+        self._full: np.ndarray | None = None
 
     def __getitem__(self, axis: int) -> np.ndarray:
         hit = self._axes.get(axis)
@@ -83,7 +84,23 @@ class Digits:
 
     def full(self) -> np.ndarray:
         """Every element's indices, ndim × n."""
-        return np.array([self[a] for a in range(len(self._pc.stride))]).reshape(len(self._pc.stride), self.n)
+        if self._full is None:
+            self._full = (self.codes[None, :] // self._pc.strides[:, None]) % self._pc.shape[:, None]
+            self._axes = dict(enumerate(self._full))
+        return self._full
+
+
+class _Moves:
+    """Local transitions as columns: element, source, code difference, order column."""
+
+    def __init__(self, moves: list[LocalTransition], strides: tuple[int, ...], column: list[int]) -> None:
+        self.moves = moves
+        self.axis = np.array([t.axis for t in moves], dtype=np.int64)
+        self.src = np.array([t.src for t in moves], dtype=np.int64)
+        self.delta = np.array([(t.dst - t.src) * strides[t.axis] for t in moves], dtype=np.int64)
+        self.column = np.array(column, dtype=np.int64)
+        self.guarded = [k for k, t in enumerate(moves) if t.guard is not None]
+        self.forbidding: list[int] = []  # moves an edge constraint may forbid
 
 
 class PlantCodes:
@@ -93,9 +110,15 @@ class PlantCodes:
         self.plant, self.oracle = p, oracle
         self.size = p.size
         self.stride, self.radix = p.strides, p.shape
+        self.strides, self.shape = np.array(p.strides, dtype=np.int64), np.array(p.shape, dtype=np.int64)
         self.uncontrollable = [t for t in p.transitions if not t.controllable]
         self.moves = moves_by_order(p)
         self.orders = sorted(self.moves)  # the region's order of the orders
+        self._u = _Moves(self.uncontrollable, p.strides, [0] * len(self.uncontrollable))
+        controllable = [t for o in self.orders for t in self.moves[o]]
+        self._c = _Moves(controllable, p.strides, [j for j, o in enumerate(self.orders) for _ in self.moves[o]])
+        self._c.forbidding = [k for k, t in enumerate(controllable) if oracle.edge_terms.get(t.event)]
+        self.controllable_moves = self._c
         self._reach = [g.ravel() for g in oracle.reach_grids] if oracle.reach_grids is not None else None
 
     def digits(self, codes: np.ndarray) -> Digits:
@@ -142,24 +165,14 @@ class PlantCodes:
         """The uncontrollable moves from ``codes`` into SUP: (row, move rank, target code),
         sorted by row then rank (the explicit engine's order)."""
         digits = self.digits(codes)
-        rows, ranks, targets = [], [], []
-        for k, t in enumerate(self.uncontrollable):
-            ok = digits[t.axis] == t.src
-            if t.guard is not None:
-                ok &= self.plant.enabled_digits(t, digits.full())
-            r = np.flatnonzero(ok)
-            if r.size:
-                rows.append(r)
-                ranks.append(np.full(r.size, k))
-                targets.append(codes[r] + (t.dst - t.src) * self.stride[t.axis])
-        if not rows:
-            empty = np.empty(0, dtype=np.int64)
-            return empty, empty, empty
-        row, rank, target = np.concatenate(rows), np.concatenate(ranks), np.concatenate(targets)
+        u = self._u
+        ok = digits.full()[u.axis, :].T == u.src
+        for k in u.guarded:
+            ok[:, k] &= self.plant.enabled_digits(self.uncontrollable[k], digits.full())
+        row, rank = np.nonzero(ok)  # row-major: by row, then rank
+        target = codes[row] + u.delta[rank]
         keep = self.kept(target)  # cannot fail from a SUP state; kept for safety, as the machine's path
-        row, rank, target = row[keep], rank[keep], target[keep]
-        order = np.lexsort((rank, row))
-        return row[order], rank[order], target[order]
+        return row[keep], rank[keep], target[keep]
 
     def refusals(self, code: int, wanted: np.ndarray) -> tuple[Prohibition, ...]:
         """The order changes SUP refuses in state ``code`` towards ``wanted`` (one bit per
@@ -225,31 +238,24 @@ def regions(pc: PlantCodes, store: Regions, entries: np.ndarray, wanted: np.ndar
     while cur.size:
         digits = pc.digits(cur)
         values = pc.values(pc.orders, digits)
-        progressed = np.zeros(cur.size, dtype=bool)
+        c = pc.controllable_moves
+        app = (values != wanted[reg])[:, c.column] & (digits.full()[c.axis, :].T == c.src)
+        row, rank = np.nonzero(app)  # row-major: by row, then the region's order of the moves
+        target = cur[row] + c.delta[rank]
+        ok = pc.kept(target)
+        for k in c.forbidding:
+            at = np.flatnonzero(rank == k)
+            if at.size:
+                ok[at] &= ~pc.forbidden(c.moves[k], digits, row[at])
         refused = np.zeros(cur.size, dtype=bool)
-        rows, ranks, targets = [], [], []
-        rank = 0
-        for j, order in enumerate(pc.orders):
-            active = values[:, j] != wanted[reg, j]
-            for t in pc.moves[order]:
-                app = np.flatnonzero(active & (digits[t.axis] == t.src))
-                rank += 1
-                if not app.size:
-                    continue
-                target = cur[app] + (t.dst - t.src) * pc.stride[t.axis]
-                ok = pc.kept(target) & ~pc.forbidden(t, digits, app)
-                refused[app[~ok]] = True
-                progressed[app[ok]] = True
-                rows.append(app[ok])
-                ranks.append(np.full(int(ok.sum()), rank))
-                targets.append(target[ok])
+        refused[row[~ok]] = True
+        progressed = np.zeros(cur.size, dtype=bool)
+        progressed[row[ok]] = True
         still = ~progressed
         settled_parts.append((reg[still], cur[still], refused[still]))
-        if not rows:
+        if not ok.any():
             break
-        row, rnk, target = np.concatenate(rows), np.concatenate(ranks), np.concatenate(targets)
-        order = np.lexsort((rnk, row))
-        nreg, target = reg[row[order]], target[order]
+        nreg, target = reg[row[ok]], target[ok]
         keys = nreg * pc.size + target
         first = first_occurrences(keys)
         first = first[seen.find(keys[first]) < 0]

@@ -40,9 +40,13 @@ from synth.plant.rules import Constraint
 from synth.sup.constraints import CompiledConstraints
 from synth.validation.conflicts import Conflict, ConflictLog
 
-__all__ = ["Prohibition", "Node", "Edge", "Sync", "synchronous_product", "region", "grafcet_inputs", "moves_by_order"]
+__all__ = ["Wide", "Prohibition", "Node", "Edge", "Sync", "synchronous_product", "region", "grafcet_inputs", "moves_by_order"]
 
 Local = tuple[int, ...]
+
+
+class Wide(Exception):
+    """The search's queue grew past the ``wide`` asked of :func:`synchronous_product`."""
 
 
 @dataclass(frozen=True, order=True)
@@ -190,8 +194,11 @@ def synchronous_product(
     *,
     max_states: int | None = None,
     progress: Callable[[int, int], None] | None = None,
+    wide: int | None = None,
 ) -> Sync:
-    """Explore SYNC from (initial plant state, initial situation), aggregated per region."""
+    """Explore SYNC from (initial plant state, initial situation), aggregated per region,
+    state by state; :class:`Wide` once more than ``wide`` states wait in the queue (the
+    frontier path, :mod:`synth.validation.frontier`, is then the faster)."""
     oracle = CompiledConstraints(p, constraints)
     nodes: list[Node] = []
     edges: list[Edge] = []
@@ -302,6 +309,8 @@ def synchronous_product(
         while queue:
             i = queue.popleft()
             expand(i)
+            if wide is not None and len(queue) > wide:
+                raise Wide()
             if progress is not None and time.monotonic() - last > 0.5:
                 progress(len(nodes), len(queue))
                 last = time.monotonic()
