@@ -42,7 +42,8 @@ from synth.plant.composition import Plant
 from synth.plant.rules import Constraint
 from synth.sup.constraints import CompiledConstraints
 from synth.validation.conflicts import Conflict, ConflictLog
-from synth.validation.regions import PlantCodes, Regions, SortedKeys, first_occurrences, regions
+from synth.validation.keys import SortedKeys, distinct, distinct_rows, first_occurrences
+from synth.validation.regions import PlantCodes, Regions, regions
 from synth.validation.sync import Edge, Node, Sync, Wide, synchronous_product
 
 __all__ = ["explore", "reason", "explore_frontier", "Unsupported", "WIDE"]
@@ -110,8 +111,9 @@ class _Situations:
 
     def number(self, A: np.ndarray, T: np.ndarray, given: list[Situation] | None = None) -> np.ndarray:
         """The numbers of the rows' situations (new ones numbered in row order)."""
-        packed = np.packbits(np.hstack([A, T]), axis=1)
-        _, first, inverse = np.unique(packed, axis=0, return_index=True, return_inverse=True)
+        bits = np.hstack([A, T])
+        first, inverse = distinct_rows(bits)
+        packed = np.packbits(bits, axis=1)
         ids = np.empty(len(first), dtype=np.int64)
         fresh = []
         for u, r in enumerate(first.tolist()):
@@ -124,7 +126,7 @@ class _Situations:
                 self.timers.append(self.vm.machine.timers(sit))
                 fresh.append(r)
             ids[u] = hit
-        out = ids[inverse.ravel()]
+        out = ids[inverse]
         if fresh:
             self.A = np.vstack([self.A, A[fresh]])
             self.T = np.vstack([self.T, T[fresh]])
@@ -163,9 +165,9 @@ def _per_row(bits: np.ndarray, make: Callable[[np.ndarray], T_]) -> list[T_]:
     """``make`` of each row of ``bits``, called once per distinct row."""
     if not bits.shape[1]:
         return [make(np.zeros(0, dtype=bool))] * len(bits)
-    uniq, inverse = np.unique(bits, axis=0, return_inverse=True)
-    made = [make(row) for row in uniq]
-    return [made[i] for i in inverse.ravel().tolist()]
+    first, inverse = distinct_rows(bits)
+    made = [make(bits[r]) for r in first.tolist()]
+    return [made[i] for i in inverse.tolist()]
 
 
 def _slices(starts: np.ndarray, groups: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -291,7 +293,7 @@ class _Explorer:
             if progress is not None and time.monotonic() - last > 0.5:
                 progress(len(self.nodes), len(self.nodes) - lo)
                 last = time.monotonic()
-        states = int(np.unique(np.concatenate(self.pairs)).size) if self.pairs else 0
+        states = len(distinct(np.concatenate(self.pairs))[0]) if self.pairs else 0
         return Sync(self.p, self.oracle, self.machine, tuple(self.nodes), tuple(self.edges), initial,
                     tuple(self.conflicts), states)
 

@@ -31,39 +31,10 @@ import numpy as np
 
 from synth.plant.composition import LocalTransition, Plant
 from synth.sup.constraints import CompiledConstraints
+from synth.validation.keys import SortedKeys, first_occurrences
 from synth.validation.sync import Prohibition, moves_by_order
 
-__all__ = ["Digits", "PlantCodes", "Regions", "regions", "SortedKeys"]
-
-
-class SortedKeys:
-    """Integer keys kept sorted, each with an integer value: a lookup table without a
-    dictionary entry per key (insertions are merges of sorted arrays)."""
-
-    def __init__(self) -> None:
-        self.keys = np.empty(0, dtype=np.int64)
-        self.values = np.empty(0, dtype=np.int64)
-
-    def find(self, keys: np.ndarray) -> np.ndarray:
-        """The value of each key, -1 where absent."""
-        if not self.keys.size:
-            return np.full(len(keys), -1, dtype=np.int64)
-        pos = np.minimum(np.searchsorted(self.keys, keys), self.keys.size - 1)
-        return np.where(self.keys[pos] == keys, self.values[pos], -1)
-
-    def add(self, keys: np.ndarray, values: np.ndarray) -> None:
-        """Insert absent, distinct ``keys``."""
-        order = np.argsort(keys, kind="stable")
-        keys, values = keys[order], values[order]
-        pos = np.searchsorted(self.keys, keys)
-        self.keys = np.insert(self.keys, pos, keys)
-        self.values = np.insert(self.values, pos, values)
-
-
-def first_occurrences(keys: np.ndarray) -> np.ndarray:
-    """Positions of the first occurrence of each distinct key, in the order they occur."""
-    _, first = np.unique(keys, return_index=True)
-    return np.sort(first)
+__all__ = ["Digits", "PlantCodes", "Regions", "regions"]
 
 
 class Digits:
