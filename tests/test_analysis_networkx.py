@@ -145,3 +145,31 @@ def test_the_random_graphs_are_not_trivial() -> None:
         held_proh += any(sync.nodes[i].proh for i in a.held)
         unreachable += len(_distances(_graph(sync), sync.initial)) < len(sync.nodes)
     assert min(blocking, held_proh, unreachable) > 10
+
+
+def _queue_shortest_paths(sync: Sync) -> tuple[dict[int, int], dict[int, tuple[int, str]]]:
+    """The breadth-first search one node at a time (the engine's before the layers)."""
+    from collections import deque
+
+    dist = {i: 0 for i in sync.initial}
+    parent: dict[int, tuple[int, str]] = {}
+    queue = deque(sync.initial)
+    while queue:
+        i = queue.popleft()
+        for e in sorted(sync.successors(i), key=lambda e: (e.event, e.target)):
+            if e.target not in dist:
+                dist[e.target] = dist[i] + 1
+                parent[e.target] = (i, e.event)
+                queue.append(e.target)
+    return dist, parent
+
+
+@pytest.mark.parametrize("seed", SEEDS)
+def test_shortest_paths_parents_as_the_queue_finds_them(seed: int) -> None:
+    sync = _random_sync(seed)
+    edges = list(sync.edges)
+    random.Random(seed).shuffle(edges)  # the engine's edges are in exploration order, not by event
+    sync = Sync(None, None, None, sync.nodes, tuple(edges), sync.initial)  # type: ignore[arg-type]
+    dist, parent = shortest_paths(sync)
+    ref_dist, ref_parent = _queue_shortest_paths(sync)
+    assert list(dist.items()) == list(ref_dist.items()) and list(parent.items()) == list(ref_parent.items())

@@ -22,10 +22,12 @@ Example
 
 from __future__ import annotations
 
-from collections import deque
 from dataclasses import dataclass
 from typing import Iterable
 
+import numpy as np
+
+from synth.validation.keys import first_occurrences
 from synth.validation.sync import Sync
 
 __all__ = ["Trace", "Analysis", "analyse", "coreachable", "held_nodes", "shortest_paths", "strongly_connected_components"]
@@ -54,31 +56,61 @@ class Analysis:
     never_starts: bool = False  # no reachable situation has other active steps than the initial one
 
 
+def _csr(keys: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Edge positions grouped by ``keys`` and each key's first position in them."""
+    order = np.argsort(keys)
+    return order, np.searchsorted(keys[order], np.arange(n + 1))
+
+
+def _slices(starts: np.ndarray, groups: np.ndarray) -> np.ndarray:
+    """The positions ``starts[g]:starts[g + 1]`` of each group, concatenated in order."""
+    counts = starts[groups + 1] - starts[groups]
+    return np.repeat(starts[groups] - np.cumsum(counts) + counts, counts) + np.arange(int(counts.sum()))
+
+
 def coreachable(sync: Sync, targets: set[int]) -> set[int]:
-    """Nodes from which some node of ``targets`` is reachable (targets included)."""
-    seen = set(targets)
-    queue = deque(sorted(targets))
-    while queue:
-        i = queue.popleft()
-        for e in sync.predecessors(i):
-            if e.source not in seen:
-                seen.add(e.source)
-                queue.append(e.source)
-    return seen
+    """Nodes from which some node of ``targets`` is reachable (targets included): breadth
+    first backwards, a whole layer of predecessors at a time."""
+    src, dst = sync.edge_arrays()
+    n = len(sync.nodes)
+    seen = np.zeros(n, dtype=bool)
+    layer = np.array(sorted(targets), dtype=np.int64)
+    seen[layer] = True
+    into, starts = _csr(dst, n)
+    while layer.size:
+        prev = src[into[_slices(starts, layer)]]
+        prev = prev[~seen[prev]]
+        seen[prev] = True
+        layer = np.flatnonzero(np.bincount(prev, minlength=n)) if prev.size else prev
+    return set(np.flatnonzero(seen).tolist())
 
 
 def shortest_paths(sync: Sync) -> tuple[dict[int, int], dict[int, tuple[int, str]]]:
-    """Breadth-first distances from the initial nodes and parents (deterministic: events sorted)."""
-    dist = {i: 0 for i in sync.initial}
-    parent: dict[int, tuple[int, str]] = {}
-    queue = deque(sync.initial)
-    while queue:
-        i = queue.popleft()
-        for e in sorted(sync.successors(i), key=lambda e: (e.event, e.target)):
-            if e.target not in dist:
-                dist[e.target] = dist[i] + 1
-                parent[e.target] = (i, e.event)
-                queue.append(e.target)
+    """Breadth-first distances from the initial nodes and parents (deterministic: each
+    node's edges taken by event, then target; a whole layer at a time, in queue order)."""
+    src, dst = sync.edge_arrays()
+    n = len(sync.nodes)
+    events = [e.event for e in sync.edges]
+    rank = {ev: r for r, ev in enumerate(sorted(set(events)))}
+    event = np.fromiter(map(rank.__getitem__, events), dtype=np.int64, count=len(events))
+    order = np.lexsort((dst, event, src))  # each node's edges by (event, target)
+    starts = np.searchsorted(src[order], np.arange(n + 1))
+    known = np.zeros(n, dtype=bool)
+    layer = np.array(list(dict.fromkeys(sync.initial)), dtype=np.int64)
+    known[layer] = True
+    found, via = [layer], [np.full(len(layer), -1, dtype=np.int64)]
+    while layer.size:
+        out = order[_slices(starts, layer)]  # the layer's edges, in queue order
+        out = out[~known[dst[out]]]
+        out = out[first_occurrences(dst[out])]  # the first edge into each new node, in discovery order
+        layer = dst[out]
+        known[layer] = True
+        found.append(layer)
+        via.append(out)
+    depth = np.repeat(np.arange(len(found)), [len(f) for f in found]).tolist()
+    dist = dict(zip(np.concatenate(found).tolist(), depth))
+    edges = np.concatenate(via[1:]) if len(via) > 1 else np.empty(0, dtype=np.int64)
+    parent = {t: (f, events[e]) for t, f, e in zip(dst[edges].tolist(), src[edges].tolist(), edges.tolist())}
     return dist, parent
 
 
@@ -144,7 +176,10 @@ def held_nodes(sync: Sync) -> set[int]:
     and the operator do, the Grafcet stays in these steps for ever.
 
     A node can change steps iff it reaches a node with an edge to other steps."""
-    changers = {e.source for e in sync.edges if sync.nodes[e.source].situation.steps != sync.nodes[e.target].situation.steps}
+    src, dst = sync.edge_arrays()
+    ids: dict[tuple[str, ...], int] = {}
+    steps = np.array([ids.setdefault(n.situation.steps, len(ids)) for n in sync.nodes], dtype=np.int64)
+    changers = set(src[steps[src] != steps[dst]].tolist()) if src.size else set()
     movable = coreachable(sync, changers)
     return {i for i in range(len(sync.nodes)) if i not in movable}
 
@@ -191,7 +226,7 @@ def analyse(sync: Sync, homes: Iterable[int] | None = None) -> Analysis:
     never_starts = bool(sync.initial) and all(n.situation.steps == first_steps for n in sync.nodes)
     seen: set[tuple[tuple[str, ...], str]] = set()
     prohibited: list[int] = []
-    for i in sorted(dist, key=lambda i: (dist[i], i)):
+    for i in sorted((i for i in dist if sync.nodes[i].proh), key=lambda i: (dist[i], i)):  # the others add nothing
         n = sync.nodes[i]
         for p in n.proh:
             key = (n.situation.steps, p.event)

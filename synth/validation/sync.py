@@ -30,6 +30,8 @@ from collections import deque
 from dataclasses import dataclass, field
 from typing import Callable, Sequence
 
+import numpy as np
+
 from synth.errors import LimitExceeded
 from synth.grafcet.language import Transition
 from synth.grafcet.machine import GrafcetMachine, Situation
@@ -96,6 +98,7 @@ class Sync:
     sync_states: int = 0  # SYNC states (all region members)
     _out: tuple[list[Edge], ...] = field(init=False, repr=False, compare=False)
     _in: tuple[list[Edge], ...] = field(init=False, repr=False, compare=False)
+    _arrays: list[np.ndarray] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         out: tuple[list[Edge], ...] = tuple([] for _ in self.nodes)
@@ -105,6 +108,15 @@ class Sync:
             into[e.target].append(e)
         object.__setattr__(self, "_out", out)
         object.__setattr__(self, "_in", into)
+        object.__setattr__(self, "_arrays", [])
+
+    def edge_arrays(self) -> tuple[np.ndarray, np.ndarray]:
+        """The edges' sources and targets as integer arrays (made on the first call)."""
+        if not self._arrays:
+            count = len(self.edges)
+            self._arrays.append(np.fromiter((e.source for e in self.edges), dtype=np.int64, count=count))
+            self._arrays.append(np.fromiter((e.target for e in self.edges), dtype=np.int64, count=count))
+        return self._arrays[0], self._arrays[1]
 
     def successors(self, i: int) -> list[Edge]:
         return self._out[i]
