@@ -222,8 +222,10 @@ class _Explorer:
             for j, c in enumerate(self._order_cols):
                 if c >= 0:
                     wanted[:, j] = emitted[:, c]
-            wid = np.array([self._wanted.setdefault(w.tobytes(), len(self._wanted))
-                            for w in np.packbits(wanted, axis=1)], dtype=np.int64)
+            rows, inverse = distinct_rows(wanted)
+            packed = np.packbits(wanted[rows], axis=1)
+            wid = np.array([self._wanted.setdefault(w.tobytes(), len(self._wanted)) for w in packed],
+                           dtype=np.int64)[inverse]
             if len(self._wanted) * self.P >= 1 << 62:
                 raise Unsupported("region keys past 64 bits")
             wkeys = wid * self.P + entry[first]
