@@ -110,7 +110,7 @@ class VectorMachine:
         for j, t in enumerate(trans):
             self._src[j, [self._step[s] for s in t.sources]] = 1
             self._dst[j, [self._step[s] for s in t.targets]] = 1
-        self._nsrc = self._src.sum(axis=1)
+        self._sources = [[self._step[s] for s in t.sources] for t in trans]
         self._timers_of = np.zeros((len(self.step_names), len(self.timer_names)), dtype=bool)
         for t in g.timers:
             self._timers_of[self._step[t.step], self._timer[t.id]] = True
@@ -164,13 +164,21 @@ class VectorMachine:
 
     # ------------------------------------------------------------------ evolution
     def _fireable(self, A: np.ndarray, T: np.ndarray, I: np.ndarray, E: np.ndarray) -> np.ndarray:
-        enabled = (A.astype(np.int32) @ self._src.T) == self._nsrc
-        Z = np.zeros(len(A), dtype=bool)
+        A, T, I = np.asfortranarray(A), np.asfortranarray(T), np.asfortranarray(I)
+        n = len(A)
+        Z = np.zeros(n, dtype=bool)
+        out = np.zeros((n, len(self._rec)), dtype=bool, order="F")
         for j, rec in enumerate(self._rec):
-            col = enabled[:, j]
+            sources = self._sources[j]
+            if sources:
+                col = A[:, sources[0]].copy()
+                for s in sources[1:]:
+                    col &= A[:, s]
+            else:
+                col = ~Z
             if col.any():
-                enabled[:, j] = col & rec(I, A, T, E, Z)
-        return enabled
+                out[:, j] = col & rec(I, A, T, E, Z)
+        return out
 
     def react(self, A: np.ndarray, T: np.ndarray, I: np.ndarray, E: np.ndarray
               ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -178,7 +186,7 @@ class VectorMachine:
         happened) from the rows (A, T); the rows where a transition fired (``moved``); and
         the rows left to the machine (``pending``: a conflict, or still evolving after
         :data:`ROUNDS` rounds), whose bits are meaningless."""
-        A, T, I = np.asfortranarray(A), np.asfortranarray(T), np.asfortranarray(I)
+        A, T = A.copy(), T.copy()
         pending = np.zeros(len(A), dtype=bool)
         moved = np.zeros(len(A), dtype=bool)
         live = np.arange(len(A))
