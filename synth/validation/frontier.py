@@ -51,11 +51,12 @@ __all__ = ["explore", "reason", "explore_frontier", "Unsupported", "WIDE"]
 Rounds = tuple[tuple, ...]
 
 
-WIDE = 16
+WIDE = 32
 """The machine's path explores SYNC alone until more than this many states wait in its
 queue: below, a frontier's numpy passes cost more than the states they carry (measured:
-a pass over a frontier of one or two states costs about 3 ms, the machine 0.2-0.6 ms a
-state)."""
+the four-cylinder station, at most 24 to 32 states waiting, 0.10 s by the machine and
+0.12-0.14 s by frontiers; par_4 and steep_4 pass 32 within their first 30 states and the
+frontiers then take half and a fifth of the machine's time)."""
 
 
 class Unsupported(Exception):
