@@ -112,8 +112,8 @@ class VectorMachine:
             self._dst[j, [self._step[s] for s in t.targets]] = 1
         self._sources = [[self._step[s] for s in t.sources] for t in trans]
         self._timers_of = np.zeros((len(self.step_names), len(self.timer_names)), dtype=bool)
-        for t in g.timers:
-            self._timers_of[self._step[t.step], self._timer[t.id]] = True
+        for timer in g.timers:
+            self._timers_of[self._step[timer.step], self._timer[timer.id]] = True
         self._rec = [self._compile(t.receptivity) for t in trans]
         orders: dict[str, None] = {}
         self._actions: list[tuple[int, str, Columns | None]] = []
