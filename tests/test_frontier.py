@@ -54,6 +54,9 @@ def _both(monkeypatch, g7: Path, rules: Path, homes=(), expert: bool = False) ->
     sa, sb = a.sync, b.sync
     assert (sa.nodes, sa.edges, sa.initial, sa.conflicts, sa.sync_states) == (
         sb.nodes, sb.edges, sb.initial, sb.conflicts, sb.sync_states)
+    assert [(sa.successors(i), sa.predecessors(i)) for i in range(len(sa.nodes))] == [
+        (sb.successors(i), sb.predecessors(i)) for i in range(len(sb.nodes))]
+    assert [x.tolist() for x in sa.edge_arrays()] == [x.tolist() for x in sb.edge_arrays()]
     assert validation_text(a) == validation_text(b)
     assert json.dumps(validation_json(a), ensure_ascii=False) == json.dumps(validation_json(b), ensure_ascii=False)
     assert a.stats == b.stats and a.passed == b.passed

@@ -195,6 +195,8 @@ class _Explorer:
         self.node_sit = np.empty(0, dtype=np.int64)
         self.node_code = np.empty(0, dtype=np.int64)
         self.edges: list[Edge] = []
+        self.sources: list[np.ndarray] = []  # the edges' sources and targets, batch by batch
+        self.targets: list[np.ndarray] = []
         self.conflicts: list[Conflict] = []
         self.log = ConflictLog()
         self.pairs: list[np.ndarray] = []  # (situation, member) keys of the regions entered
@@ -297,8 +299,9 @@ class _Explorer:
                 progress(len(self.nodes), len(self.nodes) - lo)
                 last = time.monotonic()
         states = len(distinct(np.concatenate(self.pairs))[0]) if self.pairs else 0
+        arrays = (np.concatenate(self.sources), np.concatenate(self.targets)) if self.sources else None
         return Sync(self.p, self.oracle, self.machine, tuple(self.nodes), tuple(self.edges), initial,
-                    tuple(self.conflicts), states)
+                    tuple(self.conflicts), states, arrays)
 
     def expand(self, lo: int, hi: int) -> None:
         """Every event from the nodes ``lo:hi``, in the machine's path's order."""
@@ -345,8 +348,9 @@ class _Explorer:
         row, entry, nsid = row[order], entry[order], nsid[order]
         events = [events[c] for c in order.tolist()]
         node, src = self.enter(nsid, entry)
-        source = (lo + row[src]).tolist()
-        self.edges.extend(Edge(a, events[c], b) for a, c, b in zip(source, src.tolist(), node.tolist()))
+        self.sources.append(lo + row[src])
+        self.targets.append(node)
+        self.edges.extend(map(Edge, self.sources[-1].tolist(), [events[c] for c in src.tolist()], node.tolist()))
 
     def has_timers(self) -> np.ndarray:
         return np.array([bool(t) for t in self.sits.timers], dtype=bool)

@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import time
 from collections import deque
-from dataclasses import dataclass, field
+from dataclasses import InitVar, dataclass, field
 from typing import Callable, Sequence
 
 import numpy as np
@@ -99,16 +99,26 @@ class Sync:
     _out: tuple[list[Edge], ...] = field(init=False, repr=False, compare=False)
     _in: tuple[list[Edge], ...] = field(init=False, repr=False, compare=False)
     _arrays: list[np.ndarray] = field(init=False, repr=False, compare=False)
+    # the edges' sources and targets as arrays, when the explorer has them (the indexes are
+    # then made by slicing, the edges grouped by source and target by sorting)
+    arrays: InitVar[tuple[np.ndarray, np.ndarray] | None] = None
 
-    def __post_init__(self) -> None:
-        out: tuple[list[Edge], ...] = tuple([] for _ in self.nodes)
-        into: tuple[list[Edge], ...] = tuple([] for _ in self.nodes)
-        for e in self.edges:
-            out[e.source].append(e)
-            into[e.target].append(e)
+    def __post_init__(self, arrays: tuple[np.ndarray, np.ndarray] | None) -> None:
+        n = len(self.nodes)
+        if arrays is None:
+            out: tuple[list[Edge], ...] = tuple([] for _ in self.nodes)
+            into: tuple[list[Edge], ...] = tuple([] for _ in self.nodes)
+            for e in self.edges:
+                out[e.source].append(e)
+                into[e.target].append(e)
+        else:
+            src, dst = arrays
+            out = _grouped(list(self.edges), src, np.arange(len(src)), n)
+            by_target = np.argsort(dst, kind="stable")
+            into = _grouped([self.edges[k] for k in by_target.tolist()], dst[by_target], by_target, n)
         object.__setattr__(self, "_out", out)
         object.__setattr__(self, "_in", into)
-        object.__setattr__(self, "_arrays", [])
+        object.__setattr__(self, "_arrays", [] if arrays is None else list(arrays))
 
     def edge_arrays(self) -> tuple[np.ndarray, np.ndarray]:
         """The edges' sources and targets as integer arrays (made on the first call)."""
@@ -130,6 +140,14 @@ class Sync:
 
     def vectors(self, i: int) -> tuple[str, str]:
         return self.plant.vectors(self.nodes[i].plant)
+
+
+def _grouped(edges: list[Edge], keys: np.ndarray, order: np.ndarray, n: int) -> tuple[list[Edge], ...]:
+    """``edges`` (sorted by ``keys``, stably) cut into one list per node."""
+    if keys.size and (np.diff(keys) < 0).any():
+        raise ValueError("edges not grouped by source")
+    cuts = np.searchsorted(keys, np.arange(n + 1)).tolist()
+    return tuple(edges[a:b] for a, b in zip(cuts, cuts[1:]))
 
 
 def grafcet_inputs(p: Plant, machine: GrafcetMachine, local: Local) -> dict[str, bool]:
