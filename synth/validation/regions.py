@@ -84,7 +84,9 @@ class PlantCodes:
         self.strides, self.shape = np.array(p.strides, dtype=np.int64), np.array(p.shape, dtype=np.int64)
         self.uncontrollable = [t for t in p.transitions if not t.controllable]
         self.moves = moves_by_order(p)
-        self.orders = sorted(self.moves)  # the region's order of the orders
+        self.orders = tuple(sorted(self.moves))  # the region's order of the orders
+        self._values: dict[tuple[str, ...], list[tuple[int, np.ndarray, np.ndarray]]] = {}
+        self._guards: dict[int, tuple[list[tuple[int, np.ndarray]], np.ndarray]] = {}
         self._u = _Moves(self.uncontrollable, p.strides, [0] * len(self.uncontrollable))
         controllable = [t for o in self.orders for t in self.moves[o]]
         self._c = _Moves(controllable, p.strides, [j for j, o in enumerate(self.orders) for _ in self.moves[o]])
@@ -95,15 +97,26 @@ class PlantCodes:
     def digits(self, codes: np.ndarray) -> Digits:
         return Digits(self, codes)
 
-    def values(self, names: tuple[str, ...] | list[str], digits: Digits) -> np.ndarray:
+    def values(self, names: tuple[str, ...], digits: Digits) -> np.ndarray:
         """The plant variables ``names`` at each state (n × len(names)); False for a name
         the plant does not have."""
         out = np.zeros((digits.n, len(names)), dtype=bool)
-        for j, n in enumerate(names):
-            axis = self.plant.owner.get(n)
-            if axis is not None:
-                out[:, j] = self.plant.elements[axis].value(n)[digits[axis]]
+        for axis, cols, table in self._tables(names):
+            out[:, cols] = table[digits[axis]]
         return out
+
+    def _tables(self, names: tuple[str, ...]) -> list[tuple[int, np.ndarray, np.ndarray]]:
+        """Per element owning some of ``names``: their columns and their values per local state."""
+        hit = self._values.get(names)
+        if hit is None:
+            by_axis: dict[int, list[int]] = {}
+            for j, n in enumerate(names):
+                if n in self.plant.owner:
+                    by_axis.setdefault(self.plant.owner[n], []).append(j)
+            hit = self._values[names] = [
+                (a, np.array(cols), np.stack([self.plant.elements[a].value(names[j]) for j in cols], axis=1))
+                for a, cols in sorted(by_axis.items())]
+        return hit
 
     @staticmethod
     def holds(factors: Iterable[tuple[int, np.ndarray]], digits: Digits, rows: np.ndarray | None = None) -> np.ndarray:
@@ -139,11 +152,30 @@ class PlantCodes:
         u = self._u
         ok = digits.full()[u.axis, :].T == u.src
         for k in u.guarded:
-            ok[:, k] &= self.plant.enabled_digits(self.uncontrollable[k], digits.full())
+            rows = np.flatnonzero(ok[:, k])
+            if rows.size:
+                ok[rows, k] = self._guard(k, digits, rows)
         row, rank = np.nonzero(ok)  # row-major: by row, then rank
         target = codes[row] + u.delta[rank]
         keep = self.kept(target)  # cannot fail from a SUP state; kept for safety, as the machine's path
         return row[keep], rank[keep], target[keep]
+
+    def _guard(self, k: int, digits: Digits, rows: np.ndarray) -> np.ndarray:
+        """Uncontrollable move ``k``'s guard at ``rows`` (:meth:`Plant.enabled_digits`, its
+        read variables' tables made once)."""
+        hit = self._guards.get(k)
+        if hit is None:
+            t = self.uncontrollable[k]
+            assert t.guard is not None
+            reads = self.plant.elements[t.axis].reads
+            parts = [(self.plant.owner[r], self.plant.elements[self.plant.owner[r]].value(r).astype(np.int64) << j)
+                     for j, r in enumerate(reads)]
+            hit = self._guards[k] = (parts, np.asarray(t.guard, dtype=bool))
+        parts, guard = hit
+        code = np.zeros(len(rows), dtype=np.int64)
+        for axis, bits in parts:
+            code |= bits[digits[axis][rows]]
+        return guard[code]
 
     def refusals(self, code: int, wanted: np.ndarray) -> tuple[Prohibition, ...]:
         """The order changes SUP refuses in state ``code`` towards ``wanted`` (one bit per
