@@ -187,3 +187,16 @@ def test_a_narrow_sync_stays_on_the_machines_path(tmp_path, monkeypatch):
     monkeypatch.setattr(frontier, "explore_frontier", refuse)
     s = explore(*_loaded(tmp_path / "line_3.g7", tmp_path / "line_3.rules"))
     assert s.sync_states and WIDE >= 8
+
+
+def test_max_states_is_the_same_limit(tmp_path):
+    write_par(3, tmp_path)
+    args = _loaded(tmp_path / "par_3.g7", tmp_path / "par_3.rules")
+    from synth.errors import LimitExceeded
+
+    with pytest.raises(LimitExceeded) as mine:
+        explore_frontier(*args, max_states=40)
+    with pytest.raises(LimitExceeded) as theirs:
+        synchronous_product(*args, max_states=40)
+    assert str(mine.value) == str(theirs.value) == "more than 40 aggregated states; raise --max-states or simplify the model"
+    assert len(explore_frontier(*args, max_states=1000).nodes) > 40
