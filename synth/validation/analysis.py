@@ -28,7 +28,7 @@ from typing import Iterable
 
 import numpy as np
 
-from synth.validation.keys import first_occurrences
+from synth.validation.keys import first_occurrences, slices
 from synth.validation.sync import Sync
 
 __all__ = ["Trace", "Analysis", "analyse", "coreachable", "coreachable_by_layers", "held_nodes", "shortest_paths",
@@ -64,12 +64,6 @@ def _csr(keys: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
     return order, np.searchsorted(keys[order], np.arange(n + 1))
 
 
-def _slices(starts: np.ndarray, groups: np.ndarray) -> np.ndarray:
-    """The positions ``starts[g]:starts[g + 1]`` of each group, concatenated in order."""
-    counts = starts[groups + 1] - starts[groups]
-    return np.repeat(starts[groups] - np.cumsum(counts) + counts, counts) + np.arange(int(counts.sum()))
-
-
 LAYERS = 4096
 """Edges from which the searches run a whole layer of the graph at a time on arrays; below,
 one node at a time (a layer's numpy calls cost more than a small graph's nodes: 1 ms
@@ -100,7 +94,7 @@ def coreachable_by_layers(sync: Sync, targets: set[int]) -> set[int]:
     seen[layer] = True
     into, starts = _csr(dst, n)
     while layer.size:
-        prev = src[into[_slices(starts, layer)]]
+        prev = src[into[slices(starts, layer)[1]]]
         prev = prev[~seen[prev]]
         seen[prev] = True
         layer = np.flatnonzero(np.bincount(prev, minlength=n)) if prev.size else prev
@@ -140,7 +134,7 @@ def shortest_paths_by_layers(sync: Sync) -> tuple[dict[int, int], dict[int, tupl
     known[layer] = True
     found, via = [layer], [np.full(len(layer), -1, dtype=np.int64)]
     while layer.size:
-        out = order[_slices(starts, layer)]  # the layer's edges, in queue order
+        out = order[slices(starts, layer)[1]]  # the layer's edges, in queue order
         out = out[~known[dst[out]]]
         out = out[first_occurrences(dst[out])]  # the first edge into each new node, in discovery order
         layer = dst[out]

@@ -42,7 +42,7 @@ from synth.plant.composition import Plant
 from synth.plant.rules import Constraint
 from synth.sup.constraints import CompiledConstraints
 from synth.validation.conflicts import Conflict, ConflictLog
-from synth.validation.keys import SortedKeys, distinct, distinct_rows, first_occurrences
+from synth.validation.keys import SortedKeys, distinct, distinct_rows, first_occurrences, slices
 from synth.validation.regions import PlantCodes, Regions, regions
 from synth.validation.sync import Edge, Node, Sync, Wide, synchronous_product
 
@@ -112,7 +112,7 @@ class _Situations:
         self.T = np.zeros((0, len(vm.timer_names)), dtype=bool)
 
     def number(self, A: np.ndarray, T: np.ndarray, given: list[Situation] | None = None) -> np.ndarray:
-        """The numbers of the rows' situations (new ones numbered in row order)."""
+        """The numbers of the rows' situations (a new one numbered when first met)."""
         bits = np.hstack([A, T])
         first, inverse = distinct_rows(bits)
         packed = np.packbits(bits, axis=1)
@@ -175,14 +175,6 @@ def _per_row(bits: np.ndarray, make: Callable[[np.ndarray], T_], made: dict[byte
             hit = made[key] = make(bits[r])
         out.append(hit)
     return [out[i] for i in inverse.tolist()]
-
-
-def _slices(starts: np.ndarray, groups: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The sizes of the slices ``starts[g]:starts[g + 1]`` of ``groups`` and their
-    positions, concatenated in order."""
-    counts = starts[groups + 1] - starts[groups]
-    at = np.repeat(starts[groups] - np.cumsum(counts) + counts, counts) + np.arange(int(counts.sum()))
-    return counts, at
 
 
 class _Explorer:
@@ -252,7 +244,7 @@ class _Explorer:
                 self.by_wanted.add(wkeys[new], base + np.arange(new.size))
                 gid = self.by_wanted.find(wkeys)
             self.entered.add(keys[first], gid)
-            counts, at = _slices(self.regions.member_starts, gid)
+            counts, at = slices(self.regions.member_starts, gid)
             self.pairs.append(np.repeat(sid[first], counts) * self.P + self.regions.members[at])
             found = self.entered.find(keys)
         return found
@@ -261,7 +253,7 @@ class _Explorer:
         """The nodes of the settled states of each region entered (new ones made), and for
         each of them the candidate it comes from."""
         gid = self.region_of(sid, entry)
-        counts, at = _slices(self.regions.settled_starts, gid)
+        counts, at = slices(self.regions.settled_starts, gid)
         src = np.repeat(np.arange(len(gid)), counts)
         q, proh = self.regions.settled[at], self.regions.settled_proh[at]
         tsid = sid[src]

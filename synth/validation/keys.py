@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["SortedKeys", "distinct", "distinct_rows", "first_occurrences"]
+__all__ = ["SortedKeys", "distinct", "distinct_rows", "first_occurrences", "slices"]
 
 
 class SortedKeys:
@@ -80,3 +80,16 @@ def distinct_rows(bits: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 def first_occurrences(keys: np.ndarray) -> np.ndarray:
     """Positions of the first occurrence of each distinct key, in the order they occur."""
     return np.sort(distinct(keys)[0])
+
+
+def slices(starts: np.ndarray, groups: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The sizes of the slices ``starts[g]:starts[g + 1]`` of ``groups`` and their
+    positions, concatenated in order.
+
+    >>> counts, at = slices(np.array([0, 2, 2, 5]), np.array([2, 0]))
+    >>> counts.tolist(), at.tolist()
+    ([3, 2], [2, 3, 4, 0, 1])
+    """
+    counts = starts[groups + 1] - starts[groups]
+    at = np.repeat(starts[groups] - np.cumsum(counts) + counts, counts) + np.arange(int(counts.sum()))
+    return counts, at
