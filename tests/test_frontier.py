@@ -19,9 +19,10 @@ from synth.output.result import validation_json, validation_text
 from synth.plant.composition import plant
 from synth.plant.rules_check import load_rules
 from synth.validation import validate as validate_mod
-from synth.validation.frontier import WIDE, Unsupported, explore, explore_frontier, reason
+from synth.validation.validate import explore
+from synth.validation.frontier import Unsupported, explore_frontier, reason
 from synth.validation.result import load_model
-from synth.validation.sync import synchronous_product
+from synth.validation.sync import WIDE, synchronous_product
 
 from conftest import ROOT
 from test_symbolic import CASES, _random_case
@@ -176,17 +177,31 @@ def test_a_transient_cycle_is_the_machines_error(tmp_path):
     assert str(mine.value) == str(theirs.value)
 
 
-def test_a_narrow_sync_stays_on_the_machines_path(tmp_path, monkeypatch):
-    """Below WIDE states waiting, the frontier path is never started."""
+def test_a_narrow_sync_stays_on_the_machines_path(tmp_path):
+    """Below WIDE states waiting, the frontier path is never imported (a subprocess: the
+    test process has imported it already)."""
+    import subprocess
+
     write_line(3, tmp_path)
+    code = ("import sys; from synth.validation.result import load_model; "
+            "from synth.validation.validate import validate_loaded; "
+            f"v = validate_loaded(*load_model({str(tmp_path / 'line_3.g7')!r}, {str(tmp_path / 'line_3.rules')!r})); "
+            "print(v.sync.sync_states, 'synth.validation.frontier' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
+                         env={**__import__("os").environ, "PYTHONPATH": str(ROOT)}).stdout.split()
+    assert int(out[0]) > 0 and out[1] == "False" and WIDE == 16
+
+
+def test_a_wide_sync_goes_to_the_frontier(tmp_path, monkeypatch):
+    write_par(4, tmp_path)  # more than 16 states wait after 30 states
     import synth.validation.frontier as frontier
 
-    def refuse(*args, **kw):
-        raise AssertionError("the frontier ran")
-
-    monkeypatch.setattr(frontier, "explore_frontier", refuse)
-    s = explore(*_loaded(tmp_path / "line_3.g7", tmp_path / "line_3.rules"))
-    assert s.sync_states and WIDE >= 8
+    ran = []
+    real = frontier.explore_frontier
+    monkeypatch.setattr(frontier, "explore_frontier", lambda *a, **kw: ran.append(1) or real(*a, **kw))
+    args = _loaded(tmp_path / "par_4.g7", tmp_path / "par_4.rules")
+    a, b = explore(*args), synchronous_product(*args)
+    assert ran == [1] and (a.nodes, a.edges, a.sync_states) == (b.nodes, b.edges, b.sync_states)
 
 
 def test_max_states_is_the_same_limit(tmp_path):

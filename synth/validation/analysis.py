@@ -28,7 +28,7 @@ from typing import Iterable
 
 import numpy as np
 
-from synth.validation.keys import first_occurrences, slices
+from synth.validation.keys import distinct, first_occurrences, slices
 from synth.validation.sync import Sync
 
 __all__ = ["Trace", "Analysis", "analyse", "coreachable", "coreachable_by_layers", "held_nodes", "shortest_paths",
@@ -97,7 +97,7 @@ def coreachable_by_layers(sync: Sync, targets: set[int]) -> set[int]:
         prev = src[into[slices(starts, layer)[1]]]
         prev = prev[~seen[prev]]
         seen[prev] = True
-        layer = np.flatnonzero(np.bincount(prev, minlength=n)) if prev.size else prev
+        layer = prev[distinct(prev)[0]]
     return set(np.flatnonzero(seen).tolist())
 
 

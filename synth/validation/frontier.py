@@ -14,7 +14,9 @@ node), a reaction that fires an OR divergence's conflict (its rounds are noted) 
 longer than :data:`~synth.grafcet.vector.ROUNDS` rounds. A Grafcet the rows cannot carry
 at all (:func:`reason` says why), or anything unusual met on the way (a transient cycle,
 an event that changes several inputs, keys past 64 bits), is explored by the machine's
-path from the start, which also gives the same error at the same place.
+path from the start, which also gives the same error at the same place. The machine's
+path runs alone first, until its queue goes wide (:data:`~synth.validation.sync.WIDE`):
+:func:`synth.validation.validate.explore` chooses, and imports this module only then.
 
 Example
 -------
@@ -22,7 +24,8 @@ Example
 >>> from synth.validation.result import load_model
 >>> from synth.validation.sync import synchronous_product
 >>> rs, p, g = load_model(_plants("../grafcets/tri_missing_order.g7"), _plants("tri.rules"))
->>> fast, slow = explore(p, rs.constraints, GrafcetMachine(g)), synchronous_product(p, rs.constraints, GrafcetMachine(g))
+>>> fast = explore_frontier(p, rs.constraints, GrafcetMachine(g))
+>>> slow = synchronous_product(p, rs.constraints, GrafcetMachine(g))
 >>> fast.nodes == slow.nodes, fast.edges == slow.edges, fast.sync_states == slow.sync_states
 (True, True, True)
 """
@@ -44,20 +47,11 @@ from synth.sup.constraints import CompiledConstraints
 from synth.validation.conflicts import Conflict, ConflictLog
 from synth.validation.keys import SortedKeys, distinct, distinct_rows, first_occurrences, slices
 from synth.validation.regions import PlantCodes, Regions, regions
-from synth.validation.sync import Edge, Node, Sync, Wide, synchronous_product
+from synth.validation.sync import Edge, Node, Sync, synchronous_product
 
-__all__ = ["explore", "reason", "explore_frontier", "Unsupported", "WIDE"]
+__all__ = ["explore_wide", "reason", "explore_frontier", "Unsupported"]
 
 Rounds = tuple[tuple, ...]
-
-
-WIDE = 16
-"""The machine's path explores SYNC alone until more than this many states wait in its
-queue: below, a frontier's numpy passes cost more than the states they carry (measured,
-CPU seconds of the exploration: the box sorting, never more than 16 waiting, 0.013 s by
-the machine, 0.026 s by frontiers; the four-cylinder station passes 16 after 0.018 s and
-its frontiers take 0.076 s against the machine's 0.091 s; branches_2x4 0.010 s, then
-0.069 s against 0.104 s)."""
 
 
 class Unsupported(Exception):
@@ -78,7 +72,7 @@ def reason(p: Plant, machine: GrafcetMachine) -> str | None:
     return None
 
 
-def explore(
+def explore_wide(
     p: Plant,
     constraints: Sequence[Constraint],
     machine: GrafcetMachine,
@@ -86,13 +80,10 @@ def explore(
     max_states: int | None = None,
     progress: Callable[[int, int], None] | None = None,
 ) -> Sync:
-    """SYNC, a frontier at a time when :func:`reason` allows it, else (or when the frontier
-    path meets what it leaves to the machine) by the machine's path."""
+    """SYNC of a model whose search went wide (:data:`~synth.validation.sync.WIDE`): a
+    frontier at a time when :func:`reason` allows it, else (or when the frontier path
+    meets what it leaves to the machine) by the machine's path."""
     if reason(p, machine) is None:
-        try:  # a narrow SYNC (a sequence, a line) is explored faster state by state
-            return synchronous_product(p, constraints, machine, max_states=max_states, progress=progress, wide=WIDE)
-        except Wide:
-            pass
         try:
             return explore_frontier(p, constraints, machine, max_states=max_states, progress=progress)
         except Unsupported:
