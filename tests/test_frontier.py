@@ -189,11 +189,11 @@ def test_a_narrow_sync_stays_on_the_machines_path(tmp_path):
             "print(v.sync.sync_states, 'synth.validation.frontier' in sys.modules)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
                          env={**__import__("os").environ, "PYTHONPATH": str(ROOT)}).stdout.split()
-    assert int(out[0]) > 0 and out[1] == "False" and WIDE == 16
+    assert int(out[0]) > 0 and out[1] == "False" and WIDE == 32
 
 
 def test_a_wide_sync_goes_to_the_frontier(tmp_path, monkeypatch):
-    write_par(4, tmp_path)  # more than 16 states wait after 30 states
+    write_par(4, tmp_path)  # more than 32 states wait early
     import synth.validation.frontier as frontier
 
     ran = []
