@@ -215,3 +215,33 @@ def test_max_states_is_the_same_limit(tmp_path):
         synchronous_product(*args, max_states=40)
     assert str(mine.value) == str(theirs.value) == "more than 40 aggregated states; raise --max-states or simplify the model"
     assert len(explore_frontier(*args, max_states=1000).nodes) > 40
+
+
+@pytest.mark.parametrize("wide", [1, 4])
+@pytest.mark.parametrize("case", ["par", "steep_missing", "branches", "four_cylinders", "or_conflict", "timers"])
+def test_the_frontier_goes_on_from_the_machines_path(tmp_path, monkeypatch, wide, case):
+    """validate.explore: the machine's path until more than ``wide`` states wait, then the
+    frontier from there (its nodes, edges, conflicts, regions and SYNC states taken over)."""
+    if case == "par":
+        base, g7, _ = write_par(3, tmp_path)
+    elif case == "steep_missing":
+        base, _, g7 = write_steep(3, tmp_path)
+    elif case == "branches":
+        base, g7, _ = write_branches(2, 2, tmp_path)
+    elif case == "four_cylinders":
+        base, g7 = P / "four_cylinders.rules", G / "four_cylinders.g7"
+    elif case == "or_conflict":  # 6 nodes: never 4 waiting
+        base, g7, wide = P / "tri.rules", ROOT / "tests" / "data" / "or_conflict.g7", 1
+    else:
+        base, g7 = P / "tri.rules", G / "tri.g7"
+    monkeypatch.setattr(validate_mod, "WIDE", wide)
+    import synth.validation.frontier as frontier
+
+    resumed = []
+    real = frontier.explore_frontier
+    monkeypatch.setattr(frontier, "explore_frontier", lambda *a, **kw: resumed.append(kw["partial"].next) or real(*a, **kw))
+    a, b = explore(*_loaded(g7, base)), synchronous_product(*_loaded(g7, base))
+    assert resumed and resumed[0] > 0
+    assert (a.nodes, a.edges, a.initial, a.conflicts, a.sync_states) == (b.nodes, b.edges, b.initial, b.conflicts, b.sync_states)
+    assert [(a.successors(i), a.predecessors(i)) for i in range(len(a.nodes))] == [
+        (b.successors(i), b.predecessors(i)) for i in range(len(b.nodes))]

@@ -47,7 +47,7 @@ from synth.sup.constraints import CompiledConstraints
 from synth.validation.conflicts import Conflict, ConflictLog
 from synth.validation.keys import SortedKeys, distinct, distinct_rows, first_occurrences, slices
 from synth.validation.regions import PlantCodes, Regions, regions
-from synth.validation.sync import Edge, Node, Sync, synchronous_product
+from synth.validation.sync import Edge, Node, Partial, Sync, synchronous_product
 
 __all__ = ["explore_wide", "reason", "explore_frontier", "Unsupported"]
 
@@ -79,13 +79,15 @@ def explore_wide(
     *,
     max_states: int | None = None,
     progress: Callable[[int, int], None] | None = None,
+    partial: Partial | None = None,
 ) -> Sync:
     """SYNC of a model whose search went wide (:data:`~synth.validation.sync.WIDE`): a
     frontier at a time when :func:`reason` allows it, else (or when the frontier path
-    meets what it leaves to the machine) by the machine's path."""
+    meets what it leaves to the machine) by the machine's path from the start;
+    ``partial``: how far the machine's path went before it went wide."""
     if reason(p, machine) is None:
         try:
-            return explore_frontier(p, constraints, machine, max_states=max_states, progress=progress)
+            return explore_frontier(p, constraints, machine, max_states=max_states, progress=progress, partial=partial)
         except Unsupported:
             pass
     return synchronous_product(p, constraints, machine, max_states=max_states, progress=progress)
@@ -139,16 +141,18 @@ def explore_frontier(
     *,
     max_states: int | None = None,
     progress: Callable[[int, int], None] | None = None,
+    partial: Partial | None = None,
 ) -> Sync:
-    """SYNC a frontier at a time (see module doc); :class:`Unsupported` when it meets
-    what it leaves to the machine's path."""
+    """SYNC a frontier at a time (see module doc), from the start or going on from where
+    the machine's path stopped (``partial``); :class:`Unsupported` when it meets what it
+    leaves to the machine's path."""
     why = reason(p, machine)
     if why is not None:
         raise Unsupported(why)
-    oracle = CompiledConstraints(p, constraints)
+    oracle = partial.oracle if partial is not None else CompiledConstraints(p, constraints)
     if not oracle.kept(p.initial):
         return Sync(p, oracle, machine)
-    return _Explorer(p, oracle, machine, max_states).run(progress)
+    return _Explorer(p, oracle, machine, max_states).run(progress, partial)
 
 
 T_ = TypeVar("T_")
@@ -277,12 +281,47 @@ class _Explorer:
             )
 
     # ------------------------------------------------------------------ the search
-    def run(self, progress: Callable[[int, int], None] | None) -> Sync:
-        init = np.array([self.p.initial_index], dtype=np.int64)
-        sit0 = self.machine.initial(self.as_dict(self.inputs(init)[0]))
-        node, _ = self.enter(self.sits.of([sit0]), init)
-        initial = tuple(node.tolist())
-        lo, last = 0, time.monotonic()
+    def resume(self, partial: Partial) -> tuple[tuple[int, ...], int]:
+        """Take over from the machine's path (its nodes, edges, conflicts, regions and SYNC
+        states met): the initial nodes and the first node left to expand."""
+        p, P = self.p, self.P
+        nodes = partial.nodes
+        sid = self.sits.of([n.situation for n in nodes])
+        code = np.array([p.index(n.plant) for n in nodes], dtype=np.int64)
+        self.nodes = list(nodes)
+        self.node_sit, self.node_code = sid, code
+        self.index.add(sid * P + code, np.arange(len(nodes)))
+        self.edges = list(partial.edges)
+        if self.edges:
+            self.sources.append(np.array([e.source for e in self.edges], dtype=np.int64))
+            self.targets.append(np.array([e.target for e in self.edges], dtype=np.int64))
+        self.conflicts, self.log = list(partial.conflicts), partial.log
+        if partial.regions:  # the regions entered, their settled states (members: in ``seen``)
+            keys = list(partial.regions)
+            rsid = self.sits.of([k[0] for k in keys])
+            entry = np.array([p.index(k[1]) for k in keys], dtype=np.int64)
+            settled = [partial.regions[k] for k in keys]
+            base = self.regions.count
+            self.regions.append(np.empty(0, dtype=np.int64), np.zeros(len(keys), dtype=np.int64),
+                                np.array([p.index(q) for s in settled for q, _ in s], dtype=np.int64),
+                                np.array([self.regions.proh_id(pr) for s in settled for _, pr in s], dtype=np.int64),
+                                np.array([len(s) for s in settled], dtype=np.int64))
+            self.entered.add(rsid * P + entry, base + np.arange(len(keys)))
+        if partial.seen:
+            seen = list(partial.seen)
+            self.pairs.append(self.sits.of([s for s, _ in seen]) * P
+                              + np.array([p.index(m) for _, m in seen], dtype=np.int64))
+        return partial.initial, partial.next
+
+    def run(self, progress: Callable[[int, int], None] | None, partial: Partial | None = None) -> Sync:
+        if partial is not None:
+            initial, lo = self.resume(partial)
+        else:
+            init = np.array([self.p.initial_index], dtype=np.int64)
+            sit0 = self.machine.initial(self.as_dict(self.inputs(init)[0]))
+            node, _ = self.enter(self.sits.of([sit0]), init)
+            initial, lo = tuple(node.tolist()), 0
+        last = time.monotonic()
         while lo < len(self.nodes):
             hi = len(self.nodes)
             self.expand(lo, hi)

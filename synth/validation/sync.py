@@ -42,13 +42,35 @@ from synth.plant.rules import Constraint
 from synth.sup.constraints import CompiledConstraints
 from synth.validation.conflicts import Conflict, ConflictLog
 
-__all__ = ["WIDE", "Wide", "Prohibition", "Node", "Edge", "Sync", "synchronous_product", "region", "grafcet_inputs", "moves_by_order"]
+__all__ = ["WIDE", "Wide", "Partial", "Prohibition", "Node", "Edge", "Sync", "synchronous_product", "region", "grafcet_inputs", "moves_by_order"]
 
 Local = tuple[int, ...]
 
 
 class Wide(Exception):
-    """The search's queue grew past the ``wide`` asked of :func:`synchronous_product`."""
+    """The search's queue grew past the ``wide`` asked of :func:`synchronous_product`;
+    ``partial``: how far it went, for a frontier explorer to go on from."""
+
+    def __init__(self, partial: Partial) -> None:
+        super().__init__("wide")
+        self.partial = partial
+
+
+@dataclass(frozen=True)
+class Partial:
+    """The machine's path stopped after expanding nodes ``0 .. next - 1`` (the rest wait
+    in its queue, in order): its nodes, edges and conflicts so far, the regions entered
+    (settled states by (situation, entry)) and the SYNC states met."""
+
+    oracle: CompiledConstraints
+    nodes: list[Node]
+    edges: list[Edge]
+    conflicts: list[Conflict]
+    log: ConflictLog
+    initial: tuple[int, ...]
+    next: int
+    regions: dict[tuple[Situation, Local], list[tuple[Local, tuple[Prohibition, ...]]]]
+    seen: set[tuple[Situation, Local]]
 
 
 WIDE = 32
@@ -352,7 +374,7 @@ def synchronous_product(
             i = queue.popleft()
             expand(i)
             if wide is not None and len(queue) > wide:
-                raise Wide()
+                raise Wide(Partial(oracle, nodes, edges, conflicts, log, initial, i + 1, region_cache, sync_seen))
             if progress is not None and time.monotonic() - last > 0.5:
                 progress(len(nodes), len(queue))
                 last = time.monotonic()

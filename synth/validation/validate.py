@@ -61,10 +61,10 @@ def explore(
     (:func:`synth.validation.frontier.explore_wide`, imported only then)."""
     try:
         return synchronous_product(p, constraints, machine, max_states=max_states, progress=progress, wide=WIDE)
-    except Wide:
+    except Wide as wide:
         from synth.validation.frontier import explore_wide
 
-        return explore_wide(p, constraints, machine, max_states=max_states, progress=progress)
+        return explore_wide(p, constraints, machine, max_states=max_states, progress=progress, partial=wide.partial)
 
 
 def validate(
