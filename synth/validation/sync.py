@@ -75,14 +75,14 @@ class Partial:
 
 WIDE = 32
 """The explicit engine explores SYNC state by state until more than this many states wait
-in its queue, then a frontier at a time (:mod:`synth.validation.frontier`): below, a
-frontier's numpy passes (and the frontier's modules, imported then) cost more than the
-states they carry. Measured, CPU seconds of the exploration: the box sorting never has 16
-states waiting (0.013 s state by state, 0.026 s by frontiers); the four-cylinder station
-never 32 (0.09 s state by state; it passes 16 after 0.018 s, and its frontiers take
-0.076 s, plus their modules' import); par_4 passes 32 after 0.009 s and steep_4 after
-0.007 s, then their frontiers take 0.038 s and 0.061 s against 0.071 s and 0.345 s state
-by state; branches_2x4 after 0.045 s, then 0.069 s against 0.104 s."""
+in its queue, then a frontier at a time from there (:mod:`synth.validation.frontier`):
+below, a frontier's numpy passes (and the frontier's modules, imported then) cost more
+than the states they carry. Measured, CPU seconds of whole explorations: the box sorting
+(never 16 states waiting) 0.013 s state by state, 0.026 s by frontiers; the four-cylinder
+station (never 32 waiting) 0.09 s state by state, 0.076 s by frontiers plus their
+modules' import (30-50 ms here, where no bytecode is cached); par_4, steep_4 and
+branches_2x4 pass 32 waiting after 0.009, 0.007 and 0.045 s, and take 0.038, 0.061 and
+0.069 s by frontiers against 0.071, 0.345 and 0.104 s state by state."""
 
 
 @dataclass(frozen=True, order=True)
