@@ -14,7 +14,8 @@ load hits every tree alike; the minimum of the runs is printed.
 - ``sup line_N``: ``synth sup line_N.rules --engine symbolic --quiet`` on the line of N
   double-acting cylinders of ``bench/gen_line.py`` (a tree that fails says why);
 - ``explicit F``: the explicit validation of a bench family (``par_8``: ``gen_par.py``,
-  ``line_8``: ``gen_line.py``), timed inside the process from the loaded model to the
+  ``line_8``: ``gen_line.py``, ``steep_6``: ``gen_steep.py``, ``branches_2x3``:
+  ``gen_branches.py 2 3``), timed inside the process from the loaded model to the
   result, divided by its SYNC states: microseconds per state.
 """
 
@@ -65,7 +66,8 @@ def measures(work: Path, lines: list[int], families: list[str]) -> dict[str, lis
         out[f"sup line_{n}"] = ["-m", "synth", "sup", str(work / f"line_{n}.rules"), "--engine", "symbolic", "--quiet"]
     for family in families:
         name, n = family.rsplit("_", 1)
-        subprocess.run([sys.executable, str(ROOT / f"bench/gen_{name}.py"), n, str(work)], check=True, capture_output=True)
+        sizes = n.split("x")  # branches_3x2: gen_branches.py 3 2
+        subprocess.run([sys.executable, str(ROOT / f"bench/gen_{name}.py"), *sizes, str(work)], check=True, capture_output=True)
         out[f"explicit {family}"] = ["-c", EXPLICIT, str(work / f"{family}.g7"), str(work / f"{family}.rules")]
     return out
 

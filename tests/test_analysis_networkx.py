@@ -15,7 +15,8 @@ import pytest
 
 from synth.grafcet.machine import Situation
 from synth.logic.events import Event
-from synth.validation.analysis import analyse, coreachable, held_nodes, shortest_paths, strongly_connected_components
+from synth.validation.analysis import (LAYERS, analyse, coreachable, coreachable_by_layers, held_nodes, shortest_paths,
+                                      shortest_paths_by_layers, strongly_connected_components)
 from synth.validation.sync import Edge, Node, Prohibition, Sync
 
 nx = pytest.importorskip("networkx")
@@ -69,11 +70,17 @@ def test_strongly_connected_components(seed: int) -> None:
 
 
 @pytest.mark.parametrize("seed", SEEDS)
-def test_coreachable_and_held(seed: int) -> None:
+@pytest.mark.parametrize("layers", [False, True])
+def test_coreachable_and_held(seed: int, layers: bool, monkeypatch: pytest.MonkeyPatch) -> None:
+    """One node at a time (small graphs) and a layer at a time (from LAYERS edges on)."""
+    if layers:
+        import synth.validation.analysis as analysis
+
+        monkeypatch.setattr(analysis, "LAYERS", 0)
     sync = _random_sync(seed)
     g = _graph(sync)
     targets = set(random.Random(-seed).sample(range(len(sync.nodes)), 1))
-    assert coreachable(sync, targets) == _closure_back(g, targets)
+    assert coreachable(sync, targets) == coreachable_by_layers(sync, targets) == _closure_back(g, targets)
     changers = {e.source for e in sync.edges if sync.nodes[e.source].situation.steps != sync.nodes[e.target].situation.steps}
     assert held_nodes(sync) == set(g) - _closure_back(g, changers)
 
@@ -145,3 +152,15 @@ def test_the_random_graphs_are_not_trivial() -> None:
         held_proh += any(sync.nodes[i].proh for i in a.held)
         unreachable += len(_distances(_graph(sync), sync.initial)) < len(sync.nodes)
     assert min(blocking, held_proh, unreachable) > 10
+
+
+@pytest.mark.parametrize("seed", SEEDS)
+def test_shortest_paths_parents_as_the_queue_finds_them(seed: int) -> None:
+    sync = _random_sync(seed)
+    edges = list(sync.edges)
+    random.Random(seed).shuffle(edges)  # the engine's edges are in exploration order, not by event
+    sync = Sync(None, None, None, sync.nodes, tuple(edges), sync.initial)  # type: ignore[arg-type]
+    assert len(sync.edges) < LAYERS  # shortest_paths: one node at a time
+    dist, parent = shortest_paths_by_layers(sync)
+    ref_dist, ref_parent = shortest_paths(sync)
+    assert list(dist.items()) == list(ref_dist.items()) and list(parent.items()) == list(ref_parent.items())

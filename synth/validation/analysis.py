@@ -26,9 +26,13 @@ from collections import deque
 from dataclasses import dataclass
 from typing import Iterable
 
+import numpy as np
+
+from synth.validation.keys import distinct, first_occurrences, slices
 from synth.validation.sync import Sync
 
-__all__ = ["Trace", "Analysis", "analyse", "coreachable", "held_nodes", "shortest_paths", "strongly_connected_components"]
+__all__ = ["Trace", "Analysis", "analyse", "coreachable", "coreachable_by_layers", "held_nodes", "shortest_paths",
+           "shortest_paths_by_layers", "strongly_connected_components", "LAYERS"]
 
 
 @dataclass(frozen=True)
@@ -54,8 +58,22 @@ class Analysis:
     never_starts: bool = False  # no reachable situation has other active steps than the initial one
 
 
+def _csr(keys: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Edge positions grouped by ``keys`` and each key's first position in them."""
+    order = np.argsort(keys)
+    return order, np.searchsorted(keys[order], np.arange(n + 1))
+
+
+LAYERS = 4096
+"""Edges from which the searches run a whole layer of the graph at a time on arrays; below,
+one node at a time (a layer's numpy calls cost more than a small graph's nodes: 1 ms
+against 0.06 ms for the analysis of line_8's 48 edges in 32 layers)."""
+
+
 def coreachable(sync: Sync, targets: set[int]) -> set[int]:
     """Nodes from which some node of ``targets`` is reachable (targets included)."""
+    if len(sync.edges) >= LAYERS:
+        return coreachable_by_layers(sync, targets)
     seen = set(targets)
     queue = deque(sorted(targets))
     while queue:
@@ -67,8 +85,26 @@ def coreachable(sync: Sync, targets: set[int]) -> set[int]:
     return seen
 
 
+def coreachable_by_layers(sync: Sync, targets: set[int]) -> set[int]:
+    """:func:`coreachable`, breadth first backwards a whole layer of predecessors at a time."""
+    src, dst = sync.edge_arrays()
+    n = len(sync.nodes)
+    seen = np.zeros(n, dtype=bool)
+    layer = np.array(sorted(targets), dtype=np.int64)
+    seen[layer] = True
+    into, starts = _csr(dst, n)
+    while layer.size:
+        prev = src[into[slices(starts, layer)[1]]]
+        prev = prev[~seen[prev]]
+        seen[prev] = True
+        layer = prev[distinct(prev)[0]]
+    return set(np.flatnonzero(seen).tolist())
+
+
 def shortest_paths(sync: Sync) -> tuple[dict[int, int], dict[int, tuple[int, str]]]:
     """Breadth-first distances from the initial nodes and parents (deterministic: events sorted)."""
+    if len(sync.edges) >= LAYERS:
+        return shortest_paths_by_layers(sync)
     dist = {i: 0 for i in sync.initial}
     parent: dict[int, tuple[int, str]] = {}
     queue = deque(sync.initial)
@@ -79,6 +115,36 @@ def shortest_paths(sync: Sync) -> tuple[dict[int, int], dict[int, tuple[int, str
                 dist[e.target] = dist[i] + 1
                 parent[e.target] = (i, e.event)
                 queue.append(e.target)
+    return dist, parent
+
+
+def shortest_paths_by_layers(sync: Sync) -> tuple[dict[int, int], dict[int, tuple[int, str]]]:
+    """:func:`shortest_paths` a whole layer at a time on the edges as arrays: each node's
+    edges taken by event, then target, the layer's nodes in queue order (the same
+    distances and parents, in the same order)."""
+    src, dst = sync.edge_arrays()
+    n = len(sync.nodes)
+    events = [e.event for e in sync.edges]
+    rank = {ev: r for r, ev in enumerate(sorted(set(events)))}
+    event = np.fromiter(map(rank.__getitem__, events), dtype=np.int64, count=len(events))
+    order = np.lexsort((dst, event, src))  # each node's edges by (event, target)
+    starts = np.searchsorted(src[order], np.arange(n + 1))
+    known = np.zeros(n, dtype=bool)
+    layer = np.array(list(dict.fromkeys(sync.initial)), dtype=np.int64)
+    known[layer] = True
+    found, via = [layer], [np.full(len(layer), -1, dtype=np.int64)]
+    while layer.size:
+        out = order[slices(starts, layer)[1]]  # the layer's edges, in queue order
+        out = out[~known[dst[out]]]
+        out = out[first_occurrences(dst[out])]  # the first edge into each new node, in discovery order
+        layer = dst[out]
+        known[layer] = True
+        found.append(layer)
+        via.append(out)
+    depth = np.repeat(np.arange(len(found)), [len(f) for f in found]).tolist()
+    dist = dict(zip(np.concatenate(found).tolist(), depth))
+    edges = np.concatenate(via[1:]) if len(via) > 1 else np.empty(0, dtype=np.int64)
+    parent = {t: (f, events[e]) for t, f, e in zip(dst[edges].tolist(), src[edges].tolist(), edges.tolist())}
     return dist, parent
 
 
@@ -144,7 +210,14 @@ def held_nodes(sync: Sync) -> set[int]:
     and the operator do, the Grafcet stays in these steps for ever.
 
     A node can change steps iff it reaches a node with an edge to other steps."""
-    changers = {e.source for e in sync.edges if sync.nodes[e.source].situation.steps != sync.nodes[e.target].situation.steps}
+    if len(sync.edges) < LAYERS:
+        changers = {e.source for e in sync.edges
+                    if sync.nodes[e.source].situation.steps != sync.nodes[e.target].situation.steps}
+    else:
+        src, dst = sync.edge_arrays()
+        ids: dict[tuple[str, ...], int] = {}
+        steps = np.array([ids.setdefault(n.situation.steps, len(ids)) for n in sync.nodes], dtype=np.int64)
+        changers = set(src[steps[src] != steps[dst]].tolist())
     movable = coreachable(sync, changers)
     return {i for i in range(len(sync.nodes)) if i not in movable}
 
@@ -191,7 +264,7 @@ def analyse(sync: Sync, homes: Iterable[int] | None = None) -> Analysis:
     never_starts = bool(sync.initial) and all(n.situation.steps == first_steps for n in sync.nodes)
     seen: set[tuple[tuple[str, ...], str]] = set()
     prohibited: list[int] = []
-    for i in sorted(dist, key=lambda i: (dist[i], i)):
+    for i in sorted((i for i in dist if sync.nodes[i].proh), key=lambda i: (dist[i], i)):  # the others add nothing
         n = sync.nodes[i]
         for p in n.proh:
             key = (n.situation.steps, p.event)

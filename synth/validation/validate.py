@@ -20,12 +20,12 @@ from synth.grafcet.language import Grafcet
 from synth.grafcet.machine import GrafcetMachine
 from synth.logic.expr import Expr, evaluate
 from synth.plant.composition import Plant
-from synth.plant.rules import RuleSet
+from synth.plant.rules import Constraint, RuleSet
 from synth.validation.analysis import analyse
 from synth.validation.result import Validation, home_conditions, load_model
-from synth.validation.sync import Sync, synchronous_product
+from synth.validation.sync import WIDE, Sync, Wide, synchronous_product
 
-__all__ = ["validate", "validate_loaded", "home_states"]
+__all__ = ["validate", "validate_loaded", "home_states", "explore"]
 
 
 def home_states(sync: Sync, conditions: Sequence[Expr]) -> frozenset[int]:
@@ -46,6 +46,25 @@ def home_states(sync: Sync, conditions: Sequence[Expr]) -> frozenset[int]:
         if any(evaluate(c, value) for c in conditions):
             homes.add(i)
     return frozenset(homes)
+
+
+def explore(
+    p: Plant,
+    constraints: Sequence[Constraint],
+    machine: GrafcetMachine,
+    *,
+    max_states: int | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> Sync:
+    """SYNC: state by state while at most :data:`~synth.validation.sync.WIDE` states wait
+    (a narrow SYNC, a sequence, a small station), then a frontier at a time
+    (:func:`synth.validation.frontier.explore_wide`, imported only then)."""
+    try:
+        return synchronous_product(p, constraints, machine, max_states=max_states, progress=progress, wide=WIDE)
+    except Wide as wide:
+        from synth.validation.frontier import explore_wide
+
+        return explore_wide(p, constraints, machine, max_states=max_states, progress=progress, partial=wide.partial)
 
 
 def validate(
@@ -76,7 +95,7 @@ def validate_loaded(
     ``progress(aggregated states, states to visit)`` is called now and then."""
     conditions = home_conditions(homes, p, g)
     machine = GrafcetMachine(g)
-    sync = synchronous_product(p, rs.constraints, machine, max_states=max_states, progress=progress)
+    sync = explore(p, rs.constraints, machine, max_states=max_states, progress=progress)
     sup_empty = not sync.oracle.kept(p.initial)  # the constraints compiled once
     analysis = analyse(sync, home_states(sync, conditions))
     if not (analysis.blocking or analysis.never_starts or analysis.prohibited):  # a passing run imports no diagnosis

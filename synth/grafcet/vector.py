@@ -1,0 +1,222 @@
+"""The Grafcet's evolution on many situations at once: the same IEC 60848 reading as
+:class:`~synth.grafcet.machine.GrafcetMachine`, with situations as rows of bits.
+
+A row holds the active steps (``A``, one column per step in file order) and the elapsed
+timers (``T``, one column per timer of ``grafcet.timers``); the inputs are bit columns
+(``I``, ``machine.inputs`` order) and the input event one integer per row (``E``: twice
+the input's column, plus one for a rising edge; -1 for none). Receptivities and action
+conditions become numpy Boolean expressions over those columns, and the search for
+stability runs round after round on every row until none fires; a row still firing after
+:data:`ROUNDS` rounds, or one where transitions leaving one step fire together (an OR
+divergence's conflict, which the explorer must note with the rounds fired), is left to
+the machine itself (``pending``).
+
+What the rows do not carry, the machine alone reads: internal variables, stored actions
+and assignments, ``--semantics sfc``; :func:`unsupported` names the first such feature of
+a Grafcet (the explicit engine then explores with the machine, state by state).
+
+Example
+-------
+>>> from synth.grafcet.language_check import parse_grafcet
+>>> g = parse_grafcet('''grafcet G { initial step 0  step 1: A  step 2
+...   transition 0 -> 1 when ↑a  transition 1 -> 2 when b  transition 2 -> 0 when 1 }''', "demo.g7")
+>>> v = VectorMachine(GrafcetMachine(g))
+>>> A, T = v.rows([v.machine.initial({"a": False, "b": False})] * 2)
+>>> I = np.array([[True, False], [True, True]])
+>>> A2, T2, moved, pending = v.react(A, T, I, np.array([1, 1]))
+>>> [v.situation(a, t).text() for a, t in zip(A2, T2)], moved.tolist(), pending.tolist()
+(['{X1}', '{X0}'], [True, True], [False, False])
+>>> v.orders(A2, T2, I)[:, v.order_names.index("A")].tolist()
+[True, False]
+"""
+
+from __future__ import annotations
+
+from typing import Callable
+
+import numpy as np
+
+from synth.grafcet.language import CONDITIONAL, CONTINUOUS, Semantics, step_of
+from synth.grafcet.machine import GrafcetMachine
+from synth.grafcet.situation import Situation, sorted_steps
+from synth.logic.expr import And, Compare, Const, Edge, Expr, Not, Or, Var
+
+__all__ = ["VectorMachine", "unsupported", "ROUNDS"]
+
+ROUNDS = 32
+"""Rounds of the search for stability run on the rows; a row still evolving after them is
+left to the machine (which finds the transient cycle, or the rest of a long evolution)."""
+
+Columns = Callable[[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray], np.ndarray]
+"""An expression over the columns: (I, A, T, E, zeros) -> one Boolean per row."""
+
+
+def _names_outside(e: Expr, inputs: set[str], steps: set[str], timers: set[str]) -> str | None:
+    """The first name of ``e`` that is neither a timer, a step variable nor an input."""
+    if isinstance(e, Compare):
+        return e.left
+    if isinstance(e, Var):
+        ok = e.name in timers or step_of(e.name, steps) is not None or e.name in inputs
+        return None if ok else e.name
+    if isinstance(e, Not):
+        return _names_outside(e.arg, inputs, steps, timers)
+    if isinstance(e, (And, Or)):
+        return next((n for n in (_names_outside(a, inputs, steps, timers) for a in e.args) if n), None)
+    return None
+
+
+def unsupported(machine: GrafcetMachine) -> str | None:
+    """Why :class:`VectorMachine` cannot run ``machine``'s Grafcet (the first feature it
+    does not carry), or None when it can."""
+    g = machine.grafcet
+    if machine.sfc or g.semantics is not Semantics.GRAFCET:
+        return "--semantics sfc (one evolution per scan)"
+    if g.internals:
+        return "internal variables"
+    for s in g.steps:
+        for a in s.actions:
+            if a.kind not in (CONTINUOUS, CONDITIONAL):
+                return f"{a.kind.value} actions (step {s.name}: {a.text()})"
+    steps = {s.name for s in g.steps}
+    timers = {t.id for t in g.timers}
+    exprs = [t.receptivity for t in g.transitions]
+    exprs += [a.condition for s in g.steps for a in s.actions if a.condition is not None]
+    for e in exprs:
+        name = _names_outside(e, set(machine.inputs), steps, timers)
+        if name is not None:
+            return f"'{name}' is neither an input, a step nor a timer"
+    return None
+
+
+class VectorMachine:
+    """``machine``'s evolution over rows of bits (see module doc); build it only when
+    :func:`unsupported` says None."""
+
+    def __init__(self, machine: GrafcetMachine) -> None:
+        self.machine = machine
+        g = machine.grafcet
+        self.step_names = tuple(s.name for s in g.steps)
+        self.timer_names = tuple(t.id for t in g.timers)
+        self._step = {s: i for i, s in enumerate(self.step_names)}
+        self._timer = {t: i for i, t in enumerate(self.timer_names)}
+        self._input = {n: i for i, n in enumerate(machine.inputs)}
+        self.events: dict[str, int] = {}  # edge text -> E code
+        for n, i in self._input.items():
+            self.events[Edge(False, n).text()] = 2 * i
+            self.events[Edge(True, n).text()] = 2 * i + 1
+        trans = machine.transitions
+        self._src = np.zeros((len(trans), len(self.step_names)), dtype=np.int32)
+        self._dst = np.zeros_like(self._src)
+        for j, t in enumerate(trans):
+            self._src[j, [self._step[s] for s in t.sources]] = 1
+            self._dst[j, [self._step[s] for s in t.targets]] = 1
+        self._sources = [[self._step[s] for s in t.sources] for t in trans]
+        self._timers_of = np.zeros((len(self.step_names), len(self.timer_names)), dtype=bool)
+        for timer in g.timers:
+            self._timers_of[self._step[timer.step], self._timer[timer.id]] = True
+        self._rec = [self._compile(t.receptivity) for t in trans]
+        orders: dict[str, None] = {}
+        self._actions: list[tuple[int, str, Columns | None]] = []
+        for s in g.steps:
+            for a in s.actions:
+                orders[a.order] = None
+                cond = self._compile(a.condition) if a.kind == CONDITIONAL and a.condition is not None else None
+                self._actions.append((self._step[s.name], a.order, cond))
+        self.order_names = tuple(sorted(orders))
+        self._order = {o: i for i, o in enumerate(self.order_names)}
+
+    # ------------------------------------------------------------------ compilation
+    def _code(self, e: Expr) -> str:
+        if isinstance(e, Var):  # Compare is refused by unsupported()
+            if e.name in self._timer:
+                return f"T[:, {self._timer[e.name]}]"
+            step = step_of(e.name, set(self._step))
+            if step is not None:
+                return f"A[:, {self._step[step]}]"
+            return f"I[:, {self._input[e.name]}]"
+        if isinstance(e, Const):
+            return "(~Z)" if e.value else "Z"
+        if isinstance(e, Edge):
+            return f"(E == {self.events.get(e.text(), -2)})"
+        if isinstance(e, Not):
+            return f"(~{self._code(e.arg)})"
+        op = " & " if isinstance(e, And) else " | "
+        return "(" + op.join(self._code(a) for a in e.args) + ")"
+
+    def _compile(self, e: Expr) -> Columns:
+        fn: Columns = eval(f"lambda I, A, T, E, Z: {self._code(e)}", {"__builtins__": {}})  # noqa: S307
+        return fn
+
+    # ------------------------------------------------------------------ situations as rows
+    def rows(self, sits: list[Situation]) -> tuple[np.ndarray, np.ndarray]:
+        """The bits (A, T) of ``sits``."""
+        A = np.zeros((len(sits), len(self.step_names)), dtype=bool)
+        T = np.zeros((len(sits), len(self.timer_names)), dtype=bool)
+        for r, s in enumerate(sits):
+            A[r, [self._step[x] for x in s.steps]] = True
+            T[r, [self._timer[x] for x in s.elapsed]] = True
+        return A, T
+
+    def situation(self, a: np.ndarray, t: np.ndarray) -> Situation:
+        """The situation of one row, as the machine builds it."""
+        steps = sorted_steps([self.step_names[i] for i in np.flatnonzero(a)])
+        return Situation(steps, (), tuple(sorted(self.timer_names[i] for i in np.flatnonzero(t))), ())
+
+    # ------------------------------------------------------------------ evolution
+    def _fireable(self, A: np.ndarray, T: np.ndarray, I: np.ndarray, E: np.ndarray) -> np.ndarray:
+        A, T, I = np.asfortranarray(A), np.asfortranarray(T), np.asfortranarray(I)
+        n = len(A)
+        Z = np.zeros(n, dtype=bool)
+        out = np.zeros((n, len(self._rec)), dtype=bool, order="F")
+        for j, rec in enumerate(self._rec):
+            sources = self._sources[j]
+            if sources:
+                col = A[:, sources[0]].copy()
+                for s in sources[1:]:
+                    col &= A[:, s]
+            else:
+                col = ~Z
+            if col.any():
+                out[:, j] = col & rec(I, A, T, E, Z)
+        return out
+
+    def react(self, A: np.ndarray, T: np.ndarray, I: np.ndarray, E: np.ndarray
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """The stable situations after the input events ``E`` (inputs ``I`` once they
+        happened) from the rows (A, T); the rows where a transition fired (``moved``); and
+        the rows left to the machine (``pending``: a conflict, or still evolving after
+        :data:`ROUNDS` rounds), whose bits are meaningless."""
+        A, T = A.copy(), T.copy()
+        pending = np.zeros(len(A), dtype=bool)
+        moved = np.zeros(len(A), dtype=bool)
+        live = np.arange(len(A))
+        ev = E
+        for _ in range(ROUNDS):
+            if not live.size:
+                return A, T, moved, pending
+            a, t = A[live], T[live]
+            fire = self._fireable(a, t, I[live], ev)
+            firing = fire.any(axis=1)
+            live, a, t, fire = live[firing], a[firing], t[firing], fire[firing].astype(np.int32)
+            moved[live] = True
+            leaving = fire @ self._src
+            conflict = (leaving > 1).any(axis=1)
+            pending[live[conflict]] = True
+            deact, act = leaving > 0, (fire @ self._dst) > 0
+            A[live] = (a & ~deact) | act
+            if self.timer_names:
+                T[live] = t & ~(((deact & ~act).astype(np.int32) @ self._timers_of) > 0)
+            live = live[~conflict]
+            ev = np.full(len(live), -1)
+        pending[live] = True
+        return A, T, moved, pending
+
+    def orders(self, A: np.ndarray, T: np.ndarray, I: np.ndarray) -> np.ndarray:
+        """The orders each row emits (columns :attr:`order_names`) on the input levels ``I``."""
+        out = np.zeros((len(A), len(self.order_names)), dtype=bool)
+        Z = np.zeros(len(A), dtype=bool)
+        E = np.full(len(A), -1)
+        for step, order, cond in self._actions:
+            col = A[:, step]
+            out[:, self._order[order]] |= col if cond is None else col & cond(I, A, T, E, Z)
+        return out

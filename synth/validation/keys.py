@@ -1,0 +1,95 @@
+"""Integer keys for the frontier explorer: sorted tables instead of a dictionary entry per
+state, distinct keys and rows found by sorting (never ``np.unique``, which imports
+``numpy.ma`` on its first call).
+
+Example
+-------
+>>> first, inverse = distinct(np.array([7, 3, 7, 5, 3]))
+>>> first.tolist(), inverse.tolist()
+([1, 3, 0], [2, 0, 2, 1, 0])
+>>> first_occurrences(np.array([7, 3, 7, 5, 3])).tolist()
+[0, 1, 3]
+>>> t = SortedKeys(); t.add(np.array([10, 4]), np.array([0, 1])); t.find(np.array([4, 5, 10])).tolist()
+[1, -1, 0]
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["SortedKeys", "distinct", "distinct_rows", "first_occurrences", "slices"]
+
+
+class SortedKeys:
+    """Integer keys kept sorted, each with an integer value: a lookup table without a
+    dictionary entry per key (insertions are merges of sorted arrays)."""
+
+    def __init__(self) -> None:
+        self.keys = np.empty(0, dtype=np.int64)
+        self.values = np.empty(0, dtype=np.int64)
+
+    def find(self, keys: np.ndarray) -> np.ndarray:
+        """The value of each key, -1 where absent."""
+        if not self.keys.size:
+            return np.full(len(keys), -1, dtype=np.int64)
+        pos = np.minimum(np.searchsorted(self.keys, keys), self.keys.size - 1)
+        return np.where(self.keys[pos] == keys, self.values[pos], -1)
+
+    def add(self, keys: np.ndarray, values: np.ndarray) -> None:
+        """Insert absent, distinct ``keys``."""
+        order = np.argsort(keys, kind="stable")
+        keys, values = keys[order], values[order]
+        pos = np.searchsorted(self.keys, keys)
+        self.keys = np.insert(self.keys, pos, keys)
+        self.values = np.insert(self.values, pos, values)
+
+
+def _groups(perm: np.ndarray, change: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """From a stable sorting permutation and where the sorted keys change (first True):
+    each group's first position and each position's group."""
+    inverse = np.empty(len(perm), dtype=np.int64)
+    inverse[perm] = np.cumsum(change) - 1
+    return perm[change], inverse
+
+
+def distinct(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The distinct keys, in increasing order, as the position of their first occurrence;
+    and each position's rank among them."""
+    perm = np.argsort(keys, kind="stable")
+    s = keys[perm]
+    change = np.ones(len(s), dtype=bool)
+    change[1:] = s[1:] != s[:-1]
+    return _groups(perm, change)
+
+
+def distinct_rows(bits: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`distinct` for the rows of a Boolean matrix."""
+    n, k = bits.shape
+    if k <= 62:
+        return distinct(bits.astype(np.int64) @ (np.int64(1) << np.arange(k, dtype=np.int64)))
+    packed = np.packbits(bits, axis=1)
+    packed = np.hstack([packed, np.zeros((n, -packed.shape[1] % 8), dtype=np.uint8)])
+    words = packed.view(np.uint64)
+    perm = np.lexsort(words.T[::-1])
+    s = words[perm]
+    change = np.ones(n, dtype=bool)
+    change[1:] = (s[1:] != s[:-1]).any(axis=1)
+    return _groups(perm, change)
+
+
+def first_occurrences(keys: np.ndarray) -> np.ndarray:
+    """Positions of the first occurrence of each distinct key, in the order they occur."""
+    return np.sort(distinct(keys)[0])
+
+
+def slices(starts: np.ndarray, groups: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The sizes of the slices ``starts[g]:starts[g + 1]`` of ``groups`` and their
+    positions, concatenated in order.
+
+    >>> counts, at = slices(np.array([0, 2, 2, 5]), np.array([2, 0]))
+    >>> counts.tolist(), at.tolist()
+    ([3, 2], [2, 3, 4, 0, 1])
+    """
+    counts = starts[groups + 1] - starts[groups]
+    at = np.repeat(starts[groups] - np.cumsum(counts) + counts, counts) + np.arange(int(counts.sum()))
+    return counts, at

@@ -1,0 +1,285 @@
+"""Plant states as integer codes, and many regions searched at once: the plant's side of
+the frontier explorer (:mod:`synth.validation.frontier`).
+
+A plant state is its flat code (mixed radices, :meth:`~synth.plant.composition.Plant.index`);
+:class:`PlantCodes` reads the element-local digits, the Grafcet's inputs and the orders'
+values of whole arrays of codes, follows the uncontrollable moves of a frontier, and
+decides SUP membership and SUP's refusals with the compiled constraints' factors (the
+same terms :class:`~synth.sup.constraints.CompiledConstraints` asks one state at a time).
+:func:`regions` runs :func:`synth.validation.sync.region` for many (entry, wanted orders)
+at once, layer by layer: the members of each region in the same breadth-first order, its
+settled states with the same prohibitions (computed by the oracle itself, only where a
+move was refused).
+
+Example
+-------
+>>> from synth.plant.composition import _plants, load_plant
+>>> from synth.sup.constraints import CompiledConstraints
+>>> from synth.plant.rules_check import load_rules
+>>> rs = load_rules(_plants("tri.rules"))
+>>> p = load_plant(_plants("tri.rules"))
+>>> pc = PlantCodes(p, CompiledConstraints(p, rs.constraints))
+>>> pc.kept(np.array([p.initial_index])).tolist()
+[True]
+"""
+
+from __future__ import annotations
+
+from typing import Iterable
+
+import numpy as np
+
+from synth.plant.composition import LocalTransition, Plant
+from synth.sup.constraints import CompiledConstraints
+from synth.validation.keys import SortedKeys, first_occurrences
+from synth.validation.sync import Prohibition, moves_by_order
+
+__all__ = ["Digits", "PlantCodes", "Regions", "regions"]
+
+
+class Digits:
+    """The element-local indices of an array of plant codes, each element's computed when
+    first read (``digits[axis]``)."""
+
+    def __init__(self, pc: PlantCodes, codes: np.ndarray) -> None:
+        self.codes, self.n = codes, len(codes)
+        self._pc = pc
+        self._axes: dict[int, np.ndarray] = {}
+        self._full: np.ndarray | None = None
+
+    def __getitem__(self, axis: int) -> np.ndarray:
+        hit = self._axes.get(axis)
+        if hit is None:
+            hit = self._axes[axis] = (self.codes // self._pc.stride[axis]) % self._pc.radix[axis]
+        return hit
+
+    def full(self) -> np.ndarray:
+        """Every element's indices, ndim × n."""
+        if self._full is None:
+            self._full = (self.codes[None, :] // self._pc.strides[:, None]) % self._pc.shape[:, None]
+            self._axes = dict(enumerate(self._full))
+        return self._full
+
+
+class _Moves:
+    """Local transitions as columns: element, source, code difference, order column."""
+
+    def __init__(self, moves: list[LocalTransition], strides: tuple[int, ...], column: list[int]) -> None:
+        self.moves = moves
+        self.axis = np.array([t.axis for t in moves], dtype=np.int64)
+        self.src = np.array([t.src for t in moves], dtype=np.int64)
+        self.delta = np.array([(t.dst - t.src) * strides[t.axis] for t in moves], dtype=np.int64)
+        self.column = np.array(column, dtype=np.int64)
+        self.guarded = [k for k, t in enumerate(moves) if t.guard is not None]
+        self.forbidding: list[int] = []  # moves an edge constraint may forbid
+
+
+class PlantCodes:
+    """Array reads of a plant's states given as flat codes (see module doc)."""
+
+    def __init__(self, p: Plant, oracle: CompiledConstraints) -> None:
+        self.plant, self.oracle = p, oracle
+        self.size = p.size
+        self.stride, self.radix = p.strides, p.shape
+        self.strides, self.shape = np.array(p.strides, dtype=np.int64), np.array(p.shape, dtype=np.int64)
+        self.uncontrollable = [t for t in p.transitions if not t.controllable]
+        self.moves = moves_by_order(p)
+        self.orders = tuple(sorted(self.moves))  # the region's order of the orders
+        self._values: dict[tuple[str, ...], list[tuple[int, np.ndarray, np.ndarray]]] = {}
+        self._guards: dict[int, tuple[list[tuple[int, np.ndarray]], np.ndarray]] = {}
+        self._u = _Moves(self.uncontrollable, p.strides, [0] * len(self.uncontrollable))
+        controllable = [t for o in self.orders for t in self.moves[o]]
+        self._c = _Moves(controllable, p.strides, [j for j, o in enumerate(self.orders) for _ in self.moves[o]])
+        self._c.forbidding = [k for k, t in enumerate(controllable) if oracle.edge_terms.get(t.event)]
+        self.controllable_moves = self._c
+        self._reach = [g.ravel() for g in oracle.reach_grids] if oracle.reach_grids is not None else None
+
+    def digits(self, codes: np.ndarray) -> Digits:
+        return Digits(self, codes)
+
+    def values(self, names: tuple[str, ...], digits: Digits) -> np.ndarray:
+        """The plant variables ``names`` at each state (n × len(names)); False for a name
+        the plant does not have."""
+        out = np.zeros((digits.n, len(names)), dtype=bool)
+        for axis, cols, table in self._tables(names):
+            out[:, cols] = table[digits[axis]]
+        return out
+
+    def _tables(self, names: tuple[str, ...]) -> list[tuple[int, np.ndarray, np.ndarray]]:
+        """Per element owning some of ``names``: their columns and their values per local state."""
+        hit = self._values.get(names)
+        if hit is None:
+            by_axis: dict[int, list[int]] = {}
+            for j, n in enumerate(names):
+                if n in self.plant.owner:
+                    by_axis.setdefault(self.plant.owner[n], []).append(j)
+            hit = self._values[names] = [
+                (a, np.array(cols), np.stack([self.plant.elements[a].value(names[j]) for j in cols], axis=1))
+                for a, cols in sorted(by_axis.items())]
+        return hit
+
+    @staticmethod
+    def holds(factors: Iterable[tuple[int, np.ndarray]], digits: Digits, rows: np.ndarray | None = None) -> np.ndarray:
+        """Whether a product term holds at each state (of ``rows`` only, when given)."""
+        out = np.ones(digits.n if rows is None else len(rows), dtype=bool)
+        for a, vec in factors:
+            out &= vec[digits[a] if rows is None else digits[a][rows]]
+        return out
+
+    def kept(self, codes: np.ndarray) -> np.ndarray:
+        """SUP membership of each state: no violation reachable by uncontrollable events."""
+        bad = np.zeros(len(codes), dtype=bool)
+        if self._reach is not None:
+            for g in self._reach:
+                bad |= g[codes]
+            return ~bad
+        digits = self.digits(codes)
+        for factors in self.oracle.level_reach:
+            bad |= self.holds(factors, digits)
+        return ~bad
+
+    def forbidden(self, t: LocalTransition, digits: Digits, rows: np.ndarray) -> np.ndarray:
+        """Where an edge constraint forbids the controllable ``t``, at ``rows``."""
+        out = np.zeros(len(rows), dtype=bool)
+        for term in self.oracle.edge_terms.get(t.event, ()):
+            out |= self.holds(term.factors, digits, rows)
+        return out
+
+    def successors(self, codes: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The uncontrollable moves from ``codes`` into SUP: (row, move rank, target code),
+        sorted by row then rank (the explicit engine's order)."""
+        digits = self.digits(codes)
+        u = self._u
+        ok = digits.full()[u.axis, :].T == u.src
+        for k in u.guarded:
+            rows = np.flatnonzero(ok[:, k])
+            if rows.size:
+                ok[rows, k] = self._guard(k, digits, rows)
+        row, rank = np.nonzero(ok)  # row-major: by row, then rank
+        target = codes[row] + u.delta[rank]
+        keep = self.kept(target)  # cannot fail from a SUP state; kept for safety, as the machine's path
+        return row[keep], rank[keep], target[keep]
+
+    def _guard(self, k: int, digits: Digits, rows: np.ndarray) -> np.ndarray:
+        """Uncontrollable move ``k``'s guard at ``rows`` (:meth:`Plant.enabled_digits`, its
+        read variables' tables made once)."""
+        hit = self._guards.get(k)
+        if hit is None:
+            t = self.uncontrollable[k]
+            assert t.guard is not None
+            reads = self.plant.elements[t.axis].reads
+            parts = [(self.plant.owner[r], self.plant.elements[self.plant.owner[r]].value(r).astype(np.int64) << j)
+                     for j, r in enumerate(reads)]
+            hit = self._guards[k] = (parts, np.asarray(t.guard, dtype=bool))
+        parts, guard = hit
+        code = np.zeros(len(rows), dtype=np.int64)
+        for axis, bits in parts:
+            code |= bits[digits[axis][rows]]
+        return guard[code]
+
+    def refusals(self, code: int, wanted: np.ndarray) -> tuple[Prohibition, ...]:
+        """The order changes SUP refuses in state ``code`` towards ``wanted`` (one bit per
+        :attr:`orders`), as :func:`~synth.validation.sync.region` lists them."""
+        cur = self.plant.local(code)
+        val = self.plant.valuation(cur)
+        refused: list[Prohibition] = []
+        for j, order in enumerate(self.orders):
+            if val[order] == bool(wanted[j]):
+                continue
+            for t in self.moves[order]:
+                if t.src == cur[t.axis]:
+                    ok, why = self.oracle.move(t, cur)
+                    if not ok:
+                        refused.append(Prohibition(t.event, tuple(why)))
+        return tuple(sorted(refused))
+
+
+class Regions:
+    """Regions searched so far, numbered in order: members and settled states as slices
+    of flat arrays (``starts[g]:starts[g + 1]``), prohibitions as indices into
+    :attr:`prohibitions`."""
+
+    def __init__(self) -> None:
+        self.member_starts = np.zeros(1, dtype=np.int64)
+        self.members = np.empty(0, dtype=np.int64)
+        self.settled_starts = np.zeros(1, dtype=np.int64)
+        self.settled = np.empty(0, dtype=np.int64)
+        self.settled_proh = np.empty(0, dtype=np.int64)
+        self.prohibitions: list[tuple[Prohibition, ...]] = [()]
+        self._proh_ids: dict[tuple[Prohibition, ...], int] = {(): 0}
+
+    @property
+    def count(self) -> int:
+        return len(self.member_starts) - 1
+
+    def proh_id(self, proh: tuple[Prohibition, ...]) -> int:
+        hit = self._proh_ids.get(proh)
+        if hit is None:
+            hit = self._proh_ids[proh] = len(self.prohibitions)
+            self.prohibitions.append(proh)
+        return hit
+
+    def append(self, members: np.ndarray, member_counts: np.ndarray, settled: np.ndarray, proh: np.ndarray,
+               settled_counts: np.ndarray) -> None:
+        self.member_starts = np.concatenate([self.member_starts, self.members.size + np.cumsum(member_counts)])
+        self.members = np.concatenate([self.members, members])
+        self.settled_starts = np.concatenate([self.settled_starts, self.settled.size + np.cumsum(settled_counts)])
+        self.settled = np.concatenate([self.settled, settled])
+        self.settled_proh = np.concatenate([self.settled_proh, proh])
+
+
+def regions(pc: PlantCodes, store: Regions, entries: np.ndarray, wanted: np.ndarray) -> None:
+    """Search the regions entered at ``entries`` under ``wanted`` (one row of bits over
+    ``pc.orders`` per entry) and append them to ``store``, in the order given."""
+    R = len(entries)
+    if R * pc.size >= 1 << 62:
+        raise OverflowError("region keys")
+    reg, cur = np.arange(R, dtype=np.int64), entries.astype(np.int64)
+    seen = SortedKeys()
+    seen.add(reg * pc.size + cur, reg)
+    member_parts, settled_parts = [(reg, cur)], []
+    while cur.size:
+        digits = pc.digits(cur)
+        values = pc.values(pc.orders, digits)
+        c = pc.controllable_moves
+        app = (values != wanted[reg])[:, c.column] & (digits.full()[c.axis, :].T == c.src)
+        row, rank = np.nonzero(app)  # row-major: by row, then the region's order of the moves
+        target = cur[row] + c.delta[rank]
+        ok = pc.kept(target)
+        for k in c.forbidding:
+            at = np.flatnonzero(rank == k)
+            if at.size:
+                ok[at] &= ~pc.forbidden(c.moves[k], digits, row[at])
+        refused = np.zeros(cur.size, dtype=bool)
+        refused[row[~ok]] = True
+        progressed = np.zeros(cur.size, dtype=bool)
+        progressed[row[ok]] = True
+        still = ~progressed
+        settled_parts.append((reg[still], cur[still], refused[still]))
+        if not ok.any():
+            break
+        nreg, target = reg[row[ok]], target[ok]
+        keys = nreg * pc.size + target
+        first = first_occurrences(keys)
+        first = first[seen.find(keys[first]) < 0]
+        reg, cur = nreg[first], target[first]
+        seen.add(reg * pc.size + cur, reg)
+        member_parts.append((reg, cur))
+    _store(pc, store, R, member_parts, settled_parts, wanted)
+
+
+def _store(pc: PlantCodes, store: Regions, R: int, member_parts: list[tuple[np.ndarray, np.ndarray]],
+           settled_parts: list[tuple[np.ndarray, np.ndarray, np.ndarray]], wanted: np.ndarray) -> None:
+    """Group the layers' members and settled states by region (breadth-first order kept)."""
+    mreg = np.concatenate([r for r, _ in member_parts])
+    mcode = np.concatenate([c for _, c in member_parts])
+    order = np.argsort(mreg, kind="stable")
+    sreg = np.concatenate([r for r, _, _ in settled_parts])
+    scode = np.concatenate([c for _, c, _ in settled_parts])
+    sref = np.concatenate([f for _, _, f in settled_parts])
+    sorder = np.argsort(sreg, kind="stable")
+    sreg, scode, sref = sreg[sorder], scode[sorder], sref[sorder]
+    proh = np.zeros(len(scode), dtype=np.int64)
+    for i in np.flatnonzero(sref).tolist():
+        proh[i] = store.proh_id(pc.refusals(int(scode[i]), wanted[sreg[i]]))
+    store.append(mcode[order], np.bincount(mreg, minlength=R), scode, proh, np.bincount(sreg, minlength=R))
