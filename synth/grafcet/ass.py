@@ -11,7 +11,7 @@ from __future__ import annotations
 from collections import deque
 from dataclasses import dataclass, field
 from functools import partial
-from typing import Callable, Mapping
+from typing import Callable, Mapping, NamedTuple
 
 from synth.errors import LimitExceeded
 from synth.logic.cubes import Cubes, condition_text
@@ -19,7 +19,7 @@ from synth.logic.events import Event, EventKind
 from synth.grafcet.machine import GrafcetMachine, Situation
 from synth.grafcet.recorder import InputRecorder
 
-__all__ = ["ASSState", "ASSTransition", "ASS", "stable_situation_automaton", "MAX_INPUTS"]
+__all__ = ["ASSState", "ASSTransition", "ASS", "stable_situation_automaton", "stable_situations", "MAX_INPUTS"]
 
 
 
@@ -71,31 +71,51 @@ class ASS:
 MAX_INPUTS = 20
 
 
-def stable_situation_automaton(
-    machine: GrafcetMachine,
-    *,
-    initial_inputs: Mapping[str, bool] | None = None,
-    max_states: int = 100_000,
-    admissible: Callable[[Mapping[str, bool]], bool] | None = None,
-) -> ASS:
-    """The ASS of ``machine``, explored from its initial situation.
+class _Explored(NamedTuple):
+    """What the exploration of :func:`stable_situation_automaton` found."""
 
-    The exploration runs over pairs (stable situation, valuation of the inputs the
-    Grafcet reads); from each, every read input may flip (one event) and every running
-    timer may elapse. Pairs are then projected on situations. ``initial_inputs`` gives
-    the initial input values (default: all 0; inputs not read never matter).
-    Sets of valuations are handled as bit sets, so a situation is processed at once
-    for all the valuations that reach it.
+    cubes: Cubes
+    index: dict[str, int]
+    read: tuple[str, ...]
+    base: dict[str, bool]
+    sits: list[Situation]
+    reached: list[int]  # per situation, the input vectors it is reached with
+    moves: dict[tuple[int, Event], dict[int, int]]  # (situation, label) -> {target: vectors before}
+    labels: list[Event]
+
+    def valuation(self, v: int) -> dict[str, bool]:
+        return _valuation(self.base, self.index, v)
+
+
+def _valuation(base: dict[str, bool], index: dict[str, int], v: int) -> dict[str, bool]:
+    """The inputs' values: ``base``, with the read inputs (bit ``index[n]``) taken from ``v``."""
+    d = dict(base)
+    for n, i in index.items():
+        d[n] = bool(v >> i & 1)
+    return d
+
+
+def stable_situations(machine: GrafcetMachine, *, max_states: int = 100_000) -> tuple[Situation, ...]:
+    """The situations of the ASS of ``machine`` (inputs all 0 at first), without its orders nor
+    the conditions of its transitions, in an order of their own (what needs only the set of
+    situations is spared the covers of every reached input vector).
 
     >>> from synth.grafcet.language_check import parse_grafcet
     >>> g = parse_grafcet("grafcet G { initial step 0 step 1: A "
     ...                   "transition 0 -> 1 when ↑a . b  transition 1 -> 0 when !b }")
-    >>> ass = stable_situation_automaton(GrafcetMachine(g))
-    >>> [(s.id, s.situation.text(), s.orders) for s in ass.states]
-    [(0, '{X0}', ()), (1, '{X1}', ('A',))]
-    >>> [(t.source, t.event, t.condition, t.target) for t in ass.transitions]
-    [(0, '↑a', 'b', 1), (1, '↓b', 'any', 0)]
+    >>> [s.text() for s in stable_situations(GrafcetMachine(g))]
+    ['{X0}', '{X1}']
     """
+    return tuple(_explore(machine, None, max_states, None, closed=True).sits)
+
+
+def _explore(machine: GrafcetMachine, initial_inputs: Mapping[str, bool] | None, max_states: int,
+             admissible: Callable[[Mapping[str, bool]], bool] | None, closed: bool = False) -> _Explored:
+    """The pairs (stable situation, input vectors) reachable from the initial situation, and
+    the moves between situations (see :func:`stable_situation_automaton`). ``closed``: each
+    situation taken from the queue first gets every vector the inputs its reactions ignore
+    reach (the same pairs in the end, found in fewer passes but in another order, so the
+    situations' numbering differs: for :func:`stable_situations` only)."""
     base = {n: bool((initial_inputs or {}).get(n, False)) for n in machine.inputs}
     read = machine.read_inputs
     n_in = len(read)
@@ -103,12 +123,7 @@ def stable_situation_automaton(
         raise LimitExceeded(f"the Grafcet reads {n_in} inputs; the ASS is explored for at most {MAX_INPUTS}")
     index = {n: i for i, n in enumerate(read)}
     cubes = Cubes(n_in)
-
-    def valuation(v: int) -> dict[str, bool]:
-        d = dict(base)
-        for n, i in index.items():
-            d[n] = bool(v >> i & 1)
-        return d
+    valuation = partial(_valuation, base, index)
 
     v0 = sum(1 << i for n, i in index.items() if base[n])
     allowed = -1  # every vector
@@ -155,7 +170,7 @@ def stable_situation_automaton(
             hit = rest & covered
             if hit:
                 out[target] = out.get(target, 0) | hit
-                rest &= ~covered
+                rest ^= hit
         while rest:
             v = (rest & -rest).bit_length() - 1
             reader = InputRecorder(partial(valuation, v))
@@ -168,8 +183,9 @@ def stable_situation_automaton(
             target = known(result)
             covered = cubes.cube({index[n]: x for n, x in reader.cell().items() if n in index})
             entries.append((covered, target))
-            out[target] = out.get(target, 0) | (rest & covered)
-            rest &= ~covered
+            hit = rest & covered
+            out[target] = out.get(target, 0) | hit
+            rest ^= hit
         return out
 
     def add(k: int, vectors: int) -> None:
@@ -185,17 +201,28 @@ def stable_situation_automaton(
         k = queue.popleft()
         queued.discard(k)
         todo, pending[k] = pending[k], 0
+        if closed:  # the vectors the inputs k's reactions ignore reach, at once (no admissible: a product)
+            more = todo
+            for i in range(n_in):
+                if not relevant[k] >> i & 1:
+                    more |= cubes.flip(more, i)
+            todo |= more & ~reached[k]
+            reached[k] |= todo
         for i, n in enumerate(read):
+            if not relevant[k] >> i & 1:  # both edges at once: k again, with the input flipped
+                if not closed:
+                    after = cubes.flip(todo, i)
+                    add(k, after if allowed == -1 else after & allowed)
+                continue
             for rising in (True, False):
                 src = todo & (cubes.zero[i] if rising else cubes.one[i])
                 if not src:
                     continue
-                after = cubes.flip(src, i) & allowed
-                if not after:
-                    continue
-                if not relevant[k] >> i & 1:
-                    add(k, after)
-                    continue
+                after = cubes.flip(src, i)
+                if allowed != -1:
+                    after &= allowed
+                    if not after:
+                        continue
                 label = labels[2 * i + (0 if rising else 1)]
                 for target, vecs in classify(k, label, after).items():
                     add(target, vecs)
@@ -208,10 +235,46 @@ def stable_situation_automaton(
                 if target != k:
                     m = moves.setdefault((k, t), {})
                     m[target] = m.get(target, 0) | vecs
+    return _Explored(cubes, index, read, base, sits, reached, moves, labels)
+
+
+def stable_situation_automaton(
+    machine: GrafcetMachine,
+    *,
+    initial_inputs: Mapping[str, bool] | None = None,
+    max_states: int = 100_000,
+    admissible: Callable[[Mapping[str, bool]], bool] | None = None,
+) -> ASS:
+    """The ASS of ``machine``, explored from its initial situation.
+
+    The exploration runs over pairs (stable situation, valuation of the inputs the
+    Grafcet reads); from each, every read input may flip (one event) and every running
+    timer may elapse. Pairs are then projected on situations. ``initial_inputs`` gives
+    the initial input values (default: all 0; inputs not read never matter).
+    Sets of valuations are handled as bit sets, so a situation is processed at once
+    for all the valuations that reach it.
+
+    >>> from synth.grafcet.language_check import parse_grafcet
+    >>> g = parse_grafcet("grafcet G { initial step 0 step 1: A "
+    ...                   "transition 0 -> 1 when ↑a . b  transition 1 -> 0 when !b }")
+    >>> ass = stable_situation_automaton(GrafcetMachine(g))
+    >>> [(s.id, s.situation.text(), s.orders) for s in ass.states]
+    [(0, '{X0}', ()), (1, '{X1}', ('A',))]
+    >>> [(t.source, t.event, t.condition, t.target) for t in ass.transitions]
+    [(0, '↑a', 'b', 1), (1, '↓b', 'any', 0)]
+    """
+    ex = _explore(machine, initial_inputs, max_states, admissible)
+    cubes, index, read, sits, reached, moves, labels = ex.cubes, ex.index, ex.read, ex.sits, ex.reached, ex.moves, ex.labels
+    valuation, n_in = ex.valuation, len(read)
     # states, with the orders they emit
     states: list[ASSState] = []
     for k, sit in enumerate(sits):
-        emitted = {machine.orders(sit, valuation(v)) for v in cubes.members(reached[k])}
+        emitted: set[frozenset[str]] = set()
+        rest = reached[k]
+        while rest:  # one run per cube of the inputs the orders read, not one per vector
+            reader = InputRecorder(partial(valuation, (rest & -rest).bit_length() - 1))
+            emitted.add(machine.orders(sit, reader))
+            rest &= ~cubes.cube({index[n]: x for n, x in reader.cell().items() if n in index})
         union = frozenset().union(*emitted) if emitted else frozenset()
         always = frozenset.intersection(*emitted) if emitted else frozenset()
         outs = tuple(o for o in machine.outputs if o in union)
@@ -231,4 +294,4 @@ def stable_situation_automaton(
             on = by_target[target] & domain
             trans.append(ASSTransition(k, label, condition_text(cubes, on, domain & ~on, read, free), target))
     trans.sort(key=lambda t: (t.source, rank.get(t.event, len(rank)), t.event, t.target))
-    return ASS(tuple(states), tuple(trans), 0, read, tuple((n, base[n]) for n in read), machine.sfc)
+    return ASS(tuple(states), tuple(trans), 0, read, tuple((n, ex.base[n]) for n in read), machine.sfc)
