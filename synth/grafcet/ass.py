@@ -135,6 +135,7 @@ def _explore(machine: GrafcetMachine, initial_inputs: Mapping[str, bool] | None,
     reached: list[int] = [1 << v0]
     pending: list[int] = [1 << v0]
     relevant: list[int] = []
+    by_steps: dict[tuple[str, ...], int] = {}
     timers: list[tuple[Event, ...]] = []
     labels: list[Event] = [Event.edge(n, r) for n in read for r in (True, False)]
     # (situation, label) -> [(vectors covered, target)], from memoised runs
@@ -155,7 +156,10 @@ def _explore(machine: GrafcetMachine, initial_inputs: Mapping[str, bool] | None,
             pending.append(0)
         while len(relevant) < len(sits):
             j = len(relevant)
-            relevant.append(sum(1 << index[x] for x in machine.relevant_inputs(sits[j]) if x in index))
+            bits = by_steps.get(sits[j].steps)  # the relevant inputs depend on the active steps alone
+            if bits is None:
+                bits = by_steps[sits[j].steps] = sum(1 << index[x] for x in machine.relevant_inputs(sits[j]) if x in index)
+            relevant.append(bits)
             timers.append(machine.timers(sits[j]))
         return k
 
