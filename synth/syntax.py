@@ -18,7 +18,6 @@ import sys
 import types
 from enum import StrEnum
 from functools import lru_cache
-from importlib import resources
 from pathlib import Path
 
 from typing import Any, Sequence
@@ -106,13 +105,26 @@ _TERMINAL_TEXT = {
 
 
 def grammar_text(name: str) -> str:
-    """Text of ``grammars/<name>.lark``, from the installed package or the source tree."""
+    """Text of ``grammars/<name>.lark``, from the installed package or the source tree.
+
+    An installed package that is a folder (a wheel or an editable install) is read as
+    files: ``importlib.resources`` is only needed inside a zip, and imports ``zipfile``."""
     filename = f"{name}.lark"
-    try:
-        return resources.files("synth.grammars").joinpath(filename).read_text(encoding="utf-8")
-    except (ModuleNotFoundError, FileNotFoundError):
-        here = Path(__file__).resolve().parent.parent / "grammars" / filename
-        return here.read_text(encoding="utf-8")
+    from importlib.util import find_spec
+
+    spec = find_spec("synth.grammars")
+    if spec is not None:  # installed
+        folder = Path(next(iter(spec.submodule_search_locations or ()), "")) / filename
+        if folder.is_file():
+            return folder.read_text(encoding="utf-8")
+        from importlib import resources
+
+        try:
+            return resources.files("synth.grammars").joinpath(filename).read_text(encoding="utf-8")
+        except FileNotFoundError:
+            pass
+    here = Path(__file__).resolve().parent.parent / "grammars" / filename  # a source tree not installed
+    return here.read_text(encoding="utf-8")
 
 
 @lru_cache(maxsize=None)
