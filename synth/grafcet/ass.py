@@ -136,6 +136,7 @@ def _explore(machine: GrafcetMachine, initial_inputs: Mapping[str, bool] | None,
     pending: list[int] = [1 << v0]
     relevant: list[int] = []
     by_steps: dict[tuple[str, ...], int] = {}
+    cube_of: dict[tuple[tuple[int, bool], ...], int] = {}
     timers: list[tuple[Event, ...]] = []
     labels: list[Event] = [Event.edge(n, r) for n in read for r in (True, False)]
     # (situation, label) -> [(vectors covered, target)], from memoised runs
@@ -185,7 +186,10 @@ def _explore(machine: GrafcetMachine, initial_inputs: Mapping[str, bool] | None,
             else:
                 result = machine.react_event(sits[k], event, reader)[0]
             target = known(result)
-            covered = cubes.cube({index[n]: x for n, x in reader.cell().items() if n in index})
+            cell = tuple((index[n], x) for n, x in reader.cell().items() if n in index)
+            covered = cube_of.get(cell)
+            if covered is None:  # the same few cells come back in situation after situation
+                covered = cube_of[cell] = cubes.cube(dict(cell))
             entries.append((covered, target))
             hit = rest & covered
             out[target] = out.get(target, 0) | hit
