@@ -75,7 +75,7 @@ class _Explored(NamedTuple):
     """What the exploration of :func:`stable_situation_automaton` found."""
 
     cubes: Cubes
-    index: dict[str, int]
+    position: dict[str, int]  # read input -> its bit in a vector
     read: tuple[str, ...]
     base: dict[str, bool]
     sits: list[Situation]
@@ -84,7 +84,7 @@ class _Explored(NamedTuple):
     labels: list[Event]
 
     def valuation(self, v: int) -> dict[str, bool]:
-        return _valuation(self.base, self.index, v)
+        return _valuation(self.base, self.position, v)
 
 
 def _valuation(base: dict[str, bool], index: dict[str, int], v: int) -> dict[str, bool]:
@@ -187,9 +187,10 @@ def _explore(machine: GrafcetMachine, initial_inputs: Mapping[str, bool] | None,
                 result = machine.react_event(sits[k], event, reader)[0]
             target = known(result)
             cell = tuple((index[n], x) for n, x in reader.cell().items() if n in index)
-            covered = cube_of.get(cell)
-            if covered is None:  # the same few cells come back in situation after situation
-                covered = cube_of[cell] = cubes.cube(dict(cell))
+            known_cube = cube_of.get(cell)
+            if known_cube is None:  # the same few cells come back in situation after situation
+                known_cube = cube_of[cell] = cubes.cube(dict(cell))
+            covered = known_cube
             entries.append((covered, target))
             hit = rest & covered
             out[target] = out.get(target, 0) | hit
@@ -272,7 +273,7 @@ def stable_situation_automaton(
     [(0, '↑a', 'b', 1), (1, '↓b', 'any', 0)]
     """
     ex = _explore(machine, initial_inputs, max_states, admissible)
-    cubes, index, read, sits, reached, moves, labels = ex.cubes, ex.index, ex.read, ex.sits, ex.reached, ex.moves, ex.labels
+    cubes, index, read, sits, reached, moves, labels = ex.cubes, ex.position, ex.read, ex.sits, ex.reached, ex.moves, ex.labels
     valuation, n_in = ex.valuation, len(read)
     # states, with the orders they emit
     states: list[ASSState] = []
