@@ -18,19 +18,19 @@ its warning), simultaneous divergences of two to four branches of two steps, ste
 ``N``, ``S``, ``R`` on outputs and ``P`` inline bodies. Each ``synth import FILE -o OUT``
 runs in a fresh process (that tree first on ``PYTHONPATH``, run from a neutral folder),
 timed in CPU seconds (user + system of the child); trees and runs are interleaved and
-the minimum is printed, with whether every tree wrote the same ``.g7`` and messages.
+the minimum is printed, with whether every tree wrote the same ``.g7`` and the same notes and
+warnings (``--json``).
 ``--write DIR`` keeps the generated charts.
 """
 
 from __future__ import annotations
 
 import argparse
-import os
-import resource
-import subprocess
 import sys
 import tempfile
 from pathlib import Path
+
+from speed import _child  # one fresh process, its CPU seconds (bench/speed.py)
 
 HEADERS = {
     "codesys": ('<project xmlns="http://www.plcopen.org/xml/tc6_0200">\n'
@@ -232,20 +232,6 @@ def chart_xml(steps: int, dialect: str) -> str:
             '    </pous>\n  </types>\n  <instances><configurations /></instances>\n</project>\n')
 
 
-def _child(tree: Path, argv: list[str], timeout: float) -> tuple[float, str, int]:
-    """CPU seconds, output (stdout and stderr) and exit code of one fresh process."""
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    env = dict(os.environ, PYTHONPATH=str(tree))
-    try:
-        done = subprocess.run([sys.executable, *argv], capture_output=True, text=True, env=env, timeout=timeout,
-                              cwd=tempfile.gettempdir(), check=False)
-        out, code = done.stdout + done.stderr, done.returncode
-    except subprocess.TimeoutExpired:
-        out, code = "", -1
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime, out, code
-
-
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--tree", action="append", type=Path, help="a synth source tree (default: this one); repeat to compare")
@@ -268,7 +254,8 @@ def main() -> int:
                 for _ in range(args.runs):
                     for k, tree in enumerate(trees):
                         g7 = Path(tmp) / f"out{k}.g7"
-                        seconds, out, code = _child(tree, ["-m", "synth", "import", str(xml), "-o", str(g7)], args.timeout)
+                        seconds, out, code = _child(tree, ["-m", "synth", "import", str(xml), "-o", str(g7), "--json"],
+                                                    args.timeout)
                         outputs[tree] = (g7.read_text() if g7.exists() else "", out, code)
                         best[tree] = min(best.get(tree, seconds), seconds)
                 same = len({v for v in outputs.values()}) == 1
