@@ -252,8 +252,9 @@ def main() -> int:
                 best: dict[Path, float] = {}
                 outputs: dict[Path, tuple[str, str, int]] = {}
                 for _ in range(args.runs):
-                    for k, tree in enumerate(trees):
-                        g7 = Path(tmp) / f"out{k}.g7"
+                    for tree in trees:
+                        g7 = Path(tmp) / "out.g7"  # one name: --json prints it
+                        g7.unlink(missing_ok=True)
                         seconds, out, code = _child(tree, ["-m", "synth", "import", str(xml), "-o", str(g7), "--json"],
                                                     args.timeout)
                         outputs[tree] = (g7.read_text() if g7.exists() else "", out, code)
