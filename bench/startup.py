@@ -1,4 +1,4 @@
-"""Start-up and end-to-end wall time of ``synth`` commands, a fresh process per run
+"""Start-up and end-to-end time of ``synth`` commands, a fresh process per run
 (``python -S``: interpreter start included, site-packages' ``.pth`` hooks left out).
 
     python3 bench/startup.py [--runs 15] [--tree DIR] [--tree OTHER_DIR]
@@ -9,7 +9,9 @@ before and after a change) are measured side by side in one run, their runs
 interleaved so that a change in the machine's load hits both alike. Prints the median
 and the minimum of each command, in milliseconds, process start included, and the
 floors under them measured the same way: the bare interpreter (``-c pass``),
-``import numpy`` and ``import lark``.
+``import numpy``, ``import lark`` and ``import numpy, lark`` (issue 37's floor). The time
+is the child's CPU time (user + system, ``resource.getrusage``: what a loaded machine
+changes least), or its wall time with ``--wall``.
 
 Like an installed wheel (pip compiles its ``.pyc`` files), every run reads compiled
 bytecode: ``PYTHONDONTWRITEBYTECODE`` is removed from the environment, bytecode goes
@@ -21,6 +23,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import resource
 import statistics
 import subprocess
 import sys
@@ -39,7 +42,9 @@ FLOORS = {
     "python -S -c pass": ["-c", "pass"],
     "python -S -c 'import numpy'": ["-c", "import numpy"],
     "python -S -c 'import lark'": ["-c", "import lark"],
+    "python -S -c 'import numpy, lark'": ["-c", "import numpy, lark"],
 }
+WALL = False  # --wall: wall time instead of CPU time
 
 
 def environment(tree: Path | None, pycache: str) -> dict[str, str]:
@@ -54,12 +59,17 @@ def environment(tree: Path | None, pycache: str) -> dict[str, str]:
 
 
 def run_once(args: list[str], env: dict[str, str], cwd: str) -> float:
-    """Wall time of one fresh ``python -S ARGS`` process, in milliseconds, run in ``cwd``,
-    an empty folder (the current folder comes first on ``sys.path``: a stray ``.py`` file
-    there could shadow a module)."""
+    """CPU time (or wall time, ``WALL``) of one fresh ``python -S ARGS`` process, in
+    milliseconds, run in ``cwd``, an empty folder (the current folder comes first on
+    ``sys.path``: a stray ``.py`` file there could shadow a module)."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
     done = subprocess.run([sys.executable, "-S", *args], cwd=cwd, env=env, capture_output=True, check=False)
-    elapsed = (time.perf_counter() - start) * 1000
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    if WALL:
+        elapsed = (time.perf_counter() - start) * 1000
+    else:
+        elapsed = (after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime) * 1000
     if done.returncode not in (0, 1):  # validate exits 1 when it finds problems
         sys.exit(f"{' '.join(args)} failed ({done.returncode}):\n{done.stderr.decode(errors='replace')}")
     return elapsed
@@ -85,15 +95,22 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--runs", type=int, default=15)
     ap.add_argument("--tree", action="append", type=Path, help="a synth source tree (repeatable)")
+    ap.add_argument("--wall", action="store_true", help="wall time instead of the child's CPU time")
+    ap.add_argument("--only", help="the commands to time, comma-separated names of COMMANDS (default: all)")
     args = ap.parse_args()
+    global WALL
+    WALL = args.wall
     trees = args.tree or [ROOT]
     with tempfile.TemporaryDirectory(prefix="synth-pycache-") as pycache, \
             tempfile.TemporaryDirectory(prefix="synth-startup-") as cwd:
         envs = [environment(tree, pycache) for tree in trees]
-        print(f"python {sys.version.split()[0]}, {args.runs} runs per cell, median (minimum) wall time, "
+        print(f"python {sys.version.split()[0]}, {args.runs} runs per cell, median (minimum) "
+              f"{'wall' if WALL else 'CPU'} time, "
               f"bytecode cached in a temporary PYTHONPYCACHEPREFIX")
         print(f"{'command':<32}" + "".join(f"{t.resolve().name[:24]:>26}" for t in trees))
         for name, argv in COMMANDS.items():
+            if args.only and name not in args.only.split(","):
+                continue
             row = measure([(["-m", "synth", *argv], env) for env in envs], args.runs, cwd)
             print(f"{name:<32}" + "".join(f"{cell(ms):>26}" for ms in row))
         floor_env = environment(None, pycache)

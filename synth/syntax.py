@@ -18,7 +18,6 @@ import sys
 import types
 from enum import StrEnum
 from functools import lru_cache
-from importlib import resources
 from pathlib import Path
 
 from typing import Any, Sequence
@@ -59,7 +58,7 @@ def _import_lark() -> None:
 
 _import_lark()
 
-from lark import Lark, Token, Transformer, Tree, UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken  # noqa: E402
+from lark import Lark, Token, Transformer, Tree, UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken, __version__ as lark_version  # noqa: E402,E501
 
 from synth.errors import InputError, InputErrors, Location, location_in, source_lines  # noqa: E402
 from synth.logic.expr import And, Const, Edge, Expr, Not, Or, Var  # noqa: E402
@@ -106,13 +105,19 @@ _TERMINAL_TEXT = {
 
 
 def grammar_text(name: str) -> str:
-    """Text of ``grammars/<name>.lark``, from the installed package or the source tree."""
-    filename = f"{name}.lark"
+    """Text of ``grammars/<name>.lark``: installed (a folder read as files, no zipfile) or in the source tree."""
+    from importlib.util import find_spec
+
+    spec, filename = find_spec("synth.grammars"), f"{name}.lark"
+    for folder in (spec.submodule_search_locations or []) if spec is not None else []:
+        if (Path(folder) / filename).is_file():
+            return (Path(folder) / filename).read_text(encoding="utf-8")
     try:
+        from importlib import resources
+
         return resources.files("synth.grammars").joinpath(filename).read_text(encoding="utf-8")
     except (ModuleNotFoundError, FileNotFoundError):
-        here = Path(__file__).resolve().parent.parent / "grammars" / filename
-        return here.read_text(encoding="utf-8")
+        return (Path(__file__).resolve().parent.parent / "grammars" / filename).read_text(encoding="utf-8")
 
 
 @lru_cache(maxsize=None)
@@ -133,21 +138,17 @@ def _cache_file(name: str, start: str, text: str) -> Path | None:
     """Where lark keeps the tables of one grammar: ``$XDG_CACHE_HOME/synth`` (by default
     ``~/.cache/synth``), one file per grammar text, start rule and lark version (never the
     shared temporary folder); ``None`` when there is no home to cache in."""
-    import os
     import zlib  # a checksum for the file name (hashlib loads OpenSSL: 3 ms of every command)
 
-    import lark
-
-    base = os.environ.get("XDG_CACHE_HOME") or (os.path.join(os.path.expanduser("~"), ".cache") if os.path.expanduser("~") != "~" else "")
+    home = os.path.expanduser("~")
+    base = os.environ.get("XDG_CACHE_HOME") or (os.path.join(home, ".cache") if home != "~" else "")
     if not base:
         return None
-    key = f"{zlib.crc32(text.encode()):08x}-{lark.__version__}"
-    folder = Path(base) / "synth"
     try:
-        folder.mkdir(parents=True, exist_ok=True)
+        (folder := Path(base) / "synth").mkdir(parents=True, exist_ok=True)
     except OSError:
         return None
-    return folder / f"lark-{name}-{start}-{key}.cache"
+    return folder / f"lark-{name}-{start}-{zlib.crc32(text.encode()):08x}-{lark_version}.cache"
 
 
 def _shown(terminal: str, p: Lark) -> str:

@@ -169,6 +169,52 @@ def test_a_selection_divergence_keeps_its_sfc_priority_with_a_warning():
         "program that runs there, validate the receptivities as written, without this rewrite"], LAMP_HELD]
 
 
+def _selection_of(n: int) -> bytes:
+    """A Beremiz chart: from Init, a selection divergence of ``n`` branches (branch k on
+    ``ck``), each one step and a jump back to Init on ``done``."""
+    def cond(i: int, text: str) -> str:
+        return (f'<transition localId="{i}"><position x="0" y="0" />{{into}}<condition><inline name="">'
+                f"<ST><xhtml:p><![CDATA[{text}]]></xhtml:p></ST></inline></condition></transition>")
+    parts = ['<step localId="1" name="Init" initialStep="true"><position x="0" y="0" /></step>',
+             '<selectionDivergence localId="2"><position x="0" y="0" /><connectionPointIn><connection refLocalId="1" />'
+             '</connectionPointIn>' + "".join(f'<connectionPointOut formalParameter="{k}" />' for k in range(n)) +
+             "</selectionDivergence>"]
+    for k in range(n):
+        t, s, back, jump = 10 + 4 * k, 11 + 4 * k, 12 + 4 * k, 13 + 4 * k
+        parts.append(cond(t, f"c{k}").format(into=f'<connectionPointIn><connection refLocalId="2" formalParameter="{k}" />'
+                                                  "</connectionPointIn>"))
+        parts.append(f'<step localId="{s}" name="B{k}"><position x="0" y="0" /><connectionPointIn><connection '
+                     f'refLocalId="{t}" /></connectionPointIn></step>')
+        parts.append(cond(back, "done").format(into=f'<connectionPointIn><connection refLocalId="{s}" /></connectionPointIn>'))
+        parts.append(f'<jumpStep localId="{jump}" targetName="Init"><position x="0" y="0" /><connectionPointIn>'
+                     f'<connection refLocalId="{back}" /></connectionPointIn></jumpStep>')
+    inputs = "".join(f'<variable name="{v}"><type><BOOL /></type></variable>' for v in [*(f"c{k}" for k in range(n)), "done"])
+    return ('<?xml version="1.0" encoding="utf-8"?>\n<project xmlns="http://www.plcopen.org/xml/tc6_0201" '
+            'xmlns:xhtml="http://www.w3.org/1999/xhtml"><fileHeader companyName="x" productName="Beremiz" '
+            'productVersion="1" creationDateTime="2024-01-01T00:00:00" /><contentHeader name="p">'
+            '<coordinateInfo><fbd><scaling x="1" y="1" /></fbd><ld><scaling x="1" y="1" /></ld><sfc><scaling x="1" '
+            'y="1" /></sfc></coordinateInfo></contentHeader><types><dataTypes /><pous><pou name="Sel" pouType="program">'
+            f'<interface><inputVars>{inputs}</inputVars></interface><body><SFC>\n' + "\n".join(parts) +
+            "\n</SFC></body></pou></pous></types><instances><configurations /></instances></project>\n").encode()
+
+
+def test_each_later_branch_of_a_selection_excludes_the_earlier_ones_as_written():
+    """Branch k excludes branches 0..k-1 as the chart writes them, not their rewrites (which
+    would double the text at each branch: 2^k copies of the first condition)."""
+    warnings: list[InputError] = []
+    text = import_sfc(_selection_of(4), "sel.xml", warnings=warnings)
+    assert [line for line in text.splitlines() if line.startswith("  transition Init")] == [
+        "  transition Init -> B0 when c0",
+        "  transition Init -> B1 when (c1) & !(c0)",
+        "  transition Init -> B2 when (c2) & !(c0) & !(c1)",
+        "  transition Init -> B3 when (c3) & !(c0) & !(c1) & !(c2)"]
+    assert [w.render().splitlines()[3:6] for w in warnings] == [[
+        "  = note: Init -> B1 when (c1) & !(c0)", "  = note: Init -> B2 when (c2) & !(c0) & !(c1)",
+        "  = note: Init -> B3 when (c3) & !(c0) & !(c1) & !(c2)"]]
+    text = import_sfc(_selection_of(16), "sel.xml")  # a mode selector of sixteen
+    assert next(line for line in text.splitlines() if line.startswith("  transition Init -> B15 ")) == "  transition Init -> B15 when (c15) & !(c0) & " + " & ".join(f"!(c{k})" for k in range(1, 15))
+
+
 def test_a_level_self_loop_jump_is_imported_with_a_warning():
     xml = as_codesys((DATA / "beremiz_ld_fbd.xml").read_text().replace('targetName="Idle"', 'targetName="On"'))
     warnings: list[InputError] = []

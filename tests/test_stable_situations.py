@@ -509,3 +509,30 @@ def test_timers_of_one_step_elapse_shortest_first():
     assert s1.steps == ("1",)
     assert m.timers(s1) == ("2s/X1",)  # 5s/X1 cannot elapse before 2s/X1
     assert m.fire_timer(s1, "2s/X1", {"a": True}).steps == ("0",)
+
+
+@pytest.mark.parametrize("name", ["tri", "tri_missing_order", "tri_counting", "and_divergence", "or_divergence",
+                                  "timers", "stored", "conditional"])
+@pytest.mark.parametrize("semantics", ["grafcet", "sfc"])
+def test_stable_situations_are_the_ass_states_found_in_fewer_passes(name, semantics):
+    """``stable_situations`` (the import's note) closes each situation over the inputs its
+    reactions ignore before expanding it: the same situations as the ASS, or the same error."""
+    from dataclasses import replace
+
+    from synth.errors import LimitExceeded, SynthError
+    from synth.grafcet.ass import stable_situations
+    from synth.grafcet.language import Semantics
+
+    g = replace(load_grafcet(ROOT / "grafcets" / f"{name}.g7"), semantics=Semantics(semantics))
+
+    def outcome(run):
+        try:
+            return sorted(run(), key=lambda s: s.text())
+        except SynthError as err:
+            return type(err).__name__
+
+    ass = outcome(lambda: [s.situation for s in stable_situation_automaton(GrafcetMachine(g)).states])
+    assert outcome(lambda: stable_situations(GrafcetMachine(g))) == ass
+    if isinstance(ass, list) and len(ass) > 3:
+        with pytest.raises(LimitExceeded):
+            stable_situations(GrafcetMachine(g), max_states=3)

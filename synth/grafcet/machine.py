@@ -114,6 +114,12 @@ class GrafcetMachine:
             for i, a in enumerate(s.actions):
                 if a.condition is not None:
                     self._cond[(s.name, i)] = compile_expr(a.condition, steps, timers, ints)
+        # the actions of each step for each ``when``, for the steps that have some
+        self._phase: dict[StoredWhen, dict[str, tuple[Action, ...]]] = {when: {} for when in StoredWhen}
+        for s in grafcet.steps:
+            for when in StoredWhen:
+                if acts := tuple(a for a in s.actions if a.when == when):
+                    self._phase[when][s.name] = acts
         self._event_inputs: dict[str, frozenset[str]] = {}
         for s in grafcet.steps:
             used: set[str] = set()
@@ -353,7 +359,11 @@ class GrafcetMachine:
 
     def _stored_phase(self, st: State, steps: set[str], when: StoredWhen) -> None:
         """Stored actions and assignments of ``steps`` for ``when``."""
-        acts = [a for s in sorted_steps(steps) for a in self._steps[s].actions if a.when == when]
+        phase = self._phase[when]
+        acting = [s for s in steps if s in phase]  # most steps have none: no sort, no pass
+        if not acting:
+            return
+        acts = [a for s in sorted_steps(acting) for a in phase[s]]
         self._apply(st, [a for a in acts if a.kind == STORED], [a for a in acts if a.kind == ASSIGN])
 
     def _event_actions(self, st: State, inputs: Mapping[str, bool], event: Event) -> None:

@@ -18,7 +18,7 @@ from __future__ import annotations
 from dataclasses import replace
 
 from synth.errors import InputError
-from synth.grafcet.ass import stable_situation_automaton
+from synth.grafcet.ass import stable_situations
 from synth.grafcet.language import Grafcet, Semantics, step_key
 from synth.grafcet.machine import GrafcetMachine
 
@@ -42,11 +42,11 @@ def scan_only_steps(g: Grafcet, max_states: int = IMPORT_BUDGET,
     :class:`~synth.errors.LimitExceeded` when either reading has more than ``max_states``
     situations or needs more than ``max_reactions`` runs of the machine."""
     try:
-        stable = stable_situation_automaton(GrafcetMachine(replace(g, semantics=Semantics.GRAFCET)),
-                                            max_states=max_states, max_reactions=max_reactions)
-        scans = stable_situation_automaton(GrafcetMachine(replace(g, semantics=Semantics.SFC)), max_states=max_states,
-                                           max_reactions=max_reactions)
+        stable = stable_situations(GrafcetMachine(replace(g, semantics=Semantics.GRAFCET)), max_states=max_states,
+                                   max_reactions=max_reactions)
+        scans = stable_situations(GrafcetMachine(replace(g, semantics=Semantics.SFC)), max_states=max_states,
+                                  max_reactions=max_reactions)
     except InputError:
         return None
-    seen = {s for st in stable.states for s in st.situation.steps}
-    return tuple(sorted({s for st in scans.states for s in st.situation.steps} - seen, key=step_key))
+    seen = {s for sit in stable for s in sit.steps}
+    return tuple(sorted({s for sit in scans for s in sit.steps} - seen, key=step_key))

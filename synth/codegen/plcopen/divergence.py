@@ -46,9 +46,10 @@ def exclusive_branches(branches: dict[int, list[tuple[tuple[int, int, int], int]
         ranked = [i for _, i in sorted(members)]
         prioritised = any(key[0] < NO_PRIORITY for key, _ in members)
         rewritten = []
-        for k, i in enumerate(ranked[1:], 1):
+        written = [transitions[i][3] for i in ranked]  # each branch excludes the earlier ones as written:
+        for k, i in enumerate(ranked[1:], 1):         # their own rewrites would add nothing, and double at each
             label, sources, targets, expr, el = transitions[i]
-            before = " & ".join(f"!({transitions[j][3]})" for j in ranked[:k])
+            before = " & ".join(f"!({e})" for e in written[:k])
             transitions[i] = (label, sources, targets, f"({expr}) & {before}", el)
             rewritten.append(f"{' -> '.join([', '.join(sources), ', '.join(targets)])} when {transitions[i][3]}")
         rule = ("the true branch of highest priority (smallest `priority`, then left to right)" if prioritised

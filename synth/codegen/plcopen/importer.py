@@ -40,7 +40,7 @@ from synth.codegen.plcopen.actions import ACTION_WARNINGS, action_body
 from synth.codegen.plcopen.assign import sum_text
 from synth.codegen.plcopen.data import DATA, duration
 from synth.codegen.plcopen.instances import separate_instances
-from synth.codegen.plcopen.project import NAMESPACES, PouSummary, body_language, list_pous, pous_of, read_project
+from synth.codegen.plcopen.project import NAMESPACES, PouSummary, body_language, list_pous, pous_of, read_project, summaries
 from synth.codegen.plcopen.sfc import Chart, Source, read_chart
 from synth.codegen.plcopen.mirrors import merge_mirrors
 from synth.codegen.plcopen.shared import MARK, merge_shared, shared_assignment, without_shared_or
@@ -82,7 +82,7 @@ def import_sfc(data: bytes | str, file: str = "<xml>", pou: str | None = None,
                          notes=(("POUs: " + ", ".join(names)) if names else "the file has no POU",))
     if notes is not None:  # the whole file: every POU left out; one POU (--pou): the charts inside it left out
         notes += [f"POU {s.name} not imported: {s.note}" if not s.imported else f"POU {s.name}: {s.note}"
-                  for s in list_pous(data, file) if (pou is None and not s.imported or "SFC in its action" in s.note)
+                  for s in summaries(root, q) if (pou is None and not s.imported or "SFC in its action" in s.note)
                   and (pou is None or s.name == pou)]
     several = len(sfc_pous) > 1
     charts = []

@@ -18,7 +18,7 @@ from typing import Any
 from synth.codegen.plcopen.sfc import Source
 from synth.errors import InputError, Location
 
-__all__ = ["NAMESPACES", "PouSummary", "body_language", "list_pous", "pous_of", "read_project"]
+__all__ = ["NAMESPACES", "PouSummary", "body_language", "list_pous", "pous_of", "read_project", "summaries"]
 
 NAMESPACES = {
     "http://www.plcopen.org/xml/tc6_0201": "TC6 2.01",
@@ -115,7 +115,12 @@ def pous_of(root: Any, q: Any) -> list[Any]:
 
 def list_pous(data: bytes | str, file: str = "<xml>") -> list[PouSummary]:
     """Every POU of the project: its kind, body language and whether ``import`` reads it."""
-    root, src, q = read_project(data, file)
+    root, _, q = read_project(data, file)
+    return summaries(root, q)
+
+
+def summaries(root: Any, q: Any) -> list[PouSummary]:
+    """:func:`list_pous` of a project already read (``root``, namespace function ``q``)."""
     out = []
     for pou in pous_of(root, q):
         lang = body_language(pou, q)

@@ -102,13 +102,15 @@ def prepare_scope(pou: Any, sfc: Any, q: Callable[[str], str], at: Callable[[Any
               and st.getparent().getparent() is not None and st.getparent().getparent().tag == q("action")]
     local = _locals(pou, q)
     found: dict[str, list[tuple[str, str, str, Any, str, str, str, bool]]] = {}  # V -> (T, step, PT, action, text, IN, V, IF)
+    blocks_of: dict[str | None, list[Any]] = {}  # localId -> the action blocks connected to it, in file order
+    for block in sfc.iterfind(q("actionBlock")):
+        for ref in dict.fromkeys(c.get("refLocalId") for c in block.iter(q("connection"))):
+            blocks_of.setdefault(ref, []).append(block)
     for step in sfc.iterfind(q("step")):
         sname = str(step.get("name", ""))
         g7 = prefix + (sname[1:] if re.fullmatch(r"S\d+", sname) else sname)
         runs: list[tuple[str, Any]] = [(n, attr) for k, n, attr in step_actions(step, q) if k is StepAction.ACTIVE]
-        for block in sfc.iterfind(q("actionBlock")):
-            if not any(c.get("refLocalId") == step.get("localId") for c in block.iter(q("connection"))):
-                continue
+        for block in blocks_of.get(step.get("localId"), ()):
             for a in block.iterfind(q("action")):
                 ref = a.find(q("reference"))
                 if a.get("qualifier", "N") == IecQualifier.N and ref is not None:
