@@ -936,7 +936,7 @@ def test_the_scan_note_says_when_it_is_not_computed(cli, tmp_path):
     code, _, err = cli("import", tmp_path / "wide.xml", "-o", tmp_path / "back.g7")
     assert code == 0 and err == (
         f"{tmp_path / 'wide.xml'}: note: not checked whether some steps stay active for a PLC scan where IEC 60848 "
-        "passes through them (more than 2000 situations or 20000 reactions to explore): validate with --semantics sfc "
+        "passes through them (more than 2000 situations or 8000 reactions to explore): validate with --semantics sfc "
         "for the meaning the program has on the PLC\n")
 
 

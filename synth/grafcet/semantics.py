@@ -30,7 +30,7 @@ IMPORT_BUDGET = 2_000
 it stays well under a second on a chart of 200 steps and says so when it is not computed."""
 
 
-IMPORT_REACTIONS = 20_000
+IMPORT_REACTIONS = 8_000
 """Runs of the machine each reading may make for that note (about a CPU second): many inputs
 and partial grafcets (the blocks of a Beremiz chart) make each situation costly."""
 
