@@ -42,6 +42,7 @@ from synth.errors import LimitExceeded
 from synth.plant.composition import LocalTransition, Plant
 from synth.plant.rules import Constraint
 from synth.sup.constraints import GRID_LIMIT, CompiledConstraints, term_holds, grid_of_term
+from synth.sup.explore import Counts, Explorer
 
 __all__ = ["Supervisor", "supremal_controllable", "VisitedSet", "FLAT_BITMAP_LIMIT"]
 
@@ -61,6 +62,7 @@ class Supervisor(CompiledConstraints):
         self.strides = np.array(p.strides, dtype=np.int64)
         self.radices = np.array(p.shape, dtype=np.int64)
         self.states = states if states is not None else np.zeros(0, dtype=np.int64)
+        self.explored: Counts | None = None  # the moves' counts, when :mod:`synth.sup.explore` found the states
 
     # ------------------------------------------------------------------ vectorised membership
     def digits(self, codes: np.ndarray) -> np.ndarray:
@@ -148,6 +150,8 @@ class Supervisor(CompiledConstraints):
     @cached_property
     def _counts(self) -> tuple[int, int, int]:
         """(controllable kept, uncontrollable kept, controllable cut), one sweep over SUP."""
+        if self.explored is not None:
+            return self.explored.controllable, self.explored.uncontrollable, self.explored.cut
         kept = [0, 0]
         cut = 0
         for start in range(0, self.states.size, 1 << 20):
@@ -171,6 +175,9 @@ class Supervisor(CompiledConstraints):
         """The cut controllable transitions per constraint id (a transition counts for
         every constraint whose violation it would make reachable, or that forbids its event)."""
         counts = {c.id: 0 for c in self.constraints}
+        if self.explored is not None:
+            counts.update(self.explored.per_constraint)
+            return {k: v for k, v in counts.items() if v}
         for start in range(0, self.states.size, 1 << 20):
             for t, src, _, hits in self._move_terms(self.states[start:start + (1 << 20)]):
                 if not t.controllable:
@@ -331,6 +338,10 @@ def supremal_controllable(
     sup = Supervisor(p, constraints)
     init = np.array([p.initial_index], dtype=np.int64)
     if not sup.kept_digits(sup.digits(init))[0]:
+        return sup
+    explorer = Explorer.of(sup)
+    if explorer is not None:
+        sup.states, sup.explored = explorer.explore(progress)
         return sup
     visited = VisitedSet(p.size)
     mark, seen = visited.mark, visited.seen
