@@ -36,7 +36,7 @@ Example
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable, Iterator, Sequence
+from typing import Callable, Sequence
 
 import numpy as np
 
@@ -163,7 +163,7 @@ class AxisTable:
             for a, vec in factors:
                 bit = bit & vec[layout.digit_table[a]]
             part(groups.pop())[:] += bit * (self.radix << j)
-        self.parts = [(g, t.astype(np.int32)) for g, t in sorted(parts.items())]
+        self.parts = sorted(parts.items())
         self.layout = layout
 
     def keys(self, groups: Sequence[np.ndarray]) -> np.ndarray:
@@ -176,17 +176,21 @@ class AxisTable:
             bit = np.ones(key.shape, dtype=bool)
             for a, vec in factors:
                 bit &= vec[self.layout.digit_table[a][groups[self.layout.group_of[a]]]]
-            key += bit.astype(np.int32) * weight
+            key += bit.astype(np.int64) * weight
         return key
 
-    def targets(self, codes: np.ndarray, keys: np.ndarray) -> Iterator[np.ndarray]:
-        """The codes the kept moves lead to from the states ``codes`` with these keys, slot
-        by slot (a state without a move gives itself in the first slot)."""
+    def targets(self, codes: np.ndarray, keys: np.ndarray, out: np.ndarray) -> int:
+        """Write into ``out`` the codes the kept moves lead to from the states ``codes``
+        with these keys, slot by slot (a state without a move gives itself in the first
+        slot); return how many."""
+        n = 0
         for j, deltas in enumerate(self.deltas):
             if j:
                 more = np.flatnonzero(self.degree[keys] > j)
                 codes, keys = codes[more], keys[more]
-            yield codes + deltas[keys]
+            np.add(codes, deltas[keys], out=out[n:n + codes.size])
+            n += codes.size
+        return n
 
 
 class Explorer:
@@ -227,17 +231,18 @@ class Explorer:
         visited.add(frontier)
         parts = [frontier]
         total, depth = 1, 0
+        buffer = np.empty(CHUNK * sum(len(t.deltas) for t in self.tables), dtype=np.int64)
         while frontier.size:
             found: list[np.ndarray] = []
             for lo in range(0, frontier.size, CHUNK):
                 chunk = frontier[lo:lo + CHUNK]
                 groups = self.layout.split(chunk)
-                fresh: list[np.ndarray] = []
+                n = 0
                 for h, table in zip(hist, self.tables):
                     keys = table.keys(groups)
                     h += np.bincount(keys, minlength=h.size)
-                    fresh.extend(table.targets(chunk, keys))
-                new = np.concatenate(fresh)
+                    n += table.targets(chunk, keys, buffer[n:])
+                new = buffer[:n]
                 new = new[~visited.test(new)]
                 new.sort()
                 new = new[np.concatenate(([True], new[1:] != new[:-1]))] if new.size else new

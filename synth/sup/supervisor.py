@@ -326,6 +326,7 @@ def supremal_controllable(
     constraints: Sequence[Constraint],
     *,
     progress: Callable[[str], None] | None = None,
+    per_transition: bool = False,
 ) -> Supervisor:
     """SUP of plant ``p`` under ``constraints`` (see module docstring).
 
@@ -333,13 +334,15 @@ def supremal_controllable(
     frontier by frontier: each frontier costs a few vectorised operations per local
     transition, so the work is linear in SUP's transitions and no array of the plant's
     size is built beyond a bitmap of visited states. ``progress`` receives a short text
-    after each frontier.
+    after each frontier. Plants whose elements read nothing move through one table per
+    element (:mod:`synth.sup.explore`); the others, and ``per_transition`` (the tables'
+    reference in the tests), move local transition by local transition.
     """
     sup = Supervisor(p, constraints)
     init = np.array([p.initial_index], dtype=np.int64)
     if not sup.kept_digits(sup.digits(init))[0]:
         return sup
-    explorer = Explorer.of(sup)
+    explorer = None if per_transition else Explorer.of(sup)
     if explorer is not None:
         sup.states, sup.explored = explorer.explore(progress)
         return sup

@@ -1,0 +1,132 @@
+"""SUP explored through per-element move tables (synth/sup/explore.py) against the
+per-transition exploration (itself checked against libFAUDES and a plain Tajer in
+test_supervisor.py): the same states, the same counts, on random rule sets, on lines,
+with the code's digits forced into many groups and the visited bitmap into blocks."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from randrules import random_rules
+from synth.plant.composition import plant
+from synth.plant.rules_check import load_rules, parse_rules
+from synth.sup import codes
+from synth.sup.codes import Layout, Visited
+from synth.sup.constraints import CompiledConstraints
+from synth.sup.explore import TABLE_BITS, Explorer
+from synth.sup.supervisor import supremal_controllable
+
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "bench"))
+from gen_line import write_line  # noqa: E402
+
+
+def _same(rs, **kw) -> int:
+    """Both explorations agree; returns SUP's size."""
+    p = plant(rs)
+    ref = supremal_controllable(p, rs.constraints, per_transition=True)
+    sup = supremal_controllable(p, rs.constraints)
+    assert sup.explored is not None or ref.empty
+    assert np.array_equal(sup.states, ref.states)
+    ref_counts = (ref.count_transitions(True), ref.count_transitions(False), ref.forbidden_transitions, ref.forbidden_counts())
+    assert (sup.count_transitions(True), sup.count_transitions(False), sup.forbidden_transitions,
+            sup.forbidden_counts()) == ref_counts
+    assert list(sup.forbidden_counts()) == list(ref.forbidden_counts())  # the constraints' order
+    return sup.size
+
+
+def _edge_rules(seed: int) -> str:
+    """A random rule set with edge constraints on every order (``↑O & x = 0``)."""
+    text = random_rules(seed)
+    orders = sorted({w.split("=")[0].strip() for line in text.splitlines() if line.strip().startswith("orders")
+                     for w in line.strip()[len("orders"):].split(",")})
+    levels = [f"s{e}0" for e in range(4) if f"s{e}0" in text]
+    extra = [f'constraint X{i} "edge {i}": ↑{o} & !{levels[i % len(levels)]} = 0' for i, o in enumerate(orders)]
+    return text + "\n".join(extra) + "\n"
+
+
+@pytest.mark.parametrize("seed", range(60))
+def test_random_rule_sets(seed):
+    rs = parse_rules(random_rules(seed), f"random{seed}.rules")
+    if plant(rs).reads:
+        pytest.skip("reads")
+    _same(rs)
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_random_rule_sets_with_edge_constraints(seed):
+    _same(parse_rules(_edge_rules(seed), f"edges{seed}.rules"))
+
+
+def test_random_families_meet_every_case():
+    """The random family is not trivial: empty and non-empty SUPs, cut moves, edge cuts."""
+    sizes, edge_cuts = [], 0
+    for seed in range(20):
+        rs = parse_rules(_edge_rules(seed), "e.rules")
+        sizes.append(_same(rs))
+        cuts = supremal_controllable(plant(rs), rs.constraints).forbidden_counts()
+        edge_cuts += sum(n for cid, n in cuts.items() if cid.startswith("X"))
+    assert 0 in sizes and max(sizes) > 50 and edge_cuts > 0
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_many_groups_and_cross_contexts(seed, monkeypatch):
+    """Every digit its own group: contexts span groups (read bit by bit), keys add parts."""
+    monkeypatch.setattr(codes, "GROUP_BITS", 0)
+    monkeypatch.setattr(Visited, "FLAT_BITS", 0)
+    monkeypatch.setattr(Visited, "MIN_SHIFT", 3)
+    rs = parse_rules(_edge_rules(seed), f"edges{seed}.rules")
+    cc = CompiledConstraints(plant(rs), rs.constraints)
+    ex = Explorer.of(cc)
+    assert ex is not None and len(ex.layout.groups) >= 2
+    _same(rs)
+
+
+def test_line_in_groups_and_blocks(tmp_path, monkeypatch):
+    """line_6: two groups of digits, contexts across them, the bitmap in blocks."""
+    monkeypatch.setattr(Visited, "FLAT_BITS", 0)
+    write_line(6, tmp_path)
+    rs = load_rules(tmp_path / "line_6.rules")
+    ex = Explorer.of(CompiledConstraints(plant(rs), rs.constraints))
+    assert ex is not None and len(ex.layout.groups) == 2 and ex.layout.radices == [9] * 6
+    assert any(t.parts and len(t.parts) == 2 for t in ex.tables)
+    assert _same(rs) == 20224
+
+
+def test_line_counts_match_the_closed_form(tmp_path):
+    """line_7: SUP = the states where no two neighbours can leave rest (2 safe, 7 unsafe
+    local states each): s' = 2(s + u), u' = 7s."""
+    write_line(7, tmp_path)
+    rs = load_rules(tmp_path / "line_7.rules")
+    s, u = 2, 7
+    for _ in range(6):
+        s, u = 2 * (s + u), 7 * s
+    sup = supremal_controllable(plant(rs), rs.constraints)
+    assert sup.size == s + u == 100872
+
+
+def test_an_element_in_too_many_terms_moves_per_transition():
+    """An element in more than TABLE_BITS terms with others: no table, the per-transition path."""
+    n = TABLE_BITS + 2
+    lines = ["element HUB {", "  orders H = 0", "  sensors h = 0", "  ↑H -> ↑h", "  ↓H -> ↓h", "}"]
+    for i in range(n):
+        lines += [f"element E{i} {{", f"  orders O{i} = 0", "}"]
+        lines.append(f'constraint K{i} "hub {i}": h & O{i} = 0')
+    rs = parse_rules("\n".join(lines) + "\n", "hub.rules")
+    assert Explorer.of(CompiledConstraints(plant(rs), rs.constraints)) is None
+    sup = supremal_controllable(plant(rs), rs.constraints)
+    assert sup.explored is None and sup.size == 2**n + 3  # HUB at rest: any orders; else none
+
+
+
+def test_layout_codes_and_visited_blocks():
+    lay = Layout([np.array([False, True, True]), np.array([True, False, True, True])], (4, 1))
+    assert lay.size == 6 and lay.code((0, 0)) is None and lay.code((2, 3)) == 5
+    assert lay.plant_codes(np.arange(6)).tolist() == [4, 6, 7, 8, 10, 11]
+    v = Visited(1 << 40)
+    v.add(np.array([3, 9, 1 << 35, (1 << 35) + 8191], dtype=np.int64))
+    assert v.blocks == 2 and v.test(np.array([3, 4, 9, 1 << 35, (1 << 35) + 8191, 1 << 36])).tolist() == \
+        [True, False, True, True, True, False]
