@@ -70,8 +70,9 @@ class Counts:
 class AxisTable:
     """One element's moves as a table over the keys ``digit + radix * context``."""
 
-    def __init__(self, cc: CompiledConstraints, axis: int, reduced: np.ndarray, stride: int) -> None:
+    def __init__(self, cc: CompiledConstraints, axis: int, layout: Layout, reduced: np.ndarray) -> None:
         p = cc.plant
+        self.layout = layout
         moves = [t for t in p.transitions if t.axis == axis]
         self.axis = axis
         self.radix = radix = p.shape[axis]
@@ -125,11 +126,12 @@ class AxisTable:
         first = np.searchsorted(keys, keys, side="left")
         slot = np.arange(keys.size) - first
         deltas = np.zeros((int(slot.max()) + 1 if slot.size else 0, (1 << m) * radix), dtype=np.int64)
-        deltas[slot, keys] = (rmap[dst[t]] - rmap[src[t]]) * stride
+        deltas[slot, keys] = (rmap[dst[t]] - rmap[src[t]]) * layout.offsets[axis]
         self.deltas = list(deltas)  # per slot, the offset of each key's move (0: none, the state itself)
-        self.degree = np.count_nonzero(deltas, axis=0)
-        self.parts: list[tuple[int, np.ndarray]] = []  # (group, key part of each group code)
+        degree = np.count_nonzero(deltas, axis=0)
+        self.more = [degree > j for j in range(len(self.deltas))]  # per slot, the keys with a move there
         self.cross: list[tuple[int, Factors]] = []  # contexts read across groups: (bit, factors)
+        self.parts = self._parts()  # (group, key part of each group code)
 
     def _add(self, constraint: str, column: np.ndarray, factors: Factors, contexts: list[Factors],
              columns: list[np.ndarray], owners: list[str], const: dict[str, np.ndarray]) -> None:
@@ -142,9 +144,10 @@ class AxisTable:
         columns.append(column)
         owners.append(constraint)
 
-    def index(self, layout: "Layout") -> None:
-        """Read the keys from ``layout``'s group codes: one table per group that holds the
-        digit or whole contexts, the contexts that span groups bit by bit."""
+    def _parts(self) -> list[tuple[int, np.ndarray]]:
+        """The keys read from the layout's group codes: one table per group that holds the
+        digit or whole contexts; the contexts that span groups go to ``cross``, read bit by bit."""
+        layout = self.layout
         parts: dict[int, np.ndarray] = {}
 
         def part(g: int) -> np.ndarray:
@@ -163,8 +166,7 @@ class AxisTable:
             for a, vec in factors:
                 bit = bit & vec[layout.digit_table[a]]
             part(groups.pop())[:] += bit * (self.radix << j)
-        self.parts = sorted(parts.items())
-        self.layout = layout
+        return sorted(parts.items())
 
     def keys(self, groups: Sequence[np.ndarray]) -> np.ndarray:
         """The key of each state whose group codes are given."""
@@ -186,7 +188,7 @@ class AxisTable:
         n = 0
         for j, deltas in enumerate(self.deltas):
             if j:
-                more = np.flatnonzero(self.degree[keys] > j)
+                more = self.more[j][keys]
                 codes, keys = codes[more], keys[more]
             np.add(codes, deltas[keys], out=out[n:n + codes.size])
             n += codes.size
@@ -200,8 +202,6 @@ class Explorer:
         self.cc = cc
         self.layout = layout
         self.tables = tables
-        for t in tables:
-            t.index(layout)
 
     @classmethod
     def of(cls, cc: CompiledConstraints) -> "Explorer | None":
@@ -216,7 +216,7 @@ class Explorer:
                 a, vec = factors[0]
                 kept[a] &= ~vec
         layout = Layout(kept, p.strides)
-        tables = [AxisTable(cc, a, kept[a], layout.offsets[a]) for a in range(p.ndim)]
+        tables = [AxisTable(cc, a, layout, kept[a]) for a in range(p.ndim)]
         return cls(cc, layout, tables) if all(t.fits for t in tables) else None
 
     def explore(self, progress: Callable[[str], None] | None = None) -> tuple[np.ndarray, Counts]:
