@@ -126,7 +126,12 @@ def test_layout_codes_and_visited_blocks():
     lay = Layout([np.array([False, True, True]), np.array([True, False, True, True])], (4, 1))
     assert lay.size == 6 and lay.code((0, 0)) is None and lay.code((2, 3)) == 5
     assert lay.plant_codes(np.arange(6)).tolist() == [4, 6, 7, 8, 10, 11]
-    v = Visited(1 << 40)
-    v.add(np.array([3, 9, 1 << 35, (1 << 35) + 8191], dtype=np.int64))
-    assert v.blocks == 2 and v.test(np.array([3, 4, 9, 1 << 35, (1 << 35) + 8191, 1 << 36])).tolist() == \
-        [True, False, True, True, True, False]
+    for size in (1 << 20, 1 << 40, 1 << 62):  # one block; a table of blocks; the blocks met searched
+        v = Visited(size)
+        codes = np.array([3, 9, 1 << 19, (1 << 19) + 8191, size - 1], dtype=np.int64)
+        v.add(codes[:2])
+        v.add(codes[2:])
+        assert v.test(np.array([3, 4, 9, 1 << 19, (1 << 19) + 8191, (1 << 19) + 8192, size - 2, size - 1])).tolist() == \
+            [True, False, True, True, True, False, False, True]
+        assert v.blocks == (1 if size == 1 << 20 else 3)
+        assert (v.table is None) == (size == 1 << 62)

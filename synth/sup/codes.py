@@ -95,8 +95,10 @@ class Layout:
 
 class Visited:
     """A set of codes in ``[0, size)``: a bitmap cut in blocks of ``2^shift`` codes, one
-    block allocated per block of codes met (at most :data:`MAX_BLOCKS` of them); a set of
-    at most :data:`FLAT_BITS` codes has one block.
+    block allocated per block of codes met, so memory follows the set, not ``size``. A
+    set of at most :data:`FLAT_BITS` codes has one block; blocks are found through a
+    table of at most :data:`MAX_TABLE` entries, or past that (codes of more than
+    ``2^(MAX_SHIFT + log2 MAX_TABLE)`` values) by a binary search among the blocks met.
 
     >>> v = Visited(10**12)
     >>> v.add(np.array([5, 7, 3 * 10**6 + 1], dtype=np.int64))
@@ -106,14 +108,20 @@ class Visited:
 
     FLAT_BITS = 1 << 27
     MIN_SHIFT = 13
-    MAX_BLOCKS = 1 << 22
+    MAX_SHIFT = 16
+    MAX_TABLE = 1 << 24
 
     def __init__(self, size: int) -> None:
         bits = max(size - 1, 1).bit_length()
-        self.shift = bits if size <= self.FLAT_BITS else max(self.MIN_SHIFT, bits - self.MAX_BLOCKS.bit_length() + 1)
+        self.shift = bits if size <= self.FLAT_BITS else max(self.MIN_SHIFT, bits - self.MAX_TABLE.bit_length() + 1)
+        self.table: np.ndarray | None = None  # per block, the offset of its bytes (0: the empty block)
+        if self.shift <= self.MAX_SHIFT or size <= self.FLAT_BITS:
+            self.table = np.zeros(((size - 1) >> self.shift) + 1, dtype=np.int32)  # int64 past 2 GiB of bits
+        else:
+            self.shift = self.MAX_SHIFT
+        self.met = np.array([-1], dtype=np.int64)  # without the table: the blocks met, sorted
+        self.offsets = np.zeros(1, dtype=np.int64)  # and their offsets
         self.row_bytes = (1 << self.shift) // 8
-        # per block, the offset of its bytes (0: the empty block, never written)
-        self.offset = np.zeros(((size - 1) >> self.shift) + 1, dtype=np.int32)  # int64 past 2 GiB of bits
         self.bits = np.zeros(2 * self.row_bytes, dtype=np.uint8)
         self.rows = 1
 
@@ -122,9 +130,15 @@ class Visited:
         """Blocks allocated."""
         return self.rows - 1
 
+    def _offset(self, blocks: np.ndarray) -> np.ndarray:
+        if self.table is not None:
+            return self.table[blocks]
+        pos = np.minimum(np.searchsorted(self.met, blocks), self.met.size - 1)
+        return np.where(self.met[pos] == blocks, self.offsets[pos], 0)
+
     def _index(self, codes: np.ndarray) -> np.ndarray:
         """The byte of each code (codes in unallocated blocks read the empty block)."""
-        return self.offset[codes >> self.shift] + ((codes >> 3) & (self.row_bytes - 1))
+        return self._offset(codes >> self.shift) + ((codes >> 3) & (self.row_bytes - 1))
 
     def test(self, codes: np.ndarray) -> np.ndarray:
         return ((self.bits[self._index(codes)] >> (codes & 7).astype(np.uint8)) & 1).view(bool)
@@ -135,16 +149,22 @@ class Visited:
             return
         blocks = codes >> self.shift
         new = blocks[np.concatenate(([True], blocks[1:] != blocks[:-1]))]
-        new = new[self.offset[new] == 0]
+        new = new[self._offset(new) == 0]
         if new.size:
             need = (self.rows + new.size) * self.row_bytes
             if need > self.bits.size:
                 grown = np.zeros(max(need, 2 * self.bits.size), dtype=np.uint8)
                 grown[:self.bits.size] = self.bits
                 self.bits = grown
-                if grown.size >= 1 << 31:
-                    self.offset = self.offset.astype(np.int64)
-            self.offset[new] = np.arange(self.rows, self.rows + new.size) * self.row_bytes
+            offsets = np.arange(self.rows, self.rows + new.size, dtype=np.int64) * self.row_bytes
+            if self.table is not None:
+                if self.bits.size >= 1 << 31:
+                    self.table = self.table.astype(np.int64)
+                self.table[new] = offsets
+            else:
+                met, at = np.concatenate([self.met, new]), np.concatenate([self.offsets, offsets])
+                order = np.argsort(met, kind="stable")
+                self.met, self.offsets = met[order], at[order]
             self.rows += new.size
         byte = self._index(codes)
         starts = np.flatnonzero(np.concatenate(([True], byte[1:] != byte[:-1])))
