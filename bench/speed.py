@@ -10,7 +10,9 @@ is shared, wall time says little. Trees and runs are interleaved, so a change in
 load hits every tree alike; the minimum of the runs is printed.
 
 - ``four cylinders``: ``synth validate grafcets/four_cylinders.g7 --plant plants/four_cylinders.rules``
-  (the whole command: start, constraints, SYNC, diagnosis, report text);
+  (the whole command: start, constraints, SYNC, diagnosis, report text), its constraint
+  grids read from the disk cache a first run wrote (``synth.sup.stored``); ``four cylinders,
+  no cache``: the same with ``SYNTH_NO_CACHE=1``;
 - ``sup line_N``: ``synth sup line_N.rules --engine symbolic --quiet`` on the line of N
   double-acting cylinders of ``bench/gen_line.py`` (a tree that fails says why);
 - ``explicit sup line_N``: ``synth sup line_N.rules --engine explicit --json`` (its peak
@@ -45,8 +47,12 @@ print(json.dumps({"cpu": time.process_time() - t, "states": v.sync.sync_states})
 
 
 def _child(tree: Path, argv: list[str], timeout: float) -> tuple[float, str, int, int]:
-    """CPU seconds, stdout, exit code and peak resident KiB of one fresh process."""
+    """CPU seconds, stdout, exit code and peak resident KiB of one fresh process (an argv
+    starting with ``NAME=VALUE`` words sets those in its environment)."""
     env = dict(os.environ, PYTHONPATH=str(tree))
+    while argv and "=" in argv[0] and not argv[0].startswith("-"):
+        name, _, value = argv[0].partition("=")
+        env[name], argv = value, argv[1:]
     with tempfile.TemporaryFile(mode="w+") as out:
         child = subprocess.Popen([sys.executable, *argv], stdout=out, stderr=subprocess.DEVNULL, text=True, env=env,
                                  cwd=tempfile.gettempdir())
@@ -67,8 +73,8 @@ def _child(tree: Path, argv: list[str], timeout: float) -> tuple[float, str, int
 
 def measures(work: Path, lines: list[int], families: list[str], explicit_sup: list[int] = ()) -> dict[str, list[str]]:
     """Name -> argv (after the interpreter) of every measure, its inputs generated into ``work``."""
-    out = {"four cylinders": ["-m", "synth", "validate", str(ROOT / "grafcets/four_cylinders.g7"),
-                              "--plant", str(ROOT / "plants/four_cylinders.rules")]}
+    station = ["-m", "synth", "validate", str(ROOT / "grafcets/four_cylinders.g7"), "--plant", str(ROOT / "plants/four_cylinders.rules")]
+    out = {"four cylinders": station, "four cylinders, no cache": ["SYNTH_NO_CACHE=1", *station]}
     for n in lines:
         subprocess.run([sys.executable, str(ROOT / "bench/gen_line.py"), str(n), str(work)], check=True, capture_output=True)
         out[f"sup line_{n}"] = ["-m", "synth", "sup", str(work / f"line_{n}.rules"), "--engine", "symbolic", "--quiet"]

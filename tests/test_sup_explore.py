@@ -135,3 +135,71 @@ def test_layout_codes_and_visited_blocks():
             [True, False, True, True, True, False, False, True]
         assert v.blocks == (1 if size == 1 << 20 else 3)
         assert (v.table is None) == (size == 1 << 62)
+
+
+# ---------------------------------------------------------------------------------- grids on disk
+def _grids_of(rules):
+    rs = load_rules(rules)
+    cc = CompiledConstraints(plant(rs), rs.constraints)  # a new plant: the in-memory cache misses
+    assert cc.reach_grids is not None
+    return cc
+
+
+def test_reach_grids_kept_on_disk(tmp_path, monkeypatch):
+    from synth.plant.composition import _plants
+    from synth.sup import stored
+
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    monkeypatch.delenv(stored.OFF, raising=False)
+    first = _grids_of(_plants("tri_boxes.rules"))
+    (file,) = (tmp_path / "synth" / "grids").iterdir()
+    calls = []
+    monkeypatch.setattr("synth.sup.constraints.backward_closures", lambda *a, **k: calls.append(a) or [])
+    again = _grids_of(_plants("tri_boxes.rules"))  # read back: no closure computed
+    assert calls == [] and all(np.array_equal(a, b) for a, b in zip(first.reach_grids, again.reach_grids))
+    assert not again.reach_grids[0].flags.writeable and file.suffix == ".bin"
+
+
+@pytest.mark.parametrize("damage", ["truncated", "flipped", "header"])
+def test_damaged_grid_files_are_ignored_and_written_again(damage, tmp_path, monkeypatch):
+    from synth.plant.composition import _plants
+    from synth.sup import stored
+
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    monkeypatch.delenv(stored.OFF, raising=False)
+    first = _grids_of(_plants("tri_boxes.rules"))
+    (file,) = (tmp_path / "synth" / "grids").iterdir()
+    data = bytearray(file.read_bytes())
+    if damage == "truncated":
+        data = data[:-10]
+    elif damage == "flipped":
+        data[-1] ^= 0xFF
+    else:
+        data[:11] = b"synth-grid2"
+    file.write_bytes(bytes(data))
+    again = _grids_of(_plants("tri_boxes.rules"))
+    assert all(np.array_equal(a, b) for a, b in zip(first.reach_grids, again.reach_grids))
+    assert file.read_bytes() != bytes(data)  # written whole again
+    assert [f.name for f in file.parent.iterdir()] == [file.name]  # no temporary file left
+
+
+def test_grid_keys_follow_the_content_and_the_cache_can_be_off(tmp_path, monkeypatch):
+    from synth.plant.composition import _plants
+    from synth.sup import stored
+
+    rs = load_rules(_plants("tri_boxes.rules"))
+    p = plant(rs)
+    terms = [t.factors for t in CompiledConstraints(p, rs.constraints).level_terms]
+    k = stored.key(p, terms)
+    assert k == stored.key(plant(rs), terms)
+    (a, vec), *rest = terms[0]
+    changed = ((a, ~vec), *rest)
+    assert stored.key(p, [changed, *terms[1:]]) != k
+    assert stored.key(p, terms[:-1]) != k
+    other = load_rules(_plants("four_cylinders.rules"))
+    assert stored.key(plant(other), terms) != k
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    monkeypatch.setenv(stored.OFF, "1")
+    assert stored.folder() is None
+    _grids_of(_plants("tri_boxes.rules"))
+    assert not (tmp_path / "synth").exists()
