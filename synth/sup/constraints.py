@@ -87,11 +87,8 @@ def _reach_grids(p: Plant, constraints: tuple[Constraint, ...], level_terms: Seq
     if constraints not in per_plant:
         from synth.sup import stored
 
-        key = stored.key(p, [t.factors for t in level_terms])
-        grids = stored.load(key, len(level_terms), p.shape)
-        if grids is None:
-            grids = backward_closures(p, [grid_of_term(p, t.factors) for t in level_terms], controllable=False)
-            stored.store(key, grids)
+        grids = stored.kept(p, [t.factors for t in level_terms],
+                            lambda: backward_closures(p, [grid_of_term(p, t.factors) for t in level_terms], controllable=False))
         for g in grids:
             g.flags.writeable = False
         per_plant[constraints] = grids

@@ -34,13 +34,13 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import Sequence
+from typing import Callable, Sequence
 
 import numpy as np
 
 from synth.plant.composition import Plant
 
-__all__ = ["FORMAT", "OFF", "folder", "key", "load", "store"]
+__all__ = ["FORMAT", "OFF", "folder", "key", "load", "store", "kept"]
 
 FORMAT = 1
 """The file format's number (part of the key)."""
@@ -139,3 +139,15 @@ def store(k: str, grids: Sequence[np.ndarray]) -> None:
             os.unlink(tmp)
         except OSError:
             pass
+
+
+def kept(p: Plant, terms: Sequence[Sequence[tuple[int, np.ndarray]]], compute: Callable[[], list[np.ndarray]]) -> list[np.ndarray]:
+    """The reach grids of ``terms``: read from the cache, else computed by ``compute`` and stored."""
+    if folder() is None:
+        return compute()
+    k = key(p, terms)
+    grids = load(k, len(terms), p.shape)
+    if grids is None:
+        grids = compute()
+        store(k, grids)
+    return grids
