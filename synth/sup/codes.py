@@ -141,7 +141,9 @@ class Visited:
         return self._offset(codes >> self.shift) + ((codes >> 3) & (self.row_bytes - 1))
 
     def test(self, codes: np.ndarray) -> np.ndarray:
-        return ((self.bits[self._index(codes)] >> (codes & 7).astype(np.uint8)) & 1).view(bool)
+        byte = self.bits[self._index(codes)]
+        np.right_shift(byte, np.bitwise_and(codes, 7, dtype=np.uint8, casting="unsafe"), out=byte)
+        return np.bitwise_and(byte, 1, out=byte).view(bool)
 
     def add(self, codes: np.ndarray) -> None:
         """Add sorted, distinct codes."""
