@@ -122,6 +122,17 @@ def test_an_element_in_too_many_terms_moves_per_transition():
 
 
 
+def test_visited_codes_come_back_sorted_from_flat_and_blocked_bitmaps(monkeypatch):
+    rng = np.random.default_rng(7)
+    for flat in (True, False):
+        monkeypatch.setattr(Visited, "FLAT_BITS", 1 << 27 if flat else 0)
+        v = Visited(10**7)
+        codes = np.unique(rng.integers(0, 10**7, 50_000))
+        v.add(codes[::2])
+        v.add(codes[1::2])
+        assert np.array_equal(v.codes(), codes) and (v.blocks == 1) == flat
+
+
 def test_layout_codes_and_visited_blocks():
     lay = Layout([np.array([False, True, True]), np.array([True, False, True, True])], (4, 1))
     assert lay.size == 6 and lay.code((0, 0)) is None and lay.code((2, 3)) == 5
@@ -133,7 +144,7 @@ def test_layout_codes_and_visited_blocks():
         v.add(codes[2:])
         assert v.test(np.array([3, 4, 9, 1 << 19, (1 << 19) + 8191, (1 << 19) + 8192, size - 2, size - 1])).tolist() == \
             [True, False, True, True, True, False, False, True]
-        assert v.blocks == (1 if size == 1 << 20 else 3)
+        assert v.blocks == (1 if size == 1 << 20 else 3) and v.codes().tolist() == codes.tolist()
         assert (v.table is None) == (size == 1 << 62)
 
 

@@ -21,6 +21,8 @@ __all__ = ["Layout", "Visited", "GROUP_BITS"]
 GROUP_BITS = 16
 """Consecutive digits are read together while their codes number at most 2^GROUP_BITS."""
 
+_ONES = np.array([bin(b).count("1") for b in range(256)], dtype=np.uint8)  # set bits per byte value
+
 
 class Layout:
     """The code of the states whose local states are all in ``kept`` (one boolean array
@@ -104,6 +106,8 @@ class Visited:
     >>> v.add(np.array([5, 7, 3 * 10**6 + 1], dtype=np.int64))
     >>> v.test(np.array([5, 6, 7, 3 * 10**6 + 1], dtype=np.int64)).tolist(), v.blocks
     ([True, False, True, True], 2)
+    >>> v.codes().tolist()
+    [5, 7, 3000001]
     """
 
     FLAT_BITS = 1 << 27
@@ -171,3 +175,30 @@ class Visited:
         byte = self._index(codes)
         starts = np.flatnonzero(np.concatenate(([True], byte[1:] != byte[:-1])))
         self.bits[byte[starts]] |= np.bitwise_or.reduceat(np.left_shift(1, codes & 7).astype(np.uint8), starts)
+
+    SLICE = 1 << 13
+    """Bytes of the bitmap unpacked at once by :meth:`codes` (per block, at most)."""
+
+    def codes(self) -> np.ndarray:
+        """Every code in the set, sorted (no array of the set's size but the result)."""
+        if self.table is not None:
+            blocks = np.flatnonzero(self.table)
+            offsets = self.table[blocks].astype(np.int64)
+        else:
+            blocks, offsets = self.met[1:], self.offsets[1:]
+        step = min(self.row_bytes, self.SLICE)  # a block read in slices of ``step`` bytes
+        per = self.row_bytes // step
+        starts = ((blocks << self.shift)[:, None] + np.arange(per, dtype=np.int64)[None, :] * (8 * step)).reshape(-1)
+        at = (offsets[:, None] + np.arange(per, dtype=np.int64)[None, :] * step).reshape(-1)
+        slices = self.bits[:self.rows * self.row_bytes].reshape(-1, step)
+        out = np.empty(int(_ONES[self.bits].sum(dtype=np.int64)), dtype=np.int64)
+        n = 0
+        for lo in range(0, at.size, 1024):
+            flat = slices[at[lo:lo + 1024] // step].reshape(-1)  # the slices' bytes, in code order
+            nz = np.flatnonzero(flat)
+            i, j = np.nonzero(np.unpackbits(flat[nz][:, None], axis=1, bitorder="little"))
+            byte = nz[i]
+            out[n:n + i.size] = starts[lo:lo + 1024][byte // step] + (byte % step) * 8 + j
+            n += i.size
+        return out
+

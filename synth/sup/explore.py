@@ -229,7 +229,6 @@ class Explorer:
         visited = Visited(self.layout.size)
         frontier = np.array([init], dtype=np.int64)
         visited.add(frontier)
-        parts = [frontier]
         total, depth = 1, 0
         buffer = np.empty(CHUNK * sum(len(t.deltas) for t in self.tables), dtype=np.int64)
         while frontier.size:
@@ -250,13 +249,11 @@ class Explorer:
                 found.append(new)
             frontier = np.concatenate(found)
             frontier.sort()
-            parts.append(frontier)
             total += frontier.size
             depth += 1
             if progress is not None:
                 progress(f"exploring SUP: depth {depth}, {total} states")
-        states = np.concatenate(parts)
-        states.sort()
+        states = visited.codes()  # every state met, sorted
         for lo in range(0, states.size, CHUNK):
             states[lo:lo + CHUNK] = self.layout.plant_codes(states[lo:lo + CHUNK])
         return states, self._counts(hist)
