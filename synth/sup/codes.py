@@ -22,6 +22,7 @@ GROUP_BITS = 16
 """Consecutive digits are read together while their codes number at most 2^GROUP_BITS."""
 
 _ONES = np.array([bin(b).count("1") for b in range(256)], dtype=np.uint8)  # set bits per byte value
+_LOWEST = np.array([(b & -b).bit_length() - 1 for b in range(256)], dtype=np.int64)  # its lowest set bit
 
 
 class Layout:
@@ -187,18 +188,25 @@ class Visited:
         else:
             blocks, offsets = self.met[1:], self.offsets[1:]
         step = min(self.row_bytes, self.SLICE)  # a block read in slices of ``step`` bytes
+        shift = step.bit_length() - 1
         per = self.row_bytes // step
         starts = ((blocks << self.shift)[:, None] + np.arange(per, dtype=np.int64)[None, :] * (8 * step)).reshape(-1)
         at = (offsets[:, None] + np.arange(per, dtype=np.int64)[None, :] * step).reshape(-1)
         slices = self.bits[:self.rows * self.row_bytes].reshape(-1, step)
-        out = np.empty(int(_ONES[self.bits].sum(dtype=np.int64)), dtype=np.int64)
+        out = np.empty(int(_ONES[slices].sum(dtype=np.int64)), dtype=np.int64)
         n = 0
         for lo in range(0, at.size, 1024):
             flat = slices[at[lo:lo + 1024] // step].reshape(-1)  # the slices' bytes, in code order
             nz = np.flatnonzero(flat)
-            i, j = np.nonzero(np.unpackbits(flat[nz][:, None], axis=1, bitorder="little"))
-            byte = nz[i]
-            out[n:n + i.size] = starts[lo:lo + 1024][byte // step] + (byte % step) * 8 + j
-            n += i.size
+            values = flat[nz]
+            base = starts[lo:lo + 1024][nz >> shift] + ((nz & (step - 1)) << 3)  # the code of each byte's bit 0
+            count = _ONES[values].astype(np.int64)
+            pos = n + np.cumsum(count) - count  # where each byte's codes go, lowest bit first
+            n += int(count.sum())
+            while values.size:
+                out[pos] = base + _LOWEST[values]
+                values = values & (values - 1)
+                more = values != 0
+                values, base, pos = values[more], base[more], pos[more] + 1
         return out
 
