@@ -82,10 +82,13 @@ _reach_cache: "weakref.WeakKeyDictionary[Plant, dict[tuple[Constraint, ...], lis
 def _reach_grids(p: Plant, constraints: tuple[Constraint, ...], level_terms: Sequence[Term]) -> list[np.ndarray]:
     """Per level term, the states from which uncontrollable moves (guards evaluated) reach
     it: computed once per plant and constraints (compared by content; validation, SUP and
-    the filter's closed loop share them), read-only."""
+    the filter's closed loop share them), kept on disk for the next run (:mod:`synth.sup.stored`), read-only."""
     per_plant = _reach_cache.setdefault(p, {})
     if constraints not in per_plant:
-        grids = backward_closures(p, [grid_of_term(p, t.factors) for t in level_terms], controllable=False)
+        from synth.sup import stored
+
+        grids = stored.kept(p, [t.factors for t in level_terms],
+                            lambda: backward_closures(p, [grid_of_term(p, t.factors) for t in level_terms], controllable=False))
         for g in grids:
             g.flags.writeable = False
         per_plant[constraints] = grids

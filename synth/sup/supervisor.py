@@ -40,10 +40,13 @@ import numpy as np
 
 from synth.errors import LimitExceeded
 from synth.plant.composition import LocalTransition, Plant
+from synth.plant.element import distinct
 from synth.plant.rules import Constraint
+from synth.sup.codes import Visited
 from synth.sup.constraints import GRID_LIMIT, CompiledConstraints, term_holds, grid_of_term
+from synth.sup.explore import Counts, Explorer
 
-__all__ = ["Supervisor", "supremal_controllable", "VisitedSet", "FLAT_BITMAP_LIMIT"]
+__all__ = ["Supervisor", "supremal_controllable"]
 
 
 class Supervisor(CompiledConstraints):
@@ -61,6 +64,7 @@ class Supervisor(CompiledConstraints):
         self.strides = np.array(p.strides, dtype=np.int64)
         self.radices = np.array(p.shape, dtype=np.int64)
         self.states = states if states is not None else np.zeros(0, dtype=np.int64)
+        self.explored: Counts | None = None  # the moves' counts, when :mod:`synth.sup.explore` found the states
 
     # ------------------------------------------------------------------ vectorised membership
     def digits(self, codes: np.ndarray) -> np.ndarray:
@@ -148,6 +152,8 @@ class Supervisor(CompiledConstraints):
     @cached_property
     def _counts(self) -> tuple[int, int, int]:
         """(controllable kept, uncontrollable kept, controllable cut), one sweep over SUP."""
+        if self.explored is not None:
+            return self.explored.controllable, self.explored.uncontrollable, self.explored.cut
         kept = [0, 0]
         cut = 0
         for start in range(0, self.states.size, 1 << 20):
@@ -171,6 +177,9 @@ class Supervisor(CompiledConstraints):
         """The cut controllable transitions per constraint id (a transition counts for
         every constraint whose violation it would make reachable, or that forbids its event)."""
         counts = {c.id: 0 for c in self.constraints}
+        if self.explored is not None:
+            counts.update(self.explored.per_constraint)
+            return {k: v for k, v in counts.items() if v}
         for start in range(0, self.states.size, 1 << 20):
             for t, src, _, hits in self._move_terms(self.states[start:start + (1 << 20)]):
                 if not t.controllable:
@@ -245,80 +254,12 @@ class Supervisor(CompiledConstraints):
         return out
 
 
-FLAT_BITMAP_LIMIT = 1 << 33
-"""Plants up to this many states keep one flat visited bitmap (at most 1 GiB)."""
-
-
-class VisitedSet:
-    """Visited plant state codes for the SUP exploration, sized by what is visited.
-
-    Up to :data:`FLAT_BITMAP_LIMIT` states, one bit per plant state. Beyond, the code is
-    split into a *prefix* (its high part) and a *rest* of at most 2^20 values; one
-    bitmap of the rests is allocated per prefix actually met, so memory follows SUP
-    (a line of 11 cylinders: 7.4·10^11 plant states, a flat bitmap of 86.5 GiB).
-
-    >>> v = VisitedSet(1 << 40)
-    >>> v.mark(np.array([5, 1 << 35], dtype=np.int64))
-    >>> v.seen(np.array([5, 6, 1 << 35], dtype=np.int64)).tolist(), v.blocks
-    ([True, False, True], 2)
-    """
-
-    def __init__(self, size: int) -> None:
-        self.flat = size <= FLAT_BITMAP_LIMIT
-        self.rest_bits = 20
-        if self.flat:
-            self.bits = np.zeros((size + 7) // 8, dtype=np.uint8)
-        else:
-            self.prefixes = np.zeros(0, dtype=np.int64)  # sorted prefixes met
-            self.slots = np.zeros(0, dtype=np.int64)  # their rows in ``rows``
-            self.rows = np.zeros((0, (1 << self.rest_bits) // 8), dtype=np.uint8)
-
-    @property
-    def blocks(self) -> int:
-        """Bitmaps allocated (1 for the flat bitmap)."""
-        return 1 if self.flat else int(self.rows.shape[0])
-
-    def _rows(self, codes: np.ndarray, add: bool) -> tuple[np.ndarray, np.ndarray]:
-        """Row of each code's prefix (-1 when absent and ``add`` is false) and its rest."""
-        pre = codes >> self.rest_bits
-        rest = codes & ((1 << self.rest_bits) - 1)
-        if add:
-            new = np.setdiff1d(np.unique(pre), self.prefixes, assume_unique=True)
-            if new.size:
-                base = self.rows.shape[0]
-                self.rows = np.concatenate([self.rows, np.zeros((new.size, self.rows.shape[1]), dtype=np.uint8)])
-                prefixes = np.concatenate([self.prefixes, new])
-                slots = np.concatenate([self.slots, np.arange(base, base + new.size, dtype=np.int64)])
-                order = np.argsort(prefixes, kind="stable")
-                self.prefixes, self.slots = prefixes[order], slots[order]
-        pos = np.searchsorted(self.prefixes, pre)
-        pos_ok = np.minimum(pos, max(self.prefixes.size - 1, 0))
-        found = (self.prefixes.size > 0) & (self.prefixes[pos_ok] == pre) if self.prefixes.size else np.zeros(pre.shape, bool)
-        rows = np.where(found, self.slots[pos_ok] if self.slots.size else -1, -1)
-        return rows, rest
-
-    def mark(self, codes: np.ndarray) -> None:
-        if self.flat:
-            np.bitwise_or.at(self.bits, codes >> 3, (1 << (codes & 7)).astype(np.uint8))
-            return
-        rows, rest = self._rows(codes, add=True)
-        np.bitwise_or.at(self.rows, (rows, rest >> 3), (1 << (rest & 7)).astype(np.uint8))
-
-    def seen(self, codes: np.ndarray) -> np.ndarray:
-        if self.flat:
-            return ((self.bits[codes >> 3] >> (codes & 7).astype(np.uint8)) & 1).astype(bool)
-        rows, rest = self._rows(codes, add=False)
-        out = np.zeros(codes.shape, dtype=bool)
-        hit = rows >= 0
-        out[hit] = ((self.rows[rows[hit], rest[hit] >> 3] >> (rest[hit] & 7).astype(np.uint8)) & 1).astype(bool)
-        return out
-
-
 def supremal_controllable(
     p: Plant,
     constraints: Sequence[Constraint],
     *,
     progress: Callable[[str], None] | None = None,
+    per_transition: bool = False,
 ) -> Supervisor:
     """SUP of plant ``p`` under ``constraints`` (see module docstring).
 
@@ -326,14 +267,20 @@ def supremal_controllable(
     frontier by frontier: each frontier costs a few vectorised operations per local
     transition, so the work is linear in SUP's transitions and no array of the plant's
     size is built beyond a bitmap of visited states. ``progress`` receives a short text
-    after each frontier.
+    after each frontier. Plants whose elements read nothing move through one table per
+    element (:mod:`synth.sup.explore`); the others, and ``per_transition`` (the tables'
+    reference in the tests), move local transition by local transition.
     """
     sup = Supervisor(p, constraints)
     init = np.array([p.initial_index], dtype=np.int64)
     if not sup.kept_digits(sup.digits(init))[0]:
         return sup
-    visited = VisitedSet(p.size)
-    mark, seen = visited.mark, visited.seen
+    explorer = None if per_transition else Explorer.of(sup)
+    if explorer is not None:
+        sup.states, sup.explored = explorer.explore(progress)
+        return sup
+    visited = Visited(p.size)
+    mark, seen = visited.add, visited.test
 
     mark(init)
     parts = [init]
@@ -343,7 +290,7 @@ def supremal_controllable(
         new_parts = []
         for t, src, dst, ok in sup.moves(frontier):
             dst = dst[ok]
-            dst = np.unique(dst[~seen(dst)])
+            dst = distinct(dst[~seen(dst)])
             if dst.size:
                 mark(dst)
                 new_parts.append(dst)
