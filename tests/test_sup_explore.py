@@ -214,3 +214,13 @@ def test_grid_keys_follow_the_content_and_the_cache_can_be_off(tmp_path, monkeyp
     assert stored.folder() is None
     _grids_of(_plants("tri_boxes.rules"))
     assert not (tmp_path / "synth").exists()
+
+
+@pytest.mark.parametrize("constraint", ["not v10 & not v11 & AVANCER1 = 0", "AVANCER1 & RECULER1 = 0", "v11 = 0"])
+def test_a_plant_of_fewer_than_eight_codes(constraint):
+    """One cylinder whose constraint leaves fewer than 8 codes: the visited bitmap still holds
+    a byte (it once had none: an internal error)."""
+    text = ("element V1 {\n    orders AVANCER1 = 0, RECULER1 = 0\n    sensors v10 = 1, v11 = 0\n"
+            "    incoherent v10 & v11\n    ↑AVANCER1 [v10] -> ↓v10\n}\n"
+            f'constraint C1 "x": {constraint}\n')
+    assert _same(parse_rules(text, "small.rules")) > 0

@@ -118,7 +118,8 @@ class Visited:
 
     def __init__(self, size: int) -> None:
         bits = max(size - 1, 1).bit_length()
-        self.shift = bits if size <= self.FLAT_BITS else max(self.MIN_SHIFT, bits - self.MAX_TABLE.bit_length() + 1)
+        # a block holds at least one byte (8 codes): a plant of fewer than 8 codes has one block
+        self.shift = max(3, bits) if size <= self.FLAT_BITS else max(self.MIN_SHIFT, bits - self.MAX_TABLE.bit_length() + 1)
         self.table: np.ndarray | None = None  # per block, the offset of its bytes (0: the empty block)
         if self.shift <= self.MAX_SHIFT or size <= self.FLAT_BITS:
             self.table = np.zeros(((size - 1) >> self.shift) + 1, dtype=np.int32)  # int64 past 2 GiB of bits
