@@ -97,8 +97,9 @@ def test_each_target_of_a_filter_block_runs_as_the_st_text(target):
     ours = load_st(st_of(target, files, "tri"), "t.st").instance(block.name)
     text = load_st(block.text, "b.st").instance(block.name)
     rnd = random.Random(7)
+    reads = FilterCycle(f).reads
     for _ in range(200):
-        values = {n: rnd.random() < 0.5 for n in FilterCycle(f).reads}
+        values = {n: rnd.random() < 0.5 for n in reads}
         ours.cycle(values)
         text.cycle(values)
         assert [ours[o] for o in f.outputs] == [text[o] for o in f.outputs]
