@@ -1,7 +1,7 @@
 """``validate --engine auto`` against the faster of the two engines, on every family of ``bench/``.
 
     python3 bench/auto.py [--par 3..7] [--steep 3..6] [--line 8,16] [--wide 2..5] [--branches 2..8]
-                          [--missing] [--runs 2] [--budget 60] [--before DIR] [--json FILE]
+                          [--timed-par 5,6] [--timed-branches 2..3] [--missing] [--runs 2] [--budget 60] [--before DIR] [--json FILE]
 
 Families (each written by its generator into a temporary folder):
 
@@ -12,6 +12,9 @@ Families (each written by its generator into a temporary folder):
   width grows),
 - ``branches_3xM`` (gen_branches.py, ``--branches``: three branches, each a sequence of M
   cylinders, interlocks between neighbouring branches: the depth grows),
+- ``par_N_timed`` and ``branches_3xM_timed`` (gen_branches.with_timers: each extension
+  waits 1 s once out): the symbolic engine explores them one stable situation at a time,
+  and wins on the first (its situations hold many states) but not on the second;
 - the bundled Grafcets with their plants (``grafcets/tri*.g7``, ``four_cylinders.g7``).
 
 Each case runs ``synth validate`` with ``--engine explicit``, ``--engine symbolic`` and
@@ -36,7 +39,7 @@ from typing import Iterator
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "bench"))
 
-from gen_branches import write_branches  # noqa: E402
+from gen_branches import with_timers, write_branches  # noqa: E402
 from gen_line import write_line  # noqa: E402
 from gen_par import write_par  # noqa: E402
 from gen_steep import write_steep  # noqa: E402
@@ -58,13 +61,27 @@ def cases(args: argparse.Namespace, d: Path) -> Iterator[tuple[str, str, Path, P
                 ("steep", _range(args.steep), lambda n: write_steep(n, d), "steep_{}"),
                 ("line", _range(args.line), lambda n: write_line(n, d), "line_{}"),
                 ("wide", _range(args.wide), lambda k: write_branches(k, 2, d), "branches_{}x2"),
-                ("branches", _range(args.branches), lambda m: write_branches(3, m, d), "branches_3x{}")]
+                ("branches", _range(args.branches), lambda m: write_branches(3, m, d), "branches_3x{}"),
+                ("timed par", _range(args.timed_par), lambda n: timed(write_par(n, d)), "par_{}_timed"),
+                ("timed branches", _range(args.timed_branches), lambda m: timed(write_branches(3, m, d)),
+                 "branches_3x{}_timed")]
     for family, sizes, write, name in families:
         for n in sizes:
             rules, g7, missing = write(n)
             yield family, name.format(n), Path(g7), Path(rules)
             if args.missing:
                 yield family, name.format(n) + "_missing", Path(missing), Path(rules)
+
+
+def timed(paths: tuple[Path, Path, Path]) -> tuple[Path, Path, Path]:
+    """The generator's files with the Grafcets' timed variants (gen_branches.with_timers) beside them."""
+    rules, *grafcets = paths
+    out = []
+    for g7 in grafcets:
+        t = g7.with_name(g7.stem + "_timed.g7")
+        t.write_text(with_timers(g7.read_text(encoding="utf-8")), encoding="utf-8")
+        out.append(t)
+    return rules, out[0], out[1]
 
 
 def _chose(res: dict) -> str:
@@ -79,6 +96,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--line", default="8,16")
     ap.add_argument("--wide", default="2..5", help="K for branches_Kx2")
     ap.add_argument("--branches", default="2..8", help="M for branches_3xM")
+    ap.add_argument("--timed-par", default="5,6", help="N for par_N_timed (every extension waits 1 s)")
+    ap.add_argument("--timed-branches", default="2..3", help="M for branches_3xM_timed")
     ap.add_argument("--missing", action="store_true", help="also each family's _missing variant")
     ap.add_argument("--runs", type=int, default=2)
     ap.add_argument("--budget", type=float, default=60.0, help="CPU seconds per run")

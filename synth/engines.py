@@ -10,15 +10,11 @@ Everything that decides is here, in three tables and one function:
   :func:`refusal` (exit 2); with ``auto`` it rules that engine out.
 - :data:`THRESHOLDS`: ``auto``'s estimate, per command, above which the symbolic engine runs:
 
-  - ``validate``: plant states × Grafcet steps above 10^5, then *measured*: the probe
-    (:func:`synth.probe.probe`) explores SYNC breadth-first as the explicit engine does, at
-    most :data:`PROBE_BUDGET` SYNC states, and the symbolic engine runs when one
-    breadth-first layer holds more than :data:`PROBE_LAYER` of them. The explicit engine
-    pays per SYNC state, the symbolic one per layer (a few BDD operations per plant move,
-    whatever the layer holds): wide layers are where it wins. A SYNC explored whole within
-    the budget, or narrow layers all along, keep the explicit engine. The decision reads
-    counts only (the same on every machine); measured on every bench family
-    (docs/performance.md, bench/auto.py);
+  - ``validate``: plant states × Grafcet steps above 10^5, then *measured* (counts, never
+    time): the explicit engine within :data:`PROBE_NODES` aggregated states, else the probe
+    (:func:`synth.probe.probe`): symbolic when a breadth-first layer of SYNC holds more than
+    :data:`PROBE_LAYER` states within :data:`PROBE_BUDGET` (the explicit engine pays per
+    SYNC state, the symbolic one per layer: docs/symbolic.md, "auto");
   - ``sup``: plant states above 10^6;
   - ``filter verify``: plant states above 2·10^6 (the explicit engine's arrays over the
     plant's grid).
@@ -64,7 +60,7 @@ if TYPE_CHECKING:  # pragma: no cover - the engines are imported once chosen
 
 __all__ = ["EngineChoice", "Command", "Need", "Capability", "CAPABILITIES", "Threshold", "THRESHOLDS", "Decision",
            "capability", "refuse", "refusal", "decide", "measured", "VALIDATE_THRESHOLD",
-           "PROBE_LAYER", "PROBE_BUDGET", "SUP_THRESHOLD", "VERIFY_THRESHOLD", "validate", "validate_models", "SupRun", "supervisor"]
+           "PROBE_LAYER", "PROBE_BUDGET", "PROBE_NODES", "PROBE_STEEP", "SUP_THRESHOLD", "VERIFY_THRESHOLD", "validate", "validate_models", "SupRun", "supervisor"]
 
 
 class Command(StrEnum):
@@ -114,13 +110,15 @@ class Threshold:
     """``auto`` runs the symbolic engine when the estimate exceeds ``size``; where ``layer``
     is set (``validate``), only when the explicit engine does not end within ``nodes``
     aggregated states and the probe, given ``budget`` SYNC states, meets a breadth-first
-    layer of more than ``layer`` SYNC states."""
+    layer of more than ``layer`` SYNC states (within ``steep`` of them when the symbolic
+    engine would explore one stable situation at a time)."""
 
     size: int
     estimate: str = "plant states"
     layer: int = 0
     budget: int = 0
     nodes: int = 0
+    steep: int = 0
 
 
 VALIDATE_THRESHOLD = 10**5
@@ -139,6 +137,11 @@ states (the box-sorting Grafcets' SYNC: 30 to 90; the lines of bench/gen_line.py
 cylinders, 48 at 12); when it ends there its result is the one kept and nothing else runs.
 It scales with :data:`PROBE_LAYER` (about 15 to 40 ms of this explicit engine's time)."""
 
+PROBE_STEEP = 800
+"""``validate --engine auto``: where the symbolic engine would explore one stable situation
+at a time (timers, stored actions, …), it pays per situation and wins only where SYNC grows
+steeply: the first layer above :data:`PROBE_LAYER` within this many SYNC states."""
+
 PROBE_BUDGET = 1300
 """``validate --engine auto``: the SYNC states the probe explores at most, about 0.1 s of
 the explicit engine's time. Large enough to meet the first layer above :data:`PROBE_LAYER`
@@ -154,7 +157,7 @@ VERIFY_THRESHOLD = 2_000_000
 
 THRESHOLDS: dict[Command, Threshold] = {
     Command.VALIDATE: Threshold(VALIDATE_THRESHOLD, "plant states × Grafcet steps", PROBE_LAYER, PROBE_BUDGET,
-                                PROBE_NODES),
+                                PROBE_NODES, PROBE_STEEP),
     Command.SUP: Threshold(SUP_THRESHOLD),
     Command.FILTER_VERIFY: Threshold(VERIFY_THRESHOLD),
 }
@@ -251,6 +254,10 @@ def measured(g: Growth, t: Threshold) -> Decision:
         return Decision(EngineChoice.EXPLICIT, f"auto: explicit (measured: SYNC explored whole within {t.nodes} "
                                                f"aggregated states, {g.states} SYNC states)", True)
 
+    if g.stop is Stop.WIDE and g.per_situation:
+        return Decision(EngineChoice.EXPLICIT, f"auto: explicit (measured: breadth-first layer {len(g.layers) - 1} "
+                                               f"of SYNC holds more than {layer} states after {g.states} states, not "
+                                               f"within {t.steep} as exploring per stable situation needs)", True)
     if g.stop is Stop.WIDE:
         return Decision(EngineChoice.SYMBOLIC, f"auto: symbolic (measured: breadth-first layer {len(g.layers) - 1} "
                                                f"of SYNC holds more than {layer} states, after {g.states} states)", True)
@@ -322,14 +329,13 @@ def validate_models(
 
     ran: list[Validation] = []
 
-    def growth(t: Threshold) -> Growth:  # the explicit engine within t.nodes, else the probe
-        from synth.probe import Growth, Stop, probe
+    def growth(t: Threshold) -> Growth:
+        from synth.probe import measure
 
-        try:
-            ran.append(validate_loaded(rs, p, g, expert=expert, homes=homes, max_states=min(t.nodes, max_states or t.nodes)))
-            return Growth((ran[0].sync.sync_states,), Stop.RAN)
-        except LimitExceeded:
-            return probe(p, rs.constraints, g, t.budget, t.layer)
+        counts, done = measure(rs, p, g, (t.nodes, t.budget, t.layer, t.steep), expert=expert, homes=homes,
+                               max_states=max_states)
+        ran.extend([done] if done is not None else [])
+        return counts
 
     chosen = decide(Command.VALIDATE, engine, options, estimate=p.size * max(1, len(g.steps)), growth=growth,
                     readers=p.readers, reads_at=p.reads_at)

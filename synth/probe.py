@@ -22,8 +22,9 @@ Example
 >>> g1 = probe(p, rs.constraints, g, budget=10_000)
 >>> g1.stop, g1.states, g1.widest
 (<Stop.DONE: 'done'>, 150, 15)
->>> probe(p, rs.constraints, g, budget=40)
-Growth(layers=(1, 2, 3, 6, 6, 9, 9, 5), stop=<Stop.BUDGET: 'budget'>)
+>>> g2 = probe(p, rs.constraints, g, budget=40)
+>>> g2.stop, g2.layers
+(<Stop.BUDGET: 'budget'>, (1, 2, 3, 6, 6, 9, 9, 5))
 >>> probe(p, rs.constraints, g, budget=10_000, wide=5).stop
 <Stop.WIDE: 'wide'>
 """
@@ -31,19 +32,22 @@ Growth(layers=(1, 2, 3, 6, 6, 9, 9, 5), stop=<Stop.BUDGET: 'budget'>)
 from __future__ import annotations
 
 from collections import deque
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from enum import Enum
 from typing import Sequence
 
+from synth.errors import LimitExceeded
 from synth.grafcet.language import Grafcet
 from synth.grafcet.machine import GrafcetMachine, Situation
 from synth.grafcet.situation import OutOfRange
 from synth.plant.composition import Plant
-from synth.plant.rules import Constraint
+from synth.plant.rules import Constraint, RuleSet
 from synth.sup.constraints import CompiledConstraints
+from synth.validation.result import Validation
 from synth.validation.sync import grafcet_inputs, moves_by_order, region
+from synth.validation.validate import validate_loaded
 
-__all__ = ["Stop", "Growth", "probe"]
+__all__ = ["Stop", "Growth", "probe", "measure"]
 
 Local = tuple[int, ...]
 
@@ -62,10 +66,12 @@ class Stop(Enum):
 class Growth:
     """What the probe met: ``layers``, the SYNC states first met in each breadth-first layer
     of aggregated states (the initial region's first, the layer it stopped in last);
-    ``states``, their sum; ``stop``, why it stopped."""
+    ``states``, their sum; ``stop``, why it stopped; ``per_situation``, set by the chooser: the symbolic engine would
+    explore this Grafcet one stable situation at a time (timers, stored actions, …)."""
 
     layers: tuple[int, ...]
     stop: Stop
+    per_situation: bool = False
 
     @property
     def states(self) -> int:
@@ -134,3 +140,25 @@ def probe(p: Plant, constraints: Sequence[Constraint], g: Grafcet, budget: int, 
     except OutOfRange:
         return Growth(tuple(layers), Stop.ERROR)
     return Growth(tuple(layers), Stop.DONE)
+
+
+def measure(rs: RuleSet, p: Plant, g: Grafcet, limits: tuple[int, int, int, int], *, expert: bool = False,
+            homes: Sequence[str] = (), max_states: int | None = None) -> tuple[Growth, Validation | None]:
+    """What ``validate --engine auto`` measures, ``limits`` being (nodes, budget, layer, steep):
+    the explicit engine first, within ``nodes`` aggregated states (and ``max_states``); when
+    SYNC ends there, :attr:`Stop.RAN` and its result, to be kept. Else the probe's counts
+    (``budget``, ``layer``), marked :attr:`Growth.per_situation` when its wide layer came
+    after ``steep`` states and the symbolic engine would explore one situation at a time."""
+    nodes, budget, layer, steep = limits
+    try:
+        done = validate_loaded(rs, p, g, expert=expert, homes=homes, max_states=min(nodes, max_states or nodes))
+        return Growth((done.sync.sync_states,), Stop.RAN), done
+    except LimitExceeded:
+        pass
+    counts = probe(p, rs.constraints, g, budget, layer)
+    if counts.stop is Stop.WIDE and counts.states > steep:
+        from synth.symbolic.validate import SymbolicPath, choose_path  # dd: the symbolic engine likely runs next
+
+        if choose_path(GrafcetMachine(g), p).path is SymbolicPath.SITUATIONS:
+            return replace(counts, per_situation=True), None
+    return counts, None

@@ -10,16 +10,17 @@ from typing import Any
 import pytest
 
 from synth import engines
-from synth.engines import PROBE_BUDGET, PROBE_LAYER, PROBE_NODES, Command, Decision, EngineChoice, Threshold, decide
+from synth.engines import (PROBE_BUDGET, PROBE_LAYER, PROBE_NODES, THRESHOLDS, Command, Decision, EngineChoice,
+                           Threshold, decide, measured)
 from synth.grafcet.situation import OutOfRange
-from synth.probe import Growth, Stop, probe
+from synth.probe import Growth, Stop, measure, probe
 from synth.validation.result import load_model
 from synth.validation.validate import validate_loaded
 
 from conftest import ROOT
 
 sys.path.insert(0, str(ROOT / "bench"))
-from gen_branches import write_branches  # noqa: E402
+from gen_branches import with_timers, write_branches  # noqa: E402
 from gen_par import write_par  # noqa: E402
 from gen_steep import write_steep  # noqa: E402
 
@@ -98,6 +99,27 @@ def test_auto_decides_on_the_probes_counts(case, tmp_path):
     assert asked[0].states <= PROBE_BUDGET + max(asked[0].layers)  # the budget is checked node by node
     assert (asked[0].stop is Stop.WIDE) == (chosen.engine is EngineChoice.SYMBOLIC)
     assert (max(asked[0].layers) > PROBE_LAYER) == (chosen.engine is EngineChoice.SYMBOLIC)
+
+
+@pytest.mark.parametrize("family, engine, reason", [
+    ("branches", EngineChoice.EXPLICIT, "auto: explicit (measured: breadth-first layer 10 of SYNC holds more than 250 "
+                                        "states after 1068 states, not within 800 as exploring per stable situation "
+                                        "needs)"),
+    ("par", EngineChoice.SYMBOLIC, "auto: symbolic (measured: breadth-first layer 5 of SYNC holds more than 250 "
+                                   "states, after 576 states)")])
+def test_with_timers_the_wide_layer_must_come_early(family, engine, reason, tmp_path):
+    """Timers: the symbolic engine explores one stable situation at a time, and pays per
+    situation; it wins on par_5 with timers (its first wide layer after 576 states) but not
+    on three timed branches of two cylinders (after 1 068: 1.4 times the explicit time)."""
+    rules, g7, _ = WRITERS[family](2 if family == "branches" else 5, tmp_path)
+    timed = tmp_path / "timed.g7"
+    timed.write_text(with_timers(g7.read_text(encoding="utf-8")), encoding="utf-8")
+    rs, p, g = load_model(timed, rules)
+    t = THRESHOLDS[Command.VALIDATE]
+    counts, done = measure(rs, p, g, (t.nodes, t.budget, t.layer, t.steep))
+    assert done is None and counts.stop is Stop.WIDE and counts.per_situation == (engine is EngineChoice.EXPLICIT)
+    chosen = measured(counts, t)
+    assert (chosen.engine, chosen.reason) == (engine, reason)
 
 
 def test_auto_runs_the_engine_it_chose_and_says_why_on_stderr(cli, tmp_path):
