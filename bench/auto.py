@@ -1,7 +1,8 @@
 """``validate --engine auto`` against the faster of the two engines, on every family of ``bench/``.
 
     python3 bench/auto.py [--par 3..7] [--steep 3..6] [--line 8,16] [--wide 2..5] [--branches 2..8]
-                          [--timed-par 5,6] [--timed-branches 2..3] [--missing] [--runs 2] [--budget 60] [--before DIR] [--json FILE]
+                          [--timed-par 5,6] [--timed-branches 2..3] [--missing] [--runs 2]
+                          [--budget 60] [--before DIR] [--json FILE]
 
 Families (each written by its generator into a temporary folder):
 
@@ -104,7 +105,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--before", type=Path, help="another synth tree: its auto is run too")
     ap.add_argument("--json", metavar="FILE")
     args = ap.parse_args(argv)
-    engines = [("explicit", ROOT), ("symbolic", ROOT), ("auto", ROOT)] + ([("auto", args.before)] if args.before else [])
+    engines = [("explicit", ROOT), ("symbolic", ROOT), ("auto", ROOT)]
+    engines += [("auto", args.before)] if args.before else []
     labels = [e if t == ROOT else f"{e} before" for e, t in engines]
     rows, worst, bad = [], 0.0, 0
     head = "| case | SYNC states | explicit s | symbolic s | auto → | auto s | auto / faster |"
@@ -125,7 +127,8 @@ def main(argv: list[str] | None = None) -> int:
                         over.add((family, label))
                         best[label] = res
                         continue
-                    if label not in best or best[label].get("seconds") is None or res["seconds"] < best[label]["seconds"]:
+                    kept = best.get(label, {}).get("seconds")
+                    if kept is None or res["seconds"] < kept:
                         best[label] = res
             ok = {k: v for k, v in best.items() if v.get("status") == "ok"}
             texts = {v["stdout"] for v in ok.values()}

@@ -59,8 +59,9 @@ if TYPE_CHECKING:  # pragma: no cover - the engines are imported once chosen
     from synth.validation.result import Validation
 
 __all__ = ["EngineChoice", "Command", "Need", "Capability", "CAPABILITIES", "Threshold", "THRESHOLDS", "Decision",
-           "capability", "refuse", "refusal", "decide", "measured", "VALIDATE_THRESHOLD",
-           "PROBE_LAYER", "PROBE_BUDGET", "PROBE_NODES", "PROBE_STEEP", "SUP_THRESHOLD", "VERIFY_THRESHOLD", "validate", "validate_models", "SupRun", "supervisor"]
+           "capability", "refuse", "refusal", "decide", "measured", "VALIDATE_THRESHOLD", "PROBE_LAYER",
+           "PROBE_BUDGET", "PROBE_NODES", "PROBE_STEEP", "SUP_THRESHOLD", "VERIFY_THRESHOLD", "validate",
+           "validate_models", "SupRun", "supervisor"]
 
 
 class Command(StrEnum):
@@ -259,8 +260,8 @@ def measured(g: Growth, t: Threshold) -> Decision:
                                                f"of SYNC holds more than {layer} states after {g.states} states, not "
                                                f"within {t.steep} as exploring per stable situation needs)", True)
     if g.stop is Stop.WIDE:
-        return Decision(EngineChoice.SYMBOLIC, f"auto: symbolic (measured: breadth-first layer {len(g.layers) - 1} "
-                                               f"of SYNC holds more than {layer} states, after {g.states} states)", True)
+        return Decision(EngineChoice.SYMBOLIC, f"auto: symbolic (measured: breadth-first layer {len(g.layers) - 1} of "
+                                               f"SYNC holds more than {layer} states, after {g.states} states)", True)
     if g.stop is Stop.DONE:
         return Decision(EngineChoice.EXPLICIT, f"auto: explicit (measured: SYNC has {g.states} states, its widest "
                                                f"breadth-first layer {g.widest}, not above {layer})", True)

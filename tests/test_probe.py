@@ -69,7 +69,8 @@ def test_an_assignment_out_of_range_stops_the_probe_and_the_explicit_engine_says
 # the decision on small cases of each kind: (family, n, missing) -> engine, reason
 DECISIONS = {
     ("par", 4, False): (EngineChoice.EXPLICIT,
-                        "auto: explicit (measured: SYNC has 882 states, its widest breadth-first layer 87, not above 250)"),
+                        "auto: explicit (measured: SYNC has 882 states, its widest breadth-first layer 87, "
+                        "not above 250)"),
     ("par", 5, False): (EngineChoice.SYMBOLIC,
                         "auto: symbolic (measured: breadth-first layer 7 of SYNC holds more than 250 states, "
                         "after 756 states)"),
