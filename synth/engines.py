@@ -16,8 +16,8 @@ Everything that decides is here, in three tables and one function:
     :data:`PROBE_LAYER` states within :data:`PROBE_BUDGET` (the explicit engine pays per
     SYNC state, the symbolic one per layer: docs/symbolic.md, "auto");
   - ``sup``: plant states above 10^6;
-  - ``filter verify``: plant states above 2·10^6 (the explicit engine's arrays over the
-    plant's grid).
+  - ``filter verify``: plant states above 2·10^6 (the explicit closed loop pays per node it
+    explores, the symbolic one per level).
 - :func:`decide`: the engine that runs and why (:class:`Decision`).
 
 The runners load each input once and hand the loaded models to the engine chosen:
