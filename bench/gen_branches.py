@@ -26,13 +26,14 @@ Example
 from __future__ import annotations
 
 import argparse
+import re
 import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from gen_line import LIBRARY  # noqa: E402
 
-__all__ = ["branches_rules", "branches_grafcet", "write_branches"]
+__all__ = ["branches_rules", "branches_grafcet", "with_timers", "write_branches"]
 
 
 def _check(k: int, m: int) -> None:
@@ -93,6 +94,19 @@ def branches_grafcet(k: int, m: int, missing: bool = False) -> str:
     out.append(f"  transition done: {ends} -> 0 when 1      # AND convergence")
     out.append("}")
     return "\n".join(out) + "\n"
+
+
+def with_timers(grafcet: str) -> str:
+    """``grafcet`` (of this generator, gen_par.py or gen_steep.py) where every cylinder, once
+    out, also waits 1 s in its step before it retracts: ``when a<i>_1`` becomes
+    ``when a<i>_1 & 1s/X<step>``. The symbolic engine then explores one stable situation at
+    a time (docs/symbolic.md), which ``auto`` must know.
+
+    >>> "transition out1_1: 1 -> 2 when a1_1_1 & 1s/X1" in with_timers(branches_grafcet(1, 1))
+    True
+    """
+    return re.sub(r"transition (\S+): (\d+) -> (\d+) when (a[\d_]+_1)\b",
+                  lambda mo: f"transition {mo[1]}: {mo[2]} -> {mo[3]} when {mo[4]} & 1s/X{mo[2]}", grafcet)
 
 
 def write_branches(k: int, m: int, directory: str | Path) -> tuple[Path, Path, Path]:

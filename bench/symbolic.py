@@ -47,10 +47,10 @@ __all__ = ["run", "main", "cases"]
 ENGINES = ("explicit", "symbolic")
 
 
-def run(args: list[str], budget: float) -> dict:
-    """``python -m synth ARGS`` in a fresh process limited to ``budget`` CPU seconds:
-    exit code, stdout, stderr, CPU seconds, peak MiB."""
-    env = dict(os.environ, PYTHONPATH=str(ROOT))
+def run(args: list[str], budget: float, tree: Path = ROOT) -> dict:
+    """``python -m synth ARGS`` in a fresh process limited to ``budget`` CPU seconds, the synth
+    of ``tree`` first on the path: exit code, stdout, stderr, CPU seconds, peak MiB."""
+    env = dict(os.environ, PYTHONPATH=str(tree))
     code = (
         "import resource, runpy, sys\n"
         f"resource.setrlimit(resource.RLIMIT_CPU, ({int(budget) + 1}, {int(budget) + 2}))\n"
@@ -67,7 +67,8 @@ def run(args: list[str], budget: float) -> dict:
         "sys.exit(c)\n"
     )
     try:
-        p = subprocess.run([sys.executable, "-c", code, *args], capture_output=True, text=True, timeout=3 * budget, env=env)
+        p = subprocess.run([sys.executable, "-c", code, *args], capture_output=True, text=True, timeout=3 * budget, env=env,
+                           cwd=str(tree))  # the tree first: `python -c` puts the working folder first on the path
     except subprocess.TimeoutExpired:
         return {"status": "timeout", "seconds": None, "mib": None}
     tail = [line for line in p.stderr.splitlines() if line.startswith("@@ ")]

@@ -10,17 +10,14 @@ Everything that decides is here, in three tables and one function:
   :func:`refusal` (exit 2); with ``auto`` it rules that engine out.
 - :data:`THRESHOLDS`: ``auto``'s estimate, per command, above which the symbolic engine runs:
 
-  - ``validate``: plant states × Grafcet steps above 10^5 *and* the Grafcet moves at least
-    4 actuators at once (:func:`concurrency`, the widest AND divergence). Both engines pay
-    per stable situation; per situation the explicit engine lists every interleaving of the
-    moving elements (about r^D SYNC states for D branches at once, r ≈ 3 for a cylinder),
-    the symbolic one builds BDDs whose size grows polynomially in D. Measured
-    (docs/performance.md, bench/symbolic.py): at D = 3 the explicit engine is as fast or
-    faster on every family (branches × sequence: 2.7× faster), from D = 4 on the symbolic
-    one wins (par, steep);
+  - ``validate``: plant states × Grafcet steps above 10^5, then *measured* (counts, never
+    time): the explicit engine within :data:`PROBE_NODES` aggregated states, else the probe
+    (:func:`synth.probe.probe`): symbolic when a breadth-first layer of SYNC holds more than
+    :data:`PROBE_LAYER` states within :data:`PROBE_BUDGET` (the explicit engine pays per
+    SYNC state, the symbolic one per layer: docs/symbolic.md, "auto");
   - ``sup``: plant states above 10^6;
-  - ``filter verify``: plant states above 2·10^6 (the explicit engine's arrays over the
-    plant's grid).
+  - ``filter verify``: plant states above 2·10^6 (the explicit closed loop pays per node it
+    explores, the symbolic one per level).
 - :func:`decide`: the engine that runs and why (:class:`Decision`).
 
 The runners load each input once and hand the loaded models to the engine chosen:
@@ -31,11 +28,13 @@ imported only once chosen: a passing box-sorting validation never imports the BD
 
 Example
 -------
->>> decide(Command.VALIDATE, EngineChoice.AUTO, estimate=10**8, width=4).engine
-<EngineChoice.SYMBOLIC: 'symbolic'>
->>> decide(Command.VALIDATE, EngineChoice.AUTO, estimate=10**8, width=3).reason
-'auto: the widest AND divergence starts 3 branches, fewer than 4'
->>> decide(Command.VALIDATE, EngineChoice.AUTO, {Need.LISTING}, estimate=10**8, width=4).reason
+>>> from synth.probe import Growth, Stop
+>>> decide(Command.VALIDATE, EngineChoice.AUTO, estimate=10**8,
+...        growth=lambda threshold: Growth((1, 16, 5, 18, 42, 71, 87, 78), Stop.DONE)).reason
+'auto: explicit (measured: SYNC has 318 states, its widest breadth-first layer 87, not above 250)'
+>>> decide(Command.VALIDATE, EngineChoice.AUTO, estimate=10**4).reason
+'auto: 10000 plant states × Grafcet steps, not above 100000'
+>>> decide(Command.VALIDATE, EngineChoice.AUTO, {Need.LISTING}, estimate=10**8).reason
 'auto: the symbolic engine does not serve listing'
 """
 
@@ -53,14 +52,16 @@ if TYPE_CHECKING:  # pragma: no cover - the engines are imported once chosen
     from synth.grafcet.language import Grafcet, Semantics
     from synth.plant.composition import Plant
     from synth.plant.rules import RuleSet
+    from synth.probe import Growth
     from synth.sup.explain import Explanation
     from synth.sup.supervisor import Supervisor
     from synth.symbolic.supervisor import SymbolicSupervisor
     from synth.validation.result import Validation
 
 __all__ = ["EngineChoice", "Command", "Need", "Capability", "CAPABILITIES", "Threshold", "THRESHOLDS", "Decision",
-           "capability", "refuse", "refusal", "decide", "choose", "concurrency", "VALIDATE_THRESHOLD",
-           "CONCURRENCY_THRESHOLD", "SUP_THRESHOLD", "VERIFY_THRESHOLD", "validate", "validate_models", "SupRun", "supervisor"]
+           "capability", "refuse", "refusal", "decide", "measured", "VALIDATE_THRESHOLD", "PROBE_LAYER",
+           "PROBE_BUDGET", "PROBE_NODES", "PROBE_STEEP", "SUP_THRESHOLD", "VERIFY_THRESHOLD", "validate",
+           "validate_models", "SupRun", "supervisor"]
 
 
 class Command(StrEnum):
@@ -107,19 +108,47 @@ other (its cycle encodes their guards)."""
 
 @dataclass(frozen=True)
 class Threshold:
-    """``auto`` runs the symbolic engine when the estimate exceeds ``size`` and the
-    concurrency reaches ``width``."""
+    """``auto`` runs the symbolic engine when the estimate exceeds ``size``; where ``layer``
+    is set (``validate``), only when the explicit engine does not end within ``nodes``
+    aggregated states and the probe, given ``budget`` SYNC states, meets a breadth-first
+    layer of more than ``layer`` SYNC states (within ``steep`` of them when the symbolic
+    engine would explore one stable situation at a time)."""
 
     size: int
-    width: int = 1
     estimate: str = "plant states"
+    layer: int = 0
+    budget: int = 0
+    nodes: int = 0
+    steep: int = 0
 
 
 VALIDATE_THRESHOLD = 10**5
-"""``validate --engine auto``: symbolic only when plant states × Grafcet steps exceed this."""
+"""``validate --engine auto``: symbolic only when plant states × Grafcet steps exceed this
+(below, the explicit engine without a probe)."""
 
-CONCURRENCY_THRESHOLD = 4
-"""``validate --engine auto``: symbolic only when the Grafcet starts this many branches at once."""
+PROBE_LAYER = 250
+"""``validate --engine auto``: symbolic when a breadth-first layer of SYNC holds more than
+this many SYNC states. Where the explicit engine pays about as much for a layer as the
+symbolic one: measured with this explicit engine's cost per SYNC state (about 100 µs); an
+explicit engine k times faster per state moves it about k times up."""
+
+PROBE_NODES = 100
+"""``validate --engine auto``: the explicit engine runs first within this many aggregated
+states (the box-sorting Grafcets' SYNC: 30 to 90; the lines of bench/gen_line.py: 32 at 8
+cylinders, 48 at 12); when it ends there its result is the one kept and nothing else runs.
+It scales with :data:`PROBE_LAYER` (about 15 to 40 ms of this explicit engine's time)."""
+
+PROBE_STEEP = 800
+"""``validate --engine auto``: where the symbolic engine would explore one stable situation
+at a time (timers, stored actions, …), it pays per situation and wins only where SYNC grows
+steeply: the first layer above :data:`PROBE_LAYER` within this many SYNC states."""
+
+PROBE_BUDGET = 1300
+"""``validate --engine auto``: the SYNC states the probe explores at most, about 0.1 s of
+the explicit engine's time. Large enough to meet the first layer above :data:`PROBE_LAYER`
+on every bench family that has one (branches × sequence: after 1 006 to 1 253 states), small
+enough that a probe that ends in the explicit engine costs it little; it scales with
+:data:`PROBE_LAYER`."""
 
 SUP_THRESHOLD = 10**6
 """``sup --engine auto``: symbolic when the plant has more states than this."""
@@ -128,7 +157,8 @@ VERIFY_THRESHOLD = 2_000_000
 """``filter verify --engine auto``: symbolic when the plant has more states than this."""
 
 THRESHOLDS: dict[Command, Threshold] = {
-    Command.VALIDATE: Threshold(VALIDATE_THRESHOLD, CONCURRENCY_THRESHOLD, "plant states × Grafcet steps"),
+    Command.VALIDATE: Threshold(VALIDATE_THRESHOLD, "plant states × Grafcet steps", PROBE_LAYER, PROBE_BUDGET,
+                                PROBE_NODES, PROBE_STEEP),
     Command.SUP: Threshold(SUP_THRESHOLD),
     Command.FILTER_VERIFY: Threshold(VERIFY_THRESHOLD),
 }
@@ -140,6 +170,7 @@ class Decision:
 
     engine: EngineChoice
     reason: str
+    measured: bool = False  # ``auto`` ran the probe (:mod:`synth.probe`): the reason gives its counts
 
 
 def capability(command: Command, engine: EngineChoice) -> Capability:
@@ -181,10 +212,13 @@ def refuse(command: Command, asked: EngineChoice | str, needs: Collection[Need],
 
 
 def decide(command: Command, asked: EngineChoice | str, needs: Collection[Need] = (), *, estimate: int = 0,
-           width: int = 1, readers: Sequence[str] = (), reads_at: Location | None = None) -> Decision:
+           growth: Callable[[Threshold], Growth] | None = None, readers: Sequence[str] = (),
+           reads_at: Location | None = None) -> Decision:
     """The engine that runs ``command`` asked with ``--engine asked`` for a run with
-    ``needs`` (:attr:`Need.READS` added when ``readers`` is not empty) and ``auto``'s
-    ``estimate`` and concurrency ``width`` (see the module docstring)."""
+    ``needs`` (:attr:`Need.READS` added when ``readers`` is not empty), ``auto``'s
+    ``estimate`` and, where the threshold has a ``layer``, ``growth(threshold)``: what the
+    bounded explicit run or the probe measured, asked for only when the estimate is above
+    the threshold's size (see the module docstring; without ``growth``, the estimate alone)."""
     asked = EngineChoice(asked)
     needs = set(needs) | ({Need.READS} if readers else set())
     refuse(command, asked, needs, readers, reads_at)
@@ -196,31 +230,46 @@ def decide(command: Command, asked: EngineChoice | str, needs: Collection[Need] 
     t = THRESHOLDS[command]
     if estimate <= t.size:
         return Decision(EngineChoice.EXPLICIT, f"auto: {estimate} {t.estimate}, not above {t.size}")
-    if width < t.width:
-        return Decision(EngineChoice.EXPLICIT,
-                        f"auto: the widest AND divergence starts {width} branches, fewer than {t.width}")
+    if t.layer and growth is not None:
+        return measured(growth(t), t)
     return Decision(EngineChoice.SYMBOLIC, f"auto: {estimate} {t.estimate}, above {t.size}")
 
 
-def choose(asked: EngineChoice | str, estimate: int, *, width: int = CONCURRENCY_THRESHOLD) -> EngineChoice:
-    """``validate``'s engine for an estimate and a concurrency alone (:func:`decide`).
+def measured(g: Growth, t: Threshold) -> Decision:
+    """``validate``'s engine from the counts measured (:class:`~synth.probe.Growth`) and the
+    threshold ``t``.
 
-    >>> choose(EngineChoice.AUTO, 10**8), choose(EngineChoice.AUTO, 10**8, width=3)
-    (<EngineChoice.SYMBOLIC: 'symbolic'>, <EngineChoice.EXPLICIT: 'explicit'>)
+    >>> from synth.probe import Growth, Stop
+    >>> t = THRESHOLDS[Command.VALIDATE]
+    >>> measured(Growth((1, 64, 7, 33, 107, 261), Stop.WIDE), t).reason
+    'auto: symbolic (measured: breadth-first layer 5 of SYNC holds more than 250 states, after 473 states)'
+    >>> measured(Growth((1, 5, 5, 13, 19, 40, 50, 52, 77, 118, 166, 209, 198, 170), Stop.BUDGET), t).reason
+    'auto: explicit (measured: 1123 SYNC states in 14 breadth-first layers, none above 250)'
+    >>> measured(Growth((150,), Stop.RAN), t).reason
+    'auto: explicit (measured: SYNC explored whole within 100 aggregated states, 150 SYNC states)'
     """
-    return decide(Command.VALIDATE, asked, estimate=estimate, width=width).engine
+    from synth.probe import Stop
 
+    layer = t.layer
+    if g.stop is Stop.RAN:
+        return Decision(EngineChoice.EXPLICIT, f"auto: explicit (measured: SYNC explored whole within {t.nodes} "
+                                               f"aggregated states, {g.states} SYNC states)", True)
 
-def concurrency(g: Grafcet) -> int:
-    """The widest AND divergence of ``g``: the most steps one transition activates (1
-    for a sequence), the number of branches that can move actuators at once.
-
-    >>> from synth.grafcet.language_check import load_grafcet
-    >>> from synth.plant.composition import _plants
-    >>> concurrency(load_grafcet(_plants("../grafcets/tri.g7")))
-    1
-    """
-    return max((len(t.targets) for t in g.transitions), default=1)
+    if g.stop is Stop.WIDE and g.per_situation:
+        return Decision(EngineChoice.EXPLICIT, f"auto: explicit (measured: breadth-first layer {len(g.layers) - 1} "
+                                               f"of SYNC holds more than {layer} states after {g.states} states, not "
+                                               f"within {t.steep} as exploring per stable situation needs)", True)
+    if g.stop is Stop.WIDE:
+        return Decision(EngineChoice.SYMBOLIC, f"auto: symbolic (measured: breadth-first layer {len(g.layers) - 1} of "
+                                               f"SYNC holds more than {layer} states, after {g.states} states)", True)
+    if g.stop is Stop.DONE:
+        return Decision(EngineChoice.EXPLICIT, f"auto: explicit (measured: SYNC has {g.states} states, its widest "
+                                               f"breadth-first layer {g.widest}, not above {layer})", True)
+    if g.stop is Stop.ERROR:
+        return Decision(EngineChoice.EXPLICIT, f"auto: explicit (measured: an internal variable out of range after "
+                                               f"{g.states} SYNC states)", True)
+    return Decision(EngineChoice.EXPLICIT, f"auto: explicit (measured: {g.states} SYNC states in {len(g.layers)} "
+                                           f"breadth-first layers, none above {layer})", True)
 
 
 def validate(
@@ -235,12 +284,14 @@ def validate(
     max_nodes: int | None = None,
     progress: Callable[[str], None] | None = None,
     semantics: "Semantics | str" = "grafcet",
+    decided: Callable[[Decision], None] | None = None,
 ) -> Validation:
     """``synth validate``: load, choose the engine, run it. ``needs_listing``: ``--report``
     or ``--cor`` will list every aggregated state (explicit engine only; with ``--engine
     symbolic`` an error before any input is read); ``max_states`` bounds the explicit
     engine, ``max_nodes`` the symbolic one; ``progress`` receives progress lines;
-    ``semantics`` ``sfc`` (one evolution per PLC scan) runs on the explicit engine."""
+    ``semantics`` ``sfc`` (one evolution per PLC scan) runs on the explicit engine;
+    ``decided`` receives the engine chosen and why."""
     from synth.grafcet.language import Semantics
     from synth.validation.result import load_model
 
@@ -250,7 +301,7 @@ def validate(
     refuse(Command.VALIDATE, engine, options)
     rs, p, g = load_model(grafcet_path, rules_path, semantics)
     return validate_models(rs, p, g, engine=engine, needs_listing=needs_listing, expert=expert, homes=homes,
-                           max_states=max_states, max_nodes=max_nodes, progress=progress)
+                           max_states=max_states, max_nodes=max_nodes, progress=progress, decided=decided)
 
 
 def validate_models(
@@ -265,6 +316,7 @@ def validate_models(
     max_states: int | None = None,
     max_nodes: int | None = None,
     progress: Callable[[str], None] | None = None,
+    decided: Callable[[Decision], None] | None = None,
 ) -> Validation:
     """:func:`validate` on models already loaded (a line's worker compiles each plant once and
     validates many Grafcets against it): the same choice, the same engines."""
@@ -273,8 +325,25 @@ def validate_models(
     options = {Need.LISTING} if needs_listing else set()
     if g.semantics is not Semantics.GRAFCET:
         options.add(Need.SFC)
-    chosen = decide(Command.VALIDATE, engine, options, estimate=p.size * max(1, len(g.steps)), width=concurrency(g),
+
+    from synth.validation.validate import validate_loaded
+
+    ran: list[Validation] = []
+
+    def growth(t: Threshold) -> Growth:
+        from synth.probe import measure
+
+        counts, done = measure(rs, p, g, (t.nodes, t.budget, t.layer, t.steep), expert=expert, homes=homes,
+                               max_states=max_states)
+        ran.extend([done] if done is not None else [])
+        return counts
+
+    chosen = decide(Command.VALIDATE, engine, options, estimate=p.size * max(1, len(g.steps)), growth=growth,
                     readers=p.readers, reads_at=p.reads_at)
+    if decided is not None:
+        decided(chosen)
+    if ran and chosen.engine is EngineChoice.EXPLICIT:
+        return ran[0]
     if chosen.engine is EngineChoice.SYMBOLIC:
         from synth.grafcet.situation import OutOfRange
         from synth.symbolic.validate import validate_loaded as symbolic
@@ -282,12 +351,8 @@ def validate_models(
         try:
             return symbolic(rs, p, g, expert=expert, homes=homes, max_nodes=max_nodes, progress=progress)
         except OutOfRange:  # the explicit engine says it with the shortest trace
-            from synth.validation.validate import validate_loaded as explicit
-
-            explicit(rs, p, g, expert=expert, homes=homes, max_states=max_states)
+            validate_loaded(rs, p, g, expert=expert, homes=homes, max_states=max_states)
             raise
-    from synth.validation.validate import validate_loaded
-
     explored = None
     if progress is not None:
         def explored(n: int, pending: int, show: Callable[[str], None] = progress) -> None:

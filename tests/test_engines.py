@@ -19,10 +19,11 @@ from typing import Any
 import pytest
 
 from conftest import ROOT
-from synth.engines import (CAPABILITIES, THRESHOLDS, Capability, Command, EngineChoice, Need, capability, decide,
-                           refusal)
+from synth.engines import (CAPABILITIES, PROBE_BUDGET, PROBE_LAYER, THRESHOLDS, Capability, Command, EngineChoice,
+                           Need, Threshold, capability, decide, refusal)
 from synth.errors import InputError
 from synth.plant.composition import load_plant
+from synth.probe import Growth, Stop
 
 G, P, D = ROOT / "grafcets", ROOT / "plants", ROOT / "tests" / "data" / "filter"
 TRI = ["validate", G / "tri.g7", "--plant", P / "tri.rules", "--json"]
@@ -123,13 +124,29 @@ def test_one_declaration_per_engine_and_command() -> None:
 
 def test_auto_reads_the_threshold_table_and_says_why() -> None:
     for command, t in THRESHOLDS.items():
-        below = decide(command, "auto", estimate=t.size, width=t.width)
-        above = decide(command, "auto", estimate=t.size + 1, width=t.width)
+        below = decide(command, "auto", estimate=t.size)
+        above = decide(command, "auto", estimate=t.size + 1)
         assert (below.engine, above.engine) == (EngineChoice.EXPLICIT, EngineChoice.SYMBOLIC)
         assert below.reason == f"auto: {t.size} {t.estimate}, not above {t.size}"
         assert above.reason == f"auto: {t.size + 1} {t.estimate}, above {t.size}"
-    narrow = decide(Command.VALIDATE, "auto", estimate=10**9, width=3)
-    assert narrow.reason == "auto: the widest AND divergence starts 3 branches, fewer than 4"
+        assert not (below.measured or above.measured)
+    asked: list[tuple[int, int]] = []
+
+    def narrow(threshold: Threshold) -> Growth:
+        asked.append((threshold.budget, threshold.layer))
+        return Growth((1, 5, 5, 13, 19, 40, 50, 52, 77, 118, 166, 209, 198, 170), Stop.BUDGET)
+
+    t = THRESHOLDS[Command.VALIDATE]
+    assert decide(Command.VALIDATE, "auto", estimate=t.size, growth=narrow).reason == \
+        f"auto: {t.size} {t.estimate}, not above {t.size}"
+    assert asked == []  # below the size, no probe
+    chosen = decide(Command.VALIDATE, "auto", estimate=10**9, growth=narrow)
+    assert asked == [(t.budget, t.layer)] == [(PROBE_BUDGET, PROBE_LAYER)]
+    assert (chosen.engine, chosen.measured) == (EngineChoice.EXPLICIT, True)
+    assert chosen.reason == "auto: explicit (measured: 1123 SYNC states in 14 breadth-first layers, none above 250)"
+    assert decide(Command.VALIDATE, "explicit", estimate=10**9, growth=narrow).reason == "--engine explicit"
+    assert decide(Command.VALIDATE, "auto", {Need.SFC}, estimate=10**9, growth=narrow).engine is EngineChoice.EXPLICIT
+    assert len(asked) == 1  # a forced engine or an unserved need asks no probe
     big = 10**9
     assert decide(Command.SUP, "auto", estimate=big, readers=("CELLS",)).reason == \
         "auto: the symbolic engine does not serve reads"

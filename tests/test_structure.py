@@ -97,7 +97,7 @@ def test_no_import_cycle_among_synth_modules() -> None:
 # stand on top.
 GROUND = ("synth.choices", "synth.errors", "synth._lazy", "synth.version")
 ORDER = ("synth.logic", "synth.syntax", "synth.plant", "synth.sup", "synth.grafcet", "synth.validation",
-         "synth.symbolic", "synth.engines", "synth.filter", "synth.codegen", "synth.output", "synth.commission",
+         "synth.symbolic", "synth.probe", "synth.engines", "synth.filter", "synth.codegen", "synth.output", "synth.commission",
          "synth.line", "synth.cli", "synth.__main__", "synth")
 LEVEL = {**{r: 0 for r in GROUND}, **{r: i for i, r in enumerate(ORDER, 1)}}
 

@@ -1,5 +1,5 @@
 """The symbolic engine's variable order (constraint graph), its report in ``validate
---json``, ``--engine auto``'s choice, and the bench families steep and branches × sequence."""
+--json``, and the bench families steep and branches × sequence (``--engine auto``: tests/test_probe.py)."""
 
 from __future__ import annotations
 
@@ -8,9 +8,6 @@ import sys
 
 import pytest
 
-from synth import engines
-from synth.engines import EngineChoice, choose, concurrency
-from synth.grafcet.language_check import load_grafcet
 from synth.output.result import validation_json, validation_text
 from synth.plant.composition import plant
 from synth.plant.rules_check import load_rules
@@ -90,25 +87,6 @@ def test_steep_family_identical(n, tmp_path):
         a, b = validate(grafcet, r), validate_symbolic(grafcet, r)
         assert validation_text(b) == validation_text(a)
     assert validate(g, r).passed and not validate(missing, r).passed
-
-
-def test_concurrency_is_the_widest_and_divergence(tmp_path):
-    _, g, _ = write_steep(5, tmp_path)
-    _, gb, _ = write_branches(3, 2, tmp_path)
-    assert concurrency(load_grafcet(g)) == 5
-    assert concurrency(load_grafcet(gb)) == 3
-    assert concurrency(load_grafcet(G / "tri.g7")) == 1
-
-
-def test_auto_keeps_sequences_explicit_and_takes_wide_divergences_symbolic(tmp_path):
-    assert choose(EngineChoice.AUTO, 10**9, width=3) == EngineChoice.EXPLICIT
-    assert choose(EngineChoice.AUTO, 10**9, width=4) == EngineChoice.SYMBOLIC
-    assert choose(EngineChoice.AUTO, 10**5, width=8) == EngineChoice.EXPLICIT
-    assert choose(EngineChoice.SYMBOLIC, 10, width=1) == EngineChoice.SYMBOLIC
-    r, g, _ = write_branches(3, 2, tmp_path)  # 2·12^6 plant states × 16 steps, 3 branches: explicit
-    assert engines.validate(g, r).engine_stats is None
-    r, g, _ = write_par(6, tmp_path)  # 2·12^6 × 25 steps, 6 branches: symbolic
-    assert engines.validate(g, r).engine_stats is not None
 
 
 def test_smallest_state_is_in_declaration_order_whatever_the_bdd_order(tmp_path, monkeypatch):

@@ -32,7 +32,7 @@ def register(sub: "argparse._SubParsersAction") -> None:
     v.add_argument("--semantics", choices=("grafcet", "sfc"), default="grafcet", help=SEMANTICS_HELP)
     v.add_argument("--engine", choices=("auto", "explicit", "symbolic"), default="auto",
                    help="explicit exploration, BDDs (for many actuators moving at once), or chosen by "
-                        "estimated size (default; docs/symbolic.md)")
+                        "size and a bounded probe of the exploration (default; docs/symbolic.md)")
     v.add_argument("--max-nodes", metavar="N", type=int, help="stop when the symbolic engine needs more than N BDD nodes")
     v.add_argument("--quiet", action="store_true", help="no progress on stderr")
     v.add_argument("--junit", metavar="FILE", help="also write the findings as JUnit XML (one test case per finding)")
@@ -48,7 +48,7 @@ def cmd_validate(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     from synth.cli.plant import print_warnings
-    from synth.engines import validate
+    from synth.engines import Decision, EngineChoice, validate
     from synth.errors import SynthError
     from synth.output.files import write_atomic
     from synth.output.html import write_report
@@ -60,6 +60,11 @@ def cmd_validate(args: argparse.Namespace) -> int:
     if args.cor and Path(args.cor).suffix == ".dot":
         raise SynthError(f"--cor {args.cor}: the JSON file must not end in .dot, the DOT file is written beside it")
     show = tty_progress(not args.quiet and sys.stderr.isatty())
+
+    def decided(chosen: Decision) -> None:  # auto's probe chose the symbolic engine: the counts it read
+        if chosen.measured and chosen.engine is EngineChoice.SYMBOLIC and not args.quiet:
+            print(chosen.reason, file=sys.stderr)
+
     result = validate(
         args.grafcet,
         args.plant,
@@ -71,6 +76,7 @@ def cmd_validate(args: argparse.Namespace) -> int:
         max_nodes=args.max_nodes,
         progress=show,
         semantics=args.semantics,
+        decided=decided,
     )
     clear_progress(show)
     if result.engine_stats is not None and not args.quiet:
