@@ -696,7 +696,7 @@ grafcet ASKED_SR {
     assert [w.render().splitlines()[0] for w in warnings] == [
         "l.xml:184:15: warning: DONE, a local Boolean that is only the action D T#5s of step Run, is read as the step "
         "timer 5s/XRun: IEC 61131-3 makes it TRUE from 5s after the step's activation until its deactivation, as the "
-        "timer",
+        "timer (on MATIEC, the compiler of Beremiz and OpenPLC, it turns TRUE one scan after the timer)",
         "l.xml:47:17: warning: the LD action BLINK (run while XIdle holds) blinks LAMP: T_OFF (IN:=NOT LAMP, "
         "PT:=T#700ms) sets it on the rising edge of its Q (R_TRIG UP), T_ON (IN:=LAMP, PT:=T#300ms) resets it on the "
         "rising edge of its Q (R_TRIG DOWN); read as the partial grafcet BLINK, whose steps "

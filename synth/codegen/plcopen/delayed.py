@@ -72,4 +72,5 @@ def delayed_flags(pou: Any, sfc: Any, q: Callable[[str], str], at: Callable[[Any
         scope.warnings.append(InputError(
             f"{local[name].get('name')}, a local Boolean that is only the action D {action.get('duration')} of step "
             f"{sname}, is read as the step timer {timer}: IEC 61131-3 makes it TRUE from {d} after the "
-            "step's activation until its deactivation, as the timer", at(action), severity=Severity.WARNING))
+            "step's activation until its deactivation, as the timer (on MATIEC, the compiler of Beremiz and OpenPLC, "
+            "it turns TRUE one scan after the timer)", at(action), severity=Severity.WARNING))
