@@ -24,7 +24,7 @@ from conftest import ROOT
 BUNDLED = [p for p in sorted(ROOT.glob("grafcets/*.g7")) + sorted(ROOT.glob("tests/data/**/*.g7"))
            if "codegen" not in p.parts]
 DEPTH = {"tri.g7": 3, "tri_missing_order.g7": 3, "tri_boxes.g7": 3}  # 11 inputs: 1 335 sequences at depth 3
-RANDOM_SEEDS = range(0, 120, 2)  # 1 000 more nightly (60, every other seed: the suite stays under 6 min on 2 cores)
+RANDOM_SEEDS = range(1, 120, 3)  # 1 000 more nightly (40, every third seed: the suite stays under 6 min on 2 cores)
 
 
 @pytest.mark.slow  # about 60 s: blark parses each program (about 1 ms per character)
@@ -71,7 +71,7 @@ def _random_programs(seeds: range) -> list[tuple[int, int, int, str]]:
 @pytest.mark.slow  # about 35 s on 2 cores: 80 programs for blark to parse
 def test_random_grafcets():
     results = _random_programs(RANDOM_SEEDS)
-    assert sum(cycles for _, _, cycles, _ in results) > 3000
+    assert sum(cycles for _, _, cycles, _ in results) > 1500
 
 
 @pytest.mark.nightly  # about 6 min on 2 cores: pytest -m nightly
@@ -82,18 +82,18 @@ def test_random_grafcets_nightly():
 
 
 def test_random_grafcets_cover_every_construct():
-    """The programs the suite runs cover each construct (the thresholds: two thirds of what these 60 seeds give)."""
+    """The programs the suite runs cover each construct (the thresholds: two thirds of what these 40 seeds give)."""
     texts = [random_grafcet(seed) for seed in RANDOM_SEEDS]
     gs = [parse_grafcet(t, f"random{i}.g7") for i, t in enumerate(texts)]
     assert sum(any(len(t.targets) > 1 for t in g.transitions) for g in gs) >= 3  # AND divergences
-    assert sum(any(len(t.sources) > 1 for t in g.transitions) for g in gs) >= 4  # AND convergences
-    assert sum(len({t.sources for t in g.transitions}) < len(g.transitions) for g in gs) >= 9  # OR divergences
-    assert sum(bool(g.timers) for g in gs) >= 28
-    assert sum("↑" in t or "↓" in t for t in texts) >= 37
-    assert sum(" on ↑" in t or " on ↓" in t for t in texts) >= 18  # stored actions on events
-    assert sum(" on deactivation" in t for t in texts) >= 6
-    assert sum(" if " in t for t in texts) >= 14  # conditional actions
-    assert sum(len(g.grafcets) > 1 for g in gs) >= 15  # step variables across partial grafcets
+    assert sum(any(len(t.sources) > 1 for t in g.transitions) for g in gs) >= 2  # AND convergences
+    assert sum(len({t.sources for t in g.transitions}) < len(g.transitions) for g in gs) >= 7  # OR divergences
+    assert sum(bool(g.timers) for g in gs) >= 18
+    assert sum("↑" in t or "↓" in t for t in texts) >= 24
+    assert sum(" on ↑" in t or " on ↓" in t for t in texts) >= 11  # stored actions on events
+    assert sum(" on deactivation" in t for t in texts) >= 4
+    assert sum(" if " in t for t in texts) >= 9  # conditional actions
+    assert sum(len(g.grafcets) > 1 for g in gs) >= 11  # step variables across partial grafcets
 
 
 def _flip(monkeypatch, old: str, new: str) -> None:

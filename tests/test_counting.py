@@ -60,7 +60,7 @@ def test_counts_past_a_double_and_deeper_than_the_recursion_limit():
     assert Conjunctions(e, chain, levels).count(odd) == count(e, chain & odd, levels) == 1
 
 
-@pytest.mark.slow  # about 30 CPU s: SUP of a line of 400 cylinders on BDDs, then its counts
+@pytest.mark.nightly  # about 30 CPU s: SUP of a line of 400 cylinders on BDDs, then its counts (pytest -m nightly)
 def test_symbolic_sup_of_line_400_counts_exactly(tmp_path):
     from synth.plant.composition import plant
     from synth.plant.rules_check import load_rules
