@@ -39,7 +39,7 @@ import numpy as np
 from synth.grafcet.language import CONDITIONAL, CONTINUOUS, Semantics, step_of
 from synth.grafcet.machine import GrafcetMachine
 from synth.grafcet.situation import Situation, sorted_steps
-from synth.logic.expr import And, Compare, Const, Edge, Expr, Not, Or, Var
+from synth.logic.expr import And, Compare, Edge, Expr, Not, Or, Var, evaluate, names
 
 __all__ = ["VectorMachine", "unsupported", "ROUNDS"]
 
@@ -126,25 +126,27 @@ class VectorMachine:
         self._order = {o: i for i, o in enumerate(self.order_names)}
 
     # ------------------------------------------------------------------ compilation
-    def _code(self, e: Expr) -> str:
-        if isinstance(e, Var):  # Compare is refused by unsupported()
-            if e.name in self._timer:
-                return f"T[:, {self._timer[e.name]}]"
-            step = step_of(e.name, set(self._step))
-            if step is not None:
-                return f"A[:, {self._step[step]}]"
-            return f"I[:, {self._input[e.name]}]"
-        if isinstance(e, Const):
-            return "(~Z)" if e.value else "Z"
-        if isinstance(e, Edge):
-            return f"(E == {self.events.get(e.text(), -2)})"
-        if isinstance(e, Not):
-            return f"(~{self._code(e.arg)})"
-        op = " & " if isinstance(e, And) else " | "
-        return "(" + op.join(self._code(a) for a in e.args) + ")"
-
     def _compile(self, e: Expr) -> Columns:
-        fn: Columns = eval(f"lambda I, A, T, E, Z: {self._code(e)}", {"__builtins__": {}})  # noqa: S307
+        """``e`` on whole columns: the one expression walker (:func:`~synth.logic.expr.evaluate`,
+        which takes numpy arrays), its names resolved to columns once here."""
+        where: dict[str, tuple[str, int]] = {}
+        for n in names(e):
+            if isinstance(n, Var):  # Compare is refused by unsupported()
+                step = step_of(n.name, set(self._step))
+                where[n.name] = (("T", self._timer[n.name]) if n.name in self._timer
+                                 else ("A", self._step[step]) if step is not None else ("I", self._input[n.name]))
+        events = {n.text(): self.events.get(n.text(), -2) for n in names(e) if isinstance(n, Edge)}
+
+        def fn(I: np.ndarray, A: np.ndarray, T: np.ndarray, E: np.ndarray, Z: np.ndarray) -> np.ndarray:
+            table = {"I": I, "A": A, "T": T}
+
+            def value(name: str) -> np.ndarray:
+                kind, k = where[name]
+                return table[kind][:, k]
+
+            out = evaluate(e, value, lambda x: E == events[x.text()])
+            return out if isinstance(out, np.ndarray) else (~Z if out else Z)
+
         return fn
 
     # ------------------------------------------------------------------ situations as rows
