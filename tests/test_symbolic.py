@@ -29,6 +29,7 @@ from randrules import random_rules
 from schemas import assert_valid
 
 sys.path.insert(0, str(ROOT / "bench"))
+from gen_branches import write_branches  # noqa: E402
 from gen_line import write_line  # noqa: E402
 from gen_par import write_par  # noqa: E402
 
@@ -79,6 +80,26 @@ def test_generated_families_identical(tmp_path):
     a, b = _same(tmp_path / "par_3_missing.g7", tmp_path / "par_3.rules")
     assert not a.passed and b.diagnoses[b.analysis.blocking[0]].verdict == "missing_order"
     _same(tmp_path / "line_3_missing.g7", tmp_path / "line_3.rules")
+
+
+@pytest.mark.parametrize("path", ["steps", pytest.param("situations", marks=pytest.mark.nightly)])  # 8 CPU s
+def test_traces_go_on_from_the_node_the_explicit_engine_numbers_first(tmp_path, monkeypatch, path):
+    """Four branches of two cylinders: after ``↑a1_1_0`` a region settles in two states,
+    and the explicit breadth-first search goes on from the one it numbered first, whose
+    smallest next event is ``↓a3_1_0``, although the other offers ``↓a2_1_0``: a trace is
+    the smallest (event, node number) sequence, not the smallest event sequence."""
+    import synth.symbolic.validate as symbolic_validate
+    from synth.symbolic.validate import PathChoice, SymbolicPath
+
+    if path == "situations":
+        monkeypatch.setattr(symbolic_validate, "choose_path",
+                            lambda machine, p: PathChoice(SymbolicPath.SITUATIONS, "forced by the test"))
+    base, full, _ = write_branches(4, 2, tmp_path)
+    a, b = _same(full, base)
+    traces = [" ".join(f["trace"]) for f in validation_json(b)["prohibited"]]
+    assert len(traces) == 320
+    assert traces[156] == ("↑start ↓a1_1_0 ↑a1_1_1 ↓a1_1_1 ↑a1_1_0 ↓a1_2_0 ↑a1_2_1 ↓a3_1_0 ↑a3_1_1 ↓a3_1_1 ↑a3_1_0 "
+                           "↓a2_1_0 ↑a2_1_1 ↓a2_1_1 ↑a2_1_0")
 
 
 # ---------------------------------------------------------------------------------- random

@@ -17,8 +17,9 @@ The same reading as :mod:`synth.validation.analysis`, on sets of nodes:
   explicit engine enters first (:func:`first_of`);
 - :func:`first_node`: the node of a set the explicit engine numbers first (least
   distance, then the smallest path in its order, ties as it breaks them);
-- :func:`shortest_trace`: the shortest path from an initial node whose events are
-  smallest by name (the explicit breadth-first search's parent choice).
+- :func:`shortest_trace`: the explicit breadth-first search's path to a node: ring by
+  ring the smallest event by name, then the node it enters that the explicit engine
+  numbers first (:func:`first_among`).
 
 :class:`OneByOne` answers a report's findings with these, one target at a time; the
 step path batches the same searches (:mod:`synth.symbolic.steps.batch`, checked equal).
@@ -40,7 +41,7 @@ if TYPE_CHECKING:  # pragma: no cover - the explicit order needs the explicit en
     from synth.symbolic.ties import Settled
 
 __all__ = ["Path", "MAX_LISTED", "path_key", "deepest", "terminal_components", "layers", "greedy", "first_of",
-           "depth_of", "first_node", "shortest_trace", "OneByOne", "Walk"]
+           "depth_of", "first_node", "first_among", "first_entered", "shortest_trace", "OneByOne", "Walk"]
 
 MAX_LISTED = 100_000
 """At most this many nodes of one component are listed for the diagnosis."""
@@ -181,21 +182,57 @@ def first_node(g: SymbolicGraph[S, M], candidates: S, settled: "Settled | None" 
     return g.pick(walk.chosen[-1]), depth, path_key(walk.keys, walk.ranks)
 
 
-def shortest_trace(g: SymbolicGraph[S, M], key: Key) -> Path:
-    """The shortest path from an initial node to ``key`` whose events are smallest by name
-    (the explicit breadth-first search's parent choice)."""
+def shortest_trace(g: SymbolicGraph[S, M], key: Key, settled: "Settled | None" = None) -> Path:
+    """The explicit breadth-first search's path from an initial node to ``key``: at each
+    ring the smallest event by name with a move into the target's layers, then, of the
+    nodes that event enters there, the one the explicit engine numbers first
+    (:func:`first_among`). The explicit search takes each node's edges by event, then
+    target number, and keeps the first parent it meets: its path is the smallest
+    sequence of (event, node number) pairs, decided ring by ring."""
     node = g.cube(key)
     depth = depth_of(g, node)
     if depth is None:
         raise ValueError("node not reachable")
-    walk = greedy(g, layers(g, node, depth), g.event)
-    nodes = [key]  # one concrete node per ring, backwards from the target
-    for k in range(depth - 1, -1, -1):
-        target = g.cube(nodes[-1])
-        before = g.join(g.pre_by(target, m) for m in walk.taken[k])
-        nodes.append(g.pick(g.meet(before, walk.chosen[k])))
-    nodes.reverse()
-    return Path(tuple(nodes), tuple(walk.keys))
+    steps = layers(g, node, depth)
+    rings = g.rings()
+    current = first_among(g, steps[0], settled)
+    nodes, events = [g.pick(current)], []
+    for k in range(1, depth + 1):
+        options: dict[Event, list[S]] = {}
+        for m in g.moves_from(current):
+            v = g.post_by(current, m, steps[k])
+            if not g.is_empty(v):
+                options.setdefault(g.event(m), []).append(v)
+        best = min(options)
+        current = first_entered(g, g.join(options[best]), current, rings[k - 1], settled)
+        nodes.append(g.pick(current))
+        events.append(best)
+    return Path(tuple(nodes), tuple(events))
+
+
+def first_among(g: SymbolicGraph[S, M], u: S, settled: "Settled | None" = None) -> S:
+    """The node of ``u`` (nodes of one ring) the explicit engine numbers first, as a set."""
+    if g.count(u) == 1:
+        return u
+    return g.cube(first_node(g, u, settled)[0])
+
+
+def first_entered(g: SymbolicGraph[S, M], u: S, parent: S, ring: S, settled: "Settled | None") -> S:
+    """:func:`first_among` for nodes ``u`` of the ring after ``ring``, all successors of
+    the single node ``parent``. Where no other node of ``ring`` leads into ``u``, the
+    explicit engine numbered them all from ``parent``: by its moves in exploration order,
+    then as their region settles (:func:`first_of`), no search from the initial nodes."""
+    if g.count(u) == 1:
+        return u
+    if settled is not None and g.is_empty(g.minus(g.pre(u, within=ring), parent)):
+        by_key: dict[tuple[int, int, int], list[M]] = {}
+        for m in g.moves_from(parent):
+            by_key.setdefault(g.order(m), []).append(m)
+        for key in sorted(by_key):
+            v = g.meet(u, g.join(g.post_by(parent, m) for m in by_key[key]))
+            if not g.is_empty(v):
+                return first_of(g, v, (g.pick(parent), by_key[key]), settled)[0]
+    return first_among(g, u, settled)
 
 
 class OneByOne(Generic[S, M]):
@@ -210,4 +247,4 @@ class OneByOne(Generic[S, M]):
         return [first_node(self.g, u, self.settled) for u in sets]
 
     def traces(self, keys: Sequence[Key]) -> list[Path]:
-        return [shortest_trace(self.g, k) for k in keys]
+        return [shortest_trace(self.g, k, self.settled) for k in keys]

@@ -43,18 +43,20 @@ True
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Callable, Sequence
+from typing import TYPE_CHECKING, Callable, Sequence, TypeVar
 
 from synth.logic.bdd import Engine, Function
 from synth.logic.events import Event
 from synth.symbolic.interface import Key, PathKey
-from synth.symbolic.searches import Order, Path, depth_of, first_of, path_key
+from synth.symbolic.searches import Order, Path, depth_of, first_entered, first_of, path_key
 from synth.symbolic.steps.reach import Arc, StepReach
 
 if TYPE_CHECKING:  # pragma: no cover
     from synth.symbolic.ties import Settled
 
 __all__ = ["Tags", "Findings", "Batched"]
+
+T = TypeVar("T")
 
 
 class Tags:
@@ -125,31 +127,39 @@ class _Batch:
             self.depths.append(d)
             by_depth[d] = by_depth.get(d, self.false) | (self.tags.cube(j) & u & self.s.rings[d])
         self.targets = by_depth
+        self.every = self.s.engine.disjunction(e for _, e in self.s.links)  # one relation: a pre-image is one product
         self.layers = self._layers(by_depth, max(self.depths, default=0))
+
+    def pre(self, u: Function) -> Function:
+        """The nodes with a move into ``u`` (tags kept)."""
+        return self.s.engine.and_exists(self.every, self.s.primed(u), self.s.next_vars)
 
     def _layers(self, by_depth: dict[int, Function], depth: int) -> list[Function]:
         """Per ring k, each tag's ring-k nodes from which its target is reached at its depth."""
         s = self.s
-        every = s.engine.disjunction(e for _, e in s.links)  # one relation: a pre-image is one product
         layers = [self.false] * (depth + 1)
         layers[depth] = by_depth.get(depth, self.false)
         for k in range(depth - 1, -1, -1):
-            before = s.engine.and_exists(every, s.primed(layers[k + 1]), s.next_vars)
-            layers[k] = (before & s.rings[k]) | by_depth.get(k, self.false)
+            layers[k] = (self.pre(layers[k + 1]) & s.rings[k]) | by_depth.get(k, self.false)
         return layers
 
     def greedy(self, order: Callable[[Arc], Order], settled: "Settled | None" = None,
+               narrow: Callable[[Function, Function | None, int], Function] | None = None,
                ) -> tuple[list[Function], list[list[tuple[Order, Event, Function]]], list[dict[int, int]]]:
         """Forward through the layers, each tag taking its smallest move (by ``order``):
         the tagged current sets per ring, per step the (order, event, tags) chosen (every
         move of a tag's smallest key, as :func:`~synth.symbolic.searches.greedy`), and
         with ``settled`` each tag's set narrowed at each ring to the node the explicit
-        engine enters first, with its rank (:func:`~synth.symbolic.searches.first_of`)."""
+        engine enters first, with its rank (:func:`~synth.symbolic.searches.first_of`);
+        ``narrow`` (traces) narrows each ring's tagged sets its own way instead (given the
+        previous ring's and the ring's number)."""
         s, false, exists = self.s, self.false, self.s.engine.bdd.apply
         current = self.layers[0]
         ranks: list[dict[int, int]] = []
         if settled is not None:
             current = self._first(current, None, settled, ranks)
+        elif narrow is not None:
+            current = narrow(current, None, 0)
         chosen = [current]
         steps: list[list[tuple[Order, Event, Function]]] = []
         for k in range(1, len(self.layers)):
@@ -174,6 +184,8 @@ class _Batch:
             current = s.unprimed(nxt)
             if settled is not None:
                 current = self._first(current, (chosen[-1], record), settled, ranks)
+            elif narrow is not None:
+                current = narrow(current, chosen[-1], k)
             chosen.append(current)
             steps.append(record)
         return chosen, steps, ranks
@@ -276,33 +288,40 @@ class Batched:
 
 
 def _traces(r: StepReach, b: _Batch, wanted: dict[int, Key]) -> dict[Key, Path]:
-    """The traces of the tags ``wanted`` of ``b`` (each the tag of one node, its target):
-    the events by the greedy walk in event order, then the nodes one ring back at a time
-    for every trace at once."""
-    s, false = r.s, r.false
-    chosen, steps, _ = b.greedy(r.event)
-    mask = s.engine.disjunction(b.tags.cube(j) for j in wanted)
+    """The traces of the tags ``wanted`` of ``b`` (each the tag of one node, its target),
+    as :func:`~synth.symbolic.searches.shortest_trace`: the greedy walk in event order,
+    each tag's ring narrowed to the node the explicit engine numbers first (the first
+    nodes of the tags with several, in one batch per ring)."""
+    mask = r.s.engine.disjunction(b.tags.cube(j) for j in wanted)
+    counted: dict[Function, int] = {}  # traces share their first nodes: each set counted and picked once
+    picked: dict[Function, Key] = {}
+
+    def first_each(current: Function, previous: Function | None, k: int) -> Function:
+        parts = b.tags.split(current & mask)
+        several = {j: u for j, u in parts.items() if _memo(counted, u, r.count) > 1}
+        if not several:
+            return current & mask
+        found: dict[int, Function] = {}
+        if previous is not None and r.settled is not None:  # as searches.first_entered, tag by tag
+            parents = b.tags.split(previous)
+            feeding = b.tags.split(b.pre(current & mask) & r.s.rings[k - 1])
+            for j, u in several.items():
+                if feeding[j] == parents[j]:
+                    found[j] = first_entered(r, u, parents[j], r.s.rings[k - 1], r.settled)
+        rest = list(dict.fromkeys(u for j, u in several.items() if j not in found))
+        firsts = {u: r.cube(f[0]) for u, f in zip(rest, Findings(r, rest).firsts)} if rest else {}
+        return r.s.engine.disjunction(b.tags.cube(j) & found.get(j, firsts.get(u, u)) for j, u in parts.items())
+
+    chosen, steps, _ = b.greedy(r.event, narrow=first_each)
     paths = b.paths(steps)
-    arcs = {m.event: e for m, e in s.edges}
-    nodes: dict[int, list[Key]] = {j: [k] for j, k in wanted.items()}
-    memo: dict[Function, Key] = {}
-    here = false  # per tag, its node at ring k + 1
-    for k in range(len(b.layers) - 2, -1, -1):
-        here |= b.targets.get(k + 1, false) & mask
-        primed = s.primed(here)
-        before = false
-        for _, event, sel in steps[k]:
-            if (sel & mask) != false:
-                before |= s.engine.and_exists(arcs[event], primed & sel, s.next_vars)
-        before &= chosen[k]
-        several = picked = false  # tags with several candidate nodes, and the one each picked
-        for j, u in b.tags.split(before).items():
-            key = memo.get(u)
-            if key is None:
-                key = memo[u] = r.pick(u)
-            nodes[j].append(key)
-            if r.cube(key) != u:
-                several |= b.tags.cube(j)
-                picked |= b.tags.cube(j) & r.cube(key)
-        here = (before & ~several) | picked
-    return {k: Path(tuple(reversed(nodes[j])), tuple(e for _, e in paths[j])) for j, k in wanted.items()}
+    rings = [b.tags.split(c) for c in chosen]
+    return {k: Path(tuple(_memo(picked, rings[i][j], r.pick) for i in range(b.depths[j] + 1)),
+                    tuple(e for _, e in paths[j]))
+            for j, k in wanted.items()}
+
+
+def _memo(memo: dict[Function, T], u: Function, f: Callable[[Function], T]) -> T:
+    hit = memo.get(u)
+    if hit is None:
+        hit = memo[u] = f(u)
+    return hit

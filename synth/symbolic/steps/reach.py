@@ -267,5 +267,6 @@ class StepReach:
         return first_node(self, candidates, self.settled)
 
     def shortest_trace(self, key: Key) -> Path:
-        """The shortest path from an initial node to ``key`` whose events are smallest by name."""
-        return shortest_trace(self, key)
+        """The explicit engine's shortest path from an initial node to ``key`` (events by
+        name, then the node it numbers first: :func:`~synth.symbolic.searches.shortest_trace`)."""
+        return shortest_trace(self, key, self.settled)
