@@ -10,8 +10,9 @@ Example
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from pathlib import Path
+
+from synth.frozen import frozen
 
 __all__ = ["LIBRARY_PREFIX", "LibraryModel", "library_dir", "library_file", "library_models"]
 
@@ -42,7 +43,7 @@ def library_dir() -> Path:
         return Path(__file__).resolve().parents[2] / "plants" / "lib"
 
 
-@dataclass(frozen=True)
+@frozen
 class LibraryModel:
     """A model of the library: its file (as ``use`` names it), orders and sensors with
     their initial values, and the file's first comment line."""
