@@ -34,13 +34,17 @@ def library_file(path: str, base: Path | None) -> Path:
 
 
 def library_dir() -> Path:
-    """The element library (``plants/lib`` in the source tree, ``synth.library`` installed)."""
-    from importlib import resources
+    """The element library (``plants/lib`` in the source tree, ``synth.library`` installed:
+    its folder, found without ``importlib.resources``, 2 ms of every validation)."""
+    from importlib.util import find_spec
 
     try:
-        return Path(str(resources.files("synth.library")))
-    except ModuleNotFoundError:  # a source tree that was not installed
-        return Path(__file__).resolve().parents[2] / "plants" / "lib"
+        spec = find_spec("synth.library")
+    except ModuleNotFoundError:
+        spec = None
+    for folder in (spec.submodule_search_locations or []) if spec is not None else []:
+        return Path(folder)
+    return Path(__file__).resolve().parents[2] / "plants" / "lib"  # a source tree that was not installed
 
 
 @frozen
