@@ -19,7 +19,6 @@ import types
 from enum import StrEnum
 from functools import lru_cache
 from pathlib import Path
-
 from typing import Any, Sequence
 
 
@@ -61,6 +60,7 @@ _import_lark()
 from lark import Lark, Token, Transformer, Tree, UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken, __version__ as lark_version  # noqa: E402,E501
 
 from synth.errors import InputError, InputErrors, Location, location_in, source_lines  # noqa: E402
+from synth.lexing import share_scanners  # noqa: E402
 from synth.logic.expr import And, Const, Edge, Expr, Not, Or, Var  # noqa: E402
 
 # ``Token`` is lark's, re-exported: every module of synth imports lark through this one.
@@ -128,10 +128,10 @@ def parser(name: str, start: str = "start") -> Lark:
     cache = _cache_file(name, start, text)
     if cache is not None:
         try:  # the compiled LALR tables, in the user's cache folder
-            return Lark(text, cache=str(cache), **options)
+            return share_scanners(Lark(text, cache=str(cache), **options))
         except OSError:  # an unwritable cache folder: build the tables again
             pass
-    return Lark(text, **options)
+    return share_scanners(Lark(text, **options))
 
 
 def _cache_file(name: str, start: str, text: str) -> Path | None:
