@@ -2,9 +2,10 @@
 
 lark's contextual lexer keeps one scanner per set of terminals a parser state accepts,
 each a regular expression of those terminals compiled on first use: 43 of them for a
-box-sorting validation, 10 ms of Python's ``re`` compiler in every run (docs/performance.md,
-"Session 28"). :func:`share_scanners` gives each state a lexer that first tries one
-expression of *all* the grammar's terminals, compiled once, and keeps its answer when that
+box-sorting validation, 10 ms of Python's ``re`` compiler in every run, and a lexer object
+per set built when the parser is loaded, 2 ms more (docs/performance.md, "Session 28").
+:func:`plugins` gives lark a contextual lexer whose states, made on first use, read with one
+expression of *all* the grammar's terminals, compiled once, and keep its answer when that
 is the state's own answer, which it provably is whenever the terminal found is one the
 state's scanner holds:
 
@@ -20,7 +21,7 @@ state's scanner holds:
   not in the state's scanner but read back from the regular terminal's text, as lark does.
 
 Where none of the state's terminals matches (a syntax error), lark's own lexer of the
-state takes over and reports it as it always did. The tokens, and so the
+state, made then, takes over and reports it as it always did. The tokens, and so the
 trees and the error messages, are the same: ``tests/test_lexing.py`` parses every bundled
 file and thousands of mutants of them both ways.
 """
@@ -28,12 +29,9 @@ file and thousands of mutants of them both ways.
 from __future__ import annotations
 
 import re
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
-if TYPE_CHECKING:
-    from lark import Lark
-
-__all__ = ["share_scanners"]
+__all__ = ["plugins"]
 
 
 class _Shared:
@@ -76,21 +74,22 @@ class _Shared:
 
 
 class _StateLexer:
-    """A parser state's lexer: the shared expression, and lark's lexer of the state
-    (``lark_lexer``) for the errors."""
+    """A parser state's lexer: the shared expression, and lark's lexer of the state (made
+    on the first syntax error) for the errors."""
 
-    def __init__(self, shared: _Shared, lark_lexer: Any) -> None:
+    def __init__(self, shared: _Shared, root: Any, conf: Any, names: frozenset[str]) -> None:
         from lark import Token
 
         self.token = Token
-        self.shared, self.lark_lexer = shared, lark_lexer
-        names = {t.name for t in lark_lexer.terminals}
+        self.shared, self.root, self.conf, self.names = shared, root, conf, names
         self.keywords = {r: [s for s, _ in matched if s.name in names]
                          for r, matched in shared.keywords.items() if r in names}
         left_out = {s.name for r in self.keywords for s, out in shared.keywords[r] if out and s.name in names}
         self.scanned = frozenset(names - left_out)
-        self.in_order = [(shared.order[t.name], t) for t in lark_lexer.terminals if t.name in self.scanned]
-        self.ignore_types, self.newline_types = lark_lexer.ignore_types, lark_lexer.newline_types
+        # the root lexer's terminals are in the scanners' order already
+        self.in_order = [(shared.order[t.name], t) for t in root.terminals if t.name in self.scanned]
+        self.ignore_types, self.newline_types = root.ignore_types, root.newline_types & names
+        self.lark_lexer: Any = None
 
     def match(self, text: Any, pos: int) -> tuple[str, str] | None:
         """The text and terminal of the state's scanner at ``pos`` (``None``: none matches)."""
@@ -106,6 +105,19 @@ class _StateLexer:
                 return alone, str(t.name)
         return None
 
+    def lark_state_lexer(self) -> Any:
+        """lark's own lexer of the state, as its contextual lexer makes it."""
+        if self.lark_lexer is None:
+            from copy import copy
+
+            from lark.lexer import BasicLexer
+
+            conf = copy(self.conf)
+            conf.terminals = [t for t in self.root.terminals if t.name in self.names]
+            conf.skip_validation = True  # the root lexer validated every terminal
+            self.lark_lexer = BasicLexer(conf)
+        return self.lark_lexer
+
     def keyword(self, type_: str, value: str) -> str:
         """The keyword ``value`` stands for in this state, or ``type_`` (lark's ``UnlessCallback``)."""
         for s in self.keywords.get(type_, ()):
@@ -118,7 +130,7 @@ class _StateLexer:
         line_ctr, text = lex_state.line_ctr, lex_state.text
         while line_ctr.char_pos < text.end:
             if (found := self.match(text, line_ctr.char_pos)) is None:  # an error: lark's own message
-                return self.lark_lexer.next_token(lex_state, parser_state)
+                return self.lark_state_lexer().next_token(lex_state, parser_state)
             value, type_ = found
             if type_ in self.ignore_types:
                 line_ctr.feed(value, type_ in self.newline_types)
@@ -131,29 +143,45 @@ class _StateLexer:
         raise EOFError(self)
 
 
-def share_scanners(p: Lark) -> Lark:
-    """``p`` with its contextual lexer's states reading through one shared expression (the
-    module's docstring); ``p`` unchanged when its lexer is not lark's plain contextual one
-    (another lexer, callbacks, bytes, the ``regex`` module, terminals with groups of their own)."""
+class _Lexers(dict[int, Any]):
+    """The lexer of each parser state, made when the parser first stands there (one per set
+    of terminals, as lark shares them)."""
+
+    def __init__(self, shared: _Shared, root: Any, conf: Any, states: dict[int, Any]) -> None:
+        super().__init__()
+        self.shared, self.root, self.conf, self.states = shared, root, conf, states
+        self.by_names: dict[frozenset[str], _StateLexer] = {}
+
+    def __missing__(self, state: int) -> _StateLexer:
+        names = frozenset(n for n in (*self.states[state], *self.conf.ignore) if n in self.conf.terminals_by_name)
+        if (made := self.by_names.get(names)) is None:
+            made = self.by_names[names] = _StateLexer(self.shared, self.root, self.conf, names)
+        self[state] = made
+        return made
+
+
+def plugins() -> dict[str, type]:
+    """lark's ``_plugins`` option giving a parser the shared contextual lexer (lark leaves the
+    option out of its cache's key, and takes it when it loads a parser from the cache)."""
+    from copy import copy
+
     from lark.lexer import BasicLexer, ContextualLexer
 
-    lexer = getattr(p.parser, "lexer", None)
-    if type(lexer) is not ContextualLexer or type(lexer.root_lexer) is not BasicLexer:
-        return p
-    root = lexer.root_lexer
-    if root.re is not re or root.use_bytes or root.user_callbacks or any(
-            type(s) is not BasicLexer for s in lexer.lexers.values()):
-        return p
-    if any(re.search(r"\(\?P[<=]|\\[1-9]", t.pattern.to_regexp()) for t in root.terminals):
-        return p  # group names or back-references of their own would be renumbered
-    try:
-        shared = _Shared(root)
-    except (re.error, AssertionError, OverflowError):
-        return p
-    mine: dict[int, _StateLexer] = {}  # lark shares one lexer among the states of one set of terminals
-    for s in lexer.lexers.values():
-        if id(s) not in mine:
-            mine[id(s)] = _StateLexer(shared, s)
-    states: dict[int, Any] = {state: mine[id(s)] for state, s in lexer.lexers.items()}
-    lexer.lexers = states
-    return p
+    class SharedContextualLexer(ContextualLexer):
+        """lark's contextual lexer, its states reading through one shared expression (the
+        module's docstring), each made on first use; lark's own where a grammar or an option
+        needs what the shared expression does not do (callbacks, bytes, the ``regex``
+        module, terminals with groups of their own, a post-lexer)."""
+
+        def __init__(self, conf: Any, states: dict[int, Any], always_accept: Any = ()) -> None:
+            terminals = list(conf.terminals)
+            if (conf.re_module is not re or conf.use_bytes or conf.callbacks or always_accept
+                    or any(re.search(r"\(\?P[<=]|\\[1-9]", t.pattern.to_regexp()) for t in terminals)):
+                super().__init__(conf, states, always_accept)  # group names or back-references would be renumbered
+                return
+            root_conf = copy(conf)
+            root_conf.terminals = terminals
+            self.root_lexer = BasicLexer(root_conf)
+            self.lexers = _Lexers(_Shared(self.root_lexer), self.root_lexer, root_conf, states)
+
+    return {"ContextualLexer": SharedContextualLexer}

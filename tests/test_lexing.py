@@ -12,7 +12,7 @@ import pytest
 from lark import Lark, Token, Tree, UnexpectedInput
 
 from conftest import ROOT
-from synth.lexing import share_scanners
+from synth.lexing import plugins
 from synth.syntax import grammar_text, parser
 
 SUFFIX = {".rules": "rules", ".g7": "grafcet", ".filter": "filter"}
@@ -47,10 +47,14 @@ def outcome(p: Lark, text: str) -> object:
 
 
 def test_synth_parsers_use_the_shared_scanner() -> None:
-    """Not vacuous: the parsers of synth.syntax read through synth.lexing."""
+    """Not vacuous: the parsers of synth.syntax read through synth.lexing, their states'
+    lexers made as the parser meets them."""
     for grammar in ("rules", "grafcet", "filter"):
-        states = parser(grammar).parser.lexer.lexers
-        assert {type(s).__name__ for s in states.values()} == {"_StateLexer"}, grammar
+        lexer = parser(grammar).parser.lexer
+        assert type(lexer).__name__ == "SharedContextualLexer", grammar
+        parser(grammar).parse(next(p for p in FILES if SUFFIX[p.suffix] == grammar and "bad" not in p.parts).read_text(encoding="utf-8"))
+        assert {type(s).__name__ for s in lexer.lexers.values()} == {"_StateLexer"}, grammar
+        assert 0 < len(lexer.lexers) < len(parser(grammar).parser.parser.parser.parse_table.states), grammar
     assert len(FILES) > 60
 
 
@@ -105,10 +109,13 @@ def test_expressions_alike() -> None:
             assert outcome(parser(grammar, "expr"), text) == outcome(lark_own(grammar, "expr"), text), (grammar, text)
 
 
-def test_a_grammar_share_scanners_leaves_alone() -> None:
-    """A lexer other than the contextual one is returned untouched."""
-    basic = Lark('start: "a"+', parser="lalr", lexer="basic")
-    assert share_scanners(basic).parser.lexer is basic.parser.lexer
-    contextual = Lark('start: WORD ("=" WORD)*\nWORD: /(?P<w>[a-z]+)/\n%ignore " "', parser="lalr")
-    before = dict(contextual.parser.lexer.lexers)
-    assert share_scanners(contextual).parser.lexer.lexers == before  # a group name of its own
+def test_what_the_shared_lexer_leaves_to_lark() -> None:
+    """Terminals with group names of their own, or lexer callbacks: lark's own states."""
+    for grammar, options in [('start: WORD ("=" WORD)*\nWORD: /(?P<w>[a-z]+)/\n%ignore " "', {}),
+                             ('start: WORD ("=" WORD)*\nWORD: /[a-z]+/\n%ignore " "', {"lexer_callbacks": {"WORD": lambda t: t}})]:
+        p = Lark(grammar, parser="lalr", _plugins=plugins(), **options)
+        assert {type(s).__name__ for s in p.parser.lexer.lexers.values()} == {"BasicLexer"}
+        assert [str(t) for t in p.parse("ab = c").children] == ["ab", "c"]
+    p = Lark('start: WORD ("=" WORD)*\nWORD: /[a-z]+/\n%ignore " "', parser="lalr", _plugins=plugins())
+    assert [str(t) for t in p.parse("ab = c").children] == ["ab", "c"]
+    assert {type(s).__name__ for s in p.parser.lexer.lexers.values()} == {"_StateLexer"}
