@@ -29,6 +29,7 @@ from __future__ import annotations
 import dataclasses
 from operator import attrgetter
 from reprlib import recursive_repr
+from types import FunctionType
 from typing import TYPE_CHECKING, Any, Callable, TypeVar
 
 __all__ = ["frozen"]
@@ -98,14 +99,48 @@ class _HasDefaultFactory:
 _HAS_DEFAULT_FACTORY = _HasDefaultFactory()
 
 
+# the ``__init__`` of a class of N fields without factories, compiled once per N; each class
+# gets a copy of its code with its own names (the same bytecode as its own text would give)
+_TEMPLATES: dict[int, Callable[..., None]] = {}
+
+
+def _template_init(cls: type, fields: tuple[dataclasses.Field[Any], ...]) -> Callable[..., None] | None:
+    """``cls``'s ``__init__`` made from the template of its number of fields, or ``None``
+    when its fields need more (a factory, a field left out of ``__init__``, a field named
+    ``self``, a ``__post_init__``)."""
+    if hasattr(cls, "__post_init__") or any(not f.init or f.default_factory is not dataclasses.MISSING
+                                            or f.name == "self" for f in fields):
+        return None
+    n = len(fields)
+    if (template := _TEMPLATES.get(n)) is None:
+        text = (f"def __init__(self{''.join(f', _f{i}_' for i in range(n))}):\n"
+                + "".join(f"  __dataclass_builtins_object__.__setattr__(self,'_f{i}_',_f{i}_)\n" for i in range(n))
+                + "  pass\n")
+        space: dict[str, Any] = {"__dataclass_builtins_object__": object}
+        exec(compile(text, "<string>", "exec", dont_inherit=True), space)  # noqa: S102 - made above
+        template = _TEMPLATES[n] = space["__init__"]
+    names = {f"_f{i}_": f.name for i, f in enumerate(fields)}
+    code = template.__code__
+    code = code.replace(co_varnames=tuple(names.get(v, v) for v in code.co_varnames),
+                        co_consts=tuple(names.get(c, c) if isinstance(c, str) else c for c in code.co_consts),
+                        co_qualname=f"{cls.__qualname__}.__init__")
+    defaults = tuple(f.default for f in fields if f.default is not dataclasses.MISSING)
+    init: Callable[..., None] = FunctionType(code, template.__globals__, "__init__", defaults or None)
+    init.__annotations__ = {**{f.name: f.type for f in fields}, "return": None}
+    init.__qualname__ = f"{cls.__qualname__}.__init__"
+    return init
+
+
 def _compiled_init(cls: type, fields: tuple[dataclasses.Field[Any], ...]) -> Callable[..., None]:
+    if (init := _template_init(cls, fields)) is not None:
+        return init
     text, names = _init_source(cls, fields)
     space: dict[str, Any] = {}
     # compiled without this module's ``from __future__ import annotations``, as dataclasses' text is
     exec(compile(text, "<string>", "exec", dont_inherit=True), {}, space)  # noqa: S102 - made above
-    init: Callable[..., None] = space["__create_fn__"](**names)
-    init.__qualname__ = f"{cls.__qualname__}.__init__"
-    return init
+    made: Callable[..., None] = space["__create_fn__"](**names)
+    made.__qualname__ = f"{cls.__qualname__}.__init__"
+    return made
 
 
 def _lazy_init(cls: type, fields: tuple[dataclasses.Field[Any], ...]) -> Callable[..., None]:

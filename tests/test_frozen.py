@@ -203,3 +203,38 @@ def test_what_frozen_leaves_to_dataclasses() -> None:
     # as in dataclasses, when the class is made, not when it is first instantiated
     with pytest.raises(TypeError, match="non-default argument 'b' follows default argument"):
         frozen(type("Bad", (), {"__doc__": "x", "__annotations__": {"a": "int", "b": "int"}, "a": 0}))
+
+
+def test_init_made_from_the_template_of_its_field_count() -> None:
+    """Classes without factories share one compiled ``__init__`` per number of fields, each
+    copy with its own names: the same signature, defaults and errors as dataclasses'."""
+
+    def pair() -> type:
+        class Pair:
+            """Two fields."""
+
+            left: str
+            right: tuple[int, ...] = (1,)
+
+        return Pair
+
+    def other() -> type:
+        class Other:
+            """Two other fields."""
+
+            name: int
+            size: float = 0.5
+
+        return Other
+
+    (mine, theirs), (other_mine, _) = both(pair), both(other)
+    assert (mine("a").left, mine("a").right, mine(right=(), left="b").right) == ("a", (1,), ())
+    assert other_mine(3).size == 0.5 and other_mine(size=2, name=1).name == 1
+    assert str(inspect.signature(mine)) == str(inspect.signature(theirs))
+    assert mine.__init__.__code__.co_code == other_mine.__init__.__code__.co_code  # the same template
+    assert mine.__init__.__code__.co_varnames == ("self", "left", "right")
+    assert mine.__init__.__qualname__ == "test_init_made_from_the_template_of_its_field_count.<locals>.pair.<locals>.Pair.__init__"
+    with pytest.raises(TypeError, match="got an unexpected keyword argument 'name'"):
+        mine(name=1)
+    with pytest.raises(TypeError, match="missing 1 required positional argument: 'left'"):
+        mine()
