@@ -6,8 +6,10 @@
 cost a short command (docs/performance.md, "Session 28"). ``frozen`` lets ``dataclasses``
 collect the fields (so ``dataclasses.fields``, ``replace``, ``asdict``, ``is_dataclass``
 and ``__match_args__`` work as ever), then gives the class the same methods, made of
-closures instead of compiled text, and an ``__init__`` compiled on the class's first
-instantiation (a class a run never instantiates never pays for it). What the code relies
+closures instead of compiled text, and an ``__init__`` made on the class's first
+instantiation (a class a run never instantiates never pays for it): a renamed copy of
+one compiled template per number of fields (the bytecode ``dataclasses``' text gives),
+or for fields with factories or a ``__post_init__``, ``dataclasses``' text compiled. What the code relies
 on stays: equality and hash over the compared fields as tuples (the same hash values),
 the same ``repr``, ordering with ``order=True``, ``FrozenInstanceError`` on assignment,
 ``__post_init__``, defaults and default factories, and ``__dataclass_params__`` saying
@@ -27,6 +29,7 @@ the same ``repr``, ordering with ``order=True``, ``FrozenInstanceError`` on assi
 from __future__ import annotations
 
 import dataclasses
+import operator
 from operator import attrgetter
 from reprlib import recursive_repr
 from types import FunctionType
@@ -212,8 +215,7 @@ def _comparisons(cls: type, names: tuple[str, ...], order: bool) -> None:
 
 
 def _order(get: Callable[[Any], tuple[Any, ...]], op: str) -> Callable[[Any, Any], Any]:
-    compare: Callable[[Any, Any], bool] = {"<": lambda a, b: a < b, "<=": lambda a, b: a <= b,
-                                           ">": lambda a, b: a > b, ">=": lambda a, b: a >= b}[op]
+    compare: Callable[[Any, Any], Any] = {"<": operator.lt, "<=": operator.le, ">": operator.gt, ">=": operator.ge}[op]
 
     def method(self: Any, other: Any) -> Any:
         if other.__class__ is self.__class__:

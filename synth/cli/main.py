@@ -88,8 +88,8 @@ COMMANDS = {"plant": ("plant", "sup"), "grafcet": ("ass", "run"), "validate": ("
 
 def build_parser(command: str | None = None) -> _Parser:
     """The parser of every command, or with ``command`` (a command line's first word, when it
-    names a command) of that one alone: the arguments of the others are not declared (5 ms
-    of every run), since argparse reads only the chosen command's. ``synth completion``
+    names a command) of that one alone: the arguments of the others are not declared (about
+    7 ms of every run), since argparse reads only the chosen command's. ``synth completion``
     describes every command: it gets them all."""
     from importlib import import_module
 
@@ -231,7 +231,7 @@ def entry() -> None:
     code = main()
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     # The interpreter's collections at exit walk every object left (numpy's and lark's
-    # included): 30-50 ms of a box-sorting validation, the time of its whole work. Frozen,
+    # included): 30-50 ms of a box-sorting validation, more than its work. Frozen,
     # they are left to the end of the process; exit still flushes the output, runs the
     # atexit handlers and frees what is not in a cycle (synth's files are closed by ``with``).
     gc.freeze()
