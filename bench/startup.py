@@ -9,7 +9,8 @@ before and after a change) are measured side by side in one run, their runs
 interleaved so that a change in the machine's load hits both alike. Prints the median
 and the minimum of each command, in milliseconds, process start included, and the
 floors under them measured the same way: the bare interpreter (``-c pass``),
-``import numpy``, ``import lark`` and ``import numpy, lark`` (issue 37's floor). The time
+``import numpy``, ``import lark`` and ``import numpy, lark`` (issue 37's floor, also run
+interleaved with each command's runs, and each tree's median and minimum divided by it). The time
 is the child's CPU time (user + system, ``resource.getrusage``: what a loaded machine
 changes least), or its wall time with ``--wall``.
 
@@ -44,6 +45,7 @@ FLOORS = {
     "python -S -c 'import lark'": ["-c", "import lark"],
     "python -S -c 'import numpy, lark'": ["-c", "import numpy, lark"],
 }
+FLOOR = "python -S -c 'import numpy, lark'"  # issue 37's floor, run beside every command
 WALL = False  # --wall: wall time instead of CPU time
 
 
@@ -104,16 +106,20 @@ def main() -> None:
     with tempfile.TemporaryDirectory(prefix="synth-pycache-") as pycache, \
             tempfile.TemporaryDirectory(prefix="synth-startup-") as cwd:
         envs = [environment(tree, pycache) for tree in trees]
+        floor_env = environment(None, pycache)
         print(f"python {sys.version.split()[0]}, {args.runs} runs per cell, median (minimum) "
               f"{'wall' if WALL else 'CPU'} time, "
-              f"bytecode cached in a temporary PYTHONPYCACHEPREFIX")
-        print(f"{'command':<32}" + "".join(f"{t.resolve().name[:24]:>26}" for t in trees))
+              f"bytecode cached in a temporary PYTHONPYCACHEPREFIX; each row's runs interleaved with "
+              f"those of the `import numpy, lark` floor, and each tree's ratio to it (medians, minimums)")
+        print(f"{'command':<32}" + "".join(f"{t.resolve().name[:24]:>26}" for t in trees)
+              + f"{'floor, same runs':>26}" + "".join(f"{'÷ floor':>16}" for _ in trees))
         for name, argv in COMMANDS.items():
             if args.only and name not in args.only.split(","):
                 continue
-            row = measure([(["-m", "synth", *argv], env) for env in envs], args.runs, cwd)
-            print(f"{name:<32}" + "".join(f"{cell(ms):>26}" for ms in row))
-        floor_env = environment(None, pycache)
+            *row, floor = measure([(["-m", "synth", *argv], env) for env in envs] + [(FLOORS[FLOOR], floor_env)],
+                                  args.runs, cwd)
+            ratios = [f"{statistics.median(ms) / statistics.median(floor):.2f} {min(ms) / min(floor):.2f}" for ms in row]
+            print(f"{name:<32}" + "".join(f"{cell(ms):>26}" for ms in [*row, floor]) + "".join(f"{r:>16}" for r in ratios))
         for name, argv in FLOORS.items():
             (ms,) = measure([(argv, floor_env)], args.runs, cwd)
             print(f"{name:<32}{cell(ms):>26}")

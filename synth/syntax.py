@@ -19,7 +19,6 @@ import types
 from enum import StrEnum
 from functools import lru_cache
 from pathlib import Path
-
 from typing import Any, Sequence
 
 
@@ -61,13 +60,13 @@ _import_lark()
 from lark import Lark, Token, Transformer, Tree, UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken, __version__ as lark_version  # noqa: E402,E501
 
 from synth.errors import InputError, InputErrors, Location, location_in, source_lines  # noqa: E402
+from synth.lexing import plugins  # noqa: E402
 from synth.logic.expr import And, Const, Edge, Expr, Not, Or, Var  # noqa: E402
 
 # ``Token`` is lark's, re-exported: every module of synth imports lark through this one.
 __all__ = [
     "grammar_text", "parser", "syntax_error", "read_bytes", "read_source", "ExprTransformer", "VectorKind", "Checker", "raise_all",
-    "parse_tree", "parse_expression", "Token",
-]
+    "parse_tree", "parse_expression", "Token"]
 
 # How terminals are shown to a user in "expected ..." lists.
 _TERMINAL_TEXT = {
@@ -106,24 +105,25 @@ _TERMINAL_TEXT = {
 
 def grammar_text(name: str) -> str:
     """Text of ``grammars/<name>.lark``: installed (a folder read as files, no zipfile) or in the source tree."""
+    from importlib import import_module
     from importlib.util import find_spec
 
     spec, filename = find_spec("synth.grammars"), f"{name}.lark"
     for folder in (spec.submodule_search_locations or []) if spec is not None else []:
         if (Path(folder) / filename).is_file():
             return (Path(folder) / filename).read_text(encoding="utf-8")
-    try:
-        from importlib import resources
-
-        return resources.files("synth.grammars").joinpath(filename).read_text(encoding="utf-8")
+    try:  # a zip (importlib.resources: 1 ms, imported only then); no spec: a source tree not installed
+        if spec is not None:
+            return import_module("importlib.resources").files("synth.grammars").joinpath(filename).read_text(encoding="utf-8")
     except (ModuleNotFoundError, FileNotFoundError):
-        return (Path(__file__).resolve().parent.parent / "grammars" / filename).read_text(encoding="utf-8")
+        pass
+    return (Path(__file__).resolve().parent.parent / "grammars" / filename).read_text(encoding="utf-8")
 
 
 @lru_cache(maxsize=None)
 def parser(name: str, start: str = "start") -> Lark:
     """A cached LALR parser for ``grammars/<name>.lark`` from rule ``start`` (positions propagated)."""
-    options = dict(parser="lalr", propagate_positions=True, maybe_placeholders=True, start=start)
+    options = dict(parser="lalr", propagate_positions=True, maybe_placeholders=True, start=start, _plugins=plugins())
     text = grammar_text(name)
     cache = _cache_file(name, start, text)
     if cache is not None:

@@ -47,3 +47,41 @@ def test_validate_help_explains_the_words_of_a_state(capsys):
     for term in ("Sit ", "E ", "Z ", "ORD ", "PROH "):
         assert f"\n  {term}" in out
     assert "SUP forbids" in out and "SUP authorises" in out
+
+
+def test_the_command_table_names_what_each_module_registers() -> None:
+    """``main.COMMANDS`` (which module to load for a command line's first word) matches
+    what the modules register, in the order of ``synth --help``."""
+    import argparse
+    from importlib import import_module
+
+    from synth.cli.main import COMMANDS, build_parser
+
+    for module, names in COMMANDS.items():
+        sub = argparse.ArgumentParser().add_subparsers()
+        import_module(f"synth.cli.{module}").register(sub)
+        assert tuple(sub.choices) == names, module
+    assert tuple(build_parser().commands.choices) == tuple(n for names in COMMANDS.values() for n in names)
+
+
+@pytest.mark.parametrize("argv", [
+    ["validate", "--help"], ["filter", "verify", "--help"], ["check", "--help"], ["st", "--help"],
+    ["validate", "--engin", "x"], ["filter", "chek"], ["validate"], ["sup", "--max-states", "x", "a.rules"],
+])
+def test_a_command_parsed_alone_as_among_all(argv, capsys) -> None:
+    """The parser of the command a line names (its arguments alone declared) prints the same
+    help and the same errors as the parser of every command."""
+    from synth.cli.main import build_parser, parse
+
+    def outcome(parser) -> tuple[object, str, str]:
+        try:
+            args = parse(parser, argv)
+            code: object = sorted((k, str(v)) for k, v in vars(args).items() if k != "root_parser")
+        except SystemExit as e:
+            code = e.code
+        out, err = capsys.readouterr()
+        return code, out, err
+
+    alone, among = outcome(build_parser(argv[0])), outcome(build_parser())
+    assert alone == among
+    assert alone[0] in (0, 2)  # each line above asks for help or is wrong

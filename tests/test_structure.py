@@ -91,11 +91,12 @@ def test_no_import_cycle_among_synth_modules() -> None:
 
 
 # The documented order of the rooms (docs/architecture.md), bottom first. The ground floor's
-# modules import no room (the chooser's enum, the errors, the lazy re-exports, the version);
+# modules import no room (the chooser's enum, the errors, the frozen dataclasses, lark's shared scanner,
+# the lazy re-exports, the version);
 # ``syntax`` builds the expressions of ``logic`` (its shared expression rules), so it stands
 # right above it. ``synth`` itself (an empty package) and ``__main__`` (``python -m synth``)
 # stand on top.
-GROUND = ("synth.choices", "synth.errors", "synth._lazy", "synth.version")
+GROUND = ("synth.choices", "synth.errors", "synth.frozen", "synth.lexing", "synth._lazy", "synth.version")
 ORDER = ("synth.logic", "synth.syntax", "synth.plant", "synth.sup", "synth.grafcet", "synth.validation",
          "synth.symbolic", "synth.probe", "synth.engines", "synth.filter", "synth.codegen", "synth.output", "synth.commission",
          "synth.line", "synth.cli", "synth.__main__", "synth")

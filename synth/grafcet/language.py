@@ -25,11 +25,12 @@ from __future__ import annotations
 
 import re
 from fractions import Fraction
-from dataclasses import dataclass, field
+from dataclasses import field
 from enum import StrEnum
 from typing import Collection, Iterator, Mapping, Sequence
 
 from synth.errors import Location
+from synth.frozen import frozen
 from synth.logic.expr import Expr, Var, evaluate, names
 
 __all__ = [
@@ -142,7 +143,7 @@ def timer_id(duration: str, step: str) -> str:
     return f"{duration}/X{step}"
 
 
-@dataclass(frozen=True)
+@frozen
 class Internal:
     """An internal variable: ``internal cnt : 0..3 = 0`` (bounded integer) or
     ``internal busy : bool`` (Boolean, held as 0/1). Only assignments change it.
@@ -163,7 +164,7 @@ class Internal:
         return f"internal {self.name} : {kind} = {self.initial}"
 
 
-@dataclass(frozen=True)
+@frozen
 class Sum:
     """The right side of an assignment: signed terms, each a constant or an internal variable.
 
@@ -199,7 +200,7 @@ class Sum:
         return sum(sign * (values[x] if isinstance(x, str) else x) for sign, x in self.terms)
 
 
-@dataclass(frozen=True)
+@frozen
 class Action:
     """An action attached to a step.
 
@@ -237,7 +238,7 @@ class Action:
         return f"{verb} {self.order} on {self.when}"
 
 
-@dataclass(frozen=True)
+@frozen
 class Step:
     """A step: its name (``12`` or ``wait``), partial grafcet, initial flag and actions."""
 
@@ -253,7 +254,7 @@ class Step:
         return step_variable(self.name)
 
 
-@dataclass(frozen=True)
+@frozen
 class Timer:
     """A timer atom ``2s/X101``: true once step ``101`` has been active for ``seconds``."""
 
@@ -263,7 +264,7 @@ class Timer:
     loc: Location | None = field(default=None, compare=False)
 
 
-@dataclass(frozen=True)
+@frozen
 class Transition:
     """A transition: source steps, target steps, receptivity, partial grafcet.
 
@@ -289,7 +290,7 @@ class Transition:
         return f"{self.name}: {', '.join(self.sources)} -> {', '.join(self.targets)} when {self.receptivity.text()}"
 
 
-@dataclass(frozen=True)
+@frozen
 class PartialGrafcet:
     """One partial grafcet (``grafcet G1 { ... }``): its steps and transitions."""
 
@@ -299,7 +300,7 @@ class PartialGrafcet:
     loc: Location | None = field(default=None, compare=False)
 
 
-@dataclass(frozen=True)
+@frozen
 class Grafcet:
     """A checked Grafcet program.
 

@@ -9,9 +9,8 @@ Example
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 from synth.errors import InputError, Location
+from synth.frozen import frozen
 from synth.grafcet.language import (
     TIMER_RE,
     CONDITIONAL,
@@ -32,7 +31,7 @@ from synth.syntax import ExprTransformer, Token, VectorKind, parse_tree
 __all__ = ["parse_receptivity", "VectorDecl", "InternalDecl", "StepRef", "StepDecl", "TransitionDecl", "GrafcetDecl", "grafcet_items"]
 
 
-@dataclass(frozen=True)
+@frozen
 class VectorDecl:
     """``inputs …`` or ``outputs …``."""
 
@@ -40,7 +39,7 @@ class VectorDecl:
     names: tuple[tuple[str, Location], ...]
 
 
-@dataclass(frozen=True)
+@frozen
 class InternalDecl:
     """``internal NAME [: bool | : LOW..HIGH] [= INITIAL]`` as written (checked later)."""
 
@@ -54,7 +53,7 @@ class InternalDecl:
     initial_loc: Location | None
 
 
-@dataclass(frozen=True)
+@frozen
 class StepRef:
     """A step named as a transition's source or target."""
 
@@ -62,7 +61,7 @@ class StepRef:
     loc: Location
 
 
-@dataclass(frozen=True)
+@frozen
 class StepDecl:
     """A step declaration with its actions."""
 
@@ -72,7 +71,7 @@ class StepDecl:
     loc: Location
 
 
-@dataclass(frozen=True)
+@frozen
 class TransitionDecl:
     """A transition: its sources, targets and receptivity."""
 
@@ -84,7 +83,7 @@ class TransitionDecl:
     loc: Location
 
 
-@dataclass(frozen=True)
+@frozen
 class GrafcetDecl:
     """``grafcet NAME { … }``."""
 

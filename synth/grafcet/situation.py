@@ -20,6 +20,7 @@ from dataclasses import dataclass
 from typing import Callable, Mapping, Sequence
 
 from synth.errors import ModelFailure
+from synth.frozen import frozen
 from synth.grafcet.language import Action, Internal, step_key, step_of, step_variable
 from synth.logic.events import Event
 from synth.logic.expr import And, Compare, Const, Edge, Expr, Not, Var
@@ -33,7 +34,7 @@ def sorted_steps(steps: Sequence[str] | set[str] | frozenset[str]) -> tuple[str,
     return tuple(sorted(steps, key=step_key))
 
 
-@dataclass(frozen=True, order=True)
+@frozen(order=True)
 class Situation:
     """A situation of the Grafcet: active steps, stored outputs set, elapsed timers, and
     the values of its internal variables (declaration order; Booleans as 0/1).

@@ -20,13 +20,14 @@ True
 from __future__ import annotations
 
 import operator
-from dataclasses import dataclass, field
+from dataclasses import field
 from functools import reduce
 from itertools import product
 from typing import Any, Callable, Iterator, Mapping, Union
 
 
 from synth.errors import Location
+from synth.frozen import frozen
 from synth.logic.events import Event
 
 __all__ = [
@@ -65,7 +66,7 @@ def edge_text(rising: bool, name: str) -> Event:
     return Event.edge(name, rising)
 
 
-@dataclass(frozen=True)
+@frozen
 class Var:
     """A variable (a plant input or output, a step variable ``X12``): true or false."""
 
@@ -85,7 +86,7 @@ CMP_SPELLINGS = {"!=": "<>", "≠": "<>", "≥": ">=", "≤": "<="}
 """Other spellings of the comparison operators, and the canonical one each stands for."""
 
 
-@dataclass(frozen=True)
+@frozen
 class Compare(Var):
     """``cnt >= 3``: a comparison of an integer variable with a constant or another one.
 
@@ -117,7 +118,7 @@ class Compare(Var):
         return CMP_OPS[self.op](values[self.left], right)
 
 
-@dataclass(frozen=True)
+@frozen
 class Const:
     """The constant ``1`` (True) or ``0`` (False)."""
 
@@ -128,7 +129,7 @@ class Const:
         return "1" if self.value else "0"
 
 
-@dataclass(frozen=True)
+@frozen
 class Edge:
     """A rising (``↑x``) or falling (``↓x``) edge of a variable: an event, not a level."""
 
@@ -144,7 +145,7 @@ class Edge:
         return Event.edge(self.name, self.rising)
 
 
-@dataclass(frozen=True)
+@frozen
 class Not:
     """``!arg``."""
 
@@ -157,7 +158,7 @@ class Not:
         return "!" + (inner if atomic else f"({inner})")
 
 
-@dataclass(frozen=True)
+@frozen
 class And:
     """``a & b & …``: true when every argument is."""
 
@@ -168,7 +169,7 @@ class And:
         return " & ".join(a.text() if not isinstance(a, Or) else f"({a.text()})" for a in self.args)
 
 
-@dataclass(frozen=True)
+@frozen
 class Or:
     """``a | b | …``: true when some argument is."""
 
@@ -286,7 +287,7 @@ def renamed(e: Expr, rename: Callable[[str], str]) -> Expr:
     return type(e)(tuple(renamed(a, rename) for a in e.args), e.loc)
 
 
-@dataclass(frozen=True, order=True)
+@frozen(order=True)
 class Literal:
     """``name`` (positive) or ``!name``; ``edge`` is set for ``↑name`` / ``↓name``."""
 

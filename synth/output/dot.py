@@ -9,8 +9,9 @@ Example
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import TYPE_CHECKING, Iterable, Mapping, Sequence
+
+from synth.frozen import frozen
 
 if TYPE_CHECKING:  # pragma: no cover
     from synth.grafcet.ass import ASS
@@ -26,7 +27,7 @@ UNCONTROLLABLE_STYLE = {"color": "#b03a2e", "fontcolor": "#b03a2e", "style": "da
 HIGHLIGHT_STYLE = {"penwidth": "3", "color": "#e67e22", "fontcolor": "#e67e22"}
 
 
-@dataclass(frozen=True)
+@frozen
 class Html:
     """An HTML-like Graphviz label, written ``<…>`` (its text escaped by the caller)."""
 

@@ -31,7 +31,6 @@ from __future__ import annotations
 
 import functools
 import math
-from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
 from typing import Callable, Iterator, Mapping
@@ -39,6 +38,7 @@ from typing import Callable, Iterator, Mapping
 import numpy as np
 
 from synth.errors import InputError, LimitExceeded, Location, SynthError, close_names, location_in
+from synth.frozen import frozen
 from synth.logic.events import Event
 from synth.plant.element import ElementAutomaton, element_automaton
 from synth.plant.rules import RuleSet
@@ -53,7 +53,7 @@ def _plants(name: str) -> str:
     return str(Path(__file__).resolve().parents[2] / "plants" / name)
 
 
-@dataclass(frozen=True)
+@frozen
 class LocalTransition:
     """A transition of one element, seen from the grid: axis, local source/target, event."""
 

@@ -32,13 +32,13 @@ Example
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from functools import cached_property
 from typing import Iterable
 
 import numpy as np
 
 from synth.errors import InputError, Severity
+from synth.frozen import frozen
 from synth.logic.events import Event
 from synth.logic.expr import evaluate
 from synth.plant.rules import ElementSpec, VarKind
@@ -55,7 +55,7 @@ def distinct(a: np.ndarray) -> np.ndarray:
     a = np.sort(a)
     return a[np.concatenate(([True], a[1:] != a[:-1]))] if a.size else a
 
-@dataclass(frozen=True, eq=False)
+@frozen(eq=False)
 class ElementAutomaton:
     """States are codes over the element's variables (bit i = ``variables[i]``).
 

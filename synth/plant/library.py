@@ -10,8 +10,9 @@ Example
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from pathlib import Path
+
+from synth.frozen import frozen
 
 __all__ = ["LIBRARY_PREFIX", "LibraryModel", "library_dir", "library_file", "library_models"]
 
@@ -33,16 +34,20 @@ def library_file(path: str, base: Path | None) -> Path:
 
 
 def library_dir() -> Path:
-    """The element library (``plants/lib`` in the source tree, ``synth.library`` installed)."""
-    from importlib import resources
+    """The element library (``plants/lib`` in the source tree, ``synth.library`` installed:
+    its folder, found without importing ``importlib.resources``: 1 ms of every validation)."""
+    from importlib.util import find_spec
 
     try:
-        return Path(str(resources.files("synth.library")))
-    except ModuleNotFoundError:  # a source tree that was not installed
-        return Path(__file__).resolve().parents[2] / "plants" / "lib"
+        spec = find_spec("synth.library")
+    except ModuleNotFoundError:
+        spec = None
+    for folder in (spec.submodule_search_locations or []) if spec is not None else []:
+        return Path(folder)
+    return Path(__file__).resolve().parents[2] / "plants" / "lib"  # a source tree that was not installed
 
 
-@dataclass(frozen=True)
+@frozen
 class LibraryModel:
     """A model of the library: its file (as ``use`` names it), orders and sensors with
     their initial values, and the file's first comment line."""

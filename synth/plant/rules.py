@@ -16,10 +16,11 @@ Example
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import field
 from enum import StrEnum
 
 from synth.errors import Location
+from synth.frozen import frozen
 from synth.logic.expr import Edge, Expr, Not
 
 __all__ = [
@@ -43,7 +44,7 @@ class VarKind(StrEnum):
 
 
 
-@dataclass(frozen=True)
+@frozen
 class VarDecl:
     """A variable of an element: an order (output Z), a sensor or a free input (input E)."""
 
@@ -58,7 +59,7 @@ class VarDecl:
         return self.kind != VarKind.ORDER
 
 
-@dataclass(frozen=True)
+@frozen
 class Read:
     """``reads NAME``: a variable of another element that this element's rules may read
     (in guards, and as the cause of a rule); it keeps its one owner."""
@@ -67,7 +68,7 @@ class Read:
     loc: Location | None = field(default=None, compare=False)
 
 
-@dataclass(frozen=True)
+@frozen
 class Rule:
     """Occurrence rule ``cause [guard] -> consequence``."""
 
@@ -81,7 +82,7 @@ class Rule:
         return f"{self.cause.text()}{g} -> {self.consequence.text()}"
 
 
-@dataclass(frozen=True)
+@frozen
 class Precedence:
     """``cause: first < then``: after ``cause``, ``then`` can only follow ``first``."""
 
@@ -94,7 +95,7 @@ class Precedence:
         return f"{self.cause.text()}: {self.first.text()} < {self.then.text()}"
 
 
-@dataclass(frozen=True)
+@frozen
 class ElementSpec:
     """One plant element as written (after instantiation of a model)."""
 
@@ -124,7 +125,7 @@ class ElementSpec:
         return tuple(r.name for r in self.reads)
 
 
-@dataclass(frozen=True)
+@frozen
 class Constraint:
     """``id "label": expr = 0`` (or ``= 1``: the expression must always hold)."""
 
@@ -143,7 +144,7 @@ class Constraint:
         return f"{self.expr.text()} = {int(self.equals)}"
 
 
-@dataclass(frozen=True)
+@frozen
 class RuleSet:
     """A checked plant description: elements, constraints, and the file they came from."""
 

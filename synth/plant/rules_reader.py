@@ -10,10 +10,10 @@ Example
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Iterable
 
 from synth.errors import Location
+from synth.frozen import frozen
 from synth.logic.expr import Expr
 from synth.plant.rules import Constraint, Precedence, Read, Rule, VarDecl, VarKind
 from synth.syntax import ExprTransformer, Token, VectorKind, parse_tree
@@ -21,7 +21,7 @@ from synth.syntax import ExprTransformer, Token, VectorKind, parse_tree
 __all__ = ["Body", "Model", "Instance", "Inline", "Use", "Hold", "Vector", "Item", "rules_items"]
 
 
-@dataclass(frozen=True)
+@frozen
 class Body:
     """The items of a ``model`` or ``element`` body."""
 
@@ -32,7 +32,7 @@ class Body:
     reads: tuple[Read, ...] = ()
 
 
-@dataclass(frozen=True)
+@frozen
 class Model:
     """``model NAME { … }``."""
 
@@ -41,7 +41,7 @@ class Model:
     loc: Location
 
 
-@dataclass(frozen=True)
+@frozen
 class Instance:
     """``element NAME = MODEL(a = b, …)``."""
 
@@ -52,7 +52,7 @@ class Instance:
     model_loc: Location
 
 
-@dataclass(frozen=True)
+@frozen
 class Inline:
     """``element NAME { … }``."""
 
@@ -61,7 +61,7 @@ class Inline:
     loc: Location
 
 
-@dataclass(frozen=True)
+@frozen
 class Use:
     """``use "FILE"``."""
 
@@ -69,14 +69,14 @@ class Use:
     loc: Location
 
 
-@dataclass(frozen=True)
+@frozen
 class Hold:
     """``hold NAME = BIT, …``."""
 
     decls: tuple[VarDecl, ...]
 
 
-@dataclass(frozen=True)
+@frozen
 class Vector:
     """``inputs …`` or ``outputs …``."""
 

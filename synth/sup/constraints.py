@@ -19,11 +19,11 @@ True
 from __future__ import annotations
 
 import weakref
-from dataclasses import dataclass
 from typing import Iterable, Sequence
 
 import numpy as np
 
+from synth.frozen import frozen
 from synth.logic.expr import disjunctive_normal_form, edge_text
 from synth.plant.closure import backward_closures
 from synth.plant.composition import LocalTransition, Plant
@@ -32,7 +32,7 @@ from synth.plant.rules import Constraint
 __all__ = ["CompiledConstraints", "GRID_LIMIT", "Term", "split_terms", "grid_of_term", "term_holds"]
 
 
-@dataclass(frozen=True)
+@frozen
 class Term:
     """One monomial of a constraint, split per element: ``factors[axis]`` is the set of
     local states satisfying its level literals on that element."""
