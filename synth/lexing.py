@@ -31,7 +31,7 @@ from __future__ import annotations
 import re
 from typing import Any
 
-__all__ = ["plugins"]
+__all__ = ["plugins", "LARK_TESTED"]
 
 
 class _Shared:
@@ -160,12 +160,23 @@ class _Lexers(dict[int, Any]):
         return made
 
 
+LARK_TESTED = ("1.3.",)
+"""The lark releases whose lexer internals (``ContextualLexer``'s attributes and
+``next_token``) this module was written and tested against; with any other, lark's own
+lexer runs (a few milliseconds more per start, never another reading of a file)."""
+
+
 def plugins() -> dict[str, type]:
     """lark's ``_plugins`` option giving a parser the shared contextual lexer (lark leaves the
-    option out of its cache's key, and takes it when it loads a parser from the cache)."""
+    option out of its cache's key, and takes it when it loads a parser from the cache);
+    empty (lark's own lexer) on a lark release not in :data:`LARK_TESTED`."""
     from copy import copy
 
+    from lark import __version__ as lark_version
     from lark.lexer import BasicLexer, ContextualLexer
+
+    if not lark_version.startswith(LARK_TESTED):
+        return {}
 
     class SharedContextualLexer(ContextualLexer):
         """lark's contextual lexer, its states reading through one shared expression (the
