@@ -22,7 +22,8 @@ Example
 from __future__ import annotations
 
 import random
-from typing import Any, Mapping, Sequence
+from operator import itemgetter
+from typing import Any, Callable, Mapping, Sequence
 
 from synth.logic.bdd import Function
 from synth.logic.partition import Partition
@@ -52,7 +53,7 @@ class Points:
         self._anchors = anchors
         self.goods = list(goods)
         self._base = p.relation(p.initial)
-        self._reads: dict[Function, list[str]] = {}
+        self._reads: dict[Function, tuple[list[str], Callable[[Mapping[str, bool]], tuple[bool, ...]]]] = {}
         self._restricted: dict[tuple[Function, tuple[bool, ...]], Function] = {}  # (g, its reads' values) -> g there
 
     def point(self, picked: Mapping[str, bool], default: bool) -> dict[str, bool]:
@@ -62,24 +63,31 @@ class Points:
     def at(self, g: Function, point: Mapping[str, bool]) -> Function:
         """``g`` at ``point``: a function of the outputs alone (cached per valuation of
         the variables ``g`` reads)."""
-        reads = self._reads.get(g)
-        if reads is None:
-            reads = self._reads[g] = sorted(v for v in self.bdd.support(g) if v not in self._anchors)
-        values = tuple(point[v] for v in reads)
+        reading = self._reads.get(g)
+        if reading is None:
+            reading = self._reads[g] = _reader(sorted(v for v in self.bdd.support(g) if v not in self._anchors))
+        values = reading[1](point)
         found = self._restricted.get((g, values))
         if found is None:
-            found = self._restricted[(g, values)] = self.bdd.let(dict(zip(reads, values)), g) if values else g
+            found = self._restricted[(g, values)] = self.bdd.let(dict(zip(reading[0], values)), g) if values else g
         return found
 
     def chain(self, point: Mapping[str, bool]) -> tuple[list[Function], list[bool], list[Function]]:
         """The chain at ``point``: ``S_0 … S_n`` on the outputs, whether each criterion
         finds a solution there (its ``b_j`` at Y0), and the criteria there (:meth:`at`)."""
         s = self.bdd.let(dict(point), self._base)
-        states, bests, there = [s], [], [self.at(g, point) for g in self.goods]
-        for g in there:
-            s, best = narrow(s, g, self.engine.false)
+        at, false = self.at, self.engine.false
+        there = [at(g, point) for g in self.goods]
+        states, bests = [s], []
+        for g in there:  # narrow() inline: this loop runs for every point of every witness
+            kept = s & g
+            if kept != false:
+                s = kept
+                bests.append(True)
+            else:
+                s = s & ~g
+                bests.append(False)
             states.append(s)
-            bests.append(best)
         return states, bests, there
 
     def random(self, region: Function, rng: random.Random) -> dict[str, bool]:
@@ -94,6 +102,16 @@ def narrow(s: Function, g: Function, false: Function) -> tuple[Function, bool]:
     if kept != false:
         return kept, True
     return s & ~g, False
+
+
+def _reader(reads: list[str]) -> tuple[list[str], Callable[[Mapping[str, bool]], tuple[bool, ...]]]:
+    """``reads`` and the function giving their values at a point, as a tuple."""
+    if not reads:
+        return reads, lambda point: ()
+    if len(reads) == 1:
+        only = reads[0]
+        return reads, lambda point: (point[only],)
+    return reads, itemgetter(*reads)
 
 
 def random_point(bdd: Any, u: Function, names: Sequence[str], rng: random.Random) -> dict[str, bool]:
