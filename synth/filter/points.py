@@ -55,6 +55,8 @@ class Points:
         self._base = p.relation(p.initial)
         self._reads: dict[Function, tuple[list[str], Callable[[Mapping[str, bool]], tuple[bool, ...]]]] = {}
         self._restricted: dict[tuple[Function, tuple[bool, ...]], Function] = {}  # (g, its reads' values) -> g there
+        self._last: tuple[dict[str, bool], tuple[Function, ...]] | None = None  # the last point and its criteria there
+        self._readers: dict[str, list[int]] = {}  # a variable -> the criteria (positions) reading it
 
     def point(self, picked: Mapping[str, bool], default: bool) -> dict[str, bool]:
         """``picked`` completed with ``default`` for the variables it leaves free."""
@@ -76,8 +78,8 @@ class Points:
         """The chain at ``point``: ``S_0 … S_n`` on the outputs, whether each criterion
         finds a solution there (its ``b_j`` at Y0), and the criteria there (:meth:`at`)."""
         s = self.bdd.let(dict(point), self._base)
-        at, false = self.at, self.engine.false
-        there = [at(g, point) for g in self.goods]
+        false = self.engine.false
+        there = self._there(point)
         states, bests = [s], []
         for g in there:  # narrow() inline: this loop runs for every point of every witness
             kept = s & g
@@ -89,6 +91,25 @@ class Points:
                 bests.append(False)
             states.append(s)
         return states, bests, there
+
+    def _there(self, point: Mapping[str, bool]) -> list[Function]:
+        """The criteria at ``point`` (:meth:`at`), only those reading a variable that
+        differs from the last point's asked again (the others' values, so their cached
+        restrictions, are the same): the witnesses change a few variables at a time."""
+        last = self._last
+        if last is None or last[0].keys() != point.keys():
+            there = [self.at(g, point) for g in self.goods]
+            if not self._readers:
+                for i, g in enumerate(self.goods):
+                    for v in self._reads[g][0]:
+                        self._readers.setdefault(v, []).append(i)
+        else:
+            before, there = last[0], list(last[1])
+            changed = sorted({i for v, x in point.items() if before[v] != x for i in self._readers.get(v, ())})
+            for i in changed:
+                there[i] = self.at(self.goods[i], point)
+        self._last = (dict(point), tuple(there))
+        return there
 
     def random(self, region: Function, rng: random.Random) -> dict[str, bool]:
         """A random point in ``region`` (not false, a function of :attr:`others`)."""
