@@ -22,7 +22,8 @@ Example
 from __future__ import annotations
 
 import random
-from typing import Any, Mapping, Sequence
+from operator import itemgetter
+from typing import Any, Callable, Mapping, Sequence
 
 from synth.logic.bdd import Function
 from synth.logic.partition import Partition
@@ -52,8 +53,10 @@ class Points:
         self._anchors = anchors
         self.goods = list(goods)
         self._base = p.relation(p.initial)
-        self._reads: dict[Function, list[str]] = {}
+        self._reads: dict[Function, tuple[list[str], Callable[[Mapping[str, bool]], tuple[bool, ...]]]] = {}
         self._restricted: dict[tuple[Function, tuple[bool, ...]], Function] = {}  # (g, its reads' values) -> g there
+        self._last: tuple[dict[str, bool], tuple[Function, ...]] | None = None  # the last point and its criteria there
+        self._readers: dict[str, list[int]] = {}  # a variable -> the criteria (positions) reading it
 
     def point(self, picked: Mapping[str, bool], default: bool) -> dict[str, bool]:
         """``picked`` completed with ``default`` for the variables it leaves free."""
@@ -62,25 +65,51 @@ class Points:
     def at(self, g: Function, point: Mapping[str, bool]) -> Function:
         """``g`` at ``point``: a function of the outputs alone (cached per valuation of
         the variables ``g`` reads)."""
-        reads = self._reads.get(g)
-        if reads is None:
-            reads = self._reads[g] = sorted(v for v in self.bdd.support(g) if v not in self._anchors)
-        values = tuple(point[v] for v in reads)
+        reading = self._reads.get(g)
+        if reading is None:
+            reading = self._reads[g] = _reader(sorted(v for v in self.bdd.support(g) if v not in self._anchors))
+        values = reading[1](point)
         found = self._restricted.get((g, values))
         if found is None:
-            found = self._restricted[(g, values)] = self.bdd.let(dict(zip(reads, values)), g) if values else g
+            found = self._restricted[(g, values)] = self.bdd.let(dict(zip(reading[0], values)), g) if values else g
         return found
 
     def chain(self, point: Mapping[str, bool]) -> tuple[list[Function], list[bool], list[Function]]:
         """The chain at ``point``: ``S_0 … S_n`` on the outputs, whether each criterion
         finds a solution there (its ``b_j`` at Y0), and the criteria there (:meth:`at`)."""
         s = self.bdd.let(dict(point), self._base)
-        states, bests, there = [s], [], [self.at(g, point) for g in self.goods]
-        for g in there:
-            s, best = narrow(s, g, self.engine.false)
+        false = self.engine.false
+        there = self._there(point)
+        states, bests = [s], []
+        for g in there:  # narrow() inline: this loop runs for every point of every witness
+            kept = s & g
+            if kept != false:
+                s = kept
+                bests.append(True)
+            else:
+                s = s & ~g
+                bests.append(False)
             states.append(s)
-            bests.append(best)
         return states, bests, there
+
+    def _there(self, point: Mapping[str, bool]) -> list[Function]:
+        """The criteria at ``point`` (:meth:`at`), only those reading a variable that
+        differs from the last point's asked again (the others' values, so their cached
+        restrictions, are the same): the witnesses change a few variables at a time."""
+        last = self._last
+        if last is None or last[0].keys() != point.keys():
+            there = [self.at(g, point) for g in self.goods]
+            if not self._readers:
+                for i, g in enumerate(self.goods):
+                    for v in self._reads[g][0]:
+                        self._readers.setdefault(v, []).append(i)
+        else:
+            before, there = last[0], list(last[1])
+            changed = sorted({i for v, x in point.items() if before[v] != x for i in self._readers.get(v, ())})
+            for i in changed:
+                there[i] = self.at(self.goods[i], point)
+        self._last = (dict(point), tuple(there))
+        return there
 
     def random(self, region: Function, rng: random.Random) -> dict[str, bool]:
         """A random point in ``region`` (not false, a function of :attr:`others`)."""
@@ -94,6 +123,16 @@ def narrow(s: Function, g: Function, false: Function) -> tuple[Function, bool]:
     if kept != false:
         return kept, True
     return s & ~g, False
+
+
+def _reader(reads: list[str]) -> tuple[list[str], Callable[[Mapping[str, bool]], tuple[bool, ...]]]:
+    """``reads`` and the function giving their values at a point, as a tuple."""
+    if not reads:
+        return reads, lambda point: ()
+    if len(reads) == 1:
+        only = reads[0]
+        return reads, lambda point: (point[only],)
+    return reads, itemgetter(*reads)
 
 
 def random_point(bdd: Any, u: Function, names: Sequence[str], rng: random.Random) -> dict[str, bool]:

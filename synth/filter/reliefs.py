@@ -41,7 +41,7 @@ from synth.logic.expr import And, Expr, Not, Var
 from synth.logic.partition import State
 from synth.logic.past import pre_name
 
-__all__ = ["SPELLING_WORK", "Spelling", "Spellings", "Witness", "other_spellings", "spelling_warnings"]
+__all__ = ["REGION_WORK", "SPELLING_WORK", "Spelling", "Spellings", "Witness", "other_spellings", "spelling_warnings"]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -111,11 +111,17 @@ class _Chain:
         self.states: list[State] = [self.p.initial]
         self.bests: list[Function] = []
         self._regions: dict[int, Function] = {}
+        self.budget: int | None = None
+        """While set, the work (:meth:`Engine.work`) past which running the chain gives up."""
+        self.coarse = False
+        """Whether the regions are taken on ``S_0`` (:meth:`sparse_points`)."""
 
     def _upto(self, j: int) -> State:
         """The chain's ``S_j``, the chain run that far if it is not yet (the points need it
         only up to the last relief's criterion)."""
         while len(self.states) <= j:
+            if self.budget is not None and self.m.engine.work() > self.budget:
+                raise _TooWide
             n = len(self.bests)
             state, best = self._step(self.states[-1], self.where[n], self.goods[n])
             self.states.append(state)
@@ -144,8 +150,35 @@ class _Chain:
         the file's narrows ``S_i`` (elsewhere both leave it as it is, and so the rest)."""
         found = self._regions.get(n)
         if found is None:
-            found = self._regions[n] = self._narrowed(n)
+            found = self._regions[n] = self._initial_region(n) if self.coarse else self._narrowed(n)
         return found
+
+    def _initial_region(self, n: int) -> Function:
+        """:meth:`_narrowed` on ``S_0`` instead of ``S_i``: the Y where criterion i or its
+        other spelling narrows ``S_0``, which holds those where they narrow ``S_i``
+        (``S_i ⊆ S_0``); no chain is run."""
+        alternative = self.alternatives[n]
+        assert alternative is not None
+        i, g = alternative
+        p, s, good = self.p, self.p.initial, self.goods[i]
+        k = p.position(g)
+        return (p.project(s, self.where[i], good) & p.project(s, self.where[i], ~good)) | \
+            (p.project(s, k, g) & p.project(s, k, ~g))
+
+    def sparse_points(self, candidates: Sequence[int], work: int) -> dict[int, Witness]:
+        """:meth:`at_points` with the free variables 0, its regions on the chain's ``S_i``
+        while running the chain that far costs at most ``work``; past it, on ``S_0``
+        (:meth:`_initial_region`, :attr:`coarse`: the chain is not run, and
+        :func:`spelling_warnings` compares nothing on every input)."""
+        self.budget = self.m.engine.work() + work
+        try:
+            return self.at_points(candidates, points.POINT_DEFAULTS[:1], 0)
+        except _TooWide:
+            self.coarse = True
+            self._regions.clear()
+            return self.at_points(candidates, points.POINT_DEFAULTS[:1], 0)
+        finally:
+            self.budget = None
 
     def _narrowed(self, n: int) -> Function:
         alternative = self.alternatives[n]
@@ -169,8 +202,8 @@ class _Chain:
         shown: dict[int, dict[str, bool]] = {}
 
         def run(point: dict[str, bool]) -> int:
-            states = at.chain(point)[0]
-            found = [n for n in todo if n not in shown and self._differ_at(at, states, n, point)]
+            chain = at.chain(point)
+            found = [n for n in todo if n not in shown and self._differ_at(at, chain, n, point)]
             shown.update((n, point) for n in found)
             return len(found)
 
@@ -188,25 +221,31 @@ class _Chain:
     def _at(self) -> points.Points:
         return points.Points(self.p, self.goods)
 
-    def _differ_at(self, at: points.Points, states: Sequence[Function], n: int,
+    def _differ_at(self, at: points.Points, chain: tuple[list[Function], list[bool], list[Function]], n: int,
                    point: dict[str, bool]) -> list[str]:
-        """The outputs alternative ``n`` drives differently at ``point`` (``states``: the
-        chain there), none where it rejoins the chain."""
+        """The outputs alternative ``n`` drives differently at ``point`` (``chain``: the
+        chain there, :meth:`points.Points.chain`), none where it rejoins the chain."""
         alternative = self.alternatives[n]
         assert alternative is not None
         i, g = alternative
+        states, _, there = chain
         false = self.m.engine.false
         z, _ = points.narrow(states[i], at.at(g, point), false)
         for j in range(i + 1, len(self.goods)):
             if z == states[j]:
                 return []
-            z, _ = points.narrow(z, at.at(self.goods[j], point), false)
+            z, _ = points.narrow(z, there[j], false)
         if z == states[-1]:
             return []
+        return [o for o, one, zero in self._literals
+                if ((z & one) != false, (z & zero) != false) !=
+                ((states[-1] & one) != false, (states[-1] & zero) != false)]
+
+    @functools.cached_property
+    def _literals(self) -> list[tuple[str, Function, Function]]:
+        """Each output, its BDD and its complement."""
         e = self.m.engine
-        return [o for o in self.m.outputs
-                if ((z & e.var(o)) != false, (z & ~e.var(o)) != false) !=
-                ((states[-1] & e.var(o)) != false, (states[-1] & ~e.var(o)) != false)]
+        return [(o, e.var(o), ~e.var(o)) for o in self.m.outputs]
 
     def _witness(self, at: points.Points, n: int, point: dict[str, bool]) -> Witness:
         """``point`` made sparse: its variables at 1 set to 0, all of a group at once (the
@@ -215,7 +254,7 @@ class _Chain:
         point = dict(point)
 
         def differs() -> list[str]:
-            return self._differ_at(at, at.chain(point)[0], n, point)
+            return self._differ_at(at, at.chain(point), n, point)
 
         groups = [[v for v in at.others if point[v]]]  # a stack, not a recursive closure (no cycle to collect)
         while groups:
@@ -262,6 +301,10 @@ class _Chain:
         return differ or list(self.m.outputs)
 
 
+class _TooWide(Exception):
+    """Running the chain passed :attr:`_Chain.budget`."""
+
+
 @dataclasses.dataclass(frozen=True)
 class Witness:
     """Where a point shows two spellings different: the outputs they drive differently
@@ -290,6 +333,13 @@ SPELLING_WORK = 10_000_000
 spellings of the reliefs no sparse point showed different, once the first is compared: about
 4 CPU s on this project's machine. The chain of 64 outputs needs 2 % of it for its 63
 reliefs; the grids of 32 to 64 outputs need none (a point shows each relief)."""
+
+REGION_WORK = 10_000_000
+"""The BDD work ``filter check`` spends on running the chain of narrowings up to the last
+relief's criterion, for the regions its points are taken in: past it, the regions are
+taken on ``S_0`` and no relief is compared on every input (grid_edges of 8 × 5 outputs
+and more: 13 M at 8 × 5, over 50 M at 8 × 8; the grid of 64 and grid_edges 8 × 4 need 3.4
+M, the chain of 256 0.6 M, the ring of 32 1.2 M)."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -320,7 +370,7 @@ def _relief_loc(s: Safety) -> Location | None:
 
 
 def spelling_warnings(f: Filter, safeties: Sequence[Safety] | None = None,
-                      limit: int | None = SPELLING_WORK) -> Spellings:
+                      limit: int | None = SPELLING_WORK, regions: int = REGION_WORK) -> Spellings:
     """A located warning for each relief whose other spelling gives a different algebraic
     filter: another care set, or an output that may be on or may be off on some input.
 
@@ -328,8 +378,10 @@ def spelling_warnings(f: Filter, safeties: Sequence[Safety] | None = None,
     variables 0), a relief one shows different warned with it; the others compared on
     every input while the BDD work spent on them stays under ``limit`` (the first always);
     those left tried at the other points (free variables 1, random), and the rest listed,
-    not compared. ``limit`` None: every relief compared on every input, each warning
-    naming every output it drives differently."""
+    not compared. When the chain up to the last relief costs more than ``regions``, the
+    points are taken where the criteria narrow ``S_0`` and none is compared on every input
+    (:meth:`_Chain.sparse_points`). ``limit`` None: every relief compared on every input,
+    each warning naming every output it drives differently."""
     swapped: list[tuple[Safety, Safety]] = []  # each relief and the same constraint written the other way
     for s in (safeties if safeties is not None else f.combined):
         other = _other(s) if s.has_priority else None
@@ -339,14 +391,14 @@ def spelling_warnings(f: Filter, safeties: Sequence[Safety] | None = None,
         return Spellings([])
     chain = _Chain(f, swapped)
     every = range(len(swapped))
-    sparse = {} if limit is None else chain.at_points(every, points.POINT_DEFAULTS[:1], 0)
+    sparse = {} if limit is None else chain.sparse_points(every, regions)
     compared: dict[int, list[str] | None] = {}
     left: list[int] = []
     start = chain.m.engine.work()
     for n in every:
         if n in sparse:
             continue
-        if compared and limit is not None and chain.m.engine.work() - start > limit:
+        if chain.coarse or (compared and limit is not None and chain.m.engine.work() - start > limit):
             left.append(n)
         else:
             compared[n] = chain.differ(n)
