@@ -54,6 +54,8 @@ class Points:
         self._base = p.relation(p.initial)
         self._reads: dict[Function, list[str]] = {}
         self._restricted: dict[tuple[Function, tuple[bool, ...]], Function] = {}  # (g, its reads' values) -> g there
+        self.anchors = sorted(anchors)
+        self._outputs_read: dict[Function, frozenset[str]] = {}
 
     def point(self, picked: Mapping[str, bool], default: bool) -> dict[str, bool]:
         """``picked`` completed with ``default`` for the variables it leaves free."""
@@ -74,7 +76,7 @@ class Points:
     def chain(self, point: Mapping[str, bool]) -> tuple[list[Function], list[bool], list[Function]]:
         """The chain at ``point``: ``S_0 … S_n`` on the outputs, whether each criterion
         finds a solution there (its ``b_j`` at Y0), and the criteria there (:meth:`at`)."""
-        s = self.bdd.let(dict(point), self._base)
+        s = self.base_at(point)
         states, bests, there = [s], [], [self.at(g, point) for g in self.goods]
         for g in there:
             s, best = narrow(s, g, self.engine.false)
@@ -86,10 +88,24 @@ class Points:
         """A random point in ``region`` (not false, a function of :attr:`others`)."""
         return random_point(self.bdd, region, self.others, rng)
 
+    def reads(self, g: Function) -> frozenset[str]:
+        """The variables (internal names) ``g`` reads: at a point, outputs only."""
+        found = self._outputs_read.get(g)
+        if found is None:
+            found = self._outputs_read[g] = frozenset(self.bdd.support(g))
+        return found
+
+    def base_at(self, point: Mapping[str, bool]) -> Function:
+        """``S_0`` at ``point``: a relation on the outputs alone."""
+        return self.bdd.let(dict(point), self._base)
+
 
 def narrow(s: Function, g: Function, false: Function) -> tuple[Function, bool]:
     """``Max(g)`` on ``s`` at a point: ``s ∧ g`` where it is not empty, else ``s ∧ ¬g``;
-    and whether it was not."""
+    and whether it was not. A criterion constant at the point (most priorities, whose
+    requests are off there) leaves ``s`` as it is, without a BDD operation."""
+    if g.var is None:  # the constant true or false
+        return (s, False) if g == false else (s, s != false)
     kept = s & g
     if kept != false:
         return kept, True
