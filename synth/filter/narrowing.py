@@ -172,8 +172,8 @@ def layout(m: FilterFunctions, goods: Sequence[Function], order: Sequence[str] |
 def decided(p: Partition, s: State, outputs: Sequence[str]) -> tuple[Function, dict[str, Function], dict[str, Function]]:
     """The care set ``∃O.S`` and each output's ``∃O.(S ∧ o)`` and ``∃O.(S ∧ !o)`` of state ``s``."""
     e = p.engine
-    ones = {o: p.project(s, p.position(e.var(o)), e.var(o)) for o in outputs}
-    zeros = {o: p.project(s, p.position(e.var(o)), ~e.var(o)) for o in outputs}
+    ones = {o: p.project(s, p.anchor_position(o), e.var(o)) for o in outputs}
+    zeros = {o: p.project(s, p.anchor_position(o), ~e.var(o)) for o in outputs}
     return p.project(s, 0), ones, zeros
 
 
