@@ -82,6 +82,8 @@ class AtPoint:
             self.bests.append(best)
         self._free: list[Function | None] | None = None
         self._projected: dict[int, Function] = {}
+        self.agreed = 0
+        """Races :meth:`race` ended because ``Z`` and the chain agreed (for tests and benchmarks)."""
 
     # ---- relations
     def _literal(self, v: str, value: bool) -> Function:
@@ -214,6 +216,7 @@ class AtPoint:
                 if mine is None:
                     mine = self._projected[j] = self.bdd.apply("exists", cube, s.rest)
                 if self.bdd.apply("exists", cube, z.rest) == mine:
+                    self.agreed += 1
                     return True
             z, own = self.narrow(z, g)
             if own and not best:
