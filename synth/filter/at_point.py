@@ -140,6 +140,8 @@ class AtPoint:
         """Whether ``a`` and ``b`` are the same relation. Where one fixes an output the other
         does not, the other must force it to that value (its rest false at the other one)."""
         false = self.bdd.false
+        if a is b:
+            return True
         if a.fixed == b.fixed:
             return bool(a.rest == b.rest)
         if a.rest == false or b.rest == false:
@@ -231,7 +233,10 @@ class AtPoint:
         ``i`` replaced by ``g`` drives differently at the point, none where it rejoins the
         chain (:meth:`synth.filter.reliefs._Chain.differ` at a point)."""
         points, states = self.points, self.states
-        z, _ = self.narrow(states[i], points.at(g, self.point))
+        g = points.at(g, self.point)
+        if g == self.there[i]:  # the same criterion at the point: the chain itself
+            return []
+        z, _ = self.narrow(states[i], g)
         for j in range(i + 1, len(self.there)):
             if self.same(z, states[j]):
                 return []
