@@ -75,7 +75,10 @@ class Points:
 
     def chain(self, point: Mapping[str, bool]) -> tuple[list[Function], list[bool], list[Function]]:
         """The chain at ``point``: ``S_0 … S_n`` on the outputs, whether each criterion
-        finds a solution there (its ``b_j`` at Y0), and the criteria there (:meth:`at`)."""
+        finds a solution there (its ``b_j`` at Y0), and the criteria there (:meth:`at`),
+        each relation one BDD. The races and the spellings run it as
+        :class:`synth.filter.at_point.AtPoint` (the outputs fixed kept apart: the same
+        relations, in fewer steps); this is the tests' oracle."""
         s = self.base_at(point)
         states, bests, there = [s], [], [self.at(g, point) for g in self.goods]
         for g in there:
