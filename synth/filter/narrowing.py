@@ -34,6 +34,7 @@ from functools import cached_property
 from typing import Callable, Sequence
 
 from synth.filter import points
+from synth.filter.at_point import AtPoint
 from synth.filter.model import FilterFunctions
 from synth.logic.bdd import Function
 from synth.logic.partition import Partition, State
@@ -171,8 +172,8 @@ def layout(m: FilterFunctions, goods: Sequence[Function], order: Sequence[str] |
 def decided(p: Partition, s: State, outputs: Sequence[str]) -> tuple[Function, dict[str, Function], dict[str, Function]]:
     """The care set ``∃O.S`` and each output's ``∃O.(S ∧ o)`` and ``∃O.(S ∧ !o)`` of state ``s``."""
     e = p.engine
-    ones = {o: p.project(s, p.position(e.var(o)), e.var(o)) for o in outputs}
-    zeros = {o: p.project(s, p.position(e.var(o)), ~e.var(o)) for o in outputs}
+    ones = {o: p.project(s, p.anchor_position(o), e.var(o)) for o in outputs}
+    zeros = {o: p.project(s, p.anchor_position(o), ~e.var(o)) for o in outputs}
     return p.project(s, 0), ones, zeros
 
 
@@ -268,12 +269,12 @@ def _shown_at_points(p: Partition, goods: Sequence[Function], races: Sequence[_R
 
     def run(point: dict[str, bool]) -> int:
         """Run the chain and the undecided races at ``point``: how many it shows."""
-        states, bests, restricted = at.chain(point)  # the criteria restricted: outputs only
+        here = AtPoint(at, point)  # the chain there, the criteria restricted: outputs only
         shown = 0
         for r in races:
             i = r.i
-            if r.effect is None and bests[i] and (z := states[i] & ~restricted[i]) != false and \
-                    _race_at_point(z, restricted[i + 1:], bests[i + 1:], false):
+            if r.effect is None and here.bests[i] and (z := here.dropped(i)).rest != false and \
+                    here.race(i, z):
                 r.effect = True
                 shown += 1
         return shown
@@ -286,15 +287,3 @@ def _shown_at_points(p: Partition, goods: Sequence[Function], races: Sequence[_R
         shown = sum(run(at.random(r.undecided, rng)) for r in races if r.effect is None)
         if not shown:
             break
-
-
-def _race_at_point(z: Function, at: Sequence[Function], bests: Sequence[bool], false: Function) -> bool:
-    """:func:`_race_monolithic` at one Y0: whether Y0 shows the effect."""
-    for g, best in zip(at, bests):
-        own = (z & g) != false
-        if own and not best:
-            return True
-        if best and not own:
-            return False
-        z &= g if own else ~g
-    return True

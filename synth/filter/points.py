@@ -28,7 +28,7 @@ from typing import Any, Callable, Mapping, Sequence
 from synth.logic.bdd import Function
 from synth.logic.partition import Partition
 
-__all__ = ["Points", "POINT_DEFAULTS", "POINT_ROUNDS", "POINT_SEED", "random_point"]
+__all__ = ["Points", "race_at_point", "POINT_DEFAULTS", "POINT_ROUNDS", "POINT_SEED", "random_point"]
 
 POINT_DEFAULTS = (False, True)
 """The first points tried: one of a region, the variables it leaves free first all false,
@@ -55,6 +55,8 @@ class Points:
         self._base = p.relation(p.initial)
         self._reads: dict[Function, tuple[list[str], Callable[[Mapping[str, bool]], tuple[bool, ...]]]] = {}
         self._restricted: dict[tuple[Function, tuple[bool, ...]], Function] = {}  # (g, its reads' values) -> g there
+        self.anchors = sorted(anchors)
+        self._outputs_read: dict[Function, frozenset[str]] = {}
         self._last: tuple[dict[str, bool], tuple[Function, ...]] | None = None  # the last point and its criteria there
         self._readers: dict[str, list[int]] = {}  # a variable -> the criteria (positions) reading it
 
@@ -76,23 +78,19 @@ class Points:
 
     def chain(self, point: Mapping[str, bool]) -> tuple[list[Function], list[bool], list[Function]]:
         """The chain at ``point``: ``S_0 … S_n`` on the outputs, whether each criterion
-        finds a solution there (its ``b_j`` at Y0), and the criteria there (:meth:`at`)."""
-        s = self.bdd.let(dict(point), self._base)
-        false = self.engine.false
-        there = self._there(point)
-        states, bests = [s], []
-        for g in there:  # narrow() inline: this loop runs for every point of every witness
-            kept = s & g
-            if kept != false:
-                s = kept
-                bests.append(True)
-            else:
-                s = s & ~g
-                bests.append(False)
+        finds a solution there (its ``b_j`` at Y0), and the criteria there (:meth:`at`),
+        each relation one BDD. The races and the spellings run it as
+        :class:`synth.filter.at_point.AtPoint` (the outputs fixed kept apart: the same
+        relations, in fewer steps); this is the tests' oracle."""
+        s = self.base_at(point)
+        states, bests, there = [s], [], self.there(point)
+        for g in there:
+            s, best = narrow(s, g, self.engine.false)
             states.append(s)
+            bests.append(best)
         return states, bests, there
 
-    def _there(self, point: Mapping[str, bool]) -> list[Function]:
+    def there(self, point: Mapping[str, bool]) -> list[Function]:
         """The criteria at ``point`` (:meth:`at`), only those reading a variable that
         differs from the last point's asked again (the others' values, so their cached
         restrictions, are the same): the witnesses change a few variables at a time."""
@@ -115,10 +113,24 @@ class Points:
         """A random point in ``region`` (not false, a function of :attr:`others`)."""
         return random_point(self.bdd, region, self.others, rng)
 
+    def reads(self, g: Function) -> frozenset[str]:
+        """The variables (internal names) ``g`` reads: at a point, outputs only."""
+        found = self._outputs_read.get(g)
+        if found is None:
+            found = self._outputs_read[g] = frozenset(self.bdd.support(g))
+        return found
+
+    def base_at(self, point: Mapping[str, bool]) -> Function:
+        """``S_0`` at ``point``: a relation on the outputs alone."""
+        return self.bdd.let(dict(point), self._base)
+
 
 def narrow(s: Function, g: Function, false: Function) -> tuple[Function, bool]:
     """``Max(g)`` on ``s`` at a point: ``s ∧ g`` where it is not empty, else ``s ∧ ¬g``;
-    and whether it was not."""
+    and whether it was not. A criterion constant at the point (most priorities, whose
+    requests are off there) leaves ``s`` as it is, without a BDD operation."""
+    if g.var is None:  # the constant true or false
+        return (s, False) if g == false else (s, s != false)
     kept = s & g
     if kept != false:
         return kept, True
@@ -146,3 +158,19 @@ def random_point(bdd: Any, u: Function, names: Sequence[str], rng: random.Random
             rest = bdd.let({v: point[v]}, u)
         u = rest
     return point
+
+
+def race_at_point(z: Function, at: Sequence[Function], bests: Sequence[bool], false: Function) -> bool:
+    """The "no effect" race of :mod:`synth.filter.narrowing` at one Y0, step by step on single
+    BDDs: whether Y0 shows the effect (``z``: what the criterion drops there; ``at``,
+    ``bests``: the criteria after it there and the chain's verdicts).
+    :meth:`synth.filter.at_point.AtPoint.race` gives the same verdict in fewer steps (the
+    tests hold it to this one)."""
+    for g, best in zip(at, bests):
+        own = (z & g) != false
+        if own and not best:
+            return True
+        if best and not own:
+            return False
+        z &= g if own else ~g
+    return True

@@ -35,6 +35,7 @@ from synth.errors import InputError, Location, Severity
 from synth.filter import points
 from synth.filter.language import Criterion, Filter, Forcing, Safety, Sense
 from synth.filter.language_check import output_polarities
+from synth.filter.at_point import AtPoint
 from synth.filter.narrowing import decided, layout
 from synth.logic.bdd import Function
 from synth.logic.expr import And, Expr, Not, Var
@@ -202,8 +203,8 @@ class _Chain:
         shown: dict[int, dict[str, bool]] = {}
 
         def run(point: dict[str, bool]) -> int:
-            chain = at.chain(point)
-            found = [n for n in todo if n not in shown and self._differ_at(at, chain, n, point)]
+            here = AtPoint(at, point)
+            found = [n for n in todo if n not in shown and self._differ_at(here, n)]
             shown.update((n, point) for n in found)
             return len(found)
 
@@ -221,31 +222,13 @@ class _Chain:
     def _at(self) -> points.Points:
         return points.Points(self.p, self.goods)
 
-    def _differ_at(self, at: points.Points, chain: tuple[list[Function], list[bool], list[Function]], n: int,
-                   point: dict[str, bool]) -> list[str]:
-        """The outputs alternative ``n`` drives differently at ``point`` (``chain``: the
-        chain there, :meth:`points.Points.chain`), none where it rejoins the chain."""
+    def _differ_at(self, here: AtPoint, n: int) -> list[str]:
+        """The outputs alternative ``n`` drives differently at the point ``here`` (the chain
+        there), none where it rejoins the chain."""
         alternative = self.alternatives[n]
         assert alternative is not None
         i, g = alternative
-        states, _, there = chain
-        false = self.m.engine.false
-        z, _ = points.narrow(states[i], at.at(g, point), false)
-        for j in range(i + 1, len(self.goods)):
-            if z == states[j]:
-                return []
-            z, _ = points.narrow(z, there[j], false)
-        if z == states[-1]:
-            return []
-        return [o for o, one, zero in self._literals
-                if ((z & one) != false, (z & zero) != false) !=
-                ((states[-1] & one) != false, (states[-1] & zero) != false)]
-
-    @functools.cached_property
-    def _literals(self) -> list[tuple[str, Function, Function]]:
-        """Each output, its BDD and its complement."""
-        e = self.m.engine
-        return [(o, e.var(o), ~e.var(o)) for o in self.m.outputs]
+        return here.differ(i, g, self.m.outputs)
 
     def _witness(self, at: points.Points, n: int, point: dict[str, bool]) -> Witness:
         """``point`` made sparse: its variables at 1 set to 0, all of a group at once (the
@@ -254,7 +237,7 @@ class _Chain:
         point = dict(point)
 
         def differs() -> list[str]:
-            return self._differ_at(at, at.chain(point), n, point)
+            return self._differ_at(AtPoint(at, point), n)
 
         groups = [[v for v in at.others if point[v]]]  # a stack, not a recursive closure (no cycle to collect)
         while groups:

@@ -91,6 +91,7 @@ class Partition:
         self._bwd: dict[int, Function] = {}
         self._local: dict[tuple[int, int, int], Function] = {}
         self._blocks: dict[tuple[int, Function], Function] = {}
+        self._where: dict[Function, int] = {}
         self.initial = State(tuple(engine.true for _ in range(n)), [None] * n, [None] * n)
         self.steps = 0
         """Messages computed so far (forward and backward), for benchmarks."""
@@ -100,8 +101,16 @@ class Partition:
 
     def position(self, u: Function) -> int:
         """The bag of ``u`` (that of its first anchor, 0 without any): where a domain
-        narrowed by ``u``, or a ``g`` projected with :meth:`project`, belongs."""
-        return min(self._positions(u), default=0)
+        narrowed by ``u``, or a ``g`` projected with :meth:`project`, belongs (remembered
+        per function: dd's support walks every declared variable)."""
+        found = self._where.get(u)
+        if found is None:
+            found = self._where[u] = min(self._positions(u), default=0)
+        return found
+
+    def anchor_position(self, anchor: str) -> int:
+        """The bag of the anchor ``anchor`` (the position of ``engine.var(anchor)``)."""
+        return self._pos[self.engine.declare(anchor)]
 
     def frontier(self, k: int) -> tuple[str, ...]:
         """The anchors after ``k`` that share a factor with anchor ``k`` or an earlier one."""

@@ -1,0 +1,252 @@
+"""The chain of narrowings at one point (:mod:`synth.filter.points`) with each relation kept
+as the outputs it fixes and the rest: a Sim criterion, or a priority whose requests meet
+at the point, is one literal there, and ``S ∧ o`` as one BDD keeps a node per output fixed
+before, above the rest; a chain of N outputs then walks N/2 of them at each of its N Sim
+steps (quadratic per point, cubic over the races' points). Kept apart, a literal is a
+cofactor of the rest, a step or two when its output is the rest's first.
+
+:class:`Fixed` is one relation (``fixed``: output -> value, ``rest``: a function of the
+other outputs, the relation ``⋀ fixed ∧ rest``); :class:`AtPoint` runs the chain at a point
+on them (:meth:`AtPoint.narrow` is ``Max(g)``, :meth:`AtPoint.same` compares two as
+relations), the "no effect" races there (:mod:`synth.filter.narrowing`) and the keep/force
+spellings' comparison (:meth:`AtPoint.differ`, :mod:`synth.filter.reliefs`). Cofactors are
+CUDD's and-abstract over a one-variable cube (dd's ``let`` walks every declared variable:
+0.13 ms a call with 1 000 of them). They give what
+:meth:`synth.filter.points.Points.chain` and :func:`synth.filter.points.narrow` give on
+the relations as single BDDs (``tests/test_filter_at_point.py``).
+
+Example
+-------
+>>> from synth.logic.bdd import Engine
+>>> from synth.logic.partition import Partition
+>>> from synth.filter.points import Points
+>>> e = Engine(["i", "a", "b"])
+>>> a, b, i = (e.var(n) for n in "abi")
+>>> here = AtPoint(Points(Partition(e, ["a", "b"], [~(a & b)]), [a & i, b]), {e.declare("i"): True})
+>>> here.bests, e.text(here.states[-1].relation(e.bdd))
+([True, False], 'a & !b')
+"""
+
+from __future__ import annotations
+
+from typing import Any, Mapping, Sequence
+
+from synth.filter.points import Points
+from synth.logic.bdd import Function
+
+__all__ = ["Fixed", "AtPoint"]
+
+
+class Fixed:
+    """A relation on the outputs at a point: ``⋀ fixed ∧ rest``, ``rest`` reading none of
+    the outputs ``fixed`` (internal names) fixes; ``horizon``: the last step of the chain
+    that reads one of them (-1 for none)."""
+
+    __slots__ = ("fixed", "rest", "horizon")
+
+    def __init__(self, fixed: dict[str, bool], rest: Function, horizon: int = -1) -> None:
+        self.fixed = fixed
+        self.rest = rest
+        self.horizon = horizon
+
+    def relation(self, bdd: Any) -> Function:
+        """The relation as one BDD."""
+        u = self.rest
+        for v, value in self.fixed.items():
+            u &= bdd.var(v) if value else ~bdd.var(v)
+        return u
+
+
+class AtPoint:
+    """The chain at one point: ``there`` (the criteria at the point, functions of the
+    outputs), ``states`` (``S_0 … S_n``, each a :class:`Fixed`) and ``bests`` (whether each
+    criterion finds a solution there), as :meth:`synth.filter.points.Points.chain` gives
+    them as single BDDs."""
+
+    def __init__(self, points: Points, point: Mapping[str, bool]) -> None:
+        self.points = points
+        self.engine = points.engine
+        self.bdd = points.bdd
+        self.point = point
+        self.there = points.there(point)
+        last: dict[str, int] = {v: -1 for v in points.anchors}
+        for j, g in enumerate(self.there):
+            for v in points.reads(g):
+                last[v] = j
+        self._last = last
+        s = Fixed({}, points.base_at(point))
+        self.states, self.bests = [s], []
+        for g in self.there:
+            s, best = self.narrow(s, g)
+            self.states.append(s)
+            self.bests.append(best)
+        self._free: list[Function | None] | None = None
+        self._projected: dict[int, Function] = {}
+        self.agreed = 0
+        """Races :meth:`race` ended because ``Z`` and the chain agreed (for tests and benchmarks)."""
+
+    # ---- relations
+    def _literal(self, v: str, value: bool) -> Function:
+        x = self.bdd.var(v)
+        return x if value else ~x
+
+    def _cofactor(self, u: Function, v: str, value: bool) -> Function:
+        """``u`` with output ``v`` at ``value`` (and-abstract over ``v``'s cube)."""
+        return self.engine.and_exists(u, self._literal(v, value), [v])
+
+    def _restricted(self, s: Fixed, g: Function) -> Function:
+        """``g`` with the outputs ``s`` fixes set to their values (``g``: a criterion at the point)."""
+        values = [(v, s.fixed[v]) for v in self.points.reads(g) if v in s.fixed]
+        if not values:
+            return g
+        cube = self.bdd.true
+        for v, value in values:
+            cube &= self._literal(v, value)
+        return self.engine.and_exists(g, cube, [v for v, _ in values])
+
+    def _fixing(self, s: Fixed, v: str, value: bool, rest: Function) -> Fixed:
+        return Fixed({**s.fixed, v: value}, rest, max(s.horizon, self._last[v]))
+
+    def narrow(self, s: Fixed, g: Function) -> tuple[Fixed, bool]:
+        """``Max(g)`` on ``s`` (:func:`synth.filter.points.narrow`): ``s ∧ g`` where it is
+        not empty, else ``s ∧ ¬g``; and whether it was not."""
+        false = self.bdd.false
+        if g.var is not None:
+            g = self._restricted(s, g)
+        if g.var is None:  # constant: s as it is
+            return (s, False) if g == false else (s, s.rest != false)
+        if g.low.var is None and g.high.var is None:  # a literal: a cofactor of the rest
+            v = g.var
+            value = g == self.bdd.var(v)
+            kept = self._cofactor(s.rest, v, value)
+            if kept != false:
+                return self._fixing(s, v, value, kept), True
+            return self._fixing(s, v, not value, self._cofactor(s.rest, v, not value)), False
+        kept = s.rest & g
+        if kept != false:
+            return Fixed(s.fixed, kept, s.horizon), True
+        return Fixed(s.fixed, s.rest & ~g, s.horizon), False
+
+    def conjoined(self, s: Fixed, g: Function) -> Fixed:
+        """``s ∧ g``, ``g`` a function of the outputs at the point."""
+        g = self._restricted(s, g) if g.var is not None else g
+        if g.var is not None and g.low.var is None and g.high.var is None:
+            v = g.var
+            value = g == self.bdd.var(v)
+            return self._fixing(s, v, value, self._cofactor(s.rest, v, value))
+        return Fixed(s.fixed, s.rest & g, s.horizon)
+
+    def same(self, a: Fixed, b: Fixed) -> bool:
+        """Whether ``a`` and ``b`` are the same relation. Where one fixes an output the other
+        does not, the other must force it to that value (its rest false at the other one)."""
+        false = self.bdd.false
+        if a is b:
+            return True
+        if a.fixed == b.fixed:
+            return bool(a.rest == b.rest)
+        if a.rest == false or b.rest == false:
+            return a.rest == false and b.rest == false
+        apart = a.fixed.items() ^ b.fixed.items()
+        rests = []
+        for x, y in ((a, b), (b, a)):
+            rest = y.rest
+            for v, value in apart:
+                if x.fixed.get(v) is not value:
+                    continue  # y's own, or a value x does not give v
+                if v in y.fixed:
+                    return False  # both fix v, to other values
+                if self._cofactor(rest, v, not value) != false:
+                    return False  # y leaves v free, or forces the other value: another relation
+                rest = self._cofactor(rest, v, value)
+            rests.append(rest)
+        # both now fix the same outputs to the same values: the same relation iff the same rest
+        return bool(rests[0] == rests[1])
+
+    def can(self, s: Fixed, v: str, value: bool) -> bool:
+        """Whether ``s`` holds a vector with output ``v`` at ``value``."""
+        false = self.bdd.false
+        if s.rest == false:
+            return False
+        if v in s.fixed:
+            return s.fixed[v] == value
+        return (s.rest & self._literal(v, value)) != false
+
+    # ---- the races
+    def dropped(self, i: int) -> Fixed:
+        """``S_i ∧ ¬g_i``: what criterion ``i`` drops at the point (the race's ``Z``)."""
+        return self.conjoined(self.states[i], ~self.there[i])
+
+    def _free_after(self) -> list[Function | None]:
+        """Per step j: the cube of the outputs no criterion from j on reads (None: none)."""
+        if self._free is None:
+            freed: dict[int, list[str]] = {}
+            for v, j in self._last.items():
+                freed.setdefault(j + 1, []).append(v)
+            bdd, cube = self.bdd, None
+            out: list[Function | None] = []
+            for j in range(len(self.there) + 1):
+                for v in sorted(freed.get(j, ()), key=bdd.level_of_var):
+                    cube = bdd.var(v) if cube is None else cube & bdd.var(v)
+                out.append(cube)
+            self._free = out
+        return self._free
+
+    def race(self, i: int, z: Fixed) -> bool:
+        """Whether the race of criterion ``i`` shows its effect at the point (``z``: what the
+        criterion drops there, :meth:`dropped`, not empty), as
+        :func:`synth.filter.points.race_at_point` decides it, with two shortcuts:
+
+        - a criterion constant at the point narrows neither ``Z`` nor the chain: skipped;
+        - once ``Z`` and the chain's ``S_j`` have the same projection on the outputs a
+          criterion from ``j`` on reads (here: both fix only outputs no criterion from ``j``
+          on reads, and their rests are the same once the others are quantified), every
+          later criterion finds a solution in ``Z`` exactly where it finds one in ``S_j``:
+          the race runs to the end undecided, which shows the effect (the race of a Sim
+          criterion on a chain of outputs meets this a step or two after it starts instead
+          of running to the end)."""
+        false = self.bdd.false
+        free = self._free_after()
+        for j in range(i + 1, len(self.there)):
+            g, best = self.there[j], self.bests[j]
+            if g.var is None:  # own: z is not empty (it never is) for true, false for false
+                if g != false and not best:
+                    return True
+                continue
+            cube, s = free[j], self.states[j]
+            if cube is not None and z.horizon < j and s.horizon < j:
+                mine = self._projected.get(j)
+                if mine is None:
+                    mine = self._projected[j] = self.bdd.apply("exists", cube, s.rest)
+                if self.bdd.apply("exists", cube, z.rest) == mine:
+                    self.agreed += 1
+                    return True
+            z, own = self.narrow(z, g)
+            if own and not best:
+                return True
+            if best and not own:
+                return False
+        return True
+
+    # ---- the keep/force spellings
+    def differ(self, i: int, g: Function, outputs: Sequence[str]) -> list[str]:
+        """The ``outputs`` (the engine's names, in their order) the chain with criterion
+        ``i`` replaced by ``g`` drives differently at the point, none where it rejoins the
+        chain (:meth:`synth.filter.reliefs._Chain.differ` at a point)."""
+        points, states = self.points, self.states
+        g = points.at(g, self.point)
+        if g == self.there[i]:  # the same criterion at the point: the chain itself
+            return []
+        z, _ = self.narrow(states[i], g)
+        for j in range(i + 1, len(self.there)):
+            if self.same(z, states[j]):
+                return []
+            z, _ = self.narrow(z, self.there[j])
+        last = states[-1]
+        if self.same(z, last):
+            return []
+        out = []
+        for o in outputs:
+            v = self.engine.declare(o)
+            if (self.can(z, v, True), self.can(z, v, False)) != (self.can(last, v, True), self.can(last, v, False)):
+                out.append(o)
+        return out

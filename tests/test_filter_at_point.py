@@ -1,0 +1,134 @@
+"""The chain at a point with the outputs it fixes kept apart (:mod:`synth.filter.at_point`)
+against the chain at a point as single BDDs (:meth:`synth.filter.points.Points.chain`,
+:func:`synth.filter.points.race_at_point`, the spellings' comparison written out below):
+the same states, verdicts, races and differing outputs, point by point, on small filters
+of each bench family and on bundled ones."""
+
+from __future__ import annotations
+
+import dataclasses
+import random
+import sys
+from typing import Sequence
+
+import pytest
+
+from conftest import ROOT
+from synth.filter import points
+from synth.filter.at_point import AtPoint, Fixed
+from synth.filter.language_check import load_filter, parse_filter
+from synth.filter.model import functions
+from synth.filter.narrowing import layout
+from synth.filter.reliefs import _Chain, _other
+from synth.filter.solve import criteria
+from synth.filter.language import Filter, Sense
+from synth.logic.bdd import Function
+
+sys.path.insert(0, str(ROOT / "bench"))
+from filter_scale import chain_filter, grid_edges_filter, ring_filter  # noqa: E402
+
+CASES = {
+    "chain_12": lambda: parse_filter(chain_filter(12), "chain.filter"),
+    "ring_4": lambda: parse_filter(ring_filter(4), "ring.filter"),
+    "grid_edges_16": lambda: parse_filter(grid_edges_filter(16, stations=4), "grid_edges.filter"),
+    "tri": lambda: load_filter(ROOT / "plants" / "tri.filter"),
+    "four_cylinders": lambda: load_filter(ROOT / "plants" / "four_cylinders.filter"),
+    "palletizer": lambda: load_filter(ROOT / "tests" / "data" / "filter" / "palletizer.filter"),
+}
+
+
+def _points(at: points.Points, count: int) -> list[dict[str, bool]]:
+    """All false, all true, then seeded random points."""
+    rng = random.Random(37)
+    out = [at.point({}, False), at.point({}, True)]
+    return out + [{v: rng.random() < 0.5 for v in at.others} for _ in range(count)]
+
+
+def _setup(f: Filter) -> tuple[points.Points, list[Function]]:
+    m = functions(f)
+    e = m.engine
+    goods = [u if c.sense is Sense.MAX else ~u for c in criteria(f) for u in (e.expr(c.expr),)]
+    return points.Points(layout(m, goods), goods), goods
+
+
+@pytest.mark.parametrize("case", sorted(CASES))
+def test_the_chain_and_the_races_at_points_as_on_single_bdds(case: str) -> None:
+    at, goods = _setup(CASES[case]())
+    bdd, false = at.bdd, at.engine.false
+    races = agreed = 0
+    for point in _points(at, 12):
+        states, bests, there = at.chain(point)
+        here = AtPoint(at, point)
+        assert here.bests == bests
+        assert [s.relation(bdd) for s in here.states] == states
+        assert [here.same(here.states[j], here.states[j]) for j in (0, -1)] == [True, True]
+        for i in range(len(goods)):
+            z = states[i] & ~there[i]
+            if not bests[i] or z == false:
+                continue
+            mine = here.dropped(i)
+            assert mine.relation(bdd) == z
+            assert here.race(i, mine) == points.race_at_point(z, there[i + 1:], bests[i + 1:], false)
+            races += 1
+        agreed += here.agreed
+    assert races > 0
+    if case == "chain_12":  # the races of the Sim criteria end where Z and the chain agree
+        assert agreed > 0
+
+
+def _differ_on_single_bdds(at: points.Points, point: dict[str, bool], i: int, g: Function,
+                           outputs: Sequence[str]) -> list[str]:
+    """The spellings' comparison at a point as it was written on single BDDs."""
+    e, false = at.engine, at.engine.false
+    states, _, _ = at.chain(point)
+    z, _ = points.narrow(states[i], at.at(g, point), false)
+    for j in range(i + 1, len(at.goods)):
+        if z == states[j]:
+            return []
+        z, _ = points.narrow(z, at.at(at.goods[j], point), false)
+    if z == states[-1]:
+        return []
+    return [o for o in outputs
+            if ((z & e.var(o)) != false, (z & ~e.var(o)) != false) !=
+            ((states[-1] & e.var(o)) != false, (states[-1] & ~e.var(o)) != false)]
+
+
+@pytest.mark.parametrize("case", ["chain_12", "ring_4", "grid_edges_16", "four_cylinders"])
+def test_the_spellings_at_points_as_on_single_bdds(case: str) -> None:
+    f = CASES[case]()
+    swapped = [(s, dataclasses.replace(s, keep=o.keep, force=o.force))
+               for s in f.combined if s.has_priority for o in (_other(s),) if o is not None]
+    chain = _Chain(f, swapped)
+    at = points.Points(chain.p, chain.goods)
+    regions = [chain._region(n) for n, a in enumerate(chain.alternatives) if a is not None]
+    picked = [at.point(at.bdd.pick(r), d) for r in regions if r != at.engine.false for d in (False, True)]
+    compared = shown = 0
+    for point in _points(at, 6) + picked:
+        here = AtPoint(at, point)
+        for alternative in chain.alternatives:
+            if alternative is None:
+                continue
+            i, g = alternative
+            mine = here.differ(i, g, chain.m.outputs)
+            assert mine == _differ_on_single_bdds(at, point, i, g, chain.m.outputs)
+            compared += 1
+            shown += bool(mine)
+    assert compared > 0 and shown > 0
+
+
+def test_same_relation_whatever_the_outputs_kept_apart() -> None:
+    f = parse_filter(chain_filter(3), "chain.filter")
+    at, _ = _setup(f)
+    here = AtPoint(at, at.point({}, False))
+    bdd = at.bdd
+    o1, o2, o3 = (at.engine.declare(f"o{k}") for k in (1, 2, 3))
+    x1, x2, x3 = (bdd.var(v) for v in (o1, o2, o3))
+    rest = ~(x2 & x3)
+    apart = Fixed({o1: True}, rest)  # o1 & !(o2 & o3)
+    whole = Fixed({}, x1 & rest)  # the same relation, o1 in the rest
+    assert here.same(apart, whole) and here.same(whole, apart)
+    assert not here.same(apart, Fixed({}, rest))  # o1 free
+    assert not here.same(apart, Fixed({o1: False}, rest))
+    assert here.same(Fixed({o1: True, o2: False}, bdd.true), Fixed({o2: False}, x1))
+    assert not here.same(Fixed({o1: True, o2: False}, bdd.true), Fixed({o3: False}, x1 & ~x2))
+    assert here.same(Fixed({o1: True}, bdd.false), Fixed({o2: False}, bdd.false))
