@@ -36,14 +36,38 @@ from synth.sup.constraints import Term, split_terms
 __all__ = ["Column", "PlantColumns"]
 
 
-class Move(NamedTuple):
-    """A local transition on codes: from local index ``src`` of element ``axis``, the code
-    moves by ``shift``; ``guard`` over the codes of what the element reads (None: always)."""
+class Moves(NamedTuple):
+    """One event's local transitions in one element: from local index ``src[j]`` of element
+    ``axis`` (sorted, each at most once: an element flips a variable one way per state) the
+    code moves by ``shift[j]`` where ``guard[j]`` holds on the code of what the element
+    reads (``guard`` None: always)."""
 
     axis: int
-    src: int
-    shift: int
+    src: np.ndarray
+    shift: np.ndarray
     guard: np.ndarray | None
+
+
+def _events(p: Plant) -> Iterator[tuple[Event, bool, Moves]]:
+    """Every event of each element (the plant's transition order: element, then first
+    seen by source), whether it is controllable, and its :class:`Moves`, built from the
+    elements' transition arrays at once (no object per transition)."""
+    for axis, e in enumerate(p.elements):
+        if not e.src.size:
+            continue
+        rising = (e.codes[e.dst] >> e.var) & 1
+        kind = e.var.astype(np.int64) * 2 + rising
+        order = np.argsort(kind, kind="stable")  # by event, by source within each (the arrays are by source)
+        kinds, first, counts = np.unique(kind[order], return_index=True, return_counts=True)
+        starts = np.concatenate(([0], np.cumsum(counts)))
+        for k in np.argsort(order[first], kind="stable"):  # events by their first transition
+            sel = order[starts[k]:starts[k + 1]]
+            src = e.src[sel].astype(np.int64)
+            if src.size > 1 and not (np.diff(src) > 0).all():
+                raise AssertionError(f"element {e.name}: an event with two moves from one state")
+            guard = None if e.guards is None or bool(e.guards[sel].all()) else np.asarray(e.guards[sel], dtype=bool)
+            yield (Event.edge(e.variables[int(kinds[k]) // 2], bool(kinds[k] & 1)), bool(e.controllable[sel[-1]]),
+                   Moves(axis, src, (e.dst[sel].astype(np.int64) - src) * p.strides[axis], guard))
 
 
 class Column:
@@ -81,19 +105,17 @@ class PlantColumns:
         self.level_reach: list[Term] | None = None if p.reads else [
             Term(t.constraint, tuple((a, p.elements[a].can_reach(v)) for a, v in t.factors), None)
             for t in self.level_terms]
-        by_event: dict[str, list[Move]] = {}  # per event, its local transitions, first-seen order
+        by_event: dict[str, list[Moves]] = {}  # per event, its moves in each element, first-seen order
         controllable: dict[str, bool] = {}
-        for lt in p.transitions:
-            guard = None if lt.guard is None else np.asarray(lt.guard, dtype=bool)
-            shift = (lt.dst - lt.src) * p.strides[lt.axis]
-            by_event.setdefault(lt.event, []).append(Move(lt.axis, lt.src, shift, guard))
-            controllable[lt.event] = lt.controllable
-        self.uncontrollable: tuple[tuple[str, tuple[Move, ...]], ...] = tuple(
-            (e, tuple(ts)) for e, ts in by_event.items() if not controllable[e])
+        for event, ctrl, mv in _events(p):
+            by_event.setdefault(event, []).append(mv)
+            controllable[event] = ctrl
+        self.uncontrollable: tuple[tuple[str, tuple[Moves, ...]], ...] = tuple(
+            (e, tuple(ms)) for e, ms in by_event.items() if not controllable[e])
         # per element, the (element, values) of each variable it reads (its moves' guards read them)
         self.reads = [[(p.owner[r], p.elements[p.owner[r]].value(r)) for r in e.reads] for e in p.elements]
         self.val = {v: self._value(v) for v in p.variables}
-        self.toggle = {e: self._move(tuple(ts)) for e, ts in by_event.items() if controllable[e]}
+        self.toggle = {e: self._move(tuple(ms)) for e, ms in by_event.items() if controllable[e]}
         for z in p.outputs:
             for edge in (Event.rise(z), Event.fall(z)):
                 self.toggle.setdefault(edge, self._move(()))
@@ -114,36 +136,43 @@ class PlantColumns:
     def _terms(self, terms: Sequence[Term]) -> Column:
         return Column(lambda c: self.holds(terms, c))
 
-    def _move(self, transitions: tuple[Move, ...]) -> Column:
-        return Column(lambda c: self.step(transitions, c, {}))
+    def _move(self, moves: tuple[Moves, ...]) -> Column:
+        return Column(lambda c: self.step(moves, c, {}))
 
-    def step(self, transitions: Sequence[Move], codes: np.ndarray, digits: dict[int, np.ndarray]
-             ) -> np.ndarray:
-        """The successor of each code by one of ``transitions`` (one event's; the last one
-        that applies, as an array filled transition by transition would hold), -1 where
-        none does; ``digits`` caches the codes' digits per element."""
+    def step(self, moves: Sequence[Moves], codes: np.ndarray, digits: dict[int, np.ndarray]) -> np.ndarray:
+        """The successor of each code by one event's ``moves`` (-1 where none applies; an
+        element listed later wins, as an array filled element by element would hold);
+        ``digits`` caches the codes' digits per element and, at ``-1 - axis``, the codes of
+        what element ``axis`` reads."""
         def dig(a: int) -> np.ndarray:
             if a not in digits:
-                digits[a] = self.digit(codes, a)
+                digits[a] = self.digit(codes, a) if a >= 0 else self._read_codes(-1 - a, dig)
             return digits[a]
 
         out = np.full(codes.size, -1, dtype=np.int64)
-        for t in transitions:
-            sel = dig(t.axis) == t.src
-            if t.guard is not None:
-                read = np.zeros(codes.size, dtype=np.int64)
-                for j, (a, vec) in enumerate(self.reads[t.axis]):
-                    read |= vec[dig(a)].astype(np.int64) << j
-                sel &= t.guard[read]
-            out[sel] = codes[sel] + t.shift
+        for m in moves:
+            d = dig(m.axis)
+            j = np.searchsorted(m.src, d)
+            np.minimum(j, m.src.size - 1, out=j)
+            sel = m.src[j] == d
+            if m.guard is not None:
+                sel &= m.guard[j, dig(-1 - m.axis)]
+            out[sel] = codes[sel] + m.shift[j[sel]]
         return out
+
+    def _read_codes(self, axis: int, dig: Callable[[int], np.ndarray]) -> np.ndarray:
+        """Per code, the code of the variables element ``axis`` reads (bit j: its j-th read)."""
+        read = np.zeros(dig(axis).size, dtype=np.int64)
+        for j, (a, vec) in enumerate(self.reads[axis]):
+            read |= vec[dig(a)].astype(np.int64) << j
+        return read
 
     def moves(self, codes: np.ndarray) -> Iterator[tuple[str, np.ndarray]]:
         """Every uncontrollable event (the plant's first-seen order) and its successor of
         each code (-1 where it cannot occur)."""
         digits: dict[int, np.ndarray] = {}
-        for e, ts in self.uncontrollable:
-            yield e, self.step(ts, codes, digits)
+        for e, ms in self.uncontrollable:
+            yield e, self.step(ms, codes, digits)
 
     # ------------------------------------------------------------------ constraints
     def holds(self, terms: Sequence[Term], codes: np.ndarray) -> np.ndarray:
