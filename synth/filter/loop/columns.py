@@ -122,6 +122,8 @@ class PlantColumns:
         self.illegal = self._terms(self.level_terms)
         self.forbid = {e: self._terms(ts) for e, ts in self.edge_terms.items()}
         self.outside_sup = Column(self._removed)
+        # the states decided by the searches of outside SUP so far (sorted) and whether each is outside
+        self._decided: tuple[np.ndarray, np.ndarray] = (np.zeros(0, dtype=np.int64), np.zeros(0, dtype=bool))
 
     # ------------------------------------------------------------------ digits and moves
     def digit(self, codes: np.ndarray, axis: int) -> np.ndarray:
@@ -188,13 +190,15 @@ class PlantColumns:
             out |= here
         return out
 
-    def closure(self, codes: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def closure(self, codes: np.ndarray, known: np.ndarray | None = None
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The states reachable from ``codes`` by uncontrollable moves (sorted, ``codes``
-        included) and those moves, as positions in it (sources, targets)."""
+        included) and those moves, as positions in it (sources, targets); the search does
+        not go on from the states of the sorted array ``known``."""
         nodes = np.unique(codes)
         src: list[np.ndarray] = [np.zeros(0, dtype=np.int64)]
         dst: list[np.ndarray] = [np.zeros(0, dtype=np.int64)]
-        frontier = nodes
+        frontier = nodes if known is None else nodes[~_member(nodes, known)]
         while frontier.size:
             found = []
             for _, nxt in self.moves(frontier):
@@ -203,24 +207,36 @@ class PlantColumns:
                 dst.append(nxt[ok])
                 found.append(nxt[ok])
             reached = np.unique(np.concatenate([np.zeros(0, dtype=np.int64), *found]))
-            frontier = reached[~_member(reached, nodes)]
-            nodes = np.union1d(nodes, frontier)
+            reached = reached[~_member(reached, nodes)]
+            nodes = np.union1d(nodes, reached)
+            frontier = reached if known is None else reached[~_member(reached, known)]
         s, d = np.concatenate(src), np.concatenate(dst)
         return nodes, np.searchsorted(nodes, s), np.searchsorted(nodes, d)
 
     def _removed(self, codes: np.ndarray) -> np.ndarray:
-        """Outside SUP: a violating state is reachable from the code by uncontrollable moves."""
+        """Outside SUP: a violating state is reachable from the code by uncontrollable moves.
+        Without the closed form, every state a search meets is decided (what it reaches is
+        searched too) and kept: a later search stops at the states decided before."""
         if not codes.size:
             return np.zeros(0, dtype=bool)
         if self.level_reach is not None:
             return self.holds(self.level_reach, codes)
-        nodes, s, d = self.closure(codes)
-        bad = self.holds(self.level_terms, nodes)
+        known, known_bad = self._decided
+        nodes, s, d = self.closure(codes, known)
+        old = _member(nodes, known)
+        bad = np.zeros(nodes.size, dtype=bool)
+        bad[old] = known_bad[np.searchsorted(known, nodes[old])]
+        bad[~old] = self.holds(self.level_terms, nodes[~old])
         while True:  # back along the moves, until nothing is added
             more = bad[d] & ~bad[s]
             if not more.any():
                 break
             bad[s[more]] = True
+        fresh = nodes[~old]
+        if fresh.size:
+            merged = np.concatenate((known, fresh))
+            order = np.argsort(merged, kind="stable")
+            self._decided = merged[order], np.concatenate((known_bad, bad[~old]))[order]
         return bad[np.searchsorted(nodes, codes)]
 
     def _ids(self, terms: Sequence[Term], codes: np.ndarray) -> tuple[str, ...]:
