@@ -97,6 +97,26 @@ def test_outside_sup_asked_level_by_level_equals_asked_at_once(tmp_path):
     assert pieces.outside_sup[int(order[0])] == expected[order[0]]  # one code, decided before
 
 
+def test_moves_by_element_tables_equal_moves_event_by_event(tmp_path, monkeypatch):
+    """An element's uncontrollable events side by side in one table (guards read from the
+    other elements) give the successors of looking each event's sources up alone."""
+    from synth.filter.loop import columns
+
+    ring = tmp_path / "ring3.rules"
+    ring.write_text(ring_rules(3))
+    tabled = _product(ring, tmp_path)
+    monkeypatch.setattr(columns, "TABLE_ENTRIES", 0)
+    alone = _product(ring, tmp_path)
+    kinds = [sum(isinstance(t, columns.Table) for t in pr.columns.tables) for pr in (tabled, alone)]
+    assert kinds[0] >= 6 and kinds[1] == 0 and any(t.guard is not None for t in tabled.columns.tables
+                                                   if isinstance(t, columns.Table))
+    codes = np.random.default_rng(2).permutation(tabled.size)[:5000]
+    got, want = list(tabled.moves(codes)), list(alone.moves(codes))
+    assert [e for e, _ in got] == [e for e, _ in want] == list(tabled.uncontrollable)
+    for (e, a), (_, b) in zip(got, want):
+        assert (a == b).all() and (a >= 0).any(), e
+
+
 def test_distinct_lanes_equal_first_lanes_row_by_row():
     from synth.filter.loop.outcomes import distinct_lanes, first_lanes
 

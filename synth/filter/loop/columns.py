@@ -70,6 +70,56 @@ def _events(p: Plant) -> Iterator[tuple[Event, bool, Moves]]:
                    Moves(axis, src, (e.dst[sel].astype(np.int64) - src) * p.strides[axis], guard))
 
 
+class Table(NamedTuple):
+    """The uncontrollable ``events`` of element ``axis``, side by side: ``slot[k, i]`` is the
+    move of ``events[k]`` from local index ``i`` (a row of ``shift`` and ``guard``) or -1."""
+
+    axis: int
+    events: tuple[str, ...]
+    slot: np.ndarray
+    shift: np.ndarray
+    guard: np.ndarray | None
+
+
+TABLE_ENTRIES = 1 << 22
+"""The largest table (events × local states) of an element's moves; a larger element's
+events look their sources up one event at a time."""
+
+
+def _tables(p: Plant, events: Sequence[tuple[str, tuple[Moves, ...]]]
+            ) -> list[Table | tuple[str, tuple[Moves, ...]]]:
+    """``events`` (each with its moves, in order) grouped into a :class:`Table` per run of
+    events of one element that fits in :data:`TABLE_ENTRIES`; the others left as they are."""
+    out: list[Table | tuple[str, tuple[Moves, ...]]] = []
+    run: list[tuple[str, Moves]] = []
+
+    def close() -> None:
+        axis = run[0][1].axis if run else 0
+        if len(run) > 1 and len(run) * p.shape[axis] <= TABLE_ENTRIES:
+            slot = np.full((len(run), p.shape[axis]), -1, dtype=np.int64)
+            start = 0
+            for k, (_, m) in enumerate(run):
+                slot[k, m.src] = np.arange(start, start + m.src.size)
+                start += m.src.size
+            width = 1 << len(p.elements[axis].reads)
+            guard = None if all(m.guard is None for _, m in run) else np.concatenate(
+                [np.ones((m.src.size, width), dtype=bool) if m.guard is None else m.guard for _, m in run])
+            out.append(Table(axis, tuple(e for e, _ in run), slot, np.concatenate([m.shift for _, m in run]), guard))
+        else:
+            out.extend((e, (m,)) for e, m in run)
+        run.clear()
+
+    for e, ms in events:
+        if len(ms) != 1 or (run and run[0][1].axis != ms[0].axis):
+            close()
+        if len(ms) == 1:
+            run.append((e, ms[0]))
+        else:
+            out.append((e, ms))
+    close()
+    return out
+
+
 class Column:
     """A value per plant state code, computed for the codes asked: ``column[codes]`` as
     ``array[codes]`` would be (an array of codes, or one code)."""
@@ -112,6 +162,7 @@ class PlantColumns:
             controllable[event] = ctrl
         self.uncontrollable: tuple[tuple[str, tuple[Moves, ...]], ...] = tuple(
             (e, tuple(ms)) for e, ms in by_event.items() if not controllable[e])
+        self.tables = _tables(p, self.uncontrollable)  # the same events, an element's side by side
         # per element, the (element, values) of each variable it reads (its moves' guards read them)
         self.reads = [[(p.owner[r], p.elements[p.owner[r]].value(r)) for r in e.reads] for e in p.elements]
         self.val = {v: self._value(v) for v in p.variables}
@@ -144,37 +195,48 @@ class PlantColumns:
     def step(self, moves: Sequence[Moves], codes: np.ndarray, digits: dict[int, np.ndarray]) -> np.ndarray:
         """The successor of each code by one event's ``moves`` (-1 where none applies; an
         element listed later wins, as an array filled element by element would hold);
-        ``digits`` caches the codes' digits per element and, at ``-1 - axis``, the codes of
-        what element ``axis`` reads."""
-        def dig(a: int) -> np.ndarray:
-            if a not in digits:
-                digits[a] = self.digit(codes, a) if a >= 0 else self._read_codes(-1 - a, dig)
-            return digits[a]
-
+        ``digits`` caches what :meth:`dig` computes."""
         out = np.full(codes.size, -1, dtype=np.int64)
         for m in moves:
-            d = dig(m.axis)
+            d = self.dig(codes, digits, m.axis)
             j = np.searchsorted(m.src, d)
             np.minimum(j, m.src.size - 1, out=j)
             sel = m.src[j] == d
             if m.guard is not None:
-                sel &= m.guard[j, dig(-1 - m.axis)]
+                sel &= m.guard[j, self.dig(codes, digits, -1 - m.axis)]
             out[sel] = codes[sel] + m.shift[j[sel]]
         return out
 
-    def _read_codes(self, axis: int, dig: Callable[[int], np.ndarray]) -> np.ndarray:
-        """Per code, the code of the variables element ``axis`` reads (bit j: its j-th read)."""
-        read = np.zeros(dig(axis).size, dtype=np.int64)
-        for j, (a, vec) in enumerate(self.reads[axis]):
-            read |= vec[dig(a)].astype(np.int64) << j
-        return read
+    def table_step(self, t: Table, codes: np.ndarray, digits: dict[int, np.ndarray]) -> np.ndarray:
+        """:meth:`step` of every event of the table at once: a row per event."""
+        row = t.slot[:, self.dig(codes, digits, t.axis)]
+        ok = row >= 0
+        if t.guard is not None:
+            ok &= t.guard[row, self.dig(codes, digits, -1 - t.axis)]
+        return np.where(ok, codes + t.shift[row], -1)
+
+    def dig(self, codes: np.ndarray, digits: dict[int, np.ndarray], a: int) -> np.ndarray:
+        """Element ``a``'s local index in each code; at ``a = -1 - axis``, the code of the
+        variables element ``axis`` reads (bit j: its j-th read); kept in ``digits``."""
+        if a not in digits:
+            if a >= 0:
+                digits[a] = self.digit(codes, a)
+            else:
+                read = np.zeros(codes.size, dtype=np.int64)
+                for j, (e, vec) in enumerate(self.reads[-1 - a]):
+                    read |= vec[self.dig(codes, digits, e)].astype(np.int64) << j
+                digits[a] = read
+        return digits[a]
 
     def moves(self, codes: np.ndarray) -> Iterator[tuple[str, np.ndarray]]:
         """Every uncontrollable event (the plant's first-seen order) and its successor of
         each code (-1 where it cannot occur)."""
         digits: dict[int, np.ndarray] = {}
-        for e, ms in self.uncontrollable:
-            yield e, self.step(ms, codes, digits)
+        for t in self.tables:
+            if isinstance(t, Table):
+                yield from zip(t.events, self.table_step(t, codes, digits))
+            else:
+                yield t[0], self.step(t[1], codes, digits)
 
     # ------------------------------------------------------------------ constraints
     def holds(self, terms: Sequence[Term], codes: np.ndarray) -> np.ndarray:
@@ -184,9 +246,7 @@ class PlantColumns:
         for t in terms:
             here = np.ones(codes.size, dtype=bool)
             for a, vec in t.factors:
-                if a not in digits:
-                    digits[a] = self.digit(codes, a)
-                here &= vec[digits[a]]
+                here &= vec[self.dig(codes, digits, a)]
             out |= here
         return out
 
