@@ -5,12 +5,16 @@ plant's grid it stands for (:class:`Column`). Nothing is held per plant state, s
 loop's memory follows the states it reaches, not the grid (24^N states for N cylinders).
 
 A code's local indices are its digits (mixed radices: the plant's strides); a move of one
-element changes one digit, its guard reads the digits of the elements it reads. *Outside
-SUP* (a violation reachable by uncontrollable moves) is SUP's closed form when no element
-reads another (a product of each element's own closures); otherwise, guards read where
-the moves occur, a search forward from the codes asked through the uncontrollable moves
-and back from the violating states it meets: the fixpoint SUP computes on the grid,
-restricted to what the codes can reach.
+element changes one digit, its guard reads the digits of the elements it reads. An
+event's moves are read from the element's transition arrays at once (:class:`Moves`);
+an element's uncontrollable events stand side by side in a table over its local states
+(:class:`Table`, when it fits in :data:`TABLE_ENTRIES`), so that a batch of codes gets
+every event's successor in one gather. *Outside SUP* (a violation reachable by
+uncontrollable moves) is SUP's closed form when no element reads another (a product of
+each element's own closures); otherwise, guards read where the moves occur, a search
+forward from the codes asked through the uncontrollable moves and back from the
+violating states it meets: the fixpoint SUP computes on the grid, restricted to what the
+codes can reach; the states a search decides are kept, and the next search stops there.
 
 Example
 -------
