@@ -117,6 +117,25 @@ def test_moves_by_element_tables_equal_moves_event_by_event(tmp_path, monkeypatc
         assert (a == b).all() and (a >= 0).any(), e
 
 
+def test_classes_found_a_few_at_a_time_give_the_same_verification(tmp_path, monkeypatch):
+    """The outcomes of a level's new classes, found by batches of any size, number the
+    classes, outcomes and memories alike: the same counts, findings and traces."""
+    from synth.filter.loop import explorer
+    from synth.filter.loop.verify import verify
+
+    cases = ((ROOT / "plants" / "four_cylinders.filter", ROOT / "plants" / "four_cylinders.rules"),
+             (DATA / "two_no_edge.filter", DATA / "two.rules"))
+
+    def run() -> list[dict]:
+        return [{k: x for k, x in verification_json(verify(load_filter(f), str(r), any_control=True)).items()
+                 if k != "seconds"} for f, r in cases]
+
+    whole = run()
+    monkeypatch.setattr(explorer, "CLASS_BATCH", 3)
+    assert run() == whole
+    assert whole[0]["states"] == 2160 and whole[1]["findings"]  # many classes; traces through the outcomes
+
+
 def test_distinct_lanes_equal_first_lanes_row_by_row():
     from synth.filter.loop.outcomes import distinct_lanes, first_lanes
 

@@ -35,6 +35,9 @@ from synth.filter.loop.verification import Finding, FindingKind, TraceRow
 
 __all__ = ["POWER_UP", "Explorer"]
 
+CLASS_BATCH = 512
+"""The new classes whose lanes are held before their outcomes are found (all at once)."""
+
 POWER_UP = "power-up"
 """The event of a program's first cycle: its first scan, on the plant's initial state."""
 
@@ -265,6 +268,9 @@ class Explorer:
             if k is None:
                 k = self.classes[key] = len(self.n_out) + len(new)
                 new.append((class_lanes(pr, yb, self.aux_list[aux], sit), sit))
+                if len(new) == CLASS_BATCH:  # a bounded number of lanes held at once
+                    self.add_classes(new)
+                    new = []
             class_ids[u] = k
         self.add_classes(new)
         return class_ids[inverse]
