@@ -6,7 +6,7 @@ Example
 -------
 >>> from synth.plant.composition import _plants, load_plant
 >>> from synth.filter.from_rules import skeleton
->>> from synth.filter.cycle import Algorithm
+>>> from synth.filter.cycle import Algorithm, Mode
 >>> from synth.filter.loop.product import Product
 >>> sk = skeleton(_plants("tri.rules"), _plants("F.filter"))  # the text only: nothing is written
 >>> pr = Product(sk.filter, load_plant(_plants("tri.rules")), None, Algorithm.ALGEBRAIC, Mode.SUPERVISOR, False)
@@ -25,7 +25,6 @@ from typing import Any, Callable
 import numpy as np
 
 from synth.filter.loop.control_st import TIMER_PREFIX
-from synth.filter.cycle import Mode
 from synth.errors import LimitExceeded
 from synth.filter.loop.outcomes import (ClassLanes, Outcome, OutcomeArrays, class_lanes, distinct_lanes, react,
                                        situation_text, trace_row)
