@@ -100,7 +100,7 @@ def _tables(p: Plant, events: Sequence[tuple[str, tuple[Moves, ...]]]
     def close() -> None:
         axis = run[0][1].axis if run else 0
         if len(run) > 1 and len(run) * p.shape[axis] <= TABLE_ENTRIES:
-            slot = np.full((len(run), p.shape[axis]), -1, dtype=np.int64)
+            slot = np.full((len(run), p.shape[axis]), -1, dtype=np.int32)  # at most 16 MiB
             start = 0
             for k, (_, m) in enumerate(run):
                 slot[k, m.src] = np.arange(start, start + m.src.size)
