@@ -81,6 +81,76 @@ def test_columns_agree_with_the_supervisor_state_by_state(tmp_path):
     assert all(Event.edge(z, r) in pr.toggle for z in pr.orders for r in (False, True))
 
 
+def test_outside_sup_asked_level_by_level_equals_asked_at_once(tmp_path):
+    """The searches of outside SUP stop at the states decided by the searches before: asked
+    in shuffled pieces (as the levels ask), every answer equals the one asked at once."""
+    ring = tmp_path / "ring3.rules"  # cells that read the cylinders: the forward search, not the closed form
+    ring.write_text(ring_rules(3))
+    whole = _product(ring, tmp_path)
+    codes = np.arange(whole.size, dtype=np.int64)
+    expected = whole.outside_sup[codes]
+    assert (expected & ~whole.illegal[codes]).any() and whole.plant.reads  # weakly outside states: not vacuous
+    pieces = _product(ring, tmp_path)
+    order = np.random.default_rng(5).permutation(codes)
+    for chunk in np.array_split(order, 40):
+        assert (pieces.outside_sup[chunk] == expected[chunk]).all()
+    assert pieces.outside_sup[int(order[0])] == expected[order[0]]  # one code, decided before
+
+
+def test_moves_by_element_tables_equal_moves_event_by_event(tmp_path, monkeypatch):
+    """An element's uncontrollable events side by side in one table (guards read from the
+    other elements) give the successors of looking each event's sources up alone."""
+    from synth.filter.loop import columns
+
+    ring = tmp_path / "ring3.rules"
+    ring.write_text(ring_rules(3))
+    tabled = _product(ring, tmp_path)
+    monkeypatch.setattr(columns, "TABLE_ENTRIES", 0)
+    alone = _product(ring, tmp_path)
+    kinds = [sum(isinstance(t, columns.Table) for t in pr.columns.tables) for pr in (tabled, alone)]
+    assert kinds[0] >= 6 and kinds[1] == 0 and any(t.guard is not None for t in tabled.columns.tables
+                                                   if isinstance(t, columns.Table))
+    codes = np.random.default_rng(2).permutation(tabled.size)[:5000]
+    got, want = list(tabled.moves(codes)), list(alone.moves(codes))
+    assert [e for e, _ in got] == [e for e, _ in want] == list(tabled.uncontrollable)
+    for (e, a), (_, b) in zip(got, want):
+        assert (a == b).all() and (a >= 0).any(), e
+
+
+def test_classes_found_a_few_at_a_time_give_the_same_verification(tmp_path, monkeypatch):
+    """The outcomes of a level's new classes, found by batches of any size, number the
+    classes, outcomes and memories alike: the same counts, findings and traces."""
+    from synth.filter.loop import explorer
+    from synth.filter.loop.verify import verify
+
+    cases = ((ROOT / "plants" / "four_cylinders.filter", ROOT / "plants" / "four_cylinders.rules"),
+             (DATA / "two_no_edge.filter", DATA / "two.rules"))
+
+    def run() -> list[dict]:
+        return [{k: x for k, x in verification_json(verify(load_filter(f), str(r), any_control=True)).items()
+                 if k != "seconds"} for f, r in cases]
+
+    whole = run()
+    monkeypatch.setattr(explorer, "CLASS_BATCH", 3)
+    assert run() == whole
+    assert whole[0]["states"] == 2160 and whole[1]["findings"]  # many classes; traces through the outcomes
+
+
+def test_distinct_lanes_equal_first_lanes_row_by_row():
+    from synth.filter.loop.outcomes import distinct_lanes, first_lanes
+
+    rng = np.random.default_rng(11)
+    for count, m in ((1, 3), (8, 5), (64, 12), (100, 7), (32, 63)):
+        rows = [[int(x) for x in rng.integers(0, 4, size=m)] if r % 3 == 0 else
+                [int.from_bytes(rng.bytes((count + 7) // 8), "little") & ((1 << count) - 1) for _ in range(m)]
+                for r in range(30)]
+        got = distinct_lanes(rows, count)
+        assert [lanes for lanes, _ in got] == [first_lanes(r, count) for r in rows], (count, m)
+        for r, (lanes, keys) in zip(rows, got):
+            want = None if m >= 63 else [sum(((x >> j) & 1) << i for i, x in enumerate(r)) for j in lanes]
+            assert keys == want, (count, m)
+
+
 def test_finding_kinds_print_as_before():
     assert [str(k) for k in FindingKind] == ["violation", "edge", "refused", "fallback", "outside_care",
                                              "transient", "outside_sup"]

@@ -6,7 +6,7 @@ Example
 -------
 >>> from synth.plant.composition import _plants, load_plant
 >>> from synth.filter.from_rules import skeleton
->>> from synth.filter.cycle import Algorithm
+>>> from synth.filter.cycle import Algorithm, Mode
 >>> from synth.filter.loop.product import Product
 >>> sk = skeleton(_plants("tri.rules"), _plants("F.filter"))  # the text only: nothing is written
 >>> pr = Product(sk.filter, load_plant(_plants("tri.rules")), None, Algorithm.ALGEBRAIC, Mode.SUPERVISOR, False)
@@ -25,15 +25,17 @@ from typing import Any, Callable
 import numpy as np
 
 from synth.filter.loop.control_st import TIMER_PREFIX
-from synth.filter.cycle import ACK, Memory, Mode
 from synth.errors import LimitExceeded
-from synth.filter.loop.outcomes import (Outcome, OutcomeArrays, first_lanes, lane_bits, react, situation_text,
-                                       trace_row)
+from synth.filter.loop.outcomes import (ClassLanes, Outcome, OutcomeArrays, class_lanes, distinct_lanes, react,
+                                       situation_text, trace_row)
 from synth.filter.loop.product import Product
 from synth.filter.loop.writes import merge_events, write
 from synth.filter.loop.verification import Finding, FindingKind, TraceRow
 
 __all__ = ["POWER_UP", "Explorer"]
+
+CLASS_BATCH = 512
+"""The new classes whose lanes are held before their outcomes are found (all at once)."""
 
 POWER_UP = "power-up"
 """The event of a program's first cycle: its first scan, on the plant's initial state."""
@@ -64,6 +66,7 @@ class Explorer:
         self.classes: dict[tuple, int] = {}
         self.outcomes: list[Outcome] = []
         self.outcome_of: dict[Outcome, int] = {}
+        self.outcome_by_key: dict[tuple[int, Any], int] = {}  # (a lane's bits, situation) -> outcome
         self.flat: list[int] = []  # the outcomes of every class, class after class
         self.n_out: list[int] = []
         self.arrays = OutcomeArrays(len(pr.orders))
@@ -156,63 +159,44 @@ class Explorer:
                                 int(shown[i]), ids(i) if callable(ids) else ids)
 
     # ------------------------------------------------------------------ one cycle's outcomes
-    def outcomes_for(self, ybits: int, aux: int, sit: Any) -> int:
-        """The class of (Y, aux before, situation after): its distinct outcomes over every
-        request vector (and Ack), each with the first request vector giving it."""
-        key = (ybits, aux, sit)
-        k = self.classes.get(key)
-        if k is not None:
-            return k
-        pr, cyc = self.pr, self.pr.cycle
-        mem_used, blocked, _ = self.aux_list[aux]
-        values = {n: bool((ybits >> i) & 1) for i, n in enumerate(pr.ynames)}
-        fixed = {n: values[n] for n in pr.filter.inputs}
-        free: list[str] = []
-        passed: dict[str, bool] = {}
-        requested = pr.requested(sit, values)
-        if requested is not None:
-            fixed.update(requested[0])
-            fixed.update({r: requested[1][o] for o, r in zip(cyc.outputs, cyc.requests)})
-            passed = {o: requested[1][o] for o in pr.passthrough}
-        else:
-            fixed.update({r: pr.held[o] for o, r in zip(cyc.outputs, cyc.requests) if o in pr.held})
-            passed = {o: pr.held[o] for o in pr.passthrough if o in pr.held}
-            free = [r for o, r in zip(cyc.outputs, cyc.requests) if o not in pr.held]
-            free += [o for o in pr.passthrough if o not in pr.held]
-        if cyc.mode is Mode.BLOCKING:
-            free.append(ACK)
-        previous = [False] * len(cyc.remembered)
-        for i, v in zip(pr.used_index, mem_used):
-            previous[i] = v
-        lanes = cyc.lanes(Memory(tuple(previous), blocked), fixed, free)
-        n = lanes.count
-        out = dict(zip(cyc.outputs, lanes.outputs))  # lane masks
-        for o in pr.passthrough:
-            out[o] = ((1 << n) - 1 if passed[o] else 0) if o in passed else lane_bits(free.index(o), n)
-        memory_after = [lanes.previous[i] for i in pr.used_index]
-        masks = [*(out[o] for o in pr.orders), *memory_after, lanes.blocked, lanes.fallback, lanes.outside_care]
-        found: list[int] = []
-        for j in first_lanes(masks, n):  # one witness lane per distinct outcome, the first
+    def add_classes(self, new: list[tuple[ClassLanes, Any]]) -> None:
+        """The outcomes of the classes ``new`` (their lanes, their situation after), in
+        order: each class's distinct outcomes over every request vector, each with the first
+        request vector giving it (the first lanes of all the classes found at once)."""
+        if not new:
+            return
+        count = new[0][0].lanes.count  # the same free names in every class of a run
+        for (cl, sit), (lanes, keys) in zip(new, distinct_lanes([cl.masks for cl, _ in new], count)):
+            found: list[int] = []
+            for i, j in enumerate(lanes):  # one witness lane per distinct outcome, the first
+                g = None if keys is None else self.outcome_by_key.get((keys[i], sit))
+                if g is None:
+                    g = self.outcome_of_lane(cl, sit, j)
+                    if keys is not None:  # the key is the outcome's bits: with sit, the outcome
+                        self.outcome_by_key[(keys[i], sit)] = g
+                found.append(g)
+            self.flat.extend(found)
+            self.n_out.append(len(found))
 
-            def bit(m: int) -> bool:
-                return bool((m >> j) & 1)
+    def outcome_of_lane(self, cl: ClassLanes, sit: Any, j: int) -> int:
+        """The outcome of lane ``j`` of a class (``sit``: its situation after), numbered when new."""
+        pr, lanes = self.pr, cl.lanes
 
-            oc = Outcome(tuple(bit(out[o]) for o in pr.orders),
-                         self.intern((tuple(map(bit, memory_after)), bit(lanes.blocked), sit)),
-                         bit(lanes.fallback), bit(lanes.outside_care), (), ())
-            g = self.outcome_of.get(oc)  # the witness (requests, violated) is not compared
-            if g is None:
-                req = dict(zip(cyc.outputs, map(bit, lanes.requests)))
-                req.update((o, bit(out[o])) for o in pr.passthrough)
-                oc = dataclasses.replace(oc, requests=tuple(req[o] for o in pr.orders),
-                                         violated=tuple(i for i, m in lanes.violated.items() if bit(m)))
-                g = self.outcome_of[oc] = len(self.outcomes)
-                self.outcomes.append(oc)
-            found.append(g)
-        k = self.classes[key] = len(self.n_out)
-        self.flat.extend(found)
-        self.n_out.append(len(found))
-        return k
+        def bit(m: int) -> bool:
+            return bool((m >> j) & 1)
+
+        oc = Outcome(tuple(bit(cl.out[o]) for o in pr.orders),
+                     self.intern((tuple(map(bit, cl.memory_after)), bit(lanes.blocked), sit)),
+                     bit(lanes.fallback), bit(lanes.outside_care), (), ())
+        g = self.outcome_of.get(oc)  # the witness (requests, violated) is not compared
+        if g is None:
+            req = dict(zip(pr.cycle.outputs, map(bit, lanes.requests)))
+            req.update((o, bit(cl.out[o])) for o in pr.passthrough)
+            oc = dataclasses.replace(oc, requests=tuple(req[o] for o in pr.orders),
+                                     violated=tuple(i for i, m in lanes.violated.items() if bit(m)))
+            g = self.outcome_of[oc] = len(self.outcomes)
+            self.outcomes.append(oc)
+        return g
 
     # ------------------------------------------------------------------ one level
     def events_from(self, frontier: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -271,13 +255,23 @@ class Explorer:
         combo = ((node // self.size) * len(self.events) + event) * (1 << width) + ybits
         uniq, inverse = np.unique(combo, return_inverse=True)
         class_ids = np.empty(uniq.size, dtype=np.int64)
+        new: list[tuple[ClassLanes, Any]] = []  # the classes not met before, in order
         for u, c in enumerate(uniq.tolist()):
             yb, rest = c % (1 << width), c >> width
             ei, aux = rest % len(self.events), rest // len(self.events)
             sit = self.aux_list[aux][2]
             if pr.controlled:
                 sit = react(pr, sit, self.seqs[ei], yb)
-            class_ids[u] = self.outcomes_for(yb, aux, sit)
+            key = (yb, aux, sit)  # the class: Y read, aux before, situation after
+            k = self.classes.get(key)
+            if k is None:
+                k = self.classes[key] = len(self.n_out) + len(new)
+                new.append((class_lanes(pr, yb, self.aux_list[aux], sit), sit))
+                if len(new) == CLASS_BATCH:  # a bounded number of lanes held at once
+                    self.add_classes(new)
+                    new = []
+            class_ids[u] = k
+        self.add_classes(new)
         return class_ids[inverse]
 
     def level(self, frontier: np.ndarray) -> np.ndarray:

@@ -17,10 +17,11 @@ Example
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Sequence
+from typing import Any, NamedTuple, Sequence
 
 import numpy as np
 
+from synth.filter.cycle import ACK, Lanes, Memory, Mode
 from synth.filter.loop.verification import TraceRow
 from synth.logic.events import Event, EventKind
 
@@ -28,7 +29,8 @@ TYPE_CHECKING = False
 if TYPE_CHECKING:
     from synth.filter.loop.product import Product
 
-__all__ = ["Outcome", "OutcomeArrays", "first_lanes", "lane_bits", "react", "situation_text", "trace_row"]
+__all__ = ["ClassLanes", "Outcome", "OutcomeArrays", "class_lanes", "distinct_lanes", "first_lanes", "lane_bits",
+           "react", "situation_text", "trace_row"]
 
 
 @dataclass(frozen=True)
@@ -57,6 +59,81 @@ def first_lanes(masks: Sequence[int], count: int) -> list[int]:
     else:
         _, firsts = np.unique(bits.T, axis=0, return_index=True)
     return sorted(firsts.tolist())
+
+
+def distinct_lanes(rows: Sequence[Sequence[int]], count: int) -> list[tuple[list[int], list[int] | None]]:
+    """:func:`first_lanes` of every row of masks at once (rows of one length, ``count``
+    lanes each), with the key of each lane kept: its column of bits as one integer (bit
+    i: ``row[i]``), or None when a row has 63 masks or more (then one row at a time)."""
+    if not rows:
+        return []
+    m = len(rows[0])
+    if not m or m >= 63:
+        return [(first_lanes(r, count), None) for r in rows]
+    size = (count + 7) // 8
+    out: list[tuple[list[int], list[int] | None]] = []
+    for lo in range(0, len(rows), 4096):  # a bounded block of rows at a time
+        block = rows[lo:lo + 4096]
+        raw = np.frombuffer(b"".join(x.to_bytes(size, "little") for r in block for x in r), dtype=np.uint8)
+        bits = np.unpackbits(raw.reshape(len(block), m, size), axis=2, bitorder="little")[:, :, :count]
+        keys = (bits.astype(np.int64) << np.arange(m, dtype=np.int64)[None, :, None]).sum(axis=1)
+        order = np.argsort(keys, axis=1, kind="stable")  # equal keys: the first lane first
+        ranked = np.take_along_axis(keys, order, axis=1)
+        new = np.ones(ranked.shape, dtype=bool)
+        new[:, 1:] = ranked[:, 1:] != ranked[:, :-1]
+        mark = np.zeros(keys.shape, dtype=bool)
+        row, col = np.nonzero(new)
+        mark[row, order[row, col]] = True
+        row, lane = np.nonzero(mark)  # row by row, lanes ascending
+        bounds = np.concatenate(([0], np.cumsum(np.bincount(row, minlength=len(block))))).tolist()
+        lanes, found = lane.tolist(), keys[row, lane].tolist()
+        out += [(lanes[a:b], found[a:b]) for a, b in zip(bounds[:-1], bounds[1:])]
+    return out
+
+
+class ClassLanes(NamedTuple):
+    """One class's cycle over every request vector: the lanes, each plant order's mask
+    (passed-through orders included), the filter memory the explorer keeps after the cycle,
+    and the masks that make an outcome (orders, that memory, blocked, fallback, outside care)."""
+
+    lanes: Lanes
+    out: dict[str, int]
+    memory_after: list[int]
+    masks: list[int]
+
+
+def class_lanes(pr: "Product", ybits: int, aux: tuple, sit: Any) -> ClassLanes:
+    """The cycle of the class (Y read ``ybits``, ``aux`` = (memory used, blocked, situation)
+    before, situation ``sit`` after the controller's reaction) on every request vector (and Ack)."""
+    cyc = pr.cycle
+    mem_used, blocked, _ = aux
+    values = {n: bool((ybits >> i) & 1) for i, n in enumerate(pr.ynames)}
+    fixed = {n: values[n] for n in pr.filter.inputs}
+    free: list[str] = []
+    passed: dict[str, bool] = {}
+    requested = pr.requested(sit, values)
+    if requested is not None:
+        fixed.update(requested[0])
+        fixed.update({r: requested[1][o] for o, r in zip(cyc.outputs, cyc.requests)})
+        passed = {o: requested[1][o] for o in pr.passthrough}
+    else:
+        fixed.update({r: pr.held[o] for o, r in zip(cyc.outputs, cyc.requests) if o in pr.held})
+        passed = {o: pr.held[o] for o in pr.passthrough if o in pr.held}
+        free = [r for o, r in zip(cyc.outputs, cyc.requests) if o not in pr.held]
+        free += [o for o in pr.passthrough if o not in pr.held]
+    if cyc.mode is Mode.BLOCKING:
+        free.append(ACK)
+    previous = [False] * len(cyc.remembered)
+    for i, v in zip(pr.used_index, mem_used):
+        previous[i] = v
+    lanes = cyc.lanes(Memory(tuple(previous), blocked), fixed, free)
+    n = lanes.count
+    out = dict(zip(cyc.outputs, lanes.outputs))  # lane masks
+    for o in pr.passthrough:
+        out[o] = ((1 << n) - 1 if passed[o] else 0) if o in passed else lane_bits(free.index(o), n)
+    memory_after = [lanes.previous[i] for i in pr.used_index]
+    masks = [*(out[o] for o in pr.orders), *memory_after, lanes.blocked, lanes.fallback, lanes.outside_care]
+    return ClassLanes(lanes, out, memory_after, masks)
 
 
 def lane_bits(i: int, count: int) -> int:
