@@ -245,3 +245,55 @@ def test_the_frontier_goes_on_from_the_machines_path(tmp_path, monkeypatch, wide
     assert (a.nodes, a.edges, a.initial, a.conflicts, a.sync_states) == (b.nodes, b.edges, b.initial, b.conflicts, b.sync_states)
     assert [(a.successors(i), a.predecessors(i)) for i in range(len(a.nodes))] == [
         (b.successors(i), b.predecessors(i)) for i in range(len(b.nodes))]
+
+
+def _wide(tmp_path: Path, idle: int, missing: bool = False) -> tuple[Path, Path]:
+    """par_3 and ``idle`` more double-acting cylinders the Grafcet never orders, declared
+    before par_3's second one (past 2^62 states, C1 and C2 lie in different words): a plant
+    of 2 × 12^(3 + idle) states whose SYNC stays par_3's."""
+    base, full, miss = write_par(3, tmp_path)
+    extra = "".join(f"element D{i} = double_acting(AVANCER=AD{i}, RECULER=RD{i}, v0=d{i}_0, v1=d{i}_1)\n"
+                    for i in range(idle))
+    rules = tmp_path / f"wide_{idle}.rules"
+    text = base.read_text(encoding="utf-8")
+    at = text.index("element C2 ")
+    rules.write_text(text[:at] + extra + text[at:], encoding="utf-8")
+    return (miss if missing else full), rules
+
+
+class TestWidePlants:
+    """Plants of 2^40 states and more: codes numbered as met (one word up to 2^62, then two)."""
+
+    @pytest.mark.parametrize("idle,missing,words", [(9, False, 1), (9, True, 1), (15, False, 2), (15, True, 2)])
+    def test_the_frontier_runs_them_as_the_machine(self, monkeypatch, tmp_path, idle, missing, words):
+        g7, rules = _wide(tmp_path, idle, missing)
+        _, p, _ = load_model(g7, rules)
+        assert p.size >= 1 << (40 if words == 1 else 64) and _reason(g7, rules) is None
+        from synth.validation.regions import PlantCodes
+        from synth.sup.constraints import CompiledConstraints
+
+        args = _loaded(g7, rules)
+        pc = PlantCodes(p, CompiledConstraints(p, args[1]))
+        assert pc.layout is not None and pc.layout.count == words and pc.P == 1 << 32
+        assert len({int(pc.layout.word[p.owner[f"a{i}_0"]]) for i in (1, 2, 3)}) == words
+        a, _ = _both(monkeypatch, g7, rules)
+        assert a.sync.sync_states > 20 and a.passed is not missing
+
+    def test_the_frontier_goes_on_from_the_machine_on_a_wide_plant(self, monkeypatch, tmp_path):
+        g7, rules = _wide(tmp_path, 15, missing=True)
+        monkeypatch.setattr(validate_mod, "WIDE", 4)
+        a, b = explore(*_loaded(g7, rules)), synchronous_product(*_loaded(g7, rules))
+        assert (a.nodes, a.edges, a.initial, a.conflicts, a.sync_states) == (
+            b.nodes, b.edges, b.initial, b.conflicts, b.sync_states)
+
+    def test_two_states_under_one_key_are_left_to_the_machine(self, monkeypatch, tmp_path):
+        import numpy as np
+        from synth.validation import words
+
+        g7, rules = _wide(tmp_path, 15)
+        monkeypatch.setattr(words.Interned, "_key", lambda self, w: np.zeros(len(w), dtype=np.int64))
+        with pytest.raises(Unsupported, match="two plant states under one key"):
+            explore_frontier(*_loaded(g7, rules))
+        monkeypatch.setattr(validate_mod, "WIDE", 4)
+        a, b = explore(*_loaded(g7, rules)), synchronous_product(*_loaded(g7, rules))
+        assert (a.nodes, a.edges, a.sync_states) == (b.nodes, b.edges, b.sync_states) and len(a.nodes) > 20

@@ -1,8 +1,9 @@
 """Plant states as integer codes, and many regions searched at once: the plant's side of
 the frontier explorer (:mod:`synth.validation.frontier`).
 
-A plant state is its flat code (mixed radices, :meth:`~synth.plant.composition.Plant.index`);
-:class:`PlantCodes` reads the element-local digits, the Grafcet's inputs and the orders'
+A plant state is its flat code (mixed radices, :meth:`~synth.plant.composition.Plant.index`),
+or on a plant of :data:`WIDE` states or more the dense number of its words
+(:mod:`synth.validation.words`: the states met, numbered as met); :class:`PlantCodes` reads the element-local digits, the Grafcet's inputs and the orders'
 values of whole arrays of codes, follows the uncontrollable moves of a frontier, and
 decides SUP membership and SUP's refusals with the compiled constraints' factors (the
 same terms :class:`~synth.sup.constraints.CompiledConstraints` asks one state at a time).
@@ -33,8 +34,13 @@ from synth.plant.composition import LocalTransition, Plant
 from synth.sup.constraints import CompiledConstraints
 from synth.validation.keys import SortedKeys, first_occurrences
 from synth.validation.sync import Prohibition, moves_by_order
+from synth.validation.words import CAPACITY, Interned, Layout
 
-__all__ = ["Digits", "PlantCodes", "Regions", "regions"]
+__all__ = ["Digits", "PlantCodes", "Regions", "regions", "WIDE"]
+
+WIDE = 1 << 40
+"""From this many plant states on, plant codes are the dense numbers of the states met
+(their flat codes would leave too few bits of the 64-bit keys to the situations)."""
 
 
 class Digits:
@@ -47,16 +53,28 @@ class Digits:
         self._axes: dict[int, np.ndarray] = {}
         self._full: np.ndarray | None = None
 
+        lay, ids = pc.layout, pc.interned
+        self._wide = (lay, ids.words[codes]) if lay is not None and ids is not None else None  # (layout, words)
+
     def __getitem__(self, axis: int) -> np.ndarray:
         hit = self._axes.get(axis)
         if hit is None:
-            hit = self._axes[axis] = (self.codes // self._pc.stride[axis]) % self._pc.radix[axis]
+            if self._wide is None:
+                hit = (self.codes // self._pc.stride[axis]) % self._pc.radix[axis]
+            else:
+                lay, words = self._wide
+                hit = (words[:, lay.word[axis]] // lay.stride[axis]) % self._pc.radix[axis]
+            self._axes[axis] = hit
         return hit
 
     def full(self) -> np.ndarray:
         """Every element's indices, ndim × n."""
         if self._full is None:
-            self._full = (self.codes[None, :] // self._pc.strides[:, None]) % self._pc.shape[:, None]
+            if self._wide is None:
+                self._full = (self.codes[None, :] // self._pc.strides[:, None]) % self._pc.shape[:, None]
+            else:
+                lay, words = self._wide
+                self._full = np.ascontiguousarray(lay.decode(words).T)
             self._axes = dict(enumerate(self._full))
         return self._full
 
@@ -64,11 +82,13 @@ class Digits:
 class _Moves:
     """Local transitions as columns: element, source, code difference, order column."""
 
-    def __init__(self, moves: list[LocalTransition], strides: tuple[int, ...], column: list[int]) -> None:
+    def __init__(self, moves: list[LocalTransition], strides: tuple[int, ...] | np.ndarray, column: list[int],
+                 word: np.ndarray | None = None) -> None:
         self.moves = moves
         self.axis = np.array([t.axis for t in moves], dtype=np.int64)
         self.src = np.array([t.src for t in moves], dtype=np.int64)
-        self.delta = np.array([(t.dst - t.src) * strides[t.axis] for t in moves], dtype=np.int64)
+        self.delta = np.array([(t.dst - t.src) * int(strides[t.axis]) for t in moves], dtype=np.int64)
+        self.word = word[self.axis] if word is not None else np.zeros(len(moves), dtype=np.int64)
         self.column = np.array(column, dtype=np.int64)
         self.guarded = [k for k, t in enumerate(moves) if t.guard is not None]
         self.forbidding: list[int] = []  # moves an edge constraint may forbid
@@ -80,22 +100,50 @@ class PlantCodes:
     def __init__(self, p: Plant, oracle: CompiledConstraints) -> None:
         self.plant, self.oracle = p, oracle
         self.size = p.size
+        self.layout = Layout(p.shape) if p.size >= WIDE else None
+        self.interned = Interned(self.layout.count) if self.layout is not None else None
+        self.P = CAPACITY if self.layout is not None else p.size
+        """The radix of the explorer's keys (situation × code): more than any code."""
+        code_strides = self.layout.stride if self.layout is not None else p.strides
+        word = self.layout.word if self.layout is not None else None
         self.stride, self.radix = p.strides, p.shape
-        self.strides, self.shape = np.array(p.strides, dtype=np.int64), np.array(p.shape, dtype=np.int64)
+        self.strides, self.shape = np.array(code_strides, dtype=np.int64), np.array(p.shape, dtype=np.int64)
         self.uncontrollable = [t for t in p.transitions if not t.controllable]
         self.moves = moves_by_order(p)
         self.orders = tuple(sorted(self.moves))  # the region's order of the orders
         self._values: dict[tuple[str, ...], list[tuple[int, np.ndarray, np.ndarray]]] = {}
         self._guards: dict[int, tuple[list[tuple[int, np.ndarray]], np.ndarray]] = {}
-        self._u = _Moves(self.uncontrollable, p.strides, [0] * len(self.uncontrollable))
+        self._u = _Moves(self.uncontrollable, code_strides, [0] * len(self.uncontrollable), word)
         controllable = [t for o in self.orders for t in self.moves[o]]
-        self._c = _Moves(controllable, p.strides, [j for j, o in enumerate(self.orders) for _ in self.moves[o]])
+        self._c = _Moves(controllable, code_strides, [j for j, o in enumerate(self.orders) for _ in self.moves[o]], word)
         self._c.forbidding = [k for k, t in enumerate(controllable) if oracle.edge_terms.get(t.event)]
         self.controllable_moves = self._c
-        self._reach = [g.ravel() for g in oracle.reach_grids] if oracle.reach_grids is not None else None
+        self._reach = ([g.ravel() for g in oracle.reach_grids]
+                       if oracle.reach_grids is not None and self.interned is None else None)
 
     def digits(self, codes: np.ndarray) -> Digits:
         return Digits(self, codes)
+
+    def encode(self, states: list[tuple[int, ...]]) -> np.ndarray:
+        """The codes of plant states given as element-local tuples."""
+        if self.layout is None or self.interned is None:
+            return np.array([self.plant.index(q) for q in states], dtype=np.int64)
+        local = np.array(states, dtype=np.int64).reshape(len(states), len(self.radix))
+        return self.interned.find_or_add(self.layout.encode(local))
+
+    def local(self, code: int) -> tuple[int, ...]:
+        """The element-local tuple of one code."""
+        if self.interned is None:
+            return self.plant.local(code)
+        return tuple(self.digits(np.array([code], dtype=np.int64)).full()[:, 0].tolist())
+
+    def step(self, codes: np.ndarray, moves: _Moves, rank: np.ndarray) -> np.ndarray:
+        """The codes after the moves ``rank`` (one per code)."""
+        if self.interned is None:
+            return codes + moves.delta[rank]
+        words = self.interned.words[codes]
+        words[np.arange(len(codes)), moves.word[rank]] += moves.delta[rank]
+        return self.interned.find_or_add(words)
 
     def values(self, names: tuple[str, ...], digits: Digits) -> np.ndarray:
         """The plant variables ``names`` at each state (n × len(names)); False for a name
@@ -156,7 +204,7 @@ class PlantCodes:
             if rows.size:
                 ok[rows, k] = self._guard(k, digits, rows)
         row, rank = np.nonzero(ok)  # row-major: by row, then rank
-        target = codes[row] + u.delta[rank]
+        target = self.step(codes[row], u, rank)
         keep = self.kept(target)  # cannot fail from a SUP state; kept for safety, as the machine's path
         return row[keep], rank[keep], target[keep]
 
@@ -180,7 +228,7 @@ class PlantCodes:
     def refusals(self, code: int, wanted: np.ndarray) -> tuple[Prohibition, ...]:
         """The order changes SUP refuses in state ``code`` towards ``wanted`` (one bit per
         :attr:`orders`), as :func:`~synth.validation.sync.region` lists them."""
-        cur = self.plant.local(code)
+        cur = self.local(code)
         val = self.plant.valuation(cur)
         refused: list[Prohibition] = []
         for j, order in enumerate(self.orders):
@@ -232,11 +280,11 @@ def regions(pc: PlantCodes, store: Regions, entries: np.ndarray, wanted: np.ndar
     """Search the regions entered at ``entries`` under ``wanted`` (one row of bits over
     ``pc.orders`` per entry) and append them to ``store``, in the order given."""
     R = len(entries)
-    if R * pc.size >= 1 << 62:
+    if R * pc.P >= 1 << 62:
         raise OverflowError("region keys")
     reg, cur = np.arange(R, dtype=np.int64), entries.astype(np.int64)
     seen = SortedKeys()
-    seen.add(reg * pc.size + cur, reg)
+    seen.add(reg * pc.P + cur, reg)
     member_parts, settled_parts = [(reg, cur)], []
     while cur.size:
         digits = pc.digits(cur)
@@ -244,7 +292,7 @@ def regions(pc: PlantCodes, store: Regions, entries: np.ndarray, wanted: np.ndar
         c = pc.controllable_moves
         app = (values != wanted[reg])[:, c.column] & (digits.full()[c.axis, :].T == c.src)
         row, rank = np.nonzero(app)  # row-major: by row, then the region's order of the moves
-        target = cur[row] + c.delta[rank]
+        target = pc.step(cur[row], c, rank)
         ok = pc.kept(target)
         for k in c.forbidding:
             at = np.flatnonzero(rank == k)
@@ -259,11 +307,11 @@ def regions(pc: PlantCodes, store: Regions, entries: np.ndarray, wanted: np.ndar
         if not ok.any():
             break
         nreg, target = reg[row[ok]], target[ok]
-        keys = nreg * pc.size + target
+        keys = nreg * pc.P + target
         first = first_occurrences(keys)
         first = first[seen.find(keys[first]) < 0]
         reg, cur = nreg[first], target[first]
-        seen.add(reg * pc.size + cur, reg)
+        seen.add(reg * pc.P + cur, reg)
         member_parts.append((reg, cur))
     _store(pc, store, R, member_parts, settled_parts, wanted)
 
