@@ -32,7 +32,7 @@ import numpy as np
 
 from synth.plant.composition import LocalTransition, Plant
 from synth.sup.constraints import CompiledConstraints
-from synth.validation.keys import SortedKeys, first_occurrences
+from synth.validation.keys import SortedKeys, distinct_rows, first_occurrences, slices
 from synth.validation.sync import Prohibition, moves_by_order
 from synth.validation.words import CAPACITY, Interned, Layout
 
@@ -118,8 +118,11 @@ class PlantCodes:
         self._c = _Moves(controllable, code_strides, [j for j, o in enumerate(self.orders) for _ in self.moves[o]], word)
         self._c.forbidding = [k for k, t in enumerate(controllable) if oracle.edge_terms.get(t.event)]
         self.controllable_moves = self._c
-        self._reach = ([g.ravel() for g in oracle.reach_grids]
-                       if oracle.reach_grids is not None and self.interned is None else None)
+        self.order_starts = np.searchsorted(self._c.column, np.arange(len(self.orders) + 1))
+        self._reach = [g.ravel() for g in oracle.reach_grids] if oracle.reach_grids is not None else None
+        self.prohibitions: list[Prohibition] = []  # the refusals met: one move, its constraints responsible
+        self._why: dict[tuple[int, bytes], int] = {}
+        self._edge_width = max((len(oracle.edge_terms.get(t.event, ())) for t in controllable), default=0)
 
     def digits(self, codes: np.ndarray) -> Digits:
         return Digits(self, codes)
@@ -176,15 +179,21 @@ class PlantCodes:
 
     def kept(self, codes: np.ndarray) -> np.ndarray:
         """SUP membership of each state: no violation reachable by uncontrollable events."""
-        bad = np.zeros(len(codes), dtype=bool)
+        return ~self.threats(codes).any(axis=1)
+
+    def threats(self, codes: np.ndarray) -> np.ndarray:
+        """Which level terms' violation each state can reach by uncontrollable events
+        (n × terms, the compiled constraints' order)."""
+        out = np.zeros((len(codes), len(self.oracle.level_terms)), dtype=bool)
         if self._reach is not None:
-            for g in self._reach:
-                bad |= g[codes]
-            return ~bad
+            at: np.ndarray | tuple[np.ndarray, ...] = codes if self.interned is None else tuple(self.digits(codes).full())
+            for i, g in enumerate(self._reach if self.interned is None else self.oracle.reach_grids or ()):
+                out[:, i] = g[at]
+            return out
         digits = self.digits(codes)
-        for factors in self.oracle.level_reach:
-            bad |= self.holds(factors, digits)
-        return ~bad
+        for i, factors in enumerate(self.oracle.level_reach):
+            out[:, i] = self.holds(factors, digits)
+        return out
 
     def forbidden(self, t: LocalTransition, digits: Digits, rows: np.ndarray) -> np.ndarray:
         """Where an edge constraint forbids the controllable ``t``, at ``rows``."""
@@ -225,21 +234,32 @@ class PlantCodes:
             code |= bits[digits[axis][rows]]
         return guard[code]
 
-    def refusals(self, code: int, wanted: np.ndarray) -> tuple[Prohibition, ...]:
-        """The order changes SUP refuses in state ``code`` towards ``wanted`` (one bit per
-        :attr:`orders`), as :func:`~synth.validation.sync.region` lists them."""
-        cur = self.local(code)
-        val = self.plant.valuation(cur)
-        refused: list[Prohibition] = []
-        for j, order in enumerate(self.orders):
-            if val[order] == bool(wanted[j]):
-                continue
-            for t in self.moves[order]:
-                if t.src == cur[t.axis]:
-                    ok, why = self.oracle.move(t, cur)
-                    if not ok:
-                        refused.append(Prohibition(t.event, tuple(why)))
-        return tuple(sorted(refused))
+    def refused(self, digits: Digits, row: np.ndarray, rank: np.ndarray, level: np.ndarray) -> np.ndarray:
+        """The refusal (index into :attr:`prohibitions`) of each controllable move SUP
+        refuses (from the state ``row`` of ``digits``, move ``rank`` of
+        :attr:`controllable_moves`, to a target of :meth:`threats` ``level``): its event
+        and the constraints responsible as :meth:`CompiledConstraints.move` names them, the
+        edge constraints forbidding it, then those whose violation the target can reach."""
+        c, terms = self._c, self.oracle.edge_terms
+        edge = np.zeros((len(row), self._edge_width), dtype=bool)
+        for k in c.forbidding:
+            at = np.flatnonzero(rank == k)
+            for j, term in enumerate(terms[c.moves[k].event] if at.size else ()):
+                edge[at, j] = self.holds(term.factors, digits, row[at])
+        bits = np.hstack([edge, level])
+        first, inverse = distinct_rows(np.hstack([bits, (rank[:, None] >> np.arange(32)) & 1 == 1]))
+        ids = np.empty(len(first), dtype=np.int64)
+        for u, r in enumerate(first.tolist()):
+            key = (int(rank[r]), np.packbits(bits[r]).tobytes())
+            hit = self._why.get(key)
+            if hit is None:
+                t = c.moves[key[0]]
+                why = [terms[t.event][j].constraint for j in np.flatnonzero(edge[r]).tolist()]
+                why += [self.oracle.level_terms[i].constraint for i in np.flatnonzero(level[r]).tolist()]
+                hit = self._why[key] = len(self.prohibitions)
+                self.prohibitions.append(Prohibition(t.event, tuple(dict.fromkeys(why))))
+            ids[u] = hit
+        return ids[inverse]
 
 
 class Regions:
@@ -255,6 +275,7 @@ class Regions:
         self.settled_proh = np.empty(0, dtype=np.int64)
         self.prohibitions: list[tuple[Prohibition, ...]] = [()]
         self._proh_ids: dict[tuple[Prohibition, ...], int] = {(): 0}
+        self._sets: dict[tuple[int, ...], int] = {}
 
     @property
     def count(self) -> int:
@@ -266,6 +287,21 @@ class Regions:
             hit = self._proh_ids[proh] = len(self.prohibitions)
             self.prohibitions.append(proh)
         return hit
+
+    def refusal_sets(self, rows: np.ndarray, refusals: np.ndarray, met: list[Prohibition]) -> tuple[np.ndarray, np.ndarray]:
+        """Per state of ``rows`` (sorted, repeated once per refused move), its refusals
+        (indices into ``met``) as one prohibition set: (the states, their set's index in
+        :attr:`prohibitions`)."""
+        starts = np.flatnonzero(np.concatenate([[True], rows[1:] != rows[:-1]]))
+        bounds, ids = np.append(starts, len(rows)).tolist(), refusals.tolist()
+        out = np.empty(len(starts), dtype=np.int64)
+        for u in range(len(starts)):
+            key = tuple(ids[bounds[u]:bounds[u + 1]])
+            hit = self._sets.get(key)
+            if hit is None:
+                hit = self._sets[key] = self.proh_id(tuple(sorted(met[q] for q in key)))
+            out[u] = hit
+        return rows[starts], out
 
     def append(self, members: np.ndarray, member_counts: np.ndarray, settled: np.ndarray, proh: np.ndarray,
                settled_counts: np.ndarray) -> None:
@@ -290,20 +326,27 @@ def regions(pc: PlantCodes, store: Regions, entries: np.ndarray, wanted: np.ndar
         digits = pc.digits(cur)
         values = pc.values(pc.orders, digits)
         c = pc.controllable_moves
-        app = (values != wanted[reg])[:, c.column] & (digits.full()[c.axis, :].T == c.src)
-        row, rank = np.nonzero(app)  # row-major: by row, then the region's order of the moves
+        row, order = np.nonzero(values != wanted[reg])  # the orders to change, row-major
+        counts, rank = slices(pc.order_starts, order)  # their moves (the region's order of the moves)
+        row = np.repeat(row, counts)
+        app = digits.full()[c.axis[rank], row] == c.src[rank]
+        row, rank = row[app], rank[app]  # by row, then rank
         target = pc.step(cur[row], c, rank)
-        ok = pc.kept(target)
+        threat = pc.threats(target)
+        ok = ~threat.any(axis=1)
         for k in c.forbidding:
             at = np.flatnonzero(rank == k)
             if at.size:
                 ok[at] &= ~pc.forbidden(c.moves[k], digits, row[at])
-        refused = np.zeros(cur.size, dtype=bool)
-        refused[row[~ok]] = True
         progressed = np.zeros(cur.size, dtype=bool)
         progressed[row[ok]] = True
         still = ~progressed
-        settled_parts.append((reg[still], cur[still], refused[still]))
+        proh = np.zeros(cur.size, dtype=np.int64)
+        sel = np.flatnonzero(still[row])  # the moves from settled states: every one refused
+        if sel.size:
+            at, ids = store.refusal_sets(row[sel], pc.refused(digits, row[sel], rank[sel], threat[sel]), pc.prohibitions)
+            proh[at] = ids
+        settled_parts.append((reg[still], cur[still], proh[still]))
         if not ok.any():
             break
         nreg, target = reg[row[ok]], target[ok]
@@ -324,10 +367,7 @@ def _store(pc: PlantCodes, store: Regions, R: int, member_parts: list[tuple[np.n
     order = np.argsort(mreg, kind="stable")
     sreg = np.concatenate([r for r, _, _ in settled_parts])
     scode = np.concatenate([c for _, c, _ in settled_parts])
-    sref = np.concatenate([f for _, _, f in settled_parts])
+    sproh = np.concatenate([f for _, _, f in settled_parts])
     sorder = np.argsort(sreg, kind="stable")
-    sreg, scode, sref = sreg[sorder], scode[sorder], sref[sorder]
-    proh = np.zeros(len(scode), dtype=np.int64)
-    for i in np.flatnonzero(sref).tolist():
-        proh[i] = store.proh_id(pc.refusals(int(scode[i]), wanted[sreg[i]]))
+    sreg, scode, proh = sreg[sorder], scode[sorder], sproh[sorder]
     store.append(mcode[order], np.bincount(mreg, minlength=R), scode, proh, np.bincount(sreg, minlength=R))
