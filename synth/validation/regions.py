@@ -179,7 +179,8 @@ class PlantCodes:
 
     def kept(self, codes: np.ndarray) -> np.ndarray:
         """SUP membership of each state: no violation reachable by uncontrollable events."""
-        return ~self.threats(codes).any(axis=1)
+        out: np.ndarray = ~self.threats(codes).any(axis=1)
+        return out
 
     def threats(self, codes: np.ndarray) -> np.ndarray:
         """Which level terms' violation each state can reach by uncontrollable events
@@ -333,7 +334,7 @@ def regions(pc: PlantCodes, store: Regions, entries: np.ndarray, wanted: np.ndar
         row, rank = row[app], rank[app]  # by row, then rank
         target = pc.step(cur[row], c, rank)
         threat = pc.threats(target)
-        ok = ~threat.any(axis=1)
+        ok: np.ndarray = ~threat.any(axis=1)
         for k in c.forbidding:
             at = np.flatnonzero(rank == k)
             if at.size:
