@@ -179,8 +179,7 @@ class PlantCodes:
 
     def kept(self, codes: np.ndarray) -> np.ndarray:
         """SUP membership of each state: no violation reachable by uncontrollable events."""
-        out: np.ndarray = ~self.threats(codes).any(axis=1)
-        return out
+        return np.logical_not(self.threats(codes).any(axis=1))
 
     def threats(self, codes: np.ndarray) -> np.ndarray:
         """Which level terms' violation each state can reach by uncontrollable events
@@ -334,7 +333,7 @@ def regions(pc: PlantCodes, store: Regions, entries: np.ndarray, wanted: np.ndar
         row, rank = row[app], rank[app]  # by row, then rank
         target = pc.step(cur[row], c, rank)
         threat = pc.threats(target)
-        ok: np.ndarray = ~threat.any(axis=1)
+        ok = np.logical_not(threat.any(axis=1))
         for k in c.forbidding:
             at = np.flatnonzero(rank == k)
             if at.size:
