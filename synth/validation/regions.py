@@ -33,6 +33,7 @@ import numpy as np
 from synth.plant.composition import LocalTransition, Plant
 from synth.sup.constraints import CompiledConstraints
 from synth.validation.keys import SortedKeys, distinct_rows, first_occurrences, slices
+from synth.validation.masks import Masks, Runs, pack, unpack
 from synth.validation.sync import Prohibition, moves_by_order
 from synth.validation.words import CAPACITY, Interned, Layout
 
@@ -51,20 +52,25 @@ class Digits:
         self.codes, self.n = codes, len(codes)
         self._pc = pc
         self._axes: dict[int, np.ndarray] = {}
+        self._runs: dict[int, np.ndarray] = {}
         self._full: np.ndarray | None = None
-
         lay, ids = pc.layout, pc.interned
         self._wide = (lay, ids.words[codes]) if lay is not None and ids is not None else None  # (layout, words)
+        self.words = [codes] if self._wide is None else list(self._wide[1].T)
+        """Each word of the codes, one column per word (the flat codes themselves when not wide)."""
 
     def __getitem__(self, axis: int) -> np.ndarray:
         hit = self._axes.get(axis)
         if hit is None:
-            if self._wide is None:
-                hit = (self.codes // self._pc.stride[axis]) % self._pc.radix[axis]
-            else:
-                lay, words = self._wide
-                hit = (words[:, lay.word[axis]] // lay.stride[axis]) % self._pc.radix[axis]
-            self._axes[axis] = hit
+            pc = self._pc
+            hit = self._axes[axis] = (self.words[pc.word_of[axis]] // pc.stride[axis]) % pc.radix[axis]
+        return hit
+
+    def run(self, g: int) -> np.ndarray:
+        """The joint index of run ``g`` of :attr:`PlantCodes.runs` at each state."""
+        hit = self._runs.get(g)
+        if hit is None:
+            hit = self._runs[g] = Runs.index(self._pc.runs.items[g], self.words)
         return hit
 
     def full(self) -> np.ndarray:
@@ -104,14 +110,15 @@ class PlantCodes:
         self.interned = Interned(self.layout.count) if self.layout is not None else None
         self.P = CAPACITY if self.layout is not None else p.size
         """The radix of the explorer's keys (situation × code): more than any code."""
-        code_strides = self.layout.stride if self.layout is not None else p.strides
-        word = self.layout.word if self.layout is not None else None
-        self.stride, self.radix = p.strides, p.shape
+        code_strides = self.layout.stride if self.layout is not None else np.array(p.strides, dtype=np.int64)
+        word = self.layout.word if self.layout is not None else np.zeros(len(p.shape), dtype=np.int64)
+        self.word_of, self.stride, self.radix = word.tolist(), code_strides.tolist(), p.shape
+        self.runs = Runs(p.shape, word, code_strides)
         self.strides, self.shape = np.array(code_strides, dtype=np.int64), np.array(p.shape, dtype=np.int64)
         self.uncontrollable = [t for t in p.transitions if not t.controllable]
         self.moves = moves_by_order(p)
         self.orders = tuple(sorted(self.moves))  # the region's order of the orders
-        self._values: dict[tuple[str, ...], list[tuple[int, np.ndarray, np.ndarray]]] = {}
+        self._values: dict[tuple[str, ...], Masks] = {}
         self._guards: dict[int, tuple[list[tuple[int, np.ndarray]], np.ndarray]] = {}
         self._u = _Moves(self.uncontrollable, code_strides, [0] * len(self.uncontrollable), word)
         controllable = [t for o in self.orders for t in self.moves[o]]
@@ -123,6 +130,27 @@ class PlantCodes:
         self.prohibitions: list[Prohibition] = []  # the refusals met: one move, its constraints responsible
         self._why: dict[tuple[int, bytes], int] = {}
         self._edge_width = max((len(oracle.edge_terms.get(t.event, ())) for t in controllable), default=0)
+        self._threat_masks = Masks(self.runs, self._level_tables(), len(oracle.level_terms), conj=True)
+        self._order_masks = Masks(self.runs, self._value_tables(self.orders), len(self.orders), conj=False)
+
+    def _level_tables(self) -> dict[int, np.ndarray]:
+        """Per element, which level terms' reach factors hold at each local state (True
+        where the term has no factor there)."""
+        out: dict[int, np.ndarray] = {}
+        for i, factors in enumerate(self.oracle.level_reach):
+            for a, vec in factors:
+                table = out.setdefault(a, np.ones((self.radix[a], len(self.oracle.level_reach)), dtype=bool))
+                table[:, i] &= vec.astype(bool)
+        return out
+
+    def _value_tables(self, names: tuple[str, ...]) -> dict[int, np.ndarray]:
+        """Per element owning some of ``names``, their values at each local state (False
+        in the other columns)."""
+        out: dict[int, np.ndarray] = {}
+        for a, cols, table in self._tables(names):
+            out[a] = np.zeros((self.radix[a], len(names)), dtype=bool)
+            out[a][:, cols] = table
+        return out
 
     def digits(self, codes: np.ndarray) -> Digits:
         return Digits(self, codes)
@@ -151,23 +179,19 @@ class PlantCodes:
     def values(self, names: tuple[str, ...], digits: Digits) -> np.ndarray:
         """The plant variables ``names`` at each state (n × len(names)); False for a name
         the plant does not have."""
-        out = np.zeros((digits.n, len(names)), dtype=bool)
-        for axis, cols, table in self._tables(names):
-            out[:, cols] = table[digits[axis]]
-        return out
+        masks = self._values.get(names)
+        if masks is None:
+            masks = self._values[names] = Masks(self.runs, self._value_tables(names), len(names), conj=False)
+        return unpack(masks.of(digits.run, digits.n), len(names))
 
     def _tables(self, names: tuple[str, ...]) -> list[tuple[int, np.ndarray, np.ndarray]]:
         """Per element owning some of ``names``: their columns and their values per local state."""
-        hit = self._values.get(names)
-        if hit is None:
-            by_axis: dict[int, list[int]] = {}
-            for j, n in enumerate(names):
-                if n in self.plant.owner:
-                    by_axis.setdefault(self.plant.owner[n], []).append(j)
-            hit = self._values[names] = [
-                (a, np.array(cols), np.stack([self.plant.elements[a].value(names[j]) for j in cols], axis=1))
+        by_axis: dict[int, list[int]] = {}
+        for j, n in enumerate(names):
+            if n in self.plant.owner:
+                by_axis.setdefault(self.plant.owner[n], []).append(j)
+        return [(a, np.array(cols), np.stack([self.plant.elements[a].value(names[j]) for j in cols], axis=1))
                 for a, cols in sorted(by_axis.items())]
-        return hit
 
     @staticmethod
     def holds(factors: Iterable[tuple[int, np.ndarray]], digits: Digits, rows: np.ndarray | None = None) -> np.ndarray:
@@ -182,18 +206,20 @@ class PlantCodes:
         return np.logical_not(self.threats(codes).any(axis=1))
 
     def threats(self, codes: np.ndarray) -> np.ndarray:
-        """Which level terms' violation each state can reach by uncontrollable events
-        (n × terms, the compiled constraints' order)."""
+        """Which level terms' violation each state can reach by uncontrollable events, in
+        the compiled constraints' order, packed (n × words, :func:`~synth.validation.masks.pack`)."""
+        if self._reach is None:
+            digits = self.digits(codes)
+            return self._threat_masks.of(digits.run, len(codes))
         out = np.zeros((len(codes), len(self.oracle.level_terms)), dtype=bool)
-        if self._reach is not None:
-            at: np.ndarray | tuple[np.ndarray, ...] = codes if self.interned is None else tuple(self.digits(codes).full())
-            for i, g in enumerate(self._reach if self.interned is None else self.oracle.reach_grids or ()):
-                out[:, i] = g[at]
-            return out
-        digits = self.digits(codes)
-        for i, factors in enumerate(self.oracle.level_reach):
-            out[:, i] = self.holds(factors, digits)
-        return out
+        at: np.ndarray | tuple[np.ndarray, ...] = codes if self.interned is None else tuple(self.digits(codes).full())
+        for i, g in enumerate(self._reach if self.interned is None else self.oracle.reach_grids or ()):
+            out[:, i] = g[at]
+        return pack(out)
+
+    def order_bits(self, digits: Digits) -> np.ndarray:
+        """The values of :attr:`orders` at each state, packed."""
+        return self._order_masks.of(digits.run, digits.n)
 
     def forbidden(self, t: LocalTransition, digits: Digits, rows: np.ndarray) -> np.ndarray:
         """Where an edge constraint forbids the controllable ``t``, at ``rows``."""
@@ -234,10 +260,10 @@ class PlantCodes:
             code |= bits[digits[axis][rows]]
         return guard[code]
 
-    def refused(self, digits: Digits, row: np.ndarray, rank: np.ndarray, level: np.ndarray) -> np.ndarray:
+    def refused(self, digits: Digits, row: np.ndarray, rank: np.ndarray, threats: np.ndarray) -> np.ndarray:
         """The refusal (index into :attr:`prohibitions`) of each controllable move SUP
         refuses (from the state ``row`` of ``digits``, move ``rank`` of
-        :attr:`controllable_moves`, to a target of :meth:`threats` ``level``): its event
+        :attr:`controllable_moves`, to a target of :meth:`threats` ``threats``): its event
         and the constraints responsible as :meth:`CompiledConstraints.move` names them, the
         edge constraints forbidding it, then those whose violation the target can reach."""
         c, terms = self._c, self.oracle.edge_terms
@@ -246,6 +272,7 @@ class PlantCodes:
             at = np.flatnonzero(rank == k)
             for j, term in enumerate(terms[c.moves[k].event] if at.size else ()):
                 edge[at, j] = self.holds(term.factors, digits, row[at])
+        level = unpack(threats, len(self.oracle.level_terms))
         bits = np.hstack([edge, level])
         first, inverse = distinct_rows(np.hstack([bits, (rank[:, None] >> np.arange(32)) & 1 == 1]))
         ids = np.empty(len(first), dtype=np.int64)
@@ -319,14 +346,14 @@ def regions(pc: PlantCodes, store: Regions, entries: np.ndarray, wanted: np.ndar
     if R * pc.P >= 1 << 62:
         raise OverflowError("region keys")
     reg, cur = np.arange(R, dtype=np.int64), entries.astype(np.int64)
+    wanted_bits, k = pack(wanted), len(pc.orders)
     seen = SortedKeys()
     seen.add(reg * pc.P + cur, reg)
     member_parts, settled_parts = [(reg, cur)], []
     while cur.size:
         digits = pc.digits(cur)
-        values = pc.values(pc.orders, digits)
         c = pc.controllable_moves
-        row, order = np.nonzero(values != wanted[reg])  # the orders to change, row-major
+        row, order = np.nonzero(unpack(pc.order_bits(digits) ^ wanted_bits[reg], k))  # the orders to change, row-major
         counts, rank = slices(pc.order_starts, order)  # their moves (the region's order of the moves)
         row = np.repeat(row, counts)
         app = digits.full()[c.axis[rank], row] == c.src[rank]
