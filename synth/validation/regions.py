@@ -3,14 +3,17 @@ the frontier explorer (:mod:`synth.validation.frontier`).
 
 A plant state is its flat code (mixed radices, :meth:`~synth.plant.composition.Plant.index`),
 or on a plant of :data:`WIDE` states or more the dense number of its words
-(:mod:`synth.validation.words`: the states met, numbered as met); :class:`PlantCodes` reads the element-local digits, the Grafcet's inputs and the orders'
-values of whole arrays of codes, follows the uncontrollable moves of a frontier, and
-decides SUP membership and SUP's refusals with the compiled constraints' factors (the
-same terms :class:`~synth.sup.constraints.CompiledConstraints` asks one state at a time).
+(:mod:`synth.validation.words`: the states met, numbered as met); :class:`PlantCodes`
+reads the element-local digits, the Grafcet's inputs and the orders' values of whole
+arrays of codes (a run of elements at a time, :mod:`synth.validation.masks`), follows the
+uncontrollable moves of a frontier, and decides SUP membership and SUP's refusals with the
+compiled constraints' factors (the same terms
+:class:`~synth.sup.constraints.CompiledConstraints` asks one state at a time).
 :func:`regions` runs :func:`synth.validation.sync.region` for many (entry, wanted orders)
 at once, layer by layer: the members of each region in the same breadth-first order, its
-settled states with the same prohibitions (computed by the oracle itself, only where a
-move was refused).
+settled states with the same prohibitions (each refused move's constraints responsible
+read from the same bits as the verdict, named as :meth:`CompiledConstraints.move` names
+them).
 
 Example
 -------
@@ -105,7 +108,6 @@ class PlantCodes:
 
     def __init__(self, p: Plant, oracle: CompiledConstraints) -> None:
         self.plant, self.oracle = p, oracle
-        self.size = p.size
         self.layout = Layout(p.shape) if p.size >= WIDE else None
         self.interned = Interned(self.layout.count) if self.layout is not None else None
         self.P = CAPACITY if self.layout is not None else p.size
@@ -161,12 +163,6 @@ class PlantCodes:
             return np.array([self.plant.index(q) for q in states], dtype=np.int64)
         local = np.array(states, dtype=np.int64).reshape(len(states), len(self.radix))
         return self.interned.find_or_add(self.layout.encode(local))
-
-    def local(self, code: int) -> tuple[int, ...]:
-        """The element-local tuple of one code."""
-        if self.interned is None:
-            return self.plant.local(code)
-        return tuple(self.digits(np.array([code], dtype=np.int64)).full()[:, 0].tolist())
 
     def step(self, codes: np.ndarray, moves: _Moves, rank: np.ndarray) -> np.ndarray:
         """The codes after the moves ``rank`` (one per code)."""
@@ -383,12 +379,13 @@ def regions(pc: PlantCodes, store: Regions, entries: np.ndarray, wanted: np.ndar
         reg, cur = nreg[first], target[first]
         seen.add(reg * pc.P + cur, reg)
         member_parts.append((reg, cur))
-    _store(pc, store, R, member_parts, settled_parts, wanted)
+    _store(store, R, member_parts, settled_parts)
 
 
-def _store(pc: PlantCodes, store: Regions, R: int, member_parts: list[tuple[np.ndarray, np.ndarray]],
-           settled_parts: list[tuple[np.ndarray, np.ndarray, np.ndarray]], wanted: np.ndarray) -> None:
-    """Group the layers' members and settled states by region (breadth-first order kept)."""
+def _store(store: Regions, R: int, member_parts: list[tuple[np.ndarray, np.ndarray]],
+           settled_parts: list[tuple[np.ndarray, np.ndarray, np.ndarray]]) -> None:
+    """Group the layers' members and settled states (with their prohibitions) by region
+    (breadth-first order kept)."""
     mreg = np.concatenate([r for r, _ in member_parts])
     mcode = np.concatenate([c for _, c in member_parts])
     order = np.argsort(mreg, kind="stable")
