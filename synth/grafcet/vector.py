@@ -105,15 +105,16 @@ class VectorMachine:
             self.events[Edge(False, n).text()] = 2 * i
             self.events[Edge(True, n).text()] = 2 * i + 1
         trans = machine.transitions
-        self._src = np.zeros((len(trans), len(self.step_names)), dtype=np.int32)
+        # 0/1 matrices in float32: numpy multiplies floats through BLAS, integers in a plain loop
+        self._src = np.zeros((len(trans), len(self.step_names)), dtype=np.float32)
         self._dst = np.zeros_like(self._src)
         for j, t in enumerate(trans):
             self._src[j, [self._step[s] for s in t.sources]] = 1
             self._dst[j, [self._step[s] for s in t.targets]] = 1
         self._sources = [[self._step[s] for s in t.sources] for t in trans]
-        self._timers_of = np.zeros((len(self.step_names), len(self.timer_names)), dtype=bool)
+        self._timers_of = np.zeros((len(self.step_names), len(self.timer_names)), dtype=np.float32)
         for timer in g.timers:
-            self._timers_of[self._step[timer.step], self._timer[timer.id]] = True
+            self._timers_of[self._step[timer.step], self._timer[timer.id]] = 1
         self._rec = [self._compile(t.receptivity) for t in trans]
         orders: dict[str, None] = {}
         self._actions: list[tuple[int, str, Columns | None]] = []
@@ -199,15 +200,15 @@ class VectorMachine:
             a, t = A[live], T[live]
             fire = self._fireable(a, t, I[live], ev)
             firing = fire.any(axis=1)
-            live, a, t, fire = live[firing], a[firing], t[firing], fire[firing].astype(np.int32)
+            live, a, t, fire = live[firing], a[firing], t[firing], fire[firing].astype(np.float32)
             moved[live] = True
             leaving = fire @ self._src
-            conflict = (leaving > 1).any(axis=1)
+            conflict = (leaving > 1.5).any(axis=1)
             pending[live[conflict]] = True
-            deact, act = leaving > 0, (fire @ self._dst) > 0
+            deact, act = leaving > 0.5, (fire @ self._dst) > 0.5
             A[live] = (a & ~deact) | act
             if self.timer_names:
-                T[live] = t & ~(((deact & ~act).astype(np.int32) @ self._timers_of) > 0)
+                T[live] = t & ~(((deact & ~act).astype(np.float32) @ self._timers_of) > 0.5)
             live = live[~conflict]
             ev = np.full(len(live), -1)
         pending[live] = True
