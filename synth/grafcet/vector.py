@@ -1,8 +1,10 @@
 """The Grafcet's evolution on many situations at once: the same IEC 60848 reading as
 :class:`~synth.grafcet.machine.GrafcetMachine`, with situations as rows of bits.
 
-A row holds the active steps (``A``, one column per step in file order) and the elapsed
-timers (``T``, one column per timer of ``grafcet.timers``); the inputs are bit columns
+A row holds the active steps (``A``, one column per step in file order) and the
+situation's memory (``T``: the elapsed timers, one column per timer of
+``grafcet.timers``, then the outputs set by stored actions, one column per order of
+:attr:`VectorMachine.stored_names`); the inputs are bit columns
 (``I``, ``machine.inputs`` order) and the input event one integer per row (``E``: twice
 the input's column, plus one for a rising edge; -1 for none). Receptivities and action
 conditions become numpy Boolean expressions over those columns, and the search for
@@ -11,8 +13,10 @@ stability runs round after round on every row until none fires; a row still firi
 divergence's conflict, which the explorer must note with the rounds fired), is left to
 the machine itself (``pending``).
 
-What the rows do not carry, the machine alone reads: internal variables, stored actions
-and assignments, ``--semantics sfc``; :func:`unsupported` names the first such feature of
+Stored actions on activation and on deactivation run in each round as the machine runs
+them (the deactivated steps' first, then the activated ones'; within a phase, sets first,
+then resets). What the rows do not carry, the machine alone reads: internal variables,
+assignments, stored actions on an event, ``--semantics sfc``; :func:`unsupported` names the first such feature of
 a Grafcet (the explicit engine then explores with the machine, state by state).
 
 Example
@@ -36,7 +40,8 @@ from typing import Callable
 
 import numpy as np
 
-from synth.grafcet.language import CONDITIONAL, CONTINUOUS, Semantics, step_of
+from synth.grafcet.language import (CONDITIONAL, CONTINUOUS, ON_ACTIVATION, ON_DEACTIVATION, STORED, Semantics,
+                                   StoredWhen, step_of)
 from synth.grafcet.machine import GrafcetMachine
 from synth.grafcet.situation import Situation, sorted_steps
 from synth.logic.expr import And, Compare, Edge, Expr, Not, Or, Var, evaluate, names
@@ -75,8 +80,11 @@ def unsupported(machine: GrafcetMachine) -> str | None:
         return "internal variables"
     for s in g.steps:
         for a in s.actions:
+            if a.kind == STORED and a.when in (ON_ACTIVATION, ON_DEACTIVATION):
+                continue
             if a.kind not in (CONTINUOUS, CONDITIONAL):
-                return f"{a.kind.value} actions (step {s.name}: {a.text()})"
+                moment = " on an event" if a.kind == STORED else ""
+                return f"{a.kind.value} actions{moment} (step {s.name}: {a.text()})"
     steps = {s.name for s in g.steps}
     timers = {t.id for t in g.timers}
     exprs = [t.receptivity for t in g.transitions]
@@ -112,19 +120,32 @@ class VectorMachine:
             self._src[j, [self._step[s] for s in t.sources]] = 1
             self._dst[j, [self._step[s] for s in t.targets]] = 1
         self._sources = [[self._step[s] for s in t.sources] for t in trans]
-        self._timers_of = np.zeros((len(self.step_names), len(self.timer_names)), dtype=np.float32)
+        self.stored_names = tuple(sorted({a.order for s in g.steps for a in s.actions if a.kind == STORED}))
+        nt = len(self.timer_names)
+        self.memory = nt + len(self.stored_names)
+        """The columns of ``T``: the timers, then the stored outputs."""
+        self._timers_of = np.zeros((len(self.step_names), self.memory), dtype=np.float32)
         for timer in g.timers:
             self._timers_of[self._step[timer.step], self._timer[timer.id]] = 1
+        # per phase, the stored outputs each step's actions set and reset (T's columns)
+        self._sets = {when: np.zeros_like(self._timers_of) for when in (ON_DEACTIVATION, ON_ACTIVATION)}
+        self._resets = {when: np.zeros_like(self._timers_of) for when in (ON_DEACTIVATION, ON_ACTIVATION)}
+        for s in g.steps:
+            for a in s.actions:
+                if a.kind == STORED and a.when in self._sets:
+                    (self._sets if a.value else self._resets)[a.when][self._step[s.name], nt + self.stored_names.index(a.order)] = 1
         self._rec = [self._compile(t.receptivity) for t in trans]
         orders: dict[str, None] = {}
         self._actions: list[tuple[int, str, Columns | None]] = []
         for s in g.steps:
             for a in s.actions:
                 orders[a.order] = None
-                cond = self._compile(a.condition) if a.kind == CONDITIONAL and a.condition is not None else None
-                self._actions.append((self._step[s.name], a.order, cond))
+                if a.kind in (CONTINUOUS, CONDITIONAL):
+                    cond = self._compile(a.condition) if a.kind == CONDITIONAL and a.condition is not None else None
+                    self._actions.append((self._step[s.name], a.order, cond))
         self.order_names = tuple(sorted(orders))
         self._order = {o: i for i, o in enumerate(self.order_names)}
+        self._stored_cols = [(nt + i, self._order[o]) for i, o in enumerate(self.stored_names)]
 
     # ------------------------------------------------------------------ compilation
     def _compile(self, e: Expr) -> Columns:
@@ -154,16 +175,20 @@ class VectorMachine:
     def rows(self, sits: list[Situation]) -> tuple[np.ndarray, np.ndarray]:
         """The bits (A, T) of ``sits``."""
         A = np.zeros((len(sits), len(self.step_names)), dtype=bool)
-        T = np.zeros((len(sits), len(self.timer_names)), dtype=bool)
+        T = np.zeros((len(sits), self.memory), dtype=bool)
+        nt = len(self.timer_names)
         for r, s in enumerate(sits):
             A[r, [self._step[x] for x in s.steps]] = True
             T[r, [self._timer[x] for x in s.elapsed]] = True
+            T[r, [nt + self.stored_names.index(o) for o in s.stored]] = True
         return A, T
 
     def situation(self, a: np.ndarray, t: np.ndarray) -> Situation:
         """The situation of one row, as the machine builds it."""
         steps = sorted_steps([self.step_names[i] for i in np.flatnonzero(a)])
-        return Situation(steps, (), tuple(sorted(self.timer_names[i] for i in np.flatnonzero(t))), ())
+        nt = len(self.timer_names)
+        stored = tuple(sorted(self.stored_names[i] for i in np.flatnonzero(t[nt:])))
+        return Situation(steps, stored, tuple(sorted(self.timer_names[i] for i in np.flatnonzero(t[:nt]))), ())
 
     # ------------------------------------------------------------------ evolution
     def _fireable(self, A: np.ndarray, T: np.ndarray, I: np.ndarray, E: np.ndarray) -> np.ndarray:
@@ -208,11 +233,21 @@ class VectorMachine:
             deact, act = leaving > 0.5, (fire @ self._dst) > 0.5
             A[live] = (a & ~deact) | act
             if self.timer_names:
-                T[live] = t & ~(((deact & ~act).astype(np.float32) @ self._timers_of) > 0.5)
+                t = t & ~(((deact & ~act).astype(np.float32) @ self._timers_of) > 0.5)
+            if self.stored_names:
+                t = self._stored_phase(t, deact & ~act, ON_DEACTIVATION)
+                t = self._stored_phase(t, act & ~a, ON_ACTIVATION)
+            T[live] = t
             live = live[~conflict]
             ev = np.full(len(live), -1)
         pending[live] = True
         return A, T, moved, pending
+
+    def _stored_phase(self, t: np.ndarray, steps: np.ndarray, when: StoredWhen) -> np.ndarray:
+        """The memory ``t`` after the stored actions of ``steps`` for ``when`` (the
+        machine's ``_apply``: sets, then resets)."""
+        f = steps.astype(np.float32)
+        return (t | ((f @ self._sets[when]) > 0.5)) & ~((f @ self._resets[when]) > 0.5)
 
     def orders(self, A: np.ndarray, T: np.ndarray, I: np.ndarray) -> np.ndarray:
         """The orders each row emits (columns :attr:`order_names`) on the input levels ``I``."""
@@ -222,4 +257,6 @@ class VectorMachine:
         for step, order, cond in self._actions:
             col = A[:, step]
             out[:, self._order[order]] |= col if cond is None else col & cond(I, A, T, E, Z)
+        for col_t, col_o in self._stored_cols:
+            out[:, col_o] |= T[:, col_t]
         return out

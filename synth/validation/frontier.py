@@ -103,7 +103,7 @@ class _Situations:
         self.timers: list[tuple[Event, ...]] = []
         self._ids: dict[bytes, int] = {}
         self.A = np.zeros((0, len(vm.step_names)), dtype=bool)
-        self.T = np.zeros((0, len(vm.timer_names)), dtype=bool)
+        self.T = np.zeros((0, vm.memory), dtype=bool)
 
     def number(self, A: np.ndarray, T: np.ndarray, given: list[Situation] | None = None) -> np.ndarray:
         """The numbers of the rows' situations (a new one numbered when first met)."""
