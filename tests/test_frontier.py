@@ -142,7 +142,6 @@ def _loaded(g7: Path, rules: Path) -> tuple:
 
 
 @pytest.mark.parametrize("actions,feature", [
-    ("set A1 on ↑start", "stored actions on an event"),
     ("n := 1 on activation", "internal variables"),
 ])
 def test_features_left_to_the_machine_are_named(tmp_path, actions, feature):
@@ -310,8 +309,8 @@ grafcet G {{
   step 1: set A1 on activation, set A2 on activation
   step 2: reset A1 on activation, set R1 on activation
   step 3: reset A2 on activation, set R2 on activation
-  step 4: reset R1 on deactivation, set A1 on deactivation, reset A1 on deactivation{reset}
-  step 5
+  step 4: {r1}set A1 on deactivation, reset A1 on deactivation{reset}
+  step 5{step5}
   transition 0 -> 1 when start & a1_0 & a2_0
   transition 1 -> 2, 3 when a1_1 & a2_1{wait}
   transition 2, 3 -> 4 when a1_0 & a2_0
@@ -321,17 +320,24 @@ grafcet G {{
 """
 
 
-@pytest.mark.parametrize("variant", ["plain", "timer", "missing"])
+@pytest.mark.parametrize("variant", ["plain", "timer", "missing", "event"])
 def test_stored_actions_on_activation_and_deactivation(monkeypatch, tmp_path, variant):
-    """Sets and resets on activation and on deactivation run on the rows (a set and a reset
-    of one output in one phase: the reset wins; without step 4's reset of R2, the next cycle
-    advances and retracts C2 at once), against the machine's path."""
+    """Sets and resets on activation, on deactivation and on an event run on the rows (a set
+    and a reset of one output in one phase: the reset wins; without step 4's reset of R2,
+    the next cycle advances and retracts C2 at once; ``event``: R1 reset on ↓start in step
+    5, which start may have fallen before: the next cycle may find R1 still set), against
+    the machine's path."""
     write_par(2, tmp_path)
     text = STORED.format(wait=" & 2s/X1" if variant == "timer" else "",  # the timers' columns, then the stored outputs'
-                         reset="" if variant == "missing" else ", reset R2 on deactivation")
+                         reset="" if variant == "missing" else ", reset R2 on deactivation",
+                         r1="" if variant == "event" else "reset R1 on deactivation, ",
+                         step5=": reset R1 on ↓start" if variant == "event" else "")
     (tmp_path / "s.g7").write_text(text, encoding="utf-8")
     g7, rules = tmp_path / "s.g7", tmp_path / "par_2.rules"
     assert _reason(g7, rules) is None
     a, _ = _both(monkeypatch, g7, rules)
     assert any(n.situation.stored for n in a.sync.nodes) and a.sync.sync_states > 20
-    assert a.passed is (variant != "missing")
+    assert a.passed is (variant in ("plain", "timer"))
+    if variant == "event":
+        assert any(n.situation.steps == ("5",) and "R1" in n.situation.stored for n in a.sync.nodes)
+        assert {"R1" in n.situation.stored for n in a.sync.nodes if n.situation.steps == ("0",)} == {True, False}

@@ -13,10 +13,11 @@ stability runs round after round on every row until none fires; a row still firi
 divergence's conflict, which the explorer must note with the rounds fired), is left to
 the machine itself (``pending``).
 
-Stored actions on activation and on deactivation run in each round as the machine runs
-them (the deactivated steps' first, then the activated ones'; within a phase, sets first,
-then resets). What the rows do not carry, the machine alone reads: internal variables,
-assignments, stored actions on an event, ``--semantics sfc``; :func:`unsupported` names the first such feature of
+Stored actions run as the machine runs them: those on an event before the first round
+(on the rows whose event it is), those on deactivation and on activation in each round
+(the deactivated steps' first, then the activated ones'; in each phase, sets first, then
+resets). What the rows do not carry, the machine alone reads: internal variables,
+assignments, ``--semantics sfc``; :func:`unsupported` names the first such feature of
 a Grafcet (the explicit engine then explores with the machine, state by state).
 
 Example
@@ -80,11 +81,8 @@ def unsupported(machine: GrafcetMachine) -> str | None:
         return "internal variables"
     for s in g.steps:
         for a in s.actions:
-            if a.kind == STORED and a.when in (ON_ACTIVATION, ON_DEACTIVATION):
-                continue
-            if a.kind not in (CONTINUOUS, CONDITIONAL):
-                moment = " on an event" if a.kind == STORED else ""
-                return f"{a.kind.value} actions{moment} (step {s.name}: {a.text()})"
+            if a.kind not in (CONTINUOUS, CONDITIONAL, STORED):
+                return f"{a.kind.value} actions (step {s.name}: {a.text()})"
     steps = {s.name for s in g.steps}
     timers = {t.id for t in g.timers}
     exprs = [t.receptivity for t in g.transitions]
@@ -130,10 +128,14 @@ class VectorMachine:
         # per phase, the stored outputs each step's actions set and reset (T's columns)
         self._sets = {when: np.zeros_like(self._timers_of) for when in (ON_DEACTIVATION, ON_ACTIVATION)}
         self._resets = {when: np.zeros_like(self._timers_of) for when in (ON_DEACTIVATION, ON_ACTIVATION)}
+        self._on_event: list[tuple[int, int, bool, Columns]] = []  # step, T's column, set, condition
         for s in g.steps:
             for a in s.actions:
+                col = nt + self.stored_names.index(a.order) if a.kind == STORED else -1
                 if a.kind == STORED and a.when in self._sets:
-                    (self._sets if a.value else self._resets)[a.when][self._step[s.name], nt + self.stored_names.index(a.order)] = 1
+                    (self._sets if a.value else self._resets)[a.when][self._step[s.name], col] = 1
+                elif a.kind == STORED and a.condition is not None:
+                    self._on_event.append((self._step[s.name], col, a.value, self._compile(a.condition)))
         self._rec = [self._compile(t.receptivity) for t in trans]
         orders: dict[str, None] = {}
         self._actions: list[tuple[int, str, Columns | None]] = []
@@ -211,12 +213,13 @@ class VectorMachine:
     def react(self, A: np.ndarray, T: np.ndarray, I: np.ndarray, E: np.ndarray
               ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """The stable situations after the input events ``E`` (inputs ``I`` once they
-        happened) from the rows (A, T); the rows where a transition fired (``moved``); and
+        happened) from the rows (A, T); the rows where a transition fired or an action on
+        the event stored (``moved``); and
         the rows left to the machine (``pending``: a conflict, or still evolving after
         :data:`ROUNDS` rounds), whose bits are meaningless."""
         A, T = A.copy(), T.copy()
         pending = np.zeros(len(A), dtype=bool)
-        moved = np.zeros(len(A), dtype=bool)
+        moved = self._event_actions(A, T, I, E) if self._on_event else np.zeros(len(A), dtype=bool)
         live = np.arange(len(A))
         ev = E
         for _ in range(ROUNDS):
@@ -242,6 +245,18 @@ class VectorMachine:
             ev = np.full(len(live), -1)
         pending[live] = True
         return A, T, moved, pending
+
+    def _event_actions(self, A: np.ndarray, T: np.ndarray, I: np.ndarray, E: np.ndarray) -> np.ndarray:
+        """The stored actions on the input event ``E`` of the active steps (sets, then
+        resets), in place in ``T``; the rows they changed."""
+        Z = np.zeros(len(A), dtype=bool)
+        sets, resets = np.zeros_like(T), np.zeros_like(T)
+        for step, col, value, cond in self._on_event:
+            (sets if value else resets)[:, col] |= A[:, step] & (E >= 0) & cond(I, A, T, E, Z)
+        after = (T | sets) & ~resets
+        changed: np.ndarray = (after != T).any(axis=1)
+        T[:] = after
+        return changed
 
     def _stored_phase(self, t: np.ndarray, steps: np.ndarray, when: StoredWhen) -> np.ndarray:
         """The memory ``t`` after the stored actions of ``steps`` for ``when`` (the
