@@ -341,3 +341,33 @@ def test_stored_actions_on_activation_and_deactivation(monkeypatch, tmp_path, va
     if variant == "event":
         assert any(n.situation.steps == ("5",) and "R1" in n.situation.stored for n in a.sync.nodes)
         assert {"R1" in n.situation.stored for n in a.sync.nodes if n.situation.steps == ("0",)} == {True, False}
+
+
+def test_random_grafcets_with_stored_actions(tmp_path):
+    """The code generator's random Grafcets (stored actions on activation, deactivation and
+    events, timers, edges, step variables) on free inputs and single-acting cylinders: the
+    same SYNC by both paths, or the same transient cycle."""
+    from randgrafcet import random_grafcet
+
+    lib = (P / "lib" / "single_acting.rules").read_text(encoding="utf-8")
+    (tmp_path / "r.rules").write_text(lib + "free a = 0\nfree b = 0\nfree c = 0\n" + "".join(
+        f"element V{o} = single_acting(AVANCER={o}, v0={o.lower()}0, v1={o.lower()}1)\n" for o in "PQRMN"),
+        encoding="utf-8")
+    compared = stored = 0
+    for seed in range(24):
+        (tmp_path / "g.g7").write_text(random_grafcet(seed), encoding="utf-8")
+        args = _loaded(tmp_path / "g.g7", tmp_path / "r.rules")
+        assert reason(args[0], args[2]) is None
+        try:
+            b = synchronous_product(*args)
+        except InputError as theirs:  # a transient cycle: left to the machine, or met in the initial situation
+            with pytest.raises((Unsupported, InputError)) as mine:
+                explore_frontier(*_loaded(tmp_path / "g.g7", tmp_path / "r.rules"))
+            assert mine.type is Unsupported or str(mine.value) == str(theirs)
+            continue
+        a = explore_frontier(*_loaded(tmp_path / "g.g7", tmp_path / "r.rules"))
+        assert (a.nodes, a.edges, a.initial, a.conflicts, a.sync_states) == (
+            b.nodes, b.edges, b.initial, b.conflicts, b.sync_states), seed
+        compared += 1
+        stored += any(n.situation.stored for n in a.nodes)
+    assert compared >= 16 and stored >= 4
