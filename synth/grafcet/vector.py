@@ -111,31 +111,37 @@ class VectorMachine:
             self.events[Edge(False, n).text()] = 2 * i
             self.events[Edge(True, n).text()] = 2 * i + 1
         trans = machine.transitions
-        # 0/1 matrices in float32: numpy multiplies floats through BLAS, integers in a plain loop
-        self._src = np.zeros((len(trans), len(self.step_names)), dtype=np.float32)
-        self._dst = np.zeros_like(self._src)
+        # which steps each transition leaves and enters, as lists (_Lists): a round marks the
+        # steps of its firing pairs only (a product of matrices would multiply integers in
+        # a plain loop, floats through a BLAS whose threads spend CPU on a shared machine)
+        src = np.zeros((len(trans), len(self.step_names)), dtype=bool)
+        dst = np.zeros_like(src)
         for j, t in enumerate(trans):
-            self._src[j, [self._step[s] for s in t.sources]] = 1
-            self._dst[j, [self._step[s] for s in t.targets]] = 1
+            src[j, [self._step[s] for s in t.sources]] = 1
+            dst[j, [self._step[s] for s in t.targets]] = 1
         self._sources = [[self._step[s] for s in t.sources] for t in trans]
         self.stored_names = tuple(sorted({a.order for s in g.steps for a in s.actions if a.kind == STORED}))
         nt = len(self.timer_names)
         self.memory = nt + len(self.stored_names)
         """The columns of ``T``: the timers, then the stored outputs."""
-        self._timers_of = np.zeros((len(self.step_names), self.memory), dtype=np.float32)
+        timers_of = np.zeros((len(self.step_names), self.memory), dtype=bool)
         for timer in g.timers:
-            self._timers_of[self._step[timer.step], self._timer[timer.id]] = 1
+            timers_of[self._step[timer.step], self._timer[timer.id]] = 1
         # per phase, the stored outputs each step's actions set and reset (T's columns)
-        self._sets = {when: np.zeros_like(self._timers_of) for when in (ON_DEACTIVATION, ON_ACTIVATION)}
-        self._resets = {when: np.zeros_like(self._timers_of) for when in (ON_DEACTIVATION, ON_ACTIVATION)}
+        sets = {when: np.zeros_like(timers_of) for when in (ON_DEACTIVATION, ON_ACTIVATION)}
+        resets = {when: np.zeros_like(timers_of) for when in (ON_DEACTIVATION, ON_ACTIVATION)}
         self._on_event: list[tuple[int, int, bool, Columns]] = []  # step, T's column, set, condition
         for s in g.steps:
             for a in s.actions:
                 col = nt + self.stored_names.index(a.order) if a.kind == STORED else -1
-                if a.kind == STORED and a.when in self._sets:
-                    (self._sets if a.value else self._resets)[a.when][self._step[s.name], col] = 1
+                if a.kind == STORED and a.when in sets:
+                    (sets if a.value else resets)[a.when][self._step[s.name], col] = True
                 elif a.kind == STORED and a.condition is not None:
                     self._on_event.append((self._step[s.name], col, a.value, self._compile(a.condition)))
+        self._sources_of, self._targets_of = _Lists(src), _Lists(dst)
+        self._timer_cols = _Lists(timers_of)
+        self._sets = {when: _Lists(m) for when, m in sets.items() if m.any()}
+        self._resets = {when: _Lists(m) for when, m in resets.items() if m.any()}
         self._rec = [self._compile(t.receptivity) for t in trans]
         orders: dict[str, None] = {}
         self._actions: list[tuple[int, str, Columns | None]] = []
@@ -228,17 +234,19 @@ class VectorMachine:
             a, t = A[live], T[live]
             fire = self._fireable(a, t, I[live], ev)
             firing = fire.any(axis=1)
-            live, a, t, fire = live[firing], a[firing], t[firing], fire[firing].astype(np.float32)
+            live, a, t = live[firing], a[firing], t[firing]
             moved[live] = True
-            leaving = fire @ self._src
-            conflict = (leaving > 1.5).any(axis=1)
+            row, tr = np.nonzero(fire[firing])  # the firing pairs, by row
+            deact = self._sources_of.mark(row, tr, len(live))
+            act = self._targets_of.mark(row, tr, len(live))
+            conflict = self._sources_of.shared(row, tr, len(live))  # a step left by two transitions
             pending[live[conflict]] = True
-            deact, act = leaving > 0.5, (fire @ self._dst) > 0.5
             A[live] = (a & ~deact) | act
+            left = deact & ~act
             if self.timer_names:
-                t = t & ~(((deact & ~act).astype(np.float32) @ self._timers_of) > 0.5)
+                t &= ~self._timer_cols.mark(*np.nonzero(left), len(live))
             if self.stored_names:
-                t = self._stored_phase(t, deact & ~act, ON_DEACTIVATION)
+                t = self._stored_phase(t, left, ON_DEACTIVATION)
                 t = self._stored_phase(t, act & ~a, ON_ACTIVATION)
             T[live] = t
             live = live[~conflict]
@@ -261,8 +269,12 @@ class VectorMachine:
     def _stored_phase(self, t: np.ndarray, steps: np.ndarray, when: StoredWhen) -> np.ndarray:
         """The memory ``t`` after the stored actions of ``steps`` for ``when`` (the
         machine's ``_apply``: sets, then resets)."""
-        f = steps.astype(np.float32)
-        return (t | ((f @ self._sets[when]) > 0.5)) & ~((f @ self._resets[when]) > 0.5)
+        row, step = np.nonzero(steps)
+        if when in self._sets:
+            t = t | self._sets[when].mark(row, step, len(t))
+        if when in self._resets:
+            t = t & ~self._resets[when].mark(row, step, len(t))
+        return t
 
     def orders(self, A: np.ndarray, T: np.ndarray, I: np.ndarray) -> np.ndarray:
         """The orders each row emits (columns :attr:`order_names`) on the input levels ``I``."""
@@ -274,4 +286,34 @@ class VectorMachine:
             out[:, self._order[order]] |= col if cond is None else col & cond(I, A, T, E, Z)
         for col_t, col_o in self._stored_cols:
             out[:, col_o] |= T[:, col_t]
+        return out
+
+
+class _Lists:
+    """A Boolean matrix's rows as lists of columns, to mark many rows' columns at once."""
+
+    def __init__(self, matrix: np.ndarray) -> None:
+        rows, self.cols = np.nonzero(matrix)
+        self.starts = np.searchsorted(rows, np.arange(len(matrix) + 1))
+        self.width = matrix.shape[1]
+
+    def _spread(self, row: np.ndarray, item: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(row, column) for each column of each pair's ``item``."""
+        counts = self.starts[item + 1] - self.starts[item]
+        at = np.repeat(self.starts[item] - np.cumsum(counts) + counts, counts) + np.arange(int(counts.sum()))
+        return np.repeat(row, counts), self.cols[at]
+
+    def mark(self, row: np.ndarray, item: np.ndarray, n: int) -> np.ndarray:
+        """An n-row matrix with the columns of ``item`` set in ``row``, for each pair."""
+        out = np.zeros((n, self.width), dtype=bool)
+        r, c = self._spread(row, item)
+        out[r, c] = True
+        return out
+
+    def shared(self, row: np.ndarray, item: np.ndarray, n: int) -> np.ndarray:
+        """The rows where two pairs' items share a column."""
+        r, c = self._spread(row, item)
+        key = np.sort(r * self.width + c)
+        out = np.zeros(n, dtype=bool)
+        out[key[1:][key[1:] == key[:-1]] // max(self.width, 1)] = True
         return out
