@@ -244,7 +244,8 @@ class VectorMachine:
             A[live] = (a & ~deact) | act
             left = deact & ~act
             if self.timer_names:
-                t &= ~self._timer_cols.mark(*np.nonzero(left), len(live))
+                lrow, lstep = np.nonzero(left)
+                t &= ~self._timer_cols.mark(lrow, lstep, len(live))
             if self.stored_names:
                 t = self._stored_phase(t, left, ON_DEACTIVATION)
                 t = self._stored_phase(t, act & ~a, ON_ACTIVATION)
