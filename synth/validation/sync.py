@@ -131,6 +131,7 @@ class Sync:
     conflicts: tuple[Conflict, ...] = ()
     sync_states: int = 0  # SYNC states (all region members)
     _index: list[tuple[tuple[list[Edge], ...], tuple[list[Edge], ...]]] = field(init=False, repr=False, compare=False)
+    _explored: bool = field(init=False, repr=False, compare=False)  # the arrays came from the explorer (sorted)
     _arrays: list[np.ndarray] = field(init=False, repr=False, compare=False)
     # the edges' sources and targets as arrays, when the explorer has them (the indexes are
     # then made by slicing, the edges grouped by source and target by sorting)
@@ -140,6 +141,7 @@ class Sync:
         if arrays is not None and arrays[0].size and (np.diff(arrays[0]) < 0).any():
             raise ValueError("edges not sorted by node")
         object.__setattr__(self, "_index", [])
+        object.__setattr__(self, "_explored", arrays is not None)
         object.__setattr__(self, "_arrays", [] if arrays is None else list(arrays))
 
     def _indexed(self) -> tuple[tuple[list[Edge], ...], tuple[list[Edge], ...]]:
@@ -147,7 +149,7 @@ class Sync:
         analysis reads the arrays instead)."""
         if not self._index:
             n = len(self.nodes)
-            if not self._arrays:
+            if not self._explored:
                 out: tuple[list[Edge], ...] = tuple([] for _ in self.nodes)
                 into: tuple[list[Edge], ...] = tuple([] for _ in self.nodes)
                 for e in self.edges:
