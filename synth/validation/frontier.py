@@ -4,21 +4,22 @@ The same aggregated automaton as :func:`synth.validation.sync.synchronous_produc
 for node, edge for edge and in the same order, built by numpy passes over the whole
 breadth-first frontier instead of one interpreted step per state: a node is a pair of
 integers (situation number, plant code: the flat code, or on a plant of 2^40 states or
-more the number of the state in the order met, :mod:`synth.validation.words`); the frontier's uncontrollable moves come
-from the element-local transition tables (:class:`~synth.validation.regions.PlantCodes`);
-the Grafcet reacts on rows of bits (:class:`~synth.grafcet.vector.VectorMachine`); the
-regions entered are searched many at once (:func:`~synth.validation.regions.regions`),
-and nodes, regions and situations are found again through sorted integer keys.
+more the number of the state in the order met, :mod:`synth.validation.words`); the
+frontier's uncontrollable moves come from the element-local transition tables
+(:class:`~synth.validation.regions.PlantCodes`); the Grafcet reacts on rows of bits
+(:class:`~synth.grafcet.vector.VectorMachine`); the regions entered are searched many at
+once (:func:`~synth.validation.regions.regions`), and nodes, regions and situations are
+found again through sorted integer keys.
 
 The machine itself still runs what the rows do not carry: the timers' events (per
 node), a reaction that fires an OR divergence's conflict (its rounds are noted) or evolves
 longer than :data:`~synth.grafcet.vector.ROUNDS` rounds. A Grafcet the rows cannot carry
 at all (:func:`reason` says why), or anything unusual met on the way (a transient cycle,
 an event that changes several inputs, keys past 64 bits, two wide plant states under one
-key), is explored by the machine's
-path from the start, which also gives the same error at the same place. The machine's
-path runs alone first, until its queue goes wide (:data:`~synth.validation.sync.WIDE`):
-:func:`synth.validation.validate.explore` chooses, and imports this module only then.
+key), is explored by the machine's path from the start, which also gives the same error
+at the same place. The machine's path runs alone first, until its queue goes wide
+(:data:`~synth.validation.sync.WIDE`): :func:`synth.validation.validate.explore` chooses,
+and imports this module only then.
 
 Example
 -------
