@@ -1,8 +1,10 @@
 """The Grafcet's evolution on many situations at once: the same IEC 60848 reading as
 :class:`~synth.grafcet.machine.GrafcetMachine`, with situations as rows of bits.
 
-A row holds the active steps (``A``, one column per step in file order) and the elapsed
-timers (``T``, one column per timer of ``grafcet.timers``); the inputs are bit columns
+A row holds the active steps (``A``, one column per step in file order) and the
+situation's memory (``T``: the elapsed timers, one column per timer of
+``grafcet.timers``, then the outputs set by stored actions, one column per order of
+:attr:`VectorMachine.stored_names`); the inputs are bit columns
 (``I``, ``machine.inputs`` order) and the input event one integer per row (``E``: twice
 the input's column, plus one for a rising edge; -1 for none). Receptivities and action
 conditions become numpy Boolean expressions over those columns, and the search for
@@ -11,8 +13,11 @@ stability runs round after round on every row until none fires; a row still firi
 divergence's conflict, which the explorer must note with the rounds fired), is left to
 the machine itself (``pending``).
 
-What the rows do not carry, the machine alone reads: internal variables, stored actions
-and assignments, ``--semantics sfc``; :func:`unsupported` names the first such feature of
+Stored actions run as the machine runs them: those on an event before the first round
+(on the rows whose event it is), those on deactivation and on activation in each round
+(the deactivated steps' first, then the activated ones'; in each phase, sets first, then
+resets). What the rows do not carry, the machine alone reads: internal variables,
+assignments, ``--semantics sfc``; :func:`unsupported` names the first such feature of
 a Grafcet (the explicit engine then explores with the machine, state by state).
 
 Example
@@ -36,7 +41,8 @@ from typing import Callable
 
 import numpy as np
 
-from synth.grafcet.language import CONDITIONAL, CONTINUOUS, Semantics, step_of
+from synth.grafcet.language import (CONDITIONAL, CONTINUOUS, ON_ACTIVATION, ON_DEACTIVATION, STORED, Semantics,
+                                   StoredWhen, step_of)
 from synth.grafcet.machine import GrafcetMachine
 from synth.grafcet.situation import Situation, sorted_steps
 from synth.logic.expr import And, Compare, Edge, Expr, Not, Or, Var, evaluate, names
@@ -75,7 +81,7 @@ def unsupported(machine: GrafcetMachine) -> str | None:
         return "internal variables"
     for s in g.steps:
         for a in s.actions:
-            if a.kind not in (CONTINUOUS, CONDITIONAL):
+            if a.kind not in (CONTINUOUS, CONDITIONAL, STORED):
                 return f"{a.kind.value} actions (step {s.name}: {a.text()})"
     steps = {s.name for s in g.steps}
     timers = {t.id for t in g.timers}
@@ -105,25 +111,49 @@ class VectorMachine:
             self.events[Edge(False, n).text()] = 2 * i
             self.events[Edge(True, n).text()] = 2 * i + 1
         trans = machine.transitions
-        self._src = np.zeros((len(trans), len(self.step_names)), dtype=np.int32)
-        self._dst = np.zeros_like(self._src)
+        # which steps each transition leaves and enters, as lists (_Lists): a round marks the
+        # steps of its firing pairs only (a product of matrices would multiply integers in
+        # a plain loop, floats through a BLAS whose threads spend CPU on a shared machine)
+        src = np.zeros((len(trans), len(self.step_names)), dtype=bool)
+        dst = np.zeros_like(src)
         for j, t in enumerate(trans):
-            self._src[j, [self._step[s] for s in t.sources]] = 1
-            self._dst[j, [self._step[s] for s in t.targets]] = 1
+            src[j, [self._step[s] for s in t.sources]] = 1
+            dst[j, [self._step[s] for s in t.targets]] = 1
         self._sources = [[self._step[s] for s in t.sources] for t in trans]
-        self._timers_of = np.zeros((len(self.step_names), len(self.timer_names)), dtype=bool)
+        self.stored_names = tuple(sorted({a.order for s in g.steps for a in s.actions if a.kind == STORED}))
+        nt = len(self.timer_names)
+        self.memory = nt + len(self.stored_names)
+        """The columns of ``T``: the timers, then the stored outputs."""
+        timers_of = np.zeros((len(self.step_names), self.memory), dtype=bool)
         for timer in g.timers:
-            self._timers_of[self._step[timer.step], self._timer[timer.id]] = True
+            timers_of[self._step[timer.step], self._timer[timer.id]] = 1
+        # per phase, the stored outputs each step's actions set and reset (T's columns)
+        sets = {when: np.zeros_like(timers_of) for when in (ON_DEACTIVATION, ON_ACTIVATION)}
+        resets = {when: np.zeros_like(timers_of) for when in (ON_DEACTIVATION, ON_ACTIVATION)}
+        self._on_event: list[tuple[int, int, bool, Columns]] = []  # step, T's column, set, condition
+        for s in g.steps:
+            for a in s.actions:
+                col = nt + self.stored_names.index(a.order) if a.kind == STORED else -1
+                if a.kind == STORED and a.when in sets:
+                    (sets if a.value else resets)[a.when][self._step[s.name], col] = True
+                elif a.kind == STORED and a.condition is not None:
+                    self._on_event.append((self._step[s.name], col, a.value, self._compile(a.condition)))
+        self._sources_of, self._targets_of = _Lists(src), _Lists(dst)
+        self._timer_cols = _Lists(timers_of)
+        self._sets = {when: _Lists(m) for when, m in sets.items() if m.any()}
+        self._resets = {when: _Lists(m) for when, m in resets.items() if m.any()}
         self._rec = [self._compile(t.receptivity) for t in trans]
         orders: dict[str, None] = {}
         self._actions: list[tuple[int, str, Columns | None]] = []
         for s in g.steps:
             for a in s.actions:
                 orders[a.order] = None
-                cond = self._compile(a.condition) if a.kind == CONDITIONAL and a.condition is not None else None
-                self._actions.append((self._step[s.name], a.order, cond))
+                if a.kind in (CONTINUOUS, CONDITIONAL):
+                    cond = self._compile(a.condition) if a.kind == CONDITIONAL and a.condition is not None else None
+                    self._actions.append((self._step[s.name], a.order, cond))
         self.order_names = tuple(sorted(orders))
         self._order = {o: i for i, o in enumerate(self.order_names)}
+        self._stored_cols = [(nt + i, self._order[o]) for i, o in enumerate(self.stored_names)]
 
     # ------------------------------------------------------------------ compilation
     def _compile(self, e: Expr) -> Columns:
@@ -153,16 +183,20 @@ class VectorMachine:
     def rows(self, sits: list[Situation]) -> tuple[np.ndarray, np.ndarray]:
         """The bits (A, T) of ``sits``."""
         A = np.zeros((len(sits), len(self.step_names)), dtype=bool)
-        T = np.zeros((len(sits), len(self.timer_names)), dtype=bool)
+        T = np.zeros((len(sits), self.memory), dtype=bool)
+        nt = len(self.timer_names)
         for r, s in enumerate(sits):
             A[r, [self._step[x] for x in s.steps]] = True
             T[r, [self._timer[x] for x in s.elapsed]] = True
+            T[r, [nt + self.stored_names.index(o) for o in s.stored]] = True
         return A, T
 
     def situation(self, a: np.ndarray, t: np.ndarray) -> Situation:
         """The situation of one row, as the machine builds it."""
         steps = sorted_steps([self.step_names[i] for i in np.flatnonzero(a)])
-        return Situation(steps, (), tuple(sorted(self.timer_names[i] for i in np.flatnonzero(t))), ())
+        nt = len(self.timer_names)
+        stored = tuple(sorted(self.stored_names[i] for i in np.flatnonzero(t[nt:])))
+        return Situation(steps, stored, tuple(sorted(self.timer_names[i] for i in np.flatnonzero(t[:nt]))), ())
 
     # ------------------------------------------------------------------ evolution
     def _fireable(self, A: np.ndarray, T: np.ndarray, I: np.ndarray, E: np.ndarray) -> np.ndarray:
@@ -185,12 +219,13 @@ class VectorMachine:
     def react(self, A: np.ndarray, T: np.ndarray, I: np.ndarray, E: np.ndarray
               ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """The stable situations after the input events ``E`` (inputs ``I`` once they
-        happened) from the rows (A, T); the rows where a transition fired (``moved``); and
+        happened) from the rows (A, T); the rows where a transition fired or an action on
+        the event stored (``moved``); and
         the rows left to the machine (``pending``: a conflict, or still evolving after
         :data:`ROUNDS` rounds), whose bits are meaningless."""
         A, T = A.copy(), T.copy()
         pending = np.zeros(len(A), dtype=bool)
-        moved = np.zeros(len(A), dtype=bool)
+        moved = self._event_actions(A, T, I, E) if self._on_event else np.zeros(len(A), dtype=bool)
         live = np.arange(len(A))
         ev = E
         for _ in range(ROUNDS):
@@ -199,19 +234,48 @@ class VectorMachine:
             a, t = A[live], T[live]
             fire = self._fireable(a, t, I[live], ev)
             firing = fire.any(axis=1)
-            live, a, t, fire = live[firing], a[firing], t[firing], fire[firing].astype(np.int32)
+            live, a, t = live[firing], a[firing], t[firing]
             moved[live] = True
-            leaving = fire @ self._src
-            conflict = (leaving > 1).any(axis=1)
+            row, tr = np.nonzero(fire[firing])  # the firing pairs, by row
+            deact = self._sources_of.mark(row, tr, len(live))
+            act = self._targets_of.mark(row, tr, len(live))
+            conflict = self._sources_of.shared(row, tr, len(live))  # a step left by two transitions
             pending[live[conflict]] = True
-            deact, act = leaving > 0, (fire @ self._dst) > 0
             A[live] = (a & ~deact) | act
+            left = deact & ~act
             if self.timer_names:
-                T[live] = t & ~(((deact & ~act).astype(np.int32) @ self._timers_of) > 0)
+                lrow, lstep = np.nonzero(left)
+                t &= ~self._timer_cols.mark(lrow, lstep, len(live))
+            if self.stored_names:
+                t = self._stored_phase(t, left, ON_DEACTIVATION)
+                t = self._stored_phase(t, act & ~a, ON_ACTIVATION)
+            T[live] = t
             live = live[~conflict]
             ev = np.full(len(live), -1)
         pending[live] = True
         return A, T, moved, pending
+
+    def _event_actions(self, A: np.ndarray, T: np.ndarray, I: np.ndarray, E: np.ndarray) -> np.ndarray:
+        """The stored actions on the input event ``E`` of the active steps (sets, then
+        resets), in place in ``T``; the rows they changed."""
+        Z = np.zeros(len(A), dtype=bool)
+        sets, resets = np.zeros_like(T), np.zeros_like(T)
+        for step, col, value, cond in self._on_event:
+            (sets if value else resets)[:, col] |= A[:, step] & (E >= 0) & cond(I, A, T, E, Z)
+        after = (T | sets) & ~resets
+        changed: np.ndarray = (after != T).any(axis=1)
+        T[:] = after
+        return changed
+
+    def _stored_phase(self, t: np.ndarray, steps: np.ndarray, when: StoredWhen) -> np.ndarray:
+        """The memory ``t`` after the stored actions of ``steps`` for ``when`` (the
+        machine's ``_apply``: sets, then resets)."""
+        row, step = np.nonzero(steps)
+        if when in self._sets:
+            t = t | self._sets[when].mark(row, step, len(t))
+        if when in self._resets:
+            t = t & ~self._resets[when].mark(row, step, len(t))
+        return t
 
     def orders(self, A: np.ndarray, T: np.ndarray, I: np.ndarray) -> np.ndarray:
         """The orders each row emits (columns :attr:`order_names`) on the input levels ``I``."""
@@ -221,4 +285,36 @@ class VectorMachine:
         for step, order, cond in self._actions:
             col = A[:, step]
             out[:, self._order[order]] |= col if cond is None else col & cond(I, A, T, E, Z)
+        for col_t, col_o in self._stored_cols:
+            out[:, col_o] |= T[:, col_t]
+        return out
+
+
+class _Lists:
+    """A Boolean matrix's rows as lists of columns, to mark many rows' columns at once."""
+
+    def __init__(self, matrix: np.ndarray) -> None:
+        rows, self.cols = np.nonzero(matrix)
+        self.starts = np.searchsorted(rows, np.arange(len(matrix) + 1))
+        self.width = matrix.shape[1]
+
+    def _spread(self, row: np.ndarray, item: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(row, column) for each column of each pair's ``item``."""
+        counts = self.starts[item + 1] - self.starts[item]
+        at = np.repeat(self.starts[item] - np.cumsum(counts) + counts, counts) + np.arange(int(counts.sum()))
+        return np.repeat(row, counts), self.cols[at]
+
+    def mark(self, row: np.ndarray, item: np.ndarray, n: int) -> np.ndarray:
+        """An n-row matrix with the columns of ``item`` set in ``row``, for each pair."""
+        out = np.zeros((n, self.width), dtype=bool)
+        r, c = self._spread(row, item)
+        out[r, c] = True
+        return out
+
+    def shared(self, row: np.ndarray, item: np.ndarray, n: int) -> np.ndarray:
+        """The rows where two pairs' items share a column."""
+        r, c = self._spread(row, item)
+        key = np.sort(r * self.width + c)
+        out = np.zeros(n, dtype=bool)
+        out[key[1:][key[1:] == key[:-1]] // max(self.width, 1)] = True
         return out

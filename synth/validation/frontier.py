@@ -3,20 +3,23 @@
 The same aggregated automaton as :func:`synth.validation.sync.synchronous_product`, node
 for node, edge for edge and in the same order, built by numpy passes over the whole
 breadth-first frontier instead of one interpreted step per state: a node is a pair of
-integers (situation number, flat plant code); the frontier's uncontrollable moves come
-from the element-local transition tables (:class:`~synth.validation.regions.PlantCodes`);
-the Grafcet reacts on rows of bits (:class:`~synth.grafcet.vector.VectorMachine`); the
-regions entered are searched many at once (:func:`~synth.validation.regions.regions`),
-and nodes, regions and situations are found again through sorted integer keys.
+integers (situation number, plant code: the flat code, or on a plant of 2^40 states or
+more the number of the state in the order met, :mod:`synth.validation.words`); the
+frontier's uncontrollable moves come from the element-local transition tables
+(:class:`~synth.validation.regions.PlantCodes`); the Grafcet reacts on rows of bits
+(:class:`~synth.grafcet.vector.VectorMachine`); the regions entered are searched many at
+once (:func:`~synth.validation.regions.regions`), and nodes, regions and situations are
+found again through sorted integer keys.
 
 The machine itself still runs what the rows do not carry: the timers' events (per
 node), a reaction that fires an OR divergence's conflict (its rounds are noted) or evolves
 longer than :data:`~synth.grafcet.vector.ROUNDS` rounds. A Grafcet the rows cannot carry
 at all (:func:`reason` says why), or anything unusual met on the way (a transient cycle,
-an event that changes several inputs, keys past 64 bits), is explored by the machine's
-path from the start, which also gives the same error at the same place. The machine's
-path runs alone first, until its queue goes wide (:data:`~synth.validation.sync.WIDE`):
-:func:`synth.validation.validate.explore` chooses, and imports this module only then.
+an event that changes several inputs, keys past 64 bits, two wide plant states under one
+key), is explored by the machine's path from the start, which also gives the same error
+at the same place. The machine's path runs alone first, until its queue goes wide
+(:data:`~synth.validation.sync.WIDE`): :func:`synth.validation.validate.explore` chooses,
+and imports this module only then.
 
 Example
 -------
@@ -48,6 +51,7 @@ from synth.validation.conflicts import Conflict, ConflictLog
 from synth.validation.keys import SortedKeys, distinct, distinct_rows, first_occurrences, slices
 from synth.validation.regions import PlantCodes, Regions, regions
 from synth.validation.sync import Edge, Node, Partial, Sync, synchronous_product
+from synth.validation.words import Collision
 
 __all__ = ["explore_wide", "reason", "explore_frontier", "Unsupported"]
 
@@ -67,8 +71,6 @@ def reason(p: Plant, machine: GrafcetMachine) -> str | None:
     missing = [n for n in machine.inputs if n not in p.owner]
     if missing:
         return f"input {missing[0]} is not a plant variable"
-    if p.size >= 1 << 40:
-        return f"{p.size} plant states: past the frontier path's 40-bit codes"
     return None
 
 
@@ -102,7 +104,7 @@ class _Situations:
         self.timers: list[tuple[Event, ...]] = []
         self._ids: dict[bytes, int] = {}
         self.A = np.zeros((0, len(vm.step_names)), dtype=bool)
-        self.T = np.zeros((0, len(vm.timer_names)), dtype=bool)
+        self.T = np.zeros((0, vm.memory), dtype=bool)
 
     def number(self, A: np.ndarray, T: np.ndarray, given: list[Situation] | None = None) -> np.ndarray:
         """The numbers of the rows' situations (a new one numbered when first met)."""
@@ -152,7 +154,10 @@ def explore_frontier(
     oracle = partial.oracle if partial is not None else CompiledConstraints(p, constraints)
     if not oracle.kept(p.initial):
         return Sync(p, oracle, machine)
-    return _Explorer(p, oracle, machine, max_states).run(progress, partial)
+    try:
+        return _Explorer(p, oracle, machine, max_states).run(progress, partial)
+    except Collision as err:
+        raise Unsupported(str(err)) from None
 
 
 T_ = TypeVar("T_")
@@ -177,7 +182,7 @@ class _Explorer:
         self.p, self.oracle, self.machine, self.max_states = p, oracle, machine, max_states
         self.vm = VectorMachine(machine)
         self.pc = PlantCodes(p, oracle)
-        self.P = p.size
+        self.P = self.pc.P
         self.sits = _Situations(self.vm, self.P)
         self.regions = Regions()
         self.entered = SortedKeys()  # (situation, entry) -> region
@@ -284,10 +289,10 @@ class _Explorer:
     def resume(self, partial: Partial) -> tuple[tuple[int, ...], int]:
         """Take over from the machine's path (its nodes, edges, conflicts, regions and SYNC
         states met): the initial nodes and the first node left to expand."""
-        p, P = self.p, self.P
+        P = self.P
         nodes = partial.nodes
         sid = self.sits.of([n.situation for n in nodes])
-        code = np.array([p.index(n.plant) for n in nodes], dtype=np.int64)
+        code = self.pc.encode([n.plant for n in nodes])
         self.nodes = list(nodes)
         self.node_sit, self.node_code = sid, code
         self.index.add(sid * P + code, np.arange(len(nodes)))
@@ -299,25 +304,25 @@ class _Explorer:
         if partial.regions:  # the regions entered, their settled states (members: in ``seen``)
             keys = list(partial.regions)
             rsid = self.sits.of([k[0] for k in keys])
-            entry = np.array([p.index(k[1]) for k in keys], dtype=np.int64)
+            entry = self.pc.encode([k[1] for k in keys])
             settled = [partial.regions[k] for k in keys]
             base = self.regions.count
             self.regions.append(np.empty(0, dtype=np.int64), np.zeros(len(keys), dtype=np.int64),
-                                np.array([p.index(q) for s in settled for q, _ in s], dtype=np.int64),
+                                self.pc.encode([q for s in settled for q, _ in s]),
                                 np.array([self.regions.proh_id(pr) for s in settled for _, pr in s], dtype=np.int64),
                                 np.array([len(s) for s in settled], dtype=np.int64))
             self.entered.add(rsid * P + entry, base + np.arange(len(keys)))
         if partial.seen:
             seen = list(partial.seen)
             self.pairs.append(self.sits.of([s for s, _ in seen]) * P
-                              + np.array([p.index(m) for _, m in seen], dtype=np.int64))
+                              + self.pc.encode([m for _, m in seen]))
         return partial.initial, partial.next
 
     def run(self, progress: Callable[[int, int], None] | None, partial: Partial | None = None) -> Sync:
         if partial is not None:
             initial, lo = self.resume(partial)
         else:
-            init = np.array([self.p.initial_index], dtype=np.int64)
+            init = self.pc.encode([self.p.initial])
             sit0 = self.machine.initial(self.as_dict(self.inputs(init)[0]))
             node, _ = self.enter(self.sits.of([sit0]), init)
             initial, lo = tuple(node.tolist()), 0

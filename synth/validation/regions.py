@@ -1,15 +1,19 @@
 """Plant states as integer codes, and many regions searched at once: the plant's side of
 the frontier explorer (:mod:`synth.validation.frontier`).
 
-A plant state is its flat code (mixed radices, :meth:`~synth.plant.composition.Plant.index`);
-:class:`PlantCodes` reads the element-local digits, the Grafcet's inputs and the orders'
-values of whole arrays of codes, follows the uncontrollable moves of a frontier, and
-decides SUP membership and SUP's refusals with the compiled constraints' factors (the
-same terms :class:`~synth.sup.constraints.CompiledConstraints` asks one state at a time).
+A plant state is its flat code (mixed radices, :meth:`~synth.plant.composition.Plant.index`),
+or on a plant of :data:`WIDE` states or more the dense number of its words
+(:mod:`synth.validation.words`: the states met, numbered as met); :class:`PlantCodes`
+reads the element-local digits, the Grafcet's inputs and the orders' values of whole
+arrays of codes (a run of elements at a time, :mod:`synth.validation.masks`), follows the
+uncontrollable moves of a frontier, and decides SUP membership and SUP's refusals with the
+compiled constraints' factors (the same terms
+:class:`~synth.sup.constraints.CompiledConstraints` asks one state at a time).
 :func:`regions` runs :func:`synth.validation.sync.region` for many (entry, wanted orders)
 at once, layer by layer: the members of each region in the same breadth-first order, its
-settled states with the same prohibitions (computed by the oracle itself, only where a
-move was refused).
+settled states with the same prohibitions (each refused move's constraints responsible
+read from the same bits as the verdict, named as :meth:`CompiledConstraints.move` names
+them).
 
 Example
 -------
@@ -31,10 +35,16 @@ import numpy as np
 
 from synth.plant.composition import LocalTransition, Plant
 from synth.sup.constraints import CompiledConstraints
-from synth.validation.keys import SortedKeys, first_occurrences
+from synth.validation.keys import SortedKeys, distinct_rows, first_occurrences, slices
+from synth.validation.masks import Masks, Runs, pack, unpack
 from synth.validation.sync import Prohibition, moves_by_order
+from synth.validation.words import CAPACITY, Interned, Layout
 
-__all__ = ["Digits", "PlantCodes", "Regions", "regions"]
+__all__ = ["Digits", "PlantCodes", "Regions", "regions", "WIDE"]
+
+WIDE = 1 << 40
+"""From this many plant states on, plant codes are the dense numbers of the states met
+(their flat codes would leave too few bits of the 64-bit keys to the situations)."""
 
 
 class Digits:
@@ -45,18 +55,35 @@ class Digits:
         self.codes, self.n = codes, len(codes)
         self._pc = pc
         self._axes: dict[int, np.ndarray] = {}
+        self._runs: dict[int, np.ndarray] = {}
         self._full: np.ndarray | None = None
+        lay, ids = pc.layout, pc.interned
+        self._wide = (lay, ids.words[codes]) if lay is not None and ids is not None else None  # (layout, words)
+        self.words = [codes] if self._wide is None else list(self._wide[1].T)
+        """Each word of the codes, one column per word (the flat codes themselves when not wide)."""
 
     def __getitem__(self, axis: int) -> np.ndarray:
         hit = self._axes.get(axis)
         if hit is None:
-            hit = self._axes[axis] = (self.codes // self._pc.stride[axis]) % self._pc.radix[axis]
+            pc = self._pc
+            hit = self._axes[axis] = (self.words[pc.word_of[axis]] // pc.stride[axis]) % pc.radix[axis]
+        return hit
+
+    def run(self, g: int) -> np.ndarray:
+        """The joint index of run ``g`` of :attr:`PlantCodes.runs` at each state."""
+        hit = self._runs.get(g)
+        if hit is None:
+            hit = self._runs[g] = Runs.index(self._pc.runs.items[g], self.words)
         return hit
 
     def full(self) -> np.ndarray:
         """Every element's indices, ndim × n."""
         if self._full is None:
-            self._full = (self.codes[None, :] // self._pc.strides[:, None]) % self._pc.shape[:, None]
+            if self._wide is None:
+                self._full = (self.codes[None, :] // self._pc.strides[:, None]) % self._pc.shape[:, None]
+            else:
+                lay, words = self._wide
+                self._full = np.ascontiguousarray(lay.decode(words).T)
             self._axes = dict(enumerate(self._full))
         return self._full
 
@@ -64,11 +91,13 @@ class Digits:
 class _Moves:
     """Local transitions as columns: element, source, code difference, order column."""
 
-    def __init__(self, moves: list[LocalTransition], strides: tuple[int, ...], column: list[int]) -> None:
+    def __init__(self, moves: list[LocalTransition], strides: tuple[int, ...] | np.ndarray, column: list[int],
+                 word: np.ndarray | None = None) -> None:
         self.moves = moves
         self.axis = np.array([t.axis for t in moves], dtype=np.int64)
         self.src = np.array([t.src for t in moves], dtype=np.int64)
-        self.delta = np.array([(t.dst - t.src) * strides[t.axis] for t in moves], dtype=np.int64)
+        self.delta = np.array([(t.dst - t.src) * int(strides[t.axis]) for t in moves], dtype=np.int64)
+        self.word = word[self.axis] if word is not None else np.zeros(len(moves), dtype=np.int64)
         self.column = np.array(column, dtype=np.int64)
         self.guarded = [k for k, t in enumerate(moves) if t.guard is not None]
         self.forbidding: list[int] = []  # moves an edge constraint may forbid
@@ -79,44 +108,86 @@ class PlantCodes:
 
     def __init__(self, p: Plant, oracle: CompiledConstraints) -> None:
         self.plant, self.oracle = p, oracle
-        self.size = p.size
-        self.stride, self.radix = p.strides, p.shape
-        self.strides, self.shape = np.array(p.strides, dtype=np.int64), np.array(p.shape, dtype=np.int64)
+        self.layout = Layout(p.shape) if p.size >= WIDE else None
+        self.interned = Interned(self.layout.count) if self.layout is not None else None
+        self.P = CAPACITY if self.layout is not None else p.size
+        """The radix of the explorer's keys (situation × code): more than any code."""
+        code_strides = self.layout.stride if self.layout is not None else np.array(p.strides, dtype=np.int64)
+        word = self.layout.word if self.layout is not None else np.zeros(len(p.shape), dtype=np.int64)
+        self.word_of, self.stride, self.radix = word.tolist(), code_strides.tolist(), p.shape
+        self.runs = Runs(p.shape, word, code_strides)
+        self.strides, self.shape = np.array(code_strides, dtype=np.int64), np.array(p.shape, dtype=np.int64)
         self.uncontrollable = [t for t in p.transitions if not t.controllable]
         self.moves = moves_by_order(p)
         self.orders = tuple(sorted(self.moves))  # the region's order of the orders
-        self._values: dict[tuple[str, ...], list[tuple[int, np.ndarray, np.ndarray]]] = {}
+        self._values: dict[tuple[str, ...], Masks] = {}
         self._guards: dict[int, tuple[list[tuple[int, np.ndarray]], np.ndarray]] = {}
-        self._u = _Moves(self.uncontrollable, p.strides, [0] * len(self.uncontrollable))
+        self._u = _Moves(self.uncontrollable, code_strides, [0] * len(self.uncontrollable), word)
         controllable = [t for o in self.orders for t in self.moves[o]]
-        self._c = _Moves(controllable, p.strides, [j for j, o in enumerate(self.orders) for _ in self.moves[o]])
+        self._c = _Moves(controllable, code_strides, [j for j, o in enumerate(self.orders) for _ in self.moves[o]], word)
         self._c.forbidding = [k for k, t in enumerate(controllable) if oracle.edge_terms.get(t.event)]
         self.controllable_moves = self._c
+        self.order_starts = np.searchsorted(self._c.column, np.arange(len(self.orders) + 1))
         self._reach = [g.ravel() for g in oracle.reach_grids] if oracle.reach_grids is not None else None
+        self.prohibitions: list[Prohibition] = []  # the refusals met: one move, its constraints responsible
+        self._why: dict[tuple[int, bytes], int] = {}
+        self._edge_width = max((len(oracle.edge_terms.get(t.event, ())) for t in controllable), default=0)
+        self._threat_masks = Masks(self.runs, self._level_tables(), len(oracle.level_terms), conj=True)
+        self._order_masks = Masks(self.runs, self._value_tables(self.orders), len(self.orders), conj=False)
+
+    def _level_tables(self) -> dict[int, np.ndarray]:
+        """Per element, which level terms' reach factors hold at each local state (True
+        where the term has no factor there)."""
+        out: dict[int, np.ndarray] = {}
+        for i, factors in enumerate(self.oracle.level_reach):
+            for a, vec in factors:
+                table = out.setdefault(a, np.ones((self.radix[a], len(self.oracle.level_reach)), dtype=bool))
+                table[:, i] &= vec.astype(bool)
+        return out
+
+    def _value_tables(self, names: tuple[str, ...]) -> dict[int, np.ndarray]:
+        """Per element owning some of ``names``, their values at each local state (False
+        in the other columns)."""
+        out: dict[int, np.ndarray] = {}
+        for a, cols, table in self._tables(names):
+            out[a] = np.zeros((self.radix[a], len(names)), dtype=bool)
+            out[a][:, cols] = table
+        return out
 
     def digits(self, codes: np.ndarray) -> Digits:
         return Digits(self, codes)
 
+    def encode(self, states: list[tuple[int, ...]]) -> np.ndarray:
+        """The codes of plant states given as element-local tuples."""
+        if self.layout is None or self.interned is None:
+            return np.array([self.plant.index(q) for q in states], dtype=np.int64)
+        local = np.array(states, dtype=np.int64).reshape(len(states), len(self.radix))
+        return self.interned.find_or_add(self.layout.encode(local))
+
+    def step(self, codes: np.ndarray, moves: _Moves, rank: np.ndarray) -> np.ndarray:
+        """The codes after the moves ``rank`` (one per code)."""
+        if self.interned is None:
+            return codes + moves.delta[rank]
+        words = self.interned.words[codes]
+        words[np.arange(len(codes)), moves.word[rank]] += moves.delta[rank]
+        return self.interned.find_or_add(words)
+
     def values(self, names: tuple[str, ...], digits: Digits) -> np.ndarray:
         """The plant variables ``names`` at each state (n × len(names)); False for a name
         the plant does not have."""
-        out = np.zeros((digits.n, len(names)), dtype=bool)
-        for axis, cols, table in self._tables(names):
-            out[:, cols] = table[digits[axis]]
-        return out
+        masks = self._values.get(names)
+        if masks is None:
+            masks = self._values[names] = Masks(self.runs, self._value_tables(names), len(names), conj=False)
+        return unpack(masks.of(digits.run, digits.n), len(names))
 
     def _tables(self, names: tuple[str, ...]) -> list[tuple[int, np.ndarray, np.ndarray]]:
         """Per element owning some of ``names``: their columns and their values per local state."""
-        hit = self._values.get(names)
-        if hit is None:
-            by_axis: dict[int, list[int]] = {}
-            for j, n in enumerate(names):
-                if n in self.plant.owner:
-                    by_axis.setdefault(self.plant.owner[n], []).append(j)
-            hit = self._values[names] = [
-                (a, np.array(cols), np.stack([self.plant.elements[a].value(names[j]) for j in cols], axis=1))
+        by_axis: dict[int, list[int]] = {}
+        for j, n in enumerate(names):
+            if n in self.plant.owner:
+                by_axis.setdefault(self.plant.owner[n], []).append(j)
+        return [(a, np.array(cols), np.stack([self.plant.elements[a].value(names[j]) for j in cols], axis=1))
                 for a, cols in sorted(by_axis.items())]
-        return hit
 
     @staticmethod
     def holds(factors: Iterable[tuple[int, np.ndarray]], digits: Digits, rows: np.ndarray | None = None) -> np.ndarray:
@@ -128,15 +199,23 @@ class PlantCodes:
 
     def kept(self, codes: np.ndarray) -> np.ndarray:
         """SUP membership of each state: no violation reachable by uncontrollable events."""
-        bad = np.zeros(len(codes), dtype=bool)
-        if self._reach is not None:
-            for g in self._reach:
-                bad |= g[codes]
-            return ~bad
-        digits = self.digits(codes)
-        for factors in self.oracle.level_reach:
-            bad |= self.holds(factors, digits)
-        return ~bad
+        return np.logical_not(self.threats(codes).any(axis=1))
+
+    def threats(self, codes: np.ndarray) -> np.ndarray:
+        """Which level terms' violation each state can reach by uncontrollable events, in
+        the compiled constraints' order, packed (n × words, :func:`~synth.validation.masks.pack`)."""
+        if self._reach is None:
+            digits = self.digits(codes)
+            return self._threat_masks.of(digits.run, len(codes))
+        out = np.zeros((len(codes), len(self.oracle.level_terms)), dtype=bool)
+        at: np.ndarray | tuple[np.ndarray, ...] = codes if self.interned is None else tuple(self.digits(codes).full())
+        for i, g in enumerate(self._reach if self.interned is None else self.oracle.reach_grids or ()):
+            out[:, i] = g[at]
+        return pack(out)
+
+    def order_bits(self, digits: Digits) -> np.ndarray:
+        """The values of :attr:`orders` at each state, packed."""
+        return self._order_masks.of(digits.run, digits.n)
 
     def forbidden(self, t: LocalTransition, digits: Digits, rows: np.ndarray) -> np.ndarray:
         """Where an edge constraint forbids the controllable ``t``, at ``rows``."""
@@ -156,7 +235,7 @@ class PlantCodes:
             if rows.size:
                 ok[rows, k] = self._guard(k, digits, rows)
         row, rank = np.nonzero(ok)  # row-major: by row, then rank
-        target = codes[row] + u.delta[rank]
+        target = self.step(codes[row], u, rank)
         keep = self.kept(target)  # cannot fail from a SUP state; kept for safety, as the machine's path
         return row[keep], rank[keep], target[keep]
 
@@ -177,21 +256,33 @@ class PlantCodes:
             code |= bits[digits[axis][rows]]
         return guard[code]
 
-    def refusals(self, code: int, wanted: np.ndarray) -> tuple[Prohibition, ...]:
-        """The order changes SUP refuses in state ``code`` towards ``wanted`` (one bit per
-        :attr:`orders`), as :func:`~synth.validation.sync.region` lists them."""
-        cur = self.plant.local(code)
-        val = self.plant.valuation(cur)
-        refused: list[Prohibition] = []
-        for j, order in enumerate(self.orders):
-            if val[order] == bool(wanted[j]):
-                continue
-            for t in self.moves[order]:
-                if t.src == cur[t.axis]:
-                    ok, why = self.oracle.move(t, cur)
-                    if not ok:
-                        refused.append(Prohibition(t.event, tuple(why)))
-        return tuple(sorted(refused))
+    def refused(self, digits: Digits, row: np.ndarray, rank: np.ndarray, threats: np.ndarray) -> np.ndarray:
+        """The refusal (index into :attr:`prohibitions`) of each controllable move SUP
+        refuses (from the state ``row`` of ``digits``, move ``rank`` of
+        :attr:`controllable_moves`, to a target of :meth:`threats` ``threats``): its event
+        and the constraints responsible as :meth:`CompiledConstraints.move` names them, the
+        edge constraints forbidding it, then those whose violation the target can reach."""
+        c, terms = self._c, self.oracle.edge_terms
+        edge = np.zeros((len(row), self._edge_width), dtype=bool)
+        for k in c.forbidding:
+            at = np.flatnonzero(rank == k)
+            for j, term in enumerate(terms[c.moves[k].event] if at.size else ()):
+                edge[at, j] = self.holds(term.factors, digits, row[at])
+        level = unpack(threats, len(self.oracle.level_terms))
+        bits = np.hstack([edge, level])
+        first, inverse = distinct_rows(np.hstack([bits, (rank[:, None] >> np.arange(32)) & 1 == 1]))
+        ids = np.empty(len(first), dtype=np.int64)
+        for u, r in enumerate(first.tolist()):
+            key = (int(rank[r]), np.packbits(bits[r]).tobytes())
+            hit = self._why.get(key)
+            if hit is None:
+                t = c.moves[key[0]]
+                why = [terms[t.event][j].constraint for j in np.flatnonzero(edge[r]).tolist()]
+                why += [self.oracle.level_terms[i].constraint for i in np.flatnonzero(level[r]).tolist()]
+                hit = self._why[key] = len(self.prohibitions)
+                self.prohibitions.append(Prohibition(t.event, tuple(dict.fromkeys(why))))
+            ids[u] = hit
+        return ids[inverse]
 
 
 class Regions:
@@ -207,6 +298,7 @@ class Regions:
         self.settled_proh = np.empty(0, dtype=np.int64)
         self.prohibitions: list[tuple[Prohibition, ...]] = [()]
         self._proh_ids: dict[tuple[Prohibition, ...], int] = {(): 0}
+        self._sets: dict[tuple[int, ...], int] = {}
 
     @property
     def count(self) -> int:
@@ -218,6 +310,21 @@ class Regions:
             hit = self._proh_ids[proh] = len(self.prohibitions)
             self.prohibitions.append(proh)
         return hit
+
+    def refusal_sets(self, rows: np.ndarray, refusals: np.ndarray, met: list[Prohibition]) -> tuple[np.ndarray, np.ndarray]:
+        """Per state of ``rows`` (sorted, repeated once per refused move), its refusals
+        (indices into ``met``) as one prohibition set: (the states, their set's index in
+        :attr:`prohibitions`)."""
+        starts = np.flatnonzero(np.concatenate([[True], rows[1:] != rows[:-1]]))
+        bounds, ids = np.append(starts, len(rows)).tolist(), refusals.tolist()
+        out = np.empty(len(starts), dtype=np.int64)
+        for u in range(len(starts)):
+            key = tuple(ids[bounds[u]:bounds[u + 1]])
+            hit = self._sets.get(key)
+            if hit is None:
+                hit = self._sets[key] = self.proh_id(tuple(sorted(met[q] for q in key)))
+            out[u] = hit
+        return rows[starts], out
 
     def append(self, members: np.ndarray, member_counts: np.ndarray, settled: np.ndarray, proh: np.ndarray,
                settled_counts: np.ndarray) -> None:
@@ -232,54 +339,59 @@ def regions(pc: PlantCodes, store: Regions, entries: np.ndarray, wanted: np.ndar
     """Search the regions entered at ``entries`` under ``wanted`` (one row of bits over
     ``pc.orders`` per entry) and append them to ``store``, in the order given."""
     R = len(entries)
-    if R * pc.size >= 1 << 62:
+    if R * pc.P >= 1 << 62:
         raise OverflowError("region keys")
     reg, cur = np.arange(R, dtype=np.int64), entries.astype(np.int64)
+    wanted_bits, k = pack(wanted), len(pc.orders)
     seen = SortedKeys()
-    seen.add(reg * pc.size + cur, reg)
+    seen.add(reg * pc.P + cur, reg)
     member_parts, settled_parts = [(reg, cur)], []
     while cur.size:
         digits = pc.digits(cur)
-        values = pc.values(pc.orders, digits)
         c = pc.controllable_moves
-        app = (values != wanted[reg])[:, c.column] & (digits.full()[c.axis, :].T == c.src)
-        row, rank = np.nonzero(app)  # row-major: by row, then the region's order of the moves
-        target = cur[row] + c.delta[rank]
-        ok = pc.kept(target)
+        row, order = np.nonzero(unpack(pc.order_bits(digits) ^ wanted_bits[reg], k))  # the orders to change, row-major
+        counts, rank = slices(pc.order_starts, order)  # their moves (the region's order of the moves)
+        row = np.repeat(row, counts)
+        app = digits.full()[c.axis[rank], row] == c.src[rank]
+        row, rank = row[app], rank[app]  # by row, then rank
+        target = pc.step(cur[row], c, rank)
+        threat = pc.threats(target)
+        ok = np.logical_not(threat.any(axis=1))
         for k in c.forbidding:
             at = np.flatnonzero(rank == k)
             if at.size:
                 ok[at] &= ~pc.forbidden(c.moves[k], digits, row[at])
-        refused = np.zeros(cur.size, dtype=bool)
-        refused[row[~ok]] = True
         progressed = np.zeros(cur.size, dtype=bool)
         progressed[row[ok]] = True
         still = ~progressed
-        settled_parts.append((reg[still], cur[still], refused[still]))
+        proh = np.zeros(cur.size, dtype=np.int64)
+        sel = np.flatnonzero(still[row])  # the moves from settled states: every one refused
+        if sel.size:
+            at, ids = store.refusal_sets(row[sel], pc.refused(digits, row[sel], rank[sel], threat[sel]), pc.prohibitions)
+            proh[at] = ids
+        settled_parts.append((reg[still], cur[still], proh[still]))
         if not ok.any():
             break
         nreg, target = reg[row[ok]], target[ok]
-        keys = nreg * pc.size + target
+        keys = nreg * pc.P + target
         first = first_occurrences(keys)
         first = first[seen.find(keys[first]) < 0]
         reg, cur = nreg[first], target[first]
-        seen.add(reg * pc.size + cur, reg)
+        seen.add(reg * pc.P + cur, reg)
         member_parts.append((reg, cur))
-    _store(pc, store, R, member_parts, settled_parts, wanted)
+    _store(store, R, member_parts, settled_parts)
 
 
-def _store(pc: PlantCodes, store: Regions, R: int, member_parts: list[tuple[np.ndarray, np.ndarray]],
-           settled_parts: list[tuple[np.ndarray, np.ndarray, np.ndarray]], wanted: np.ndarray) -> None:
-    """Group the layers' members and settled states by region (breadth-first order kept)."""
+def _store(store: Regions, R: int, member_parts: list[tuple[np.ndarray, np.ndarray]],
+           settled_parts: list[tuple[np.ndarray, np.ndarray, np.ndarray]]) -> None:
+    """Group the layers' members and settled states (with their prohibitions) by region
+    (breadth-first order kept)."""
     mreg = np.concatenate([r for r, _ in member_parts])
     mcode = np.concatenate([c for _, c in member_parts])
     order = np.argsort(mreg, kind="stable")
     sreg = np.concatenate([r for r, _, _ in settled_parts])
     scode = np.concatenate([c for _, c, _ in settled_parts])
-    sref = np.concatenate([f for _, _, f in settled_parts])
+    sproh = np.concatenate([f for _, _, f in settled_parts])
     sorder = np.argsort(sreg, kind="stable")
-    sreg, scode, sref = sreg[sorder], scode[sorder], sref[sorder]
-    proh = np.zeros(len(scode), dtype=np.int64)
-    for i in np.flatnonzero(sref).tolist():
-        proh[i] = store.proh_id(pc.refusals(int(scode[i]), wanted[sreg[i]]))
+    sreg, scode, proh = sreg[sorder], scode[sorder], sproh[sorder]
     store.append(mcode[order], np.bincount(mreg, minlength=R), scode, proh, np.bincount(sreg, minlength=R))

@@ -120,7 +120,7 @@ class Edge:
 @dataclass(frozen=True)
 class Sync:
     """The aggregated view of SYNC, explored from the initial state (fully built:
-    successors and predecessors are indexed on construction)."""
+    successors and predecessors are indexed on their first call)."""
 
     plant: Plant
     oracle: CompiledConstraints
@@ -130,29 +130,38 @@ class Sync:
     initial: tuple[int, ...] = ()  # the initial region may settle in several plant states
     conflicts: tuple[Conflict, ...] = ()
     sync_states: int = 0  # SYNC states (all region members)
-    _out: tuple[list[Edge], ...] = field(init=False, repr=False, compare=False)
-    _in: tuple[list[Edge], ...] = field(init=False, repr=False, compare=False)
+    _index: list[tuple[tuple[list[Edge], ...], tuple[list[Edge], ...]]] = field(init=False, repr=False, compare=False)
+    _explored: bool = field(init=False, repr=False, compare=False)  # the arrays came from the explorer (sorted)
     _arrays: list[np.ndarray] = field(init=False, repr=False, compare=False)
     # the edges' sources and targets as arrays, when the explorer has them (the indexes are
     # then made by slicing, the edges grouped by source and target by sorting)
     arrays: InitVar[tuple[np.ndarray, np.ndarray] | None] = None
 
     def __post_init__(self, arrays: tuple[np.ndarray, np.ndarray] | None) -> None:
-        n = len(self.nodes)
-        if arrays is None:
-            out: tuple[list[Edge], ...] = tuple([] for _ in self.nodes)
-            into: tuple[list[Edge], ...] = tuple([] for _ in self.nodes)
-            for e in self.edges:
-                out[e.source].append(e)
-                into[e.target].append(e)
-        else:
-            src, dst = arrays
-            out = _grouped(list(self.edges), src, n)
-            by_target = np.argsort(dst, kind="stable")
-            into = _grouped([self.edges[k] for k in by_target.tolist()], dst[by_target], n)
-        object.__setattr__(self, "_out", out)
-        object.__setattr__(self, "_in", into)
+        if arrays is not None and arrays[0].size and (np.diff(arrays[0]) < 0).any():
+            raise ValueError("edges not sorted by node")
+        object.__setattr__(self, "_index", [])
+        object.__setattr__(self, "_explored", arrays is not None)
         object.__setattr__(self, "_arrays", [] if arrays is None else list(arrays))
+
+    def _indexed(self) -> tuple[tuple[list[Edge], ...], tuple[list[Edge], ...]]:
+        """Each node's outgoing and incoming edges (made on the first call: a large SYNC's
+        analysis reads the arrays instead)."""
+        if not self._index:
+            n = len(self.nodes)
+            if not self._explored:
+                out: tuple[list[Edge], ...] = tuple([] for _ in self.nodes)
+                into: tuple[list[Edge], ...] = tuple([] for _ in self.nodes)
+                for e in self.edges:
+                    out[e.source].append(e)
+                    into[e.target].append(e)
+            else:
+                src, dst = self._arrays
+                out = _grouped(list(self.edges), src, n)
+                by_target = np.argsort(dst, kind="stable")
+                into = _grouped([self.edges[k] for k in by_target.tolist()], dst[by_target], n)
+            self._index.append((out, into))
+        return self._index[0]
 
     def edge_arrays(self) -> tuple[np.ndarray, np.ndarray]:
         """The edges' sources and targets as integer arrays (made on the first call)."""
@@ -163,10 +172,10 @@ class Sync:
         return self._arrays[0], self._arrays[1]
 
     def successors(self, i: int) -> list[Edge]:
-        return self._out[i]
+        return self._indexed()[0][i]
 
     def predecessors(self, i: int) -> list[Edge]:
-        return self._in[i]
+        return self._indexed()[1][i]
 
     def inputs(self, local: Local) -> dict[str, bool]:
         """The Grafcet's inputs in plant state ``local``."""
@@ -178,8 +187,6 @@ class Sync:
 
 def _grouped(edges: list[Edge], keys: np.ndarray, n: int) -> tuple[list[Edge], ...]:
     """``edges``, sorted by ``keys`` (their sources or targets), cut into one list per node."""
-    if keys.size and (np.diff(keys) < 0).any():
-        raise ValueError("edges not sorted by node")
     cuts = np.searchsorted(keys, np.arange(n + 1)).tolist()
     return tuple(edges[a:b] for a, b in zip(cuts, cuts[1:]))
 
