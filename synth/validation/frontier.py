@@ -80,17 +80,20 @@ def explore_wide(
     max_states: int | None = None,
     progress: Callable[[int, int], None] | None = None,
     partial: Partial | None = None,
+    watch: Callable[[int, int], None] | None = None,
 ) -> Sync:
     """SYNC of a model whose search went wide (:data:`~synth.validation.sync.WIDE`): a
     frontier at a time when :func:`reason` allows it, else (or when the frontier path
     meets what it leaves to the machine) by the machine's path from the start;
-    ``partial``: how far the machine's path went before it went wide."""
+    ``partial``: how far the machine's path went before it went wide; ``watch(met,
+    waiting)``: after each frontier (or state, on the machine's path) expanded."""
     if reason(p, machine) is None:
         try:
-            return explore_frontier(p, constraints, machine, max_states=max_states, progress=progress, partial=partial)
+            return explore_frontier(p, constraints, machine, max_states=max_states, progress=progress, partial=partial,
+                                    watch=watch)
         except Unsupported:
             pass
-    return synchronous_product(p, constraints, machine, max_states=max_states, progress=progress)
+    return synchronous_product(p, constraints, machine, max_states=max_states, progress=progress, watch=watch)
 
 
 class _Situations:
@@ -142,6 +145,7 @@ def explore_frontier(
     max_states: int | None = None,
     progress: Callable[[int, int], None] | None = None,
     partial: Partial | None = None,
+    watch: Callable[[int, int], None] | None = None,
 ) -> Sync:
     """SYNC a frontier at a time (see module doc), from the start or going on from where
     the machine's path stopped (``partial``); :class:`Unsupported` when it meets what it
@@ -152,7 +156,7 @@ def explore_frontier(
     oracle = partial.oracle if partial is not None else CompiledConstraints(p, constraints)
     if not oracle.kept(p.initial):
         return Sync(p, oracle, machine)
-    return _Explorer(p, oracle, machine, max_states).run(progress, partial)
+    return _Explorer(p, oracle, machine, max_states).run(progress, partial, watch)
 
 
 T_ = TypeVar("T_")
@@ -313,7 +317,8 @@ class _Explorer:
                               + np.array([p.index(m) for _, m in seen], dtype=np.int64))
         return partial.initial, partial.next
 
-    def run(self, progress: Callable[[int, int], None] | None, partial: Partial | None = None) -> Sync:
+    def run(self, progress: Callable[[int, int], None] | None, partial: Partial | None = None,
+            watch: Callable[[int, int], None] | None = None) -> Sync:
         if partial is not None:
             initial, lo = self.resume(partial)
         else:
@@ -326,6 +331,8 @@ class _Explorer:
             hi = len(self.nodes)
             self.expand(lo, hi)
             lo = hi
+            if watch is not None:
+                watch(len(self.nodes), len(self.nodes) - lo)
             if progress is not None and time.monotonic() - last > 0.5:
                 progress(len(self.nodes), len(self.nodes) - lo)
                 last = time.monotonic()
