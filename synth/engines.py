@@ -32,7 +32,7 @@ Example
 -------
 >>> from synth.probe import Growth, Stop
 >>> decide(Command.VALIDATE, EngineChoice.AUTO, estimate=10**8,
-...        growth=lambda threshold: Growth(1167, 395, Stop.STEEP, "input x is not a plant variable")).reason
+...        growth=lambda threshold: Growth(1167, 395, Stop.STEEP, "input x is not a plant variable", share=30)).reason
 'auto: symbolic (measured: 395 of the 1167 aggregated states met wait to be explored, more than 30 %, state by state (input x is not a plant variable))'
 >>> decide(Command.VALIDATE, EngineChoice.AUTO, estimate=10**4).reason
 'auto: 10000 plant states × Grafcet steps, not above 100000'
@@ -63,7 +63,8 @@ if TYPE_CHECKING:  # pragma: no cover - the engines are imported once chosen
 
 __all__ = ["EngineChoice", "Command", "Need", "Capability", "CAPABILITIES", "Threshold", "THRESHOLDS", "Decision",
            "capability", "refuse", "refusal", "decide", "measured", "VALIDATE_THRESHOLD", "PROBE_NODES",
-           "PROBE_MACHINE_NODES", "PROBE_SHARE", "PROBE_MACHINE_SHARE", "PROBE_SITUATION_SHARE", "SUP_THRESHOLD", "VERIFY_THRESHOLD", "validate",
+           "PROBE_MACHINE_NODES", "PROBE_SHARE", "PROBE_MACHINE_SHARE", "PROBE_SITUATION_SHARE",
+           "PROBE_EARLY_SHARE", "SUP_THRESHOLD", "VERIFY_THRESHOLD", "validate",
            "validate_models", "SupRun", "supervisor"]
 
 
@@ -149,6 +150,12 @@ PROBE_MACHINE_SHARE = 30
 """``validate --engine auto``: :data:`PROBE_SHARE` where the explicit engine explores state
 by state, about five times slower per state: the symbolic engine wins sooner."""
 
+PROBE_EARLY_SHARE = 60
+"""``validate --engine auto``: on the frontier path, symbolic already at
+:data:`PROBE_MACHINE_NODES` aggregated states when more than this percent of them wait
+(measured there: par_8 68, par_9 72, par_5/6 with timers 71/76; steep_6 55, par_7 53,
+steep_5 49, par_6 45 wait for the decision point; branches_5x2 37)."""
+
 PROBE_SITUATION_SHARE = 50
 """``validate --engine auto``: where the symbolic engine would explore one stable situation
 at a time (timers, stored actions, internal variables), it pays per situation and wins only
@@ -164,7 +171,7 @@ VERIFY_THRESHOLD = 2_000_000
 THRESHOLDS: dict[Command, Threshold] = {
     Command.VALIDATE: Threshold(VALIDATE_THRESHOLD, "plant states × Grafcet steps",
                                 Points(PROBE_NODES, PROBE_MACHINE_NODES, PROBE_SHARE, PROBE_MACHINE_SHARE,
-                                       PROBE_SITUATION_SHARE)),
+                                       PROBE_SITUATION_SHARE, PROBE_EARLY_SHARE)),
     Command.SUP: Threshold(SUP_THRESHOLD),
     Command.FILTER_VERIFY: Threshold(VERIFY_THRESHOLD),
 }
@@ -247,9 +254,9 @@ def measured(g: Growth, t: Threshold) -> Decision:
 
     >>> from synth.probe import Growth, Stop
     >>> t = THRESHOLDS[Command.VALIDATE]
-    >>> measured(Growth(1438, 623, Stop.STEEP), t).reason
+    >>> measured(Growth(1438, 623, Stop.STEEP, share=40), t).reason
     'auto: symbolic (measured: 623 of the 1438 aggregated states met wait to be explored, more than 40 %)'
-    >>> measured(Growth(1072, 236, Stop.NARROW), t).reason
+    >>> measured(Growth(1072, 236, Stop.NARROW, share=40), t).reason
     'auto: explicit (measured: 236 of the 1072 aggregated states met wait to be explored, not more than 40 %)'
     >>> measured(Growth(90, 0, Stop.RAN, sync_states=150), t).reason
     'auto: explicit (measured: SYNC explored whole before the decision point, 90 aggregated states, 150 SYNC states)'
@@ -264,7 +271,7 @@ def measured(g: Growth, t: Threshold) -> Decision:
     if g.stop is Stop.ERROR:
         return Decision(EngineChoice.EXPLICIT, f"auto: explicit (measured: an internal variable out of range after "
                                                f"{g.met} aggregated states)", True)
-    share = pt.share if g.machine is None else pt.machine_share
+    share = g.share
     counts = f"{g.waiting} of the {g.met} aggregated states met wait to be explored"
     path = "" if g.machine is None else f", state by state ({g.machine})"
     if g.stop is Stop.STEEP:

@@ -15,7 +15,9 @@ each breadth-first frontier, expanded, the aggregated states met and those still
   :func:`synth.validation.frontier.reason` says which), the share of those met that still
   wait says how steeply SYNC grows: above ``share`` percent the run stops and the symbolic
   engine runs (:attr:`Stop.STEEP`); otherwise the same run goes on to the end and its
-  result is kept (:attr:`Stop.NARROW`): the explicit engine chosen has lost nothing.
+  result is kept (:attr:`Stop.NARROW`): the explicit engine chosen has lost nothing. On
+  the frontier path a share above ``early_share`` stops the run already at the state-by-state
+  path's decision point (the steepest models: less explored for nothing).
 
 Counts only, never time: the same choice on every machine and every run. :mod:`synth.engines`
 holds the constants and words the reason.
@@ -25,7 +27,7 @@ Example
 >>> from synth.plant.composition import _plants
 >>> from synth.validation.result import load_model
 >>> rs, p, g = load_model(_plants("../grafcets/tri.g7"), _plants("tri.rules"))
->>> counts, done = measure(rs, p, g, Points(1000, 400, 40, 30, 50))
+>>> counts, done = measure(rs, p, g, Points(1000, 400, 40, 30, 50, 60))
 >>> counts.stop, counts.sync_states, done.sync.sync_states
 (<Stop.RAN: 'ran'>, 150, 150)
 """
@@ -62,13 +64,15 @@ class Points:
     frontier path (``machine_nodes`` on the state-by-state path), steep when more than
     ``share`` percent of them wait (``machine_share`` on the state-by-state path;
     ``situation_share`` where the symbolic engine would explore one stable situation at a
-    time: timers, stored actions, internal variables)."""
+    time: timers, stored actions, internal variables); on the frontier path, steep already
+    after ``machine_nodes`` when more than ``early_share`` percent wait."""
 
     nodes: int
     machine_nodes: int
     share: int
     machine_share: int
     situation_share: int
+    early_share: int
 
 
 @dataclass(frozen=True)
@@ -77,7 +81,8 @@ class Growth:
     ``met`` aggregated states, ``waiting`` of them not yet expanded; ``stop``, how it ended;
     ``machine``: why the explicit engine explored state by state (None: a frontier at a
     time); ``per_situation``: the symbolic engine would explore one stable situation at a
-    time; ``sync_states``: SYNC's size, when explored whole."""
+    time; ``sync_states``: SYNC's size, when explored whole; ``share``: the percent it was
+    judged against."""
 
     met: int
     waiting: int
@@ -85,6 +90,7 @@ class Growth:
     machine: str | None = None
     per_situation: bool = False
     sync_states: int = 0
+    share: int = 0
 
 
 class _Steep(Exception):
@@ -110,29 +116,34 @@ class _Watch:
 
     def __call__(self, met: int, waiting: int) -> None:
         self.last = (met, waiting)
-        if self.growth is not None or met < self.points.machine_nodes:
+        pt = self.points
+        if self.growth is not None or met < pt.machine_nodes:
             return
         why = self.machine()
-        if why is None and met < self.points.nodes:
+        if why is None and met < pt.nodes:
+            early = self.judged(met, waiting, why, pt.early_share)
+            if early.stop is Stop.STEEP:
+                self.growth = early
+                raise _Steep
             return
         self.judge(met, waiting, why)
         if self.growth is not None and self.growth.stop is Stop.STEEP:
             raise _Steep
 
     def judge(self, met: int, waiting: int, why: str | None) -> None:
-        pt = self.points
-        share = pt.share if why is None else pt.machine_share
+        """Decide on the counts at the decision point."""
+        self.growth = self.judged(met, waiting, why, self.points.share if why is None else self.points.machine_share)
+
+    def judged(self, met: int, waiting: int, why: str | None, share: int) -> Growth:
         if 100 * waiting <= share * met:
-            self.growth = Growth(met, waiting, Stop.NARROW, why)
-            return
-        if 100 * waiting <= pt.situation_share * met:
+            return Growth(met, waiting, Stop.NARROW, why, share=share)
+        if 100 * waiting <= self.points.situation_share * met:
             from synth.grafcet.machine import GrafcetMachine
             from synth.symbolic.validate import SymbolicPath, choose_path  # dd: the symbolic engine likely runs next
 
             if choose_path(GrafcetMachine(self.g), self.p).path is SymbolicPath.SITUATIONS:
-                self.growth = Growth(met, waiting, Stop.NARROW, why, per_situation=True)
-                return
-        self.growth = Growth(met, waiting, Stop.STEEP, why)
+                return Growth(met, waiting, Stop.NARROW, why, per_situation=True, share=share)
+        return Growth(met, waiting, Stop.STEEP, why, share=share)
 
 
 def measure(rs: RuleSet, p: Plant, g: Grafcet, points: Points, *, expert: bool = False, homes: Sequence[str] = (),

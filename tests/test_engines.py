@@ -135,7 +135,7 @@ def test_auto_reads_the_threshold_table_and_says_why() -> None:
     def narrow(threshold: Threshold) -> Growth:
         assert threshold.points is not None
         asked.append((threshold.points.nodes, threshold.points.share))
-        return Growth(1070, 150, Stop.NARROW)
+        return Growth(1070, 150, Stop.NARROW, share=40)
 
     t = THRESHOLDS[Command.VALIDATE]
     assert decide(Command.VALIDATE, "auto", estimate=t.size, growth=narrow).reason == \

@@ -85,9 +85,12 @@ DECISIONS = {
     ("wide", 4, ""): (Stop.NARROW, EngineChoice.EXPLICIT,
                       "auto: explicit (measured: 240 of the 1072 aggregated states met wait to be explored, not more "
                       "than 40 %)"),
-    ("par", 5, "timed"): (Stop.STEEP, EngineChoice.SYMBOLIC,
-                          "auto: symbolic (measured: 1109 of the 1826 aggregated states met wait to be explored, more "
-                          "than 40 %)"),
+    ("par", 5, "timed"): (Stop.STEEP, EngineChoice.SYMBOLIC,  # early: at 400 on the frontier path
+                          "auto: symbolic (measured: 506 of the 717 aggregated states met wait to be explored, more "
+                          "than 60 %)"),
+    ("par", 8, ""): (Stop.STEEP, EngineChoice.SYMBOLIC,
+                     "auto: symbolic (measured: 363 of the 536 aggregated states met wait to be explored, more than "
+                     "60 %)"),
     ("branches", 2, "timed"): (Stop.NARROW, EngineChoice.EXPLICIT,
                                "auto: explicit (measured: 230 of the 1167 aggregated states met wait to be explored, "
                                "not more than 40 %)"),
@@ -115,7 +118,8 @@ def test_auto_decides_on_the_watched_runs_counts(case, tmp_path, monkeypatch):
     assert runs == [0]
     share = POINTS.share if counts.machine is None else POINTS.machine_share
     if stop is Stop.STEEP:
-        assert done is None and counts.waiting * 100 > counts.met * share
+        assert done is None and counts.waiting * 100 > counts.met * counts.share
+        assert counts.share == (POINTS.early_share if counts.met < POINTS.nodes and counts.machine is None else share)
     else:
         assert done is not None and done.sync.sync_states > 0
         assert stop is Stop.RAN or counts.waiting * 100 <= counts.met * share
@@ -139,7 +143,7 @@ def test_where_the_symbolic_engine_explores_per_situation_the_share_must_be_high
     asked is the per-situation one: 70 % keeps the explicit engine (the run went on), 45 %
     does not."""
     rs, p, g = model("par", 3, tmp_path, "timed")
-    kept = engines.Threshold(1, "", Points(200, 200, 40, 30, 70))
+    kept = engines.Threshold(1, "", Points(200, 200, 40, 30, 70, 100))
     assert kept.points is not None
     counts, done = measure(rs, p, g, kept.points)
     assert (counts.stop, counts.per_situation, counts.met, counts.waiting) == (Stop.NARROW, True, 213, 99)
@@ -147,7 +151,7 @@ def test_where_the_symbolic_engine_explores_per_situation_the_share_must_be_high
     assert measured(counts, kept).reason == (
         "auto: explicit (measured: 99 of the 213 aggregated states met wait to be explored, more than 40 % but not "
         "more than 70 % as exploring per stable situation needs)")
-    counts, done = measure(rs, p, g, Points(200, 200, 40, 30, 45))
+    counts, done = measure(rs, p, g, Points(200, 200, 40, 30, 45, 100))
     assert (counts.stop, counts.per_situation, done) == (Stop.STEEP, False, None)
 
 
@@ -207,7 +211,7 @@ def test_the_share_decides_exactly_at_the_decision_point(tmp_path):
     steep for a share of 23 %, narrow for 24 %; a decision point past SYNC's 2 913 aggregated
     states: explored whole."""
     rs, p, g = model("par", 6, tmp_path)
-    at = [measure(rs, p, g, Points(1000, 400, share, 30, 50))[0] for share in (23, 24)]
+    at = [measure(rs, p, g, Points(1000, 400, share, 30, 50, 100))[0] for share in (23, 24)]
     assert [(c.stop, c.met, c.waiting) for c in at] == [(Stop.STEEP, 1119, 258), (Stop.NARROW, 1119, 258)]
-    whole = measure(rs, p, g, Points(3000, 400, 0, 30, 50))[0]
+    whole = measure(rs, p, g, Points(3000, 400, 0, 30, 50, 100))[0]
     assert (whole.stop, whole.met, whole.sync_states) == (Stop.RAN, 2913, 9492)
