@@ -12,9 +12,9 @@ Everything that decides is here, in three tables and one function:
 
   - ``validate``: plant states × Grafcet steps above 10^5, then *measured* (counts, never
     time): the explicit engine runs, watched (:func:`synth.probe.measure`); at
-    :data:`PROBE_NODES` aggregated states met (:data:`PROBE_MACHINE_NODES` where it explores
-    state by state) it stops for the symbolic engine when more than :data:`PROBE_SHARE`
-    percent of them wait to be explored (SYNC grows steeply), else goes on, its result kept
+    :data:`PROBE_NODES` aggregated states met it stops for the symbolic engine when more
+    than :data:`PROBE_SHARE` percent of them wait to be explored (SYNC grows steeply;
+    :data:`PROBE_MACHINE_SHARE` state by state), else goes on, its result kept
     (the explicit engine pays per SYNC state, the symbolic one per layer: docs/symbolic.md,
     "auto");
   - ``sup``: plant states above 10^6;
@@ -63,8 +63,7 @@ if TYPE_CHECKING:  # pragma: no cover - the engines are imported once chosen
 
 __all__ = ["EngineChoice", "Command", "Need", "Capability", "CAPABILITIES", "Threshold", "THRESHOLDS", "Decision",
            "capability", "refuse", "refusal", "decide", "measured", "VALIDATE_THRESHOLD", "PROBE_NODES",
-           "PROBE_MACHINE_NODES", "PROBE_SHARE", "PROBE_MACHINE_SHARE", "PROBE_SITUATION_SHARE",
-           "PROBE_EARLY_SHARE", "SUP_THRESHOLD", "VERIFY_THRESHOLD", "validate",
+           "PROBE_SHARE", "PROBE_MACHINE_SHARE", "PROBE_SITUATION_SHARE", "SUP_THRESHOLD", "VERIFY_THRESHOLD", "validate",
            "validate_models", "SupRun", "supervisor"]
 
 
@@ -125,42 +124,33 @@ VALIDATE_THRESHOLD = 10**5
 """``validate --engine auto``: symbolic only when plant states × Grafcet steps exceed this
 (below, the explicit engine without a probe)."""
 
-PROBE_NODES = 1000
-"""``validate --engine auto``: the decision point on the explicit engine's frontier path
-(:mod:`synth.validation.frontier`, 14 to 27 µs per SYNC state): the aggregated states met
-when the run is judged, about 0.05 to 0.1 s of its time. A SYNC explored whole before it
-(the box sorting: 90 aggregated states; par_5: 969; branches_3x3: 2 385 is not) is the
-explicit engine's result, nothing else runs."""
+PROBE_NODES = 400
+"""``validate --engine auto``: the decision point, the aggregated states the explicit
+engine's watched run has met when it is judged: about 0.03 to 0.1 s of that engine's time
+on its frontier path (14 to 27 µs per SYNC state), 0.15 s state by state. A SYNC explored
+whole before it (the box sorting: 90 aggregated states; a line of 16 cylinders: 64; par_4:
+321) is the explicit engine's result, nothing else runs."""
 
-PROBE_MACHINE_NODES = 400
-"""``validate --engine auto``: the decision point where the explicit engine explores state
-by state (``frontier.reason``: stored actions, internal variables, plants of 2^40 codes or
-more), about 0.15 s at its 90 to 130 µs per SYNC state."""
-
-PROBE_SHARE = 40
+PROBE_SHARE = 45
 """``validate --engine auto``: symbolic when, at the decision point, more than this percent
 of the aggregated states met still wait to be expanded (SYNC grows steeply: each layer
-larger than all before it together). Measured at 1 000 aggregated states on the bench
-families: par_7 43, par_8 59, par_9 64, steep_6 49, par_5/6 with timers 61/76 (symbolic 2.6 to
-8 times faster); steep_5 36 (the engines within 1.2 of each other, whole commands),
-branches_5x2 34, branches_4x2 22, branches_3x3 14, three timed branches 20-21 (explicit 2
-to 3 times faster)."""
+about as large as all before it together). Measured there on the bench families: par_7 53,
+steep_6 55, par_8 68, par_9 72, par_5/6 with timers 71/76 (symbolic 1.5 to 8 times faster,
+whole commands); steep_5 49, par_6 45 (the engines within 1.2 of each other); branches_5x2
+38, branches_4x2 30, three timed branches 30, branches_3x3 20, par_5 22 (explicit up to 3
+times faster)."""
 
 PROBE_MACHINE_SHARE = 30
 """``validate --engine auto``: :data:`PROBE_SHARE` where the explicit engine explores state
-by state, about five times slower per state: the symbolic engine wins sooner."""
-
-PROBE_EARLY_SHARE = 60
-"""``validate --engine auto``: on the frontier path, symbolic already at
-:data:`PROBE_MACHINE_NODES` aggregated states when more than this percent of them wait
-(measured there: par_8 68, par_9 72, par_5/6 with timers 71/76; steep_6 55, par_7 53,
-steep_5 49, par_6 45 wait for the decision point; branches_5x2 37)."""
+by state (stored actions, internal variables, plants of 2^40 codes or more), about five
+times slower per state: the symbolic engine wins sooner (par_6 with an internal variable:
+53; par_5 22; branches_3x2 14)."""
 
 PROBE_SITUATION_SHARE = 50
 """``validate --engine auto``: where the symbolic engine would explore one stable situation
 at a time (timers, stored actions, internal variables), it pays per situation and wins only
 where SYNC grows more steeply still: more than this percent waiting (par_5 and par_6 with a
-1 s wait after each extension: 61 and 76)."""
+1 s wait after each extension: 71 and 76; three timed branches 30)."""
 
 SUP_THRESHOLD = 10**6
 """``sup --engine auto``: symbolic when the plant has more states than this."""
@@ -170,8 +160,7 @@ VERIFY_THRESHOLD = 2_000_000
 
 THRESHOLDS: dict[Command, Threshold] = {
     Command.VALIDATE: Threshold(VALIDATE_THRESHOLD, "plant states × Grafcet steps",
-                                Points(PROBE_NODES, PROBE_MACHINE_NODES, PROBE_SHARE, PROBE_MACHINE_SHARE,
-                                       PROBE_SITUATION_SHARE, PROBE_EARLY_SHARE)),
+                                Points(PROBE_NODES, PROBE_SHARE, PROBE_MACHINE_SHARE, PROBE_SITUATION_SHARE)),
     Command.SUP: Threshold(SUP_THRESHOLD),
     Command.FILTER_VERIFY: Threshold(VERIFY_THRESHOLD),
 }
@@ -254,10 +243,10 @@ def measured(g: Growth, t: Threshold) -> Decision:
 
     >>> from synth.probe import Growth, Stop
     >>> t = THRESHOLDS[Command.VALIDATE]
-    >>> measured(Growth(1438, 623, Stop.STEEP, share=40), t).reason
-    'auto: symbolic (measured: 623 of the 1438 aggregated states met wait to be explored, more than 40 %)'
-    >>> measured(Growth(1072, 236, Stop.NARROW, share=40), t).reason
-    'auto: explicit (measured: 236 of the 1072 aggregated states met wait to be explored, not more than 40 %)'
+    >>> measured(Growth(815, 432, Stop.STEEP, share=45), t).reason
+    'auto: symbolic (measured: 432 of the 815 aggregated states met wait to be explored, more than 45 %)'
+    >>> measured(Growth(628, 172, Stop.NARROW, share=45), t).reason
+    'auto: explicit (measured: 172 of the 628 aggregated states met wait to be explored, not more than 45 %)'
     >>> measured(Growth(90, 0, Stop.RAN, sync_states=150), t).reason
     'auto: explicit (measured: SYNC explored whole before the decision point, 90 aggregated states, 150 SYNC states)'
     """

@@ -10,14 +10,12 @@ each breadth-first frontier, expanded, the aggregated states met and those still
 
 - SYNC explored whole before the decision point: that run's result is the one kept
   (:attr:`Stop.RAN`); nothing runs twice and ``dd`` is never imported;
-- at the decision point (``nodes`` aggregated states met on the frontier path, fewer on the
-  state-by-state path, where the explicit engine is about five times slower per state:
-  :func:`synth.validation.frontier.reason` says which), the share of those met that still
-  wait says how steeply SYNC grows: above ``share`` percent the run stops and the symbolic
-  engine runs (:attr:`Stop.STEEP`); otherwise the same run goes on to the end and its
-  result is kept (:attr:`Stop.NARROW`): the explicit engine chosen has lost nothing. On
-  the frontier path a share above ``early_share`` stops the run already at the state-by-state
-  path's decision point (the steepest models: less explored for nothing).
+- at the decision point (``nodes`` aggregated states met), the share of those met that
+  still wait says how steeply SYNC grows: above ``share`` percent (``machine_share`` where
+  the explicit engine explores state by state, about five times slower per state:
+  :func:`synth.validation.frontier.reason` says so) the run stops and the symbolic engine
+  runs (:attr:`Stop.STEEP`); otherwise the same run goes on to the end and its result is
+  kept (:attr:`Stop.NARROW`): the explicit engine chosen has lost nothing.
 
 Counts only, never time: the same choice on every machine and every run. :mod:`synth.engines`
 holds the constants and words the reason.
@@ -27,7 +25,7 @@ Example
 >>> from synth.plant.composition import _plants
 >>> from synth.validation.result import load_model
 >>> rs, p, g = load_model(_plants("../grafcets/tri.g7"), _plants("tri.rules"))
->>> counts, done = measure(rs, p, g, Points(1000, 400, 40, 30, 50, 60))
+>>> counts, done = measure(rs, p, g, Points(400, 45, 30, 50))
 >>> counts.stop, counts.sync_states, done.sync.sync_states
 (<Stop.RAN: 'ran'>, 150, 150)
 """
@@ -60,19 +58,15 @@ class Stop(Enum):
 
 @dataclass(frozen=True)
 class Points:
-    """Where and on what the run is judged: after ``nodes`` aggregated states on the
-    frontier path (``machine_nodes`` on the state-by-state path), steep when more than
-    ``share`` percent of them wait (``machine_share`` on the state-by-state path;
-    ``situation_share`` where the symbolic engine would explore one stable situation at a
-    time: timers, stored actions, internal variables); on the frontier path, steep already
-    after ``machine_nodes`` when more than ``early_share`` percent wait."""
+    """Where and on what the run is judged: after ``nodes`` aggregated states, steep when
+    more than ``share`` percent of them wait (``machine_share`` where the explicit engine
+    explores state by state; ``situation_share`` where the symbolic engine would explore one
+    stable situation at a time: timers, stored actions, internal variables)."""
 
     nodes: int
-    machine_nodes: int
     share: int
     machine_share: int
     situation_share: int
-    early_share: int
 
 
 @dataclass(frozen=True)
@@ -116,22 +110,15 @@ class _Watch:
 
     def __call__(self, met: int, waiting: int) -> None:
         self.last = (met, waiting)
-        pt = self.points
-        if self.growth is not None or met < pt.machine_nodes:
+        if self.growth is not None or met < self.points.nodes:
             return
-        why = self.machine()
-        if why is None and met < pt.nodes:
-            early = self.judged(met, waiting, why, pt.early_share)
-            if early.stop is Stop.STEEP:
-                self.growth = early
-                raise _Steep
-            return
-        self.judge(met, waiting, why)
+        self.judge(met, waiting)
         if self.growth is not None and self.growth.stop is Stop.STEEP:
             raise _Steep
 
-    def judge(self, met: int, waiting: int, why: str | None) -> None:
+    def judge(self, met: int, waiting: int) -> None:
         """Decide on the counts at the decision point."""
+        why = self.machine()
         self.growth = self.judged(met, waiting, why, self.points.share if why is None else self.points.machine_share)
 
     def judged(self, met: int, waiting: int, why: str | None, share: int) -> Growth:
@@ -170,7 +157,7 @@ def measure(rs: RuleSet, p: Plant, g: Grafcet, points: Points, *, expert: bool =
         return Growth(*watch.last, Stop.ERROR), None
     except LimitExceeded:
         if watch.growth is None:
-            watch.judge(*watch.last, watch.machine())
+            watch.judge(*watch.last)
         assert watch.growth is not None
         if watch.growth.stop is Stop.STEEP:
             return watch.growth, None

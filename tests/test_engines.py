@@ -135,17 +135,17 @@ def test_auto_reads_the_threshold_table_and_says_why() -> None:
     def narrow(threshold: Threshold) -> Growth:
         assert threshold.points is not None
         asked.append((threshold.points.nodes, threshold.points.share))
-        return Growth(1070, 150, Stop.NARROW, share=40)
+        return Growth(448, 91, Stop.NARROW, share=45)
 
     t = THRESHOLDS[Command.VALIDATE]
     assert decide(Command.VALIDATE, "auto", estimate=t.size, growth=narrow).reason == \
         f"auto: {t.size} {t.estimate}, not above {t.size}"
     assert asked == []  # below the size, no probe
     chosen = decide(Command.VALIDATE, "auto", estimate=10**9, growth=narrow)
-    assert asked == [(PROBE_NODES, PROBE_SHARE)] == [(1000, 40)]
+    assert asked == [(PROBE_NODES, PROBE_SHARE)] == [(400, 45)]
     assert (chosen.engine, chosen.measured) == (EngineChoice.EXPLICIT, True)
     assert chosen.reason == \
-        "auto: explicit (measured: 150 of the 1070 aggregated states met wait to be explored, not more than 40 %)"
+        "auto: explicit (measured: 91 of the 448 aggregated states met wait to be explored, not more than 45 %)"
     assert decide(Command.VALIDATE, "explicit", estimate=10**9, growth=narrow).reason == "--engine explicit"
     assert decide(Command.VALIDATE, "auto", {Need.SFC}, estimate=10**9, growth=narrow).engine is EngineChoice.EXPLICIT
     assert len(asked) == 1  # a forced engine or an unserved need asks no probe

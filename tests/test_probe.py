@@ -64,36 +64,33 @@ def explored(monkeypatch: pytest.MonkeyPatch) -> list[int]:
 
 # (family, n, variant) -> how the watched run ended, the engine and the reason
 DECISIONS = {
-    ("par", 5, ""): (Stop.RAN, EngineChoice.EXPLICIT,
-                     "auto: explicit (measured: SYNC explored whole before the decision point, 969 aggregated states, "
-                     "2907 SYNC states)"),
+    ("par", 4, ""): (Stop.RAN, EngineChoice.EXPLICIT,
+                     "auto: explicit (measured: SYNC explored whole before the decision point, 321 aggregated states, "
+                     "882 SYNC states)"),
     ("par", 6, ""): (Stop.NARROW, EngineChoice.EXPLICIT,
-                     "auto: explicit (measured: 258 of the 1119 aggregated states met wait to be explored, not more "
-                     "than 40 %)"),
+                     "auto: explicit (measured: 255 of the 573 aggregated states met wait to be explored, not more "
+                     "than 45 %)"),
     ("par", 7, ""): (Stop.STEEP, EngineChoice.SYMBOLIC,
-                     "auto: symbolic (measured: 623 of the 1438 aggregated states met wait to be explored, more than "
-                     "40 %)"),
-    ("steep", 5, "missing"): (Stop.NARROW, EngineChoice.EXPLICIT,
-                              "auto: explicit (measured: 433 of the 1291 aggregated states met wait to be explored, "
-                              "not more than 40 %)"),
-    ("steep", 6, ""): (Stop.STEEP, EngineChoice.SYMBOLIC,
-                       "auto: symbolic (measured: 836 of the 1697 aggregated states met wait to be explored, more "
-                       "than 40 %)"),
+                     "auto: symbolic (measured: 428 of the 815 aggregated states met wait to be explored, more than "
+                     "45 %)"),
+    ("steep", 4, ""): (Stop.NARROW, EngineChoice.EXPLICIT,
+                       "auto: explicit (measured: 160 of the 504 aggregated states met wait to be explored, not more "
+                       "than 45 %)"),
+    ("steep", 5, "missing"): (Stop.STEEP, EngineChoice.SYMBOLIC,
+                              "auto: symbolic (measured: 241 of the 515 aggregated states met wait to be explored, "
+                              "more than 45 %)"),
     ("branches", 3, ""): (Stop.NARROW, EngineChoice.EXPLICIT,
-                          "auto: explicit (measured: 150 of the 1070 aggregated states met wait to be explored, not "
-                          "more than 40 %)"),
+                          "auto: explicit (measured: 91 of the 448 aggregated states met wait to be explored, not "
+                          "more than 45 %)"),
     ("wide", 4, ""): (Stop.NARROW, EngineChoice.EXPLICIT,
-                      "auto: explicit (measured: 240 of the 1072 aggregated states met wait to be explored, not more "
-                      "than 40 %)"),
-    ("par", 5, "timed"): (Stop.STEEP, EngineChoice.SYMBOLIC,  # early: at 400 on the frontier path
+                      "auto: explicit (measured: 139 of the 456 aggregated states met wait to be explored, not more "
+                      "than 45 %)"),
+    ("par", 5, "timed"): (Stop.STEEP, EngineChoice.SYMBOLIC,
                           "auto: symbolic (measured: 506 of the 717 aggregated states met wait to be explored, more "
-                          "than 60 %)"),
-    ("par", 8, ""): (Stop.STEEP, EngineChoice.SYMBOLIC,
-                     "auto: symbolic (measured: 363 of the 536 aggregated states met wait to be explored, more than "
-                     "60 %)"),
+                          "than 45 %)"),
     ("branches", 2, "timed"): (Stop.NARROW, EngineChoice.EXPLICIT,
-                               "auto: explicit (measured: 230 of the 1167 aggregated states met wait to be explored, "
-                               "not more than 40 %)"),
+                               "auto: explicit (measured: 156 of the 527 aggregated states met wait to be explored, "
+                               "not more than 45 %)"),
     ("par", 5, "internal"): (Stop.NARROW, EngineChoice.EXPLICIT,
                              "auto: explicit (measured: 90 of the 400 aggregated states met wait to be explored, not "
                              "more than 30 %, state by state (internal variables))"),
@@ -118,8 +115,7 @@ def test_auto_decides_on_the_watched_runs_counts(case, tmp_path, monkeypatch):
     assert runs == [0]
     share = POINTS.share if counts.machine is None else POINTS.machine_share
     if stop is Stop.STEEP:
-        assert done is None and counts.waiting * 100 > counts.met * counts.share
-        assert counts.share == (POINTS.early_share if counts.met < POINTS.nodes and counts.machine is None else share)
+        assert done is None and counts.waiting * 100 > counts.met * share == counts.met * counts.share
     else:
         assert done is not None and done.sync.sync_states > 0
         assert stop is Stop.RAN or counts.waiting * 100 <= counts.met * share
@@ -143,7 +139,7 @@ def test_where_the_symbolic_engine_explores_per_situation_the_share_must_be_high
     asked is the per-situation one: 70 % keeps the explicit engine (the run went on), 45 %
     does not."""
     rs, p, g = model("par", 3, tmp_path, "timed")
-    kept = engines.Threshold(1, "", Points(200, 200, 40, 30, 70, 100))
+    kept = engines.Threshold(1, "", Points(200, 40, 30, 70))
     assert kept.points is not None
     counts, done = measure(rs, p, g, kept.points)
     assert (counts.stop, counts.per_situation, counts.met, counts.waiting) == (Stop.NARROW, True, 213, 99)
@@ -151,7 +147,7 @@ def test_where_the_symbolic_engine_explores_per_situation_the_share_must_be_high
     assert measured(counts, kept).reason == (
         "auto: explicit (measured: 99 of the 213 aggregated states met wait to be explored, more than 40 % but not "
         "more than 70 % as exploring per stable situation needs)")
-    counts, done = measure(rs, p, g, Points(200, 200, 40, 30, 45, 100))
+    counts, done = measure(rs, p, g, Points(200, 40, 30, 45))
     assert (counts.stop, counts.per_situation, done) == (Stop.STEEP, False, None)
 
 
@@ -160,11 +156,11 @@ def test_a_limit_met_before_the_decision_point_is_judged_there(tmp_path):
     steep, the symbolic engine runs (it has no such bound), narrow, the explicit engine's
     limit is the error."""
     rs, p, g = model("par", 7, tmp_path)
-    counts, done = measure(rs, p, g, POINTS, max_states=600)
-    assert (counts.stop, counts.met, counts.waiting, done) == (Stop.STEEP, 387, 239, None)
+    counts, done = measure(rs, p, g, POINTS, max_states=300)
+    assert (counts.stop, counts.met, counts.waiting, done) == (Stop.STEEP, 148, 106, None)
     rs, p, g = model("branches", 3, tmp_path)
-    with pytest.raises(LimitExceeded, match="more than 600 aggregated states"):
-        measure(rs, p, g, POINTS, max_states=600)
+    with pytest.raises(LimitExceeded, match="more than 300 aggregated states"):
+        measure(rs, p, g, POINTS, max_states=300)
 
 
 def test_an_assignment_out_of_range_stops_the_run_and_the_explicit_engine_says_where(tmp_path):
@@ -194,11 +190,10 @@ def test_a_small_sync_is_explored_once_by_the_explicit_engine_and_kept(monkeypat
 
 
 def test_auto_runs_the_engine_it_chose_and_says_why_on_stderr(cli, tmp_path):
-    rules, _, g7 = write_steep(6, tmp_path)
+    rules, _, g7 = write_steep(5, tmp_path)
     code, out, err = cli("validate", g7, "--plant", rules)
     assert code == 1
-    assert err.splitlines()[0] == ("auto: symbolic (measured: 743 of the 1559 aggregated states met wait to be "
-                                   "explored, more than 40 %)")
+    assert err.splitlines()[0] == DECISIONS[("steep", 5, "missing")][2]
     assert err.splitlines()[1].startswith("symbolic engine: ") and len(err.splitlines()) == 2
     assert cli("validate", g7, "--plant", rules, "--engine", "symbolic", "--quiet") == (1, out, "")
     rules, g7, _ = write_par(6, tmp_path)  # the explicit engine: nothing more said, as before
@@ -211,7 +206,7 @@ def test_the_share_decides_exactly_at_the_decision_point(tmp_path):
     steep for a share of 23 %, narrow for 24 %; a decision point past SYNC's 2 913 aggregated
     states: explored whole."""
     rs, p, g = model("par", 6, tmp_path)
-    at = [measure(rs, p, g, Points(1000, 400, share, 30, 50, 100))[0] for share in (23, 24)]
+    at = [measure(rs, p, g, Points(1000, share, 30, 50))[0] for share in (23, 24)]
     assert [(c.stop, c.met, c.waiting) for c in at] == [(Stop.STEEP, 1119, 258), (Stop.NARROW, 1119, 258)]
-    whole = measure(rs, p, g, Points(3000, 400, 0, 30, 50, 100))[0]
+    whole = measure(rs, p, g, Points(3000, 0, 30, 50))[0]
     assert (whole.stop, whole.met, whole.sync_states) == (Stop.RAN, 2913, 9492)
