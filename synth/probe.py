@@ -101,6 +101,7 @@ class _Watch:
         self.last = (0, 0)
 
     def machine(self) -> str | None:
+        """Why the explicit engine explores this model state by state (None: a frontier at a time)."""
         if self.path is None:
             from synth.grafcet.machine import GrafcetMachine
             from synth.validation.frontier import reason
@@ -122,6 +123,8 @@ class _Watch:
         self.growth = self.judged(met, waiting, why, self.points.share if why is None else self.points.machine_share)
 
     def judged(self, met: int, waiting: int, why: str | None, share: int) -> Growth:
+        """Steep when more than ``share`` percent of ``met`` wait (and, where the symbolic
+        engine would explore per stable situation, more than its own share)."""
         if 100 * waiting <= share * met:
             return Growth(met, waiting, Stop.NARROW, why, share=share)
         if 100 * waiting <= self.points.situation_share * met:
