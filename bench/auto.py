@@ -1,7 +1,7 @@
 """``validate --engine auto`` against the faster of the two engines, on every family of ``bench/``.
 
-    python3 bench/auto.py [--par 3..7] [--steep 3..6] [--line 8,16] [--wide 2..5] [--branches 2..8]
-                          [--timed-par 5,6] [--timed-branches 2..3] [--missing] [--runs 2]
+    python3 bench/auto.py [--par 3..9] [--steep 3..6] [--line 8,16] [--wide 2..5] [--branches 2..8]
+                          [--timed-par 5,6] [--timed-branches 2..3] [--internal-par 5..7] [--missing] [--runs 2]
                           [--budget 60] [--before DIR] [--json FILE]
 
 Families (each written by its generator into a temporary folder):
@@ -16,6 +16,8 @@ Families (each written by its generator into a temporary folder):
 - ``par_N_timed`` and ``branches_3xM_timed`` (gen_branches.with_timers: each extension
   waits 1 s once out): the symbolic engine explores them one stable situation at a time,
   and wins on the first (its situations hold many states) but not on the second;
+- ``par_N_internal`` (gen_par.py with an internal variable the Grafcet never uses): the
+  explicit engine explores it state by state (no frontier path), about five times slower;
 - the bundled Grafcets with their plants (``grafcets/tri*.g7``, ``four_cylinders.g7``).
 
 Each case runs ``synth validate`` with ``--engine explicit``, ``--engine symbolic`` and
@@ -35,7 +37,7 @@ import json
 import sys
 import tempfile
 from pathlib import Path
-from typing import Iterator
+from typing import Callable, Iterator
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "bench"))
@@ -65,7 +67,8 @@ def cases(args: argparse.Namespace, d: Path) -> Iterator[tuple[str, str, Path, P
                 ("branches", _range(args.branches), lambda m: write_branches(3, m, d), "branches_3x{}"),
                 ("timed par", _range(args.timed_par), lambda n: timed(write_par(n, d)), "par_{}_timed"),
                 ("timed branches", _range(args.timed_branches), lambda m: timed(write_branches(3, m, d)),
-                 "branches_3x{}_timed")]
+                 "branches_3x{}_timed"),
+                ("internal par", _range(args.internal_par), lambda n: internal(write_par(n, d)), "par_{}_internal")]
     for family, sizes, write, name in families:
         for n in sizes:
             rules, g7, missing = write(n)
@@ -74,15 +77,25 @@ def cases(args: argparse.Namespace, d: Path) -> Iterator[tuple[str, str, Path, P
                 yield family, name.format(n) + "_missing", Path(missing), Path(rules)
 
 
-def timed(paths: tuple[Path, Path, Path]) -> tuple[Path, Path, Path]:
-    """The generator's files with the Grafcets' timed variants (gen_branches.with_timers) beside them."""
+def variant(paths: tuple[Path, Path, Path], suffix: str, change: Callable[[str], str]) -> tuple[Path, Path, Path]:
+    """The generator's files with the Grafcets' variants ``change(text)`` beside them (``_suffix.g7``)."""
     rules, *grafcets = paths
     out = []
     for g7 in grafcets:
-        t = g7.with_name(g7.stem + "_timed.g7")
-        t.write_text(with_timers(g7.read_text(encoding="utf-8")), encoding="utf-8")
+        t = g7.with_name(f"{g7.stem}_{suffix}.g7")
+        t.write_text(change(g7.read_text(encoding="utf-8")), encoding="utf-8")
         out.append(t)
     return rules, out[0], out[1]
+
+
+def timed(paths: tuple[Path, Path, Path]) -> tuple[Path, Path, Path]:
+    """Each extension waits 1 s once out (gen_branches.with_timers)."""
+    return variant(paths, "timed", with_timers)
+
+
+def internal(paths: tuple[Path, Path, Path]) -> tuple[Path, Path, Path]:
+    """An internal variable declared that no step uses: the explicit engine explores state by state."""
+    return variant(paths, "internal", lambda text: text.replace("\ngrafcet ", "\ninternal k : 0..1 = 0\n\ngrafcet ", 1))
 
 
 def _chose(res: dict) -> str:
@@ -92,13 +105,14 @@ def _chose(res: dict) -> str:
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--par", default="3..7")
+    ap.add_argument("--par", default="3..9")
     ap.add_argument("--steep", default="3..6")
     ap.add_argument("--line", default="8,16")
     ap.add_argument("--wide", default="2..5", help="K for branches_Kx2")
     ap.add_argument("--branches", default="2..8", help="M for branches_3xM")
     ap.add_argument("--timed-par", default="5,6", help="N for par_N_timed (every extension waits 1 s)")
     ap.add_argument("--timed-branches", default="2..3", help="M for branches_3xM_timed")
+    ap.add_argument("--internal-par", default="5..7", help="N for par_N_internal (explored state by state)")
     ap.add_argument("--missing", action="store_true", help="also each family's _missing variant")
     ap.add_argument("--runs", type=int, default=2)
     ap.add_argument("--budget", type=float, default=60.0, help="CPU seconds per run")

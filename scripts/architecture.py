@@ -27,7 +27,7 @@ PACKAGES = {
     "grafcet": (".g7 language, IEC 60848 machine, ASS", "Grafcet, GrafcetMachine, ASS"),
     "validation": ("SYNC, analysis, diagnosis", "Validation"),
     "symbolic": ("BDD engine for SUP and validation", "same results, symbolically"),
-    "probe": ("auto's bounded probe: SYNC's first layers, counted", "Growth"),
+    "probe": ("auto's measure: the explicit run watched, its growth counted", "Growth"),
     "engines": ("the one engine chooser: capabilities, thresholds", "the engine that runs"),
     "filter": ("safety logic filter: check, solve, verify", "equations, filter FB"),
     "codegen": ("IEC 61131-3 ST, PLCopen XML, ST interpreter", "program, proof"),

@@ -11,10 +11,12 @@ Everything that decides is here, in three tables and one function:
 - :data:`THRESHOLDS`: ``auto``'s estimate, per command, above which the symbolic engine runs:
 
   - ``validate``: plant states × Grafcet steps above 10^5, then *measured* (counts, never
-    time): the explicit engine within :data:`PROBE_NODES` aggregated states, else the probe
-    (:func:`synth.probe.probe`): symbolic when a breadth-first layer of SYNC holds more than
-    :data:`PROBE_LAYER` states within :data:`PROBE_BUDGET` (the explicit engine pays per
-    SYNC state, the symbolic one per layer: docs/symbolic.md, "auto");
+    time): the explicit engine runs, watched (:func:`synth.probe.measure`); at
+    :data:`PROBE_NODES` aggregated states met it stops for the symbolic engine when more
+    than :data:`PROBE_SHARE` percent of them wait to be explored (SYNC grows steeply;
+    :data:`PROBE_MACHINE_SHARE` state by state), else goes on, its result kept
+    (the explicit engine pays per SYNC state, the symbolic one per layer: docs/symbolic.md,
+    "auto");
   - ``sup``: plant states above 10^6;
   - ``filter verify``: plant states above 2·10^6 (the explicit closed loop pays per node it
     explores, the symbolic one per level).
@@ -30,8 +32,8 @@ Example
 -------
 >>> from synth.probe import Growth, Stop
 >>> decide(Command.VALIDATE, EngineChoice.AUTO, estimate=10**8,
-...        growth=lambda threshold: Growth((1, 16, 5, 18, 42, 71, 87, 78), Stop.DONE)).reason
-'auto: explicit (measured: SYNC has 318 states, its widest breadth-first layer 87, not above 250)'
+...        growth=lambda threshold: Growth(1167, 395, Stop.STEEP, "input x is not a plant variable", share=30)).reason
+'auto: symbolic (measured: 395 of the 1167 aggregated states met wait to be explored, more than 30 %, state by state (input x is not a plant variable))'
 >>> decide(Command.VALIDATE, EngineChoice.AUTO, estimate=10**4).reason
 'auto: 10000 plant states × Grafcet steps, not above 100000'
 >>> decide(Command.VALIDATE, EngineChoice.AUTO, {Need.LISTING}, estimate=10**8).reason
@@ -47,6 +49,7 @@ from typing import TYPE_CHECKING, Callable, Collection, Sequence
 
 from synth.choices import EngineChoice
 from synth.errors import InputError, LimitExceeded, Location, SynthError
+from synth.probe import Points
 
 if TYPE_CHECKING:  # pragma: no cover - the engines are imported once chosen
     from synth.grafcet.language import Grafcet, Semantics
@@ -59,8 +62,8 @@ if TYPE_CHECKING:  # pragma: no cover - the engines are imported once chosen
     from synth.validation.result import Validation
 
 __all__ = ["EngineChoice", "Command", "Need", "Capability", "CAPABILITIES", "Threshold", "THRESHOLDS", "Decision",
-           "capability", "refuse", "refusal", "decide", "measured", "VALIDATE_THRESHOLD", "PROBE_LAYER",
-           "PROBE_BUDGET", "PROBE_NODES", "PROBE_STEEP", "SUP_THRESHOLD", "VERIFY_THRESHOLD", "validate",
+           "capability", "refuse", "refusal", "decide", "measured", "VALIDATE_THRESHOLD", "PROBE_NODES",
+           "PROBE_SHARE", "PROBE_MACHINE_SHARE", "PROBE_SITUATION_SHARE", "SUP_THRESHOLD", "VERIFY_THRESHOLD", "validate",
            "validate_models", "SupRun", "supervisor"]
 
 
@@ -108,47 +111,46 @@ other (its cycle encodes their guards)."""
 
 @dataclass(frozen=True)
 class Threshold:
-    """``auto`` runs the symbolic engine when the estimate exceeds ``size``; where ``layer``
-    is set (``validate``), only when the explicit engine does not end within ``nodes``
-    aggregated states and the probe, given ``budget`` SYNC states, meets a breadth-first
-    layer of more than ``layer`` SYNC states (within ``steep`` of them when the symbolic
-    engine would explore one stable situation at a time)."""
+    """``auto`` runs the symbolic engine when the estimate exceeds ``size``; where
+    ``points`` is set (``validate``), only when the explicit engine's own run, watched
+    (:func:`synth.probe.measure`), finds SYNC growing steeply at its decision point."""
 
     size: int
     estimate: str = "plant states"
-    layer: int = 0
-    budget: int = 0
-    nodes: int = 0
-    steep: int = 0
+    points: Points | None = None
 
 
 VALIDATE_THRESHOLD = 10**5
 """``validate --engine auto``: symbolic only when plant states × Grafcet steps exceed this
 (below, the explicit engine without a probe)."""
 
-PROBE_LAYER = 250
-"""``validate --engine auto``: symbolic when a breadth-first layer of SYNC holds more than
-this many SYNC states. Where the explicit engine pays about as much for a layer as the
-symbolic one: measured with this explicit engine's cost per SYNC state (about 100 µs); an
-explicit engine k times faster per state moves it about k times up."""
+PROBE_NODES = 400
+"""``validate --engine auto``: the decision point, the aggregated states the explicit
+engine's watched run has met when it is judged: about 0.03 to 0.1 s of that engine's time
+on its frontier path (14 to 27 µs per SYNC state), 0.15 s state by state. A SYNC explored
+whole before it (the box sorting: 90 aggregated states; a line of 16 cylinders: 64; par_4:
+321) is the explicit engine's result, nothing else runs."""
 
-PROBE_NODES = 100
-"""``validate --engine auto``: the explicit engine runs first within this many aggregated
-states (the box-sorting Grafcets' SYNC: 30 to 90; the lines of bench/gen_line.py: 32 at 8
-cylinders, 48 at 12); when it ends there its result is the one kept and nothing else runs.
-It scales with :data:`PROBE_LAYER` (about 15 to 40 ms of this explicit engine's time)."""
+PROBE_SHARE = 45
+"""``validate --engine auto``: symbolic when, at the decision point, more than this percent
+of the aggregated states met still wait to be expanded (SYNC grows steeply: each layer
+about as large as all before it together). Measured there on the bench families: par_7 53,
+steep_6 55, par_8 68, par_9 72, par_5/6 with timers 71/76 (symbolic 1.5 to 8 times faster,
+whole commands); steep_5 49, par_6 45 (the engines within 1.2 of each other); branches_5x2
+38, branches_4x2 30, three timed branches 30, branches_3x3 20, par_5 22 (explicit up to 3
+times faster)."""
 
-PROBE_STEEP = 800
+PROBE_MACHINE_SHARE = 30
+"""``validate --engine auto``: :data:`PROBE_SHARE` where the explicit engine explores state
+by state (stored actions, internal variables, plants of 2^40 codes or more), about five
+times slower per state: the symbolic engine wins sooner (par_6 with an internal variable:
+53; par_5 22; branches_3x2 14)."""
+
+PROBE_SITUATION_SHARE = 50
 """``validate --engine auto``: where the symbolic engine would explore one stable situation
-at a time (timers, stored actions, …), it pays per situation and wins only where SYNC grows
-steeply: the first layer above :data:`PROBE_LAYER` within this many SYNC states."""
-
-PROBE_BUDGET = 1300
-"""``validate --engine auto``: the SYNC states the probe explores at most, about 0.1 s of
-the explicit engine's time. Large enough to meet the first layer above :data:`PROBE_LAYER`
-on every bench family that has one (branches × sequence: after 1 006 to 1 253 states), small
-enough that a probe that ends in the explicit engine costs it little; it scales with
-:data:`PROBE_LAYER`."""
+at a time (timers, stored actions, internal variables), it pays per situation and wins only
+where SYNC grows more steeply still: more than this percent waiting (par_5 and par_6 with a
+1 s wait after each extension: 71 and 76; three timed branches 30)."""
 
 SUP_THRESHOLD = 10**6
 """``sup --engine auto``: symbolic when the plant has more states than this."""
@@ -157,8 +159,8 @@ VERIFY_THRESHOLD = 2_000_000
 """``filter verify --engine auto``: symbolic when the plant has more states than this."""
 
 THRESHOLDS: dict[Command, Threshold] = {
-    Command.VALIDATE: Threshold(VALIDATE_THRESHOLD, "plant states × Grafcet steps", PROBE_LAYER, PROBE_BUDGET,
-                                PROBE_NODES, PROBE_STEEP),
+    Command.VALIDATE: Threshold(VALIDATE_THRESHOLD, "plant states × Grafcet steps",
+                                Points(PROBE_NODES, PROBE_SHARE, PROBE_MACHINE_SHARE, PROBE_SITUATION_SHARE)),
     Command.SUP: Threshold(SUP_THRESHOLD),
     Command.FILTER_VERIFY: Threshold(VERIFY_THRESHOLD),
 }
@@ -216,8 +218,8 @@ def decide(command: Command, asked: EngineChoice | str, needs: Collection[Need] 
            reads_at: Location | None = None) -> Decision:
     """The engine that runs ``command`` asked with ``--engine asked`` for a run with
     ``needs`` (:attr:`Need.READS` added when ``readers`` is not empty), ``auto``'s
-    ``estimate`` and, where the threshold has a ``layer``, ``growth(threshold)``: what the
-    bounded explicit run or the probe measured, asked for only when the estimate is above
+    ``estimate`` and, where the threshold has ``points``, ``growth(threshold)``: what the
+    explicit engine's watched run measured, asked for only when the estimate is above
     the threshold's size (see the module docstring; without ``growth``, the estimate alone)."""
     asked = EngineChoice(asked)
     needs = set(needs) | ({Need.READS} if readers else set())
@@ -230,7 +232,7 @@ def decide(command: Command, asked: EngineChoice | str, needs: Collection[Need] 
     t = THRESHOLDS[command]
     if estimate <= t.size:
         return Decision(EngineChoice.EXPLICIT, f"auto: {estimate} {t.estimate}, not above {t.size}")
-    if t.layer and growth is not None:
+    if t.points is not None and growth is not None:
         return measured(growth(t), t)
     return Decision(EngineChoice.SYMBOLIC, f"auto: {estimate} {t.estimate}, above {t.size}")
 
@@ -241,35 +243,33 @@ def measured(g: Growth, t: Threshold) -> Decision:
 
     >>> from synth.probe import Growth, Stop
     >>> t = THRESHOLDS[Command.VALIDATE]
-    >>> measured(Growth((1, 64, 7, 33, 107, 261), Stop.WIDE), t).reason
-    'auto: symbolic (measured: breadth-first layer 5 of SYNC holds more than 250 states, after 473 states)'
-    >>> measured(Growth((1, 5, 5, 13, 19, 40, 50, 52, 77, 118, 166, 209, 198, 170), Stop.BUDGET), t).reason
-    'auto: explicit (measured: 1123 SYNC states in 14 breadth-first layers, none above 250)'
-    >>> measured(Growth((150,), Stop.RAN), t).reason
-    'auto: explicit (measured: SYNC explored whole within 100 aggregated states, 150 SYNC states)'
+    >>> measured(Growth(815, 432, Stop.STEEP, share=45), t).reason
+    'auto: symbolic (measured: 432 of the 815 aggregated states met wait to be explored, more than 45 %)'
+    >>> measured(Growth(628, 172, Stop.NARROW, share=45), t).reason
+    'auto: explicit (measured: 172 of the 628 aggregated states met wait to be explored, not more than 45 %)'
+    >>> measured(Growth(90, 0, Stop.RAN, sync_states=150), t).reason
+    'auto: explicit (measured: SYNC explored whole before the decision point, 90 aggregated states, 150 SYNC states)'
     """
     from synth.probe import Stop
 
-    layer = t.layer
+    pt = t.points
+    assert pt is not None
     if g.stop is Stop.RAN:
-        return Decision(EngineChoice.EXPLICIT, f"auto: explicit (measured: SYNC explored whole within {t.nodes} "
-                                               f"aggregated states, {g.states} SYNC states)", True)
-
-    if g.stop is Stop.WIDE and g.per_situation:
-        return Decision(EngineChoice.EXPLICIT, f"auto: explicit (measured: breadth-first layer {len(g.layers) - 1} "
-                                               f"of SYNC holds more than {layer} states after {g.states} states, not "
-                                               f"within {t.steep} as exploring per stable situation needs)", True)
-    if g.stop is Stop.WIDE:
-        return Decision(EngineChoice.SYMBOLIC, f"auto: symbolic (measured: breadth-first layer {len(g.layers) - 1} of "
-                                               f"SYNC holds more than {layer} states, after {g.states} states)", True)
-    if g.stop is Stop.DONE:
-        return Decision(EngineChoice.EXPLICIT, f"auto: explicit (measured: SYNC has {g.states} states, its widest "
-                                               f"breadth-first layer {g.widest}, not above {layer})", True)
+        return Decision(EngineChoice.EXPLICIT, f"auto: explicit (measured: SYNC explored whole before the decision "
+                                               f"point, {g.met} aggregated states, {g.sync_states} SYNC states)", True)
     if g.stop is Stop.ERROR:
         return Decision(EngineChoice.EXPLICIT, f"auto: explicit (measured: an internal variable out of range after "
-                                               f"{g.states} SYNC states)", True)
-    return Decision(EngineChoice.EXPLICIT, f"auto: explicit (measured: {g.states} SYNC states in {len(g.layers)} "
-                                           f"breadth-first layers, none above {layer})", True)
+                                               f"{g.met} aggregated states)", True)
+    share = g.share
+    counts = f"{g.waiting} of the {g.met} aggregated states met wait to be explored"
+    path = "" if g.machine is None else f", state by state ({g.machine})"
+    if g.stop is Stop.STEEP:
+        return Decision(EngineChoice.SYMBOLIC, f"auto: symbolic (measured: {counts}, more than {share} %{path})", True)
+    if g.per_situation:
+        return Decision(EngineChoice.EXPLICIT, f"auto: explicit (measured: {counts}, more than {share} % but not more "
+                                               f"than {pt.situation_share} % as exploring per stable situation needs"
+                                               f"{path})", True)
+    return Decision(EngineChoice.EXPLICIT, f"auto: explicit (measured: {counts}, not more than {share} %{path})", True)
 
 
 def validate(
@@ -328,13 +328,19 @@ def validate_models(
 
     from synth.validation.validate import validate_loaded
 
+    explored = None
+    if progress is not None:
+        def explored(n: int, pending: int, show: Callable[[str], None] = progress) -> None:
+            show(f"exploring SYNC: {n} aggregated states, {pending} to visit")
+
     ran: list[Validation] = []
 
     def growth(t: Threshold) -> Growth:
         from synth.probe import measure
 
-        counts, done = measure(rs, p, g, (t.nodes, t.budget, t.layer, t.steep), expert=expert, homes=homes,
-                               max_states=max_states)
+        assert t.points is not None
+        counts, done = measure(rs, p, g, t.points, expert=expert, homes=homes, max_states=max_states,
+                               progress=explored)
         ran.extend([done] if done is not None else [])
         return counts
 
@@ -353,11 +359,6 @@ def validate_models(
         except OutOfRange:  # the explicit engine says it with the shortest trace
             validate_loaded(rs, p, g, expert=expert, homes=homes, max_states=max_states)
             raise
-    explored = None
-    if progress is not None:
-        def explored(n: int, pending: int, show: Callable[[str], None] = progress) -> None:
-            show(f"exploring SYNC: {n} aggregated states, {pending} to visit")
-
     return validate_loaded(rs, p, g, expert=expert, homes=homes, max_states=max_states, progress=explored)
 
 

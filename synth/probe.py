@@ -1,164 +1,170 @@
-"""``validate --engine auto``'s probe: the first SYNC states of the explicit exploration,
-counted breadth-first layer by layer, within a budget.
+"""``validate --engine auto``'s measure: the explicit engine's own run, watched.
 
 The explicit engine pays per SYNC state (a plant state of SUP paired with a stable
 situation, docs/method.md); the symbolic one per breadth-first level and per BDD node,
-whatever the number of states a level holds. Which one is faster thus depends on how many
-SYNC states there are, which no count read off the inputs tells (plant states × steps
-overestimates by orders of magnitude, and the Grafcet's concurrency says how wide a region
-is, not how many situations follow each other). The probe measures it: it explores SYNC as
-the explicit engine does (:func:`synth.validation.sync.region` for each situation's
-region, the plant's uncontrollable moves and the timers between regions, breadth-first
-over the aggregated states) and stops once it has met ``budget`` SYNC states. It keeps
-counts only: the SYNC states of each complete layer, the states met in all, whether the
-exploration ended within the budget. :mod:`synth.engines` decides on those counts
-(never on time, so the choice is the same on every machine and every run).
+whatever the number of states a level holds. Which one is faster depends on how SYNC
+grows, which no count read off the inputs tells (plant states × steps overestimates by
+orders of magnitude). So ``auto`` starts the explicit engine itself and watches its
+exploration (:func:`synth.validation.validate.explore`'s ``watch``: after each state, or
+each breadth-first frontier, expanded, the aggregated states met and those still waiting):
+
+- SYNC explored whole before the decision point: that run's result is the one kept
+  (:attr:`Stop.RAN`); nothing runs twice and ``dd`` is never imported;
+- at the decision point (``nodes`` aggregated states met), the share of those met that
+  still wait says how steeply SYNC grows: above ``share`` percent (``machine_share`` where
+  the explicit engine explores state by state, about five times slower per state:
+  :func:`synth.validation.frontier.reason` says so) the run stops and the symbolic engine
+  runs (:attr:`Stop.STEEP`); otherwise the same run goes on to the end and its result is
+  kept (:attr:`Stop.NARROW`): the explicit engine chosen has lost nothing.
+
+Counts only, never time: the same choice on every machine and every run. :mod:`synth.engines`
+holds the constants and words the reason.
 
 Example
 -------
 >>> from synth.plant.composition import _plants
 >>> from synth.validation.result import load_model
 >>> rs, p, g = load_model(_plants("../grafcets/tri.g7"), _plants("tri.rules"))
->>> g1 = probe(p, rs.constraints, g, budget=10_000)
->>> g1.stop, g1.states, g1.widest
-(<Stop.DONE: 'done'>, 150, 15)
->>> g2 = probe(p, rs.constraints, g, budget=40)
->>> g2.stop, g2.layers
-(<Stop.BUDGET: 'budget'>, (1, 2, 3, 6, 6, 9, 9, 5))
->>> probe(p, rs.constraints, g, budget=10_000, wide=5).stop
-<Stop.WIDE: 'wide'>
+>>> counts, done = measure(rs, p, g, Points(400, 45, 30, 50))
+>>> counts.stop, counts.sync_states, done.sync.sync_states
+(<Stop.RAN: 'ran'>, 150, 150)
 """
 
 from __future__ import annotations
 
-from collections import deque
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from enum import Enum
-from typing import Sequence
+from typing import TYPE_CHECKING, Callable, Sequence
 
 from synth.errors import LimitExceeded
-from synth.grafcet.language import Grafcet
-from synth.grafcet.machine import GrafcetMachine, Situation
-from synth.grafcet.situation import OutOfRange
-from synth.plant.composition import Plant
-from synth.plant.rules import Constraint, RuleSet
-from synth.sup.constraints import CompiledConstraints
-from synth.validation.result import Validation
-from synth.validation.sync import grafcet_inputs, moves_by_order, region
-from synth.validation.validate import validate_loaded
 
-__all__ = ["Stop", "Growth", "probe", "measure"]
+if TYPE_CHECKING:  # pragma: no cover - imported when measuring: synth.engines reads Points at start-up
+    from synth.grafcet.language import Grafcet
+    from synth.plant.composition import Plant
+    from synth.plant.rules import RuleSet
+    from synth.validation.result import Validation
 
-Local = tuple[int, ...]
+__all__ = ["Stop", "Points", "Growth", "measure"]
 
 
 class Stop(Enum):
-    """Why the probe stopped."""
+    """How the watched explicit run ended."""
 
-    RAN = "ran"  # the explicit engine itself explored SYNC whole (``layers``: its size alone)
-    DONE = "done"  # SYNC explored whole: ``states`` is its size
-    WIDE = "wide"  # a layer holds more than ``wide`` SYNC states
-    BUDGET = "budget"  # more than ``budget`` SYNC states met, every layer narrower
-    ERROR = "error"  # an internal variable out of range: the engine that runs says where
+    RAN = "ran"  # SYNC explored whole before the decision point: ``sync_states`` is its size
+    NARROW = "narrow"  # at the decision point, no more than the share waiting: the run went on, kept
+    STEEP = "steep"  # at the decision point, more than the share waiting: the run stopped
+    ERROR = "error"  # an internal variable out of range: the explicit engine says where
+
+
+@dataclass(frozen=True)
+class Points:
+    """Where and on what the run is judged: after ``nodes`` aggregated states, steep when
+    more than ``share`` percent of them wait (``machine_share`` where the explicit engine
+    explores state by state; ``situation_share`` where the symbolic engine would explore one
+    stable situation at a time: timers, stored actions, internal variables)."""
+
+    nodes: int
+    share: int
+    machine_share: int
+    situation_share: int
 
 
 @dataclass(frozen=True)
 class Growth:
-    """What the probe met: ``layers``, the SYNC states first met in each breadth-first layer
-    of aggregated states (the initial region's first, the layer it stopped in last);
-    ``states``, their sum; ``stop``, why it stopped; ``per_situation``, set by the chooser: the symbolic engine would
-    explore this Grafcet one stable situation at a time (timers, stored actions, …)."""
+    """What the watched run met: at the decision point (or where it ended before),
+    ``met`` aggregated states, ``waiting`` of them not yet expanded; ``stop``, how it ended;
+    ``machine``: why the explicit engine explored state by state (None: a frontier at a
+    time); ``per_situation``: the symbolic engine would explore one stable situation at a
+    time; ``sync_states``: SYNC's size, when explored whole; ``share``: the percent it was
+    judged against."""
 
-    layers: tuple[int, ...]
+    met: int
+    waiting: int
     stop: Stop
+    machine: str | None = None
     per_situation: bool = False
-
-    @property
-    def states(self) -> int:
-        return sum(self.layers)
-
-    @property
-    def widest(self) -> int:
-        return max(self.layers, default=0)
+    sync_states: int = 0
+    share: int = 0
 
 
-def probe(p: Plant, constraints: Sequence[Constraint], g: Grafcet, budget: int, wide: int | None = None) -> Growth:
-    """SYNC of ``g`` against ``p`` and ``constraints``, explored breadth-first until it ends,
-    more than ``budget`` SYNC states are met, or one layer holds more than ``wide`` (see the
-    module docstring)."""
-    oracle = CompiledConstraints(p, constraints)  # cached per plant: the engine that runs reuses it
-    if not oracle.kept(p.initial):
-        return Growth((), Stop.DONE)
-    machine = GrafcetMachine(g)
-    moves = moves_by_order(p)
-    uncontrollable = [t for t in p.transitions if not t.controllable]
-    seen: set[tuple[Situation, Local]] = set()  # SYNC states
-    entered: set[tuple[Situation, Local]] = set()  # regions entered
-    nodes: set[tuple[Situation, Local]] = set()  # aggregated states
-    layers: list[int] = [0]
-    queue: deque[tuple[int, Situation, Local]] = deque()
-    read: dict[Local, dict[str, bool]] = {}  # the Grafcet's inputs per plant state, read once
+class _Steep(Exception):
+    """Stops the watched run: the symbolic engine runs instead."""
 
-    def inputs(local: Local) -> dict[str, bool]:
-        hit = read.get(local)
-        if hit is None:
-            hit = read[local] = grafcet_inputs(p, machine, local)
-        return hit
 
-    def enter(sit: Situation, entry: Local, depth: int) -> None:
-        if (sit, entry) in entered:
+class _Watch:
+    """The explicit run's watcher: decides once, at the first decision point passed."""
+
+    def __init__(self, p: Plant, g: Grafcet, points: Points) -> None:
+        self.p, self.g, self.points = p, g, points
+        self.growth: Growth | None = None
+        self.path: tuple[str | None] | None = None  # the frontier's reason, once asked
+        self.last = (0, 0)
+
+    def machine(self) -> str | None:
+        """Why the explicit engine explores this model state by state (None: a frontier at a time)."""
+        if self.path is None:
+            from synth.grafcet.machine import GrafcetMachine
+            from synth.validation.frontier import reason
+
+            self.path = (reason(self.p, GrafcetMachine(self.g)),)
+        return self.path[0]
+
+    def __call__(self, met: int, waiting: int) -> None:
+        self.last = (met, waiting)
+        if self.growth is not None or met < self.points.nodes:
             return
-        entered.add((sit, entry))
-        members, settled = region(p, oracle, entry, machine.orders(sit, inputs(entry)), moves)
-        fresh = [m for m in members if (sit, m) not in seen]
-        seen.update((sit, m) for m in fresh)
-        if depth == len(layers):
-            layers.append(0)
-        layers[depth] += len(fresh)
-        for q, _ in settled:
-            if (sit, q) not in nodes:
-                nodes.add((sit, q))
-                queue.append((depth, sit, q))
+        self.judge(met, waiting)
+        if self.growth is not None and self.growth.stop is Stop.STEEP:
+            raise _Steep
 
+    def judge(self, met: int, waiting: int) -> None:
+        """Decide on the counts at the decision point."""
+        why = self.machine()
+        self.growth = self.judged(met, waiting, why, self.points.share if why is None else self.points.machine_share)
+
+    def judged(self, met: int, waiting: int, why: str | None, share: int) -> Growth:
+        """Steep when more than ``share`` percent of ``met`` wait (and, where the symbolic
+        engine would explore per stable situation, more than its own share)."""
+        if 100 * waiting <= share * met:
+            return Growth(met, waiting, Stop.NARROW, why, share=share)
+        if 100 * waiting <= self.points.situation_share * met:
+            from synth.grafcet.machine import GrafcetMachine
+            from synth.symbolic.validate import SymbolicPath, choose_path  # dd: the symbolic engine likely runs next
+
+            if choose_path(GrafcetMachine(self.g), self.p).path is SymbolicPath.SITUATIONS:
+                return Growth(met, waiting, Stop.NARROW, why, per_situation=True, share=share)
+        return Growth(met, waiting, Stop.STEEP, why, share=share)
+
+
+def measure(rs: RuleSet, p: Plant, g: Grafcet, points: Points, *, expert: bool = False, homes: Sequence[str] = (),
+            max_states: int | None = None,
+            progress: Callable[[int, int], None] | None = None) -> tuple[Growth, Validation | None]:
+    """What ``validate --engine auto`` measures (see the module docstring): the counts, and
+    the explicit engine's result when it is the one to keep (:attr:`Stop.RAN`,
+    :attr:`Stop.NARROW`); None when the symbolic engine is to run (:attr:`Stop.STEEP`) or
+    the explicit engine is to run again and say where a variable went out of range
+    (:attr:`Stop.ERROR`). ``max_states`` bounds the run as it bounds the explicit engine: met
+    before the decision point, the counts there decide (the explicit engine, chosen, says
+    it is over); ``progress``: the explicit engine's progress lines."""
+    from synth.grafcet.situation import OutOfRange
+    from synth.validation.validate import validate_loaded
+
+    watch = _Watch(p, g, points)
     try:
-        enter(machine.initial(inputs(p.initial)), p.initial, 0)
-        while queue:
-            depth, sit, cur = queue.popleft()
-            before = inputs(cur)
-            for t in uncontrollable:
-                if t.src != cur[t.axis] or not p.enabled(t, cur):
-                    continue
-                n = cur[: t.axis] + (t.dst,) + cur[t.axis + 1:]
-                if oracle.kept(n):
-                    enter(machine.react(sit, before, inputs(n)), n, depth + 1)
-            for timer in machine.timers(sit):
-                enter(machine.fire_timer(sit, timer, before), cur, depth + 1)
-            if wide is not None and layers[-1] > wide:
-                return Growth(tuple(layers), Stop.WIDE)
-            if sum(layers) > budget:
-                return Growth(tuple(layers), Stop.BUDGET)
+        done = validate_loaded(rs, p, g, expert=expert, homes=homes, max_states=max_states, progress=progress,
+                               watch=watch)
+    except _Steep:
+        assert watch.growth is not None
+        return watch.growth, None
     except OutOfRange:
-        return Growth(tuple(layers), Stop.ERROR)
-    return Growth(tuple(layers), Stop.DONE)
-
-
-def measure(rs: RuleSet, p: Plant, g: Grafcet, limits: tuple[int, int, int, int], *, expert: bool = False,
-            homes: Sequence[str] = (), max_states: int | None = None) -> tuple[Growth, Validation | None]:
-    """What ``validate --engine auto`` measures, ``limits`` being (nodes, budget, layer, steep):
-    the explicit engine first, within ``nodes`` aggregated states (and ``max_states``); when
-    SYNC ends there, :attr:`Stop.RAN` and its result, to be kept. Else the probe's counts
-    (``budget``, ``layer``), marked :attr:`Growth.per_situation` when its wide layer came
-    after ``steep`` states and the symbolic engine would explore one situation at a time."""
-    nodes, budget, layer, steep = limits
-    try:
-        done = validate_loaded(rs, p, g, expert=expert, homes=homes, max_states=min(nodes, max_states or nodes))
-        return Growth((done.sync.sync_states,), Stop.RAN), done
+        return Growth(*watch.last, Stop.ERROR), None
     except LimitExceeded:
-        pass
-    counts = probe(p, rs.constraints, g, budget, layer)
-    if counts.stop is Stop.WIDE and counts.states > steep:
-        from synth.symbolic.validate import SymbolicPath, choose_path  # dd: the symbolic engine likely runs next
-
-        if choose_path(GrafcetMachine(g), p).path is SymbolicPath.SITUATIONS:
-            return replace(counts, per_situation=True), None
-    return counts, None
+        if watch.growth is None:
+            watch.judge(*watch.last)
+        assert watch.growth is not None
+        if watch.growth.stop is Stop.STEEP:
+            return watch.growth, None
+        raise
+    if watch.growth is None:
+        return Growth(len(done.sync.nodes), 0, Stop.RAN, sync_states=done.sync.sync_states), done
+    return watch.growth, done

@@ -19,8 +19,8 @@ from typing import Any
 import pytest
 
 from conftest import ROOT
-from synth.engines import (CAPABILITIES, PROBE_BUDGET, PROBE_LAYER, THRESHOLDS, Capability, Command, EngineChoice,
-                           Need, Threshold, capability, decide, refusal)
+from synth.engines import (CAPABILITIES, PROBE_NODES, PROBE_SHARE, THRESHOLDS, Capability, Command, EngineChoice, Need,
+                           Threshold, capability, decide, refusal)
 from synth.errors import InputError
 from synth.plant.composition import load_plant
 from synth.probe import Growth, Stop
@@ -133,17 +133,19 @@ def test_auto_reads_the_threshold_table_and_says_why() -> None:
     asked: list[tuple[int, int]] = []
 
     def narrow(threshold: Threshold) -> Growth:
-        asked.append((threshold.budget, threshold.layer))
-        return Growth((1, 5, 5, 13, 19, 40, 50, 52, 77, 118, 166, 209, 198, 170), Stop.BUDGET)
+        assert threshold.points is not None
+        asked.append((threshold.points.nodes, threshold.points.share))
+        return Growth(448, 91, Stop.NARROW, share=45)
 
     t = THRESHOLDS[Command.VALIDATE]
     assert decide(Command.VALIDATE, "auto", estimate=t.size, growth=narrow).reason == \
         f"auto: {t.size} {t.estimate}, not above {t.size}"
     assert asked == []  # below the size, no probe
     chosen = decide(Command.VALIDATE, "auto", estimate=10**9, growth=narrow)
-    assert asked == [(t.budget, t.layer)] == [(PROBE_BUDGET, PROBE_LAYER)]
+    assert asked == [(PROBE_NODES, PROBE_SHARE)] == [(400, 45)]
     assert (chosen.engine, chosen.measured) == (EngineChoice.EXPLICIT, True)
-    assert chosen.reason == "auto: explicit (measured: 1123 SYNC states in 14 breadth-first layers, none above 250)"
+    assert chosen.reason == \
+        "auto: explicit (measured: 91 of the 448 aggregated states met wait to be explored, not more than 45 %)"
     assert decide(Command.VALIDATE, "explicit", estimate=10**9, growth=narrow).reason == "--engine explicit"
     assert decide(Command.VALIDATE, "auto", {Need.SFC}, estimate=10**9, growth=narrow).engine is EngineChoice.EXPLICIT
     assert len(asked) == 1  # a forced engine or an unserved need asks no probe

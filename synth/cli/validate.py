@@ -32,7 +32,7 @@ def register(sub: "argparse._SubParsersAction") -> None:
     v.add_argument("--semantics", choices=("grafcet", "sfc"), default="grafcet", help=SEMANTICS_HELP)
     v.add_argument("--engine", choices=("auto", "explicit", "symbolic"), default="auto",
                    help="explicit exploration, BDDs (for many actuators moving at once), or chosen by "
-                        "size and a bounded probe of the exploration (default; docs/symbolic.md)")
+                        "size and by watching how the explicit exploration grows (default; docs/symbolic.md)")
     v.add_argument("--max-nodes", metavar="N", type=int, help="stop when the symbolic engine needs more than N BDD nodes")
     v.add_argument("--quiet", action="store_true", help="no progress on stderr")
     v.add_argument("--junit", metavar="FILE", help="also write the findings as JUnit XML (one test case per finding)")
@@ -61,7 +61,7 @@ def cmd_validate(args: argparse.Namespace) -> int:
         raise SynthError(f"--cor {args.cor}: the JSON file must not end in .dot, the DOT file is written beside it")
     show = tty_progress(not args.quiet and sys.stderr.isatty())
 
-    def decided(chosen: Decision) -> None:  # auto's probe chose the symbolic engine: the counts it read
+    def decided(chosen: Decision) -> None:  # auto chose the symbolic engine on the counts it read
         if chosen.measured and chosen.engine is EngineChoice.SYMBOLIC and not args.quiet:
             print(chosen.reason, file=sys.stderr)
 

@@ -82,17 +82,20 @@ def explore_wide(
     max_states: int | None = None,
     progress: Callable[[int, int], None] | None = None,
     partial: Partial | None = None,
+    watch: Callable[[int, int], None] | None = None,
 ) -> Sync:
     """SYNC of a model whose search went wide (:data:`~synth.validation.sync.WIDE`): a
     frontier at a time when :func:`reason` allows it, else (or when the frontier path
     meets what it leaves to the machine) by the machine's path from the start;
-    ``partial``: how far the machine's path went before it went wide."""
+    ``partial``: how far the machine's path went before it went wide; ``watch(met,
+    waiting)``: after each frontier (or state, on the machine's path) expanded."""
     if reason(p, machine) is None:
         try:
-            return explore_frontier(p, constraints, machine, max_states=max_states, progress=progress, partial=partial)
+            return explore_frontier(p, constraints, machine, max_states=max_states, progress=progress, partial=partial,
+                                    watch=watch)
         except Unsupported:
             pass
-    return synchronous_product(p, constraints, machine, max_states=max_states, progress=progress)
+    return synchronous_product(p, constraints, machine, max_states=max_states, progress=progress, watch=watch)
 
 
 class _Situations:
@@ -144,6 +147,7 @@ def explore_frontier(
     max_states: int | None = None,
     progress: Callable[[int, int], None] | None = None,
     partial: Partial | None = None,
+    watch: Callable[[int, int], None] | None = None,
 ) -> Sync:
     """SYNC a frontier at a time (see module doc), from the start or going on from where
     the machine's path stopped (``partial``); :class:`Unsupported` when it meets what it
@@ -155,7 +159,7 @@ def explore_frontier(
     if not oracle.kept(p.initial):
         return Sync(p, oracle, machine)
     try:
-        return _Explorer(p, oracle, machine, max_states).run(progress, partial)
+        return _Explorer(p, oracle, machine, max_states).run(progress, partial, watch)
     except Collision as err:
         raise Unsupported(str(err)) from None
 
@@ -318,7 +322,8 @@ class _Explorer:
                               + self.pc.encode([m for _, m in seen]))
         return partial.initial, partial.next
 
-    def run(self, progress: Callable[[int, int], None] | None, partial: Partial | None = None) -> Sync:
+    def run(self, progress: Callable[[int, int], None] | None, partial: Partial | None = None,
+            watch: Callable[[int, int], None] | None = None) -> Sync:
         if partial is not None:
             initial, lo = self.resume(partial)
         else:
@@ -331,6 +336,8 @@ class _Explorer:
             hi = len(self.nodes)
             self.expand(lo, hi)
             lo = hi
+            if watch is not None:
+                watch(len(self.nodes), len(self.nodes) - lo)
             if progress is not None and time.monotonic() - last > 0.5:
                 progress(len(self.nodes), len(self.nodes) - lo)
                 last = time.monotonic()

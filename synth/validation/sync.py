@@ -266,10 +266,12 @@ def synchronous_product(
     max_states: int | None = None,
     progress: Callable[[int, int], None] | None = None,
     wide: int | None = None,
+    watch: Callable[[int, int], None] | None = None,
 ) -> Sync:
     """Explore SYNC from (initial plant state, initial situation), aggregated per region,
     state by state; :class:`Wide` once more than ``wide`` states wait in the queue (the
-    frontier path, :mod:`synth.validation.frontier`, is then the faster)."""
+    frontier path, :mod:`synth.validation.frontier`, is then the faster); ``watch(met,
+    waiting)`` after each aggregated state expanded (it may raise to stop the run)."""
     oracle = CompiledConstraints(p, constraints)
     nodes: list[Node] = []
     edges: list[Edge] = []
@@ -380,6 +382,8 @@ def synchronous_product(
         while queue:
             i = queue.popleft()
             expand(i)
+            if watch is not None:
+                watch(len(nodes), len(queue))
             if wide is not None and len(queue) > wide:
                 raise Wide(Partial(oracle, nodes, edges, conflicts, log, initial, i + 1, region_cache, sync_seen))
             if progress is not None and time.monotonic() - last > 0.5:

@@ -55,16 +55,21 @@ def explore(
     *,
     max_states: int | None = None,
     progress: Callable[[int, int], None] | None = None,
+    watch: Callable[[int, int], None] | None = None,
 ) -> Sync:
     """SYNC: state by state while at most :data:`~synth.validation.sync.WIDE` states wait
     (a narrow SYNC, a sequence, a small station), then a frontier at a time
-    (:func:`synth.validation.frontier.explore_wide`, imported only then)."""
+    (:func:`synth.validation.frontier.explore_wide`, imported only then); ``watch(met,
+    waiting)``: the aggregated states met and those waiting, after each state or frontier
+    expanded (it may raise to stop the run: ``validate --engine auto``)."""
     try:
-        return synchronous_product(p, constraints, machine, max_states=max_states, progress=progress, wide=WIDE)
+        return synchronous_product(p, constraints, machine, max_states=max_states, progress=progress, wide=WIDE,
+                                   watch=watch)
     except Wide as wide:
         from synth.validation.frontier import explore_wide
 
-        return explore_wide(p, constraints, machine, max_states=max_states, progress=progress, partial=wide.partial)
+        return explore_wide(p, constraints, machine, max_states=max_states, progress=progress, partial=wide.partial,
+                            watch=watch)
 
 
 def validate(
@@ -90,12 +95,14 @@ def validate_loaded(
     homes: Sequence[str] = (),
     max_states: int | None = None,
     progress: Callable[[int, int], None] | None = None,
+    watch: Callable[[int, int], None] | None = None,
 ) -> Validation:
     """:func:`validate` on a rule set, its plant and a Grafcet already loaded;
-    ``progress(aggregated states, states to visit)`` is called now and then."""
+    ``progress(aggregated states, states to visit)`` is called now and then, ``watch``
+    after each step of the exploration (:func:`explore`)."""
     conditions = home_conditions(homes, p, g)
     machine = GrafcetMachine(g)
-    sync = explore(p, rs.constraints, machine, max_states=max_states, progress=progress)
+    sync = explore(p, rs.constraints, machine, max_states=max_states, progress=progress, watch=watch)
     sup_empty = not sync.oracle.kept(p.initial)  # the constraints compiled once
     analysis = analyse(sync, home_states(sync, conditions))
     if not (analysis.blocking or analysis.never_starts or analysis.prohibited):  # a passing run imports no diagnosis
