@@ -42,13 +42,13 @@ Example
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from enum import StrEnum
 from pathlib import Path
 from typing import TYPE_CHECKING, Callable, Collection, Sequence
 
 from synth.choices import EngineChoice
 from synth.errors import InputError, LimitExceeded, Location, SynthError
+from synth.frozen import frozen
 from synth.probe import Points
 
 if TYPE_CHECKING:  # pragma: no cover - the engines are imported once chosen
@@ -85,7 +85,7 @@ class Need(StrEnum):
     PROGRESS = "progress"  # filter verify --progress: fair cycles, on the whole product
 
 
-@dataclass(frozen=True)
+@frozen
 class Capability:
     """One engine's declaration for one command: the needs it serves."""
 
@@ -109,7 +109,7 @@ the symbolic ones the plain run, and the closed loop's a plant whose elements re
 other (its cycle encodes their guards)."""
 
 
-@dataclass(frozen=True)
+@frozen
 class Threshold:
     """``auto`` runs the symbolic engine when the estimate exceeds ``size``; where
     ``points`` is set (``validate``), only when the explicit engine's own run, watched
@@ -166,7 +166,7 @@ THRESHOLDS: dict[Command, Threshold] = {
 }
 
 
-@dataclass(frozen=True)
+@frozen
 class Decision:
     """The engine that runs, and why."""
 
@@ -362,7 +362,7 @@ def validate_models(
     return validate_loaded(rs, p, g, expert=expert, homes=homes, max_states=max_states, progress=explored)
 
 
-@dataclass(frozen=True)
+@frozen
 class SupRun:
     """One run of ``synth sup``: the rule set, its plant, and SUP from the engine chosen
     (a :class:`~synth.sup.supervisor.Supervisor` listing its states, or a

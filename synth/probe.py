@@ -32,11 +32,11 @@ Example
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from enum import Enum
 from typing import TYPE_CHECKING, Callable, Sequence
 
 from synth.errors import LimitExceeded
+from synth.frozen import frozen
 
 if TYPE_CHECKING:  # pragma: no cover - imported when measuring: synth.engines reads Points at start-up
     from synth.grafcet.language import Grafcet
@@ -56,7 +56,7 @@ class Stop(Enum):
     ERROR = "error"  # an internal variable out of range: the explicit engine says where
 
 
-@dataclass(frozen=True)
+@frozen
 class Points:
     """Where and on what the run is judged: after ``nodes`` aggregated states, steep when
     more than ``share`` percent of them wait (``machine_share`` where the explicit engine
@@ -69,7 +69,7 @@ class Points:
     situation_share: int
 
 
-@dataclass(frozen=True)
+@frozen
 class Growth:
     """What the watched run met: at the decision point (or where it ended before),
     ``met`` aggregated states, ``waiting`` of them not yet expanded; ``stop``, how it ended;

@@ -23,11 +23,11 @@ Example
 from __future__ import annotations
 
 from collections import deque
-from dataclasses import dataclass
 from typing import Iterable
 
 import numpy as np
 
+from synth.frozen import frozen
 from synth.validation.keys import distinct, first_occurrences, slices
 from synth.validation.sync import Sync
 
@@ -35,7 +35,7 @@ __all__ = ["Trace", "Analysis", "analyse", "coreachable", "coreachable_by_layers
            "shortest_paths_by_layers", "strongly_connected_components", "LAYERS"]
 
 
-@dataclass(frozen=True)
+@frozen
 class Trace:
     """Nodes from the initial state to ``nodes[-1]`` and the events between them."""
 
@@ -43,7 +43,7 @@ class Trace:
     events: tuple[str, ...]
 
 
-@dataclass(frozen=True)
+@frozen
 class Analysis:
     """What the graph searches found in SYNC: blocking states, their traces, prohibited orders."""
 

@@ -17,13 +17,14 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Sequence
 
+from synth.frozen import frozen
 from synth.grafcet.language import Transition
 from synth.logic.events import Event
 
 __all__ = ["Conflict", "ConflictLog"]
 
 
-@dataclass(frozen=True)
+@frozen
 class Conflict:
     """Transitions leaving the same step fired together (an OR divergence whose
     receptivities were true at once): every branch became active."""

@@ -16,11 +16,12 @@ Example
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import field
 from pathlib import Path
 from typing import TYPE_CHECKING, Sequence
 
 from synth.errors import InputError, close_names
+from synth.frozen import frozen
 from synth.grafcet.language import Grafcet
 from synth.logic.expr import Edge as ExprEdge, Expr, names
 from synth.plant.composition import Plant, plant
@@ -36,7 +37,7 @@ if TYPE_CHECKING:  # pragma: no cover - imported by the engines when there is so
 __all__ = ["Validation", "ReducedController", "reduced_controller", "home_conditions", "load_model"]
 
 
-@dataclass(frozen=True)
+@frozen
 class Validation:
     """One whole run of ``synth validate``: its inputs, SYNC, the analysis and the diagnoses."""
 
@@ -82,7 +83,7 @@ class Validation:
                 and self.never_starts is None)
 
 
-@dataclass(frozen=True)
+@frozen
 class ReducedController:
     """COR (docs/method.md): the aggregated automaton without the states from which the
     initial situation cannot be reached again, nor the transitions into them.

@@ -27,12 +27,13 @@ from __future__ import annotations
 
 import time
 from collections import deque
-from dataclasses import InitVar, dataclass, field
+from dataclasses import InitVar, field
 from typing import Callable, Sequence
 
 import numpy as np
 
 from synth.errors import LimitExceeded
+from synth.frozen import frozen
 from synth.grafcet.language import Transition
 from synth.grafcet.machine import GrafcetMachine, Situation
 from synth.grafcet.situation import OutOfRange, with_trace
@@ -56,7 +57,7 @@ class Wide(Exception):
         self.partial = partial
 
 
-@dataclass(frozen=True)
+@frozen
 class Partial:
     """The machine's path stopped after expanding nodes ``0 .. next - 1`` (the rest wait
     in its queue, in order): its nodes, edges and conflicts so far, the regions entered
@@ -85,7 +86,7 @@ branches_2x4 pass 32 waiting after 0.009, 0.007 and 0.045 s, and take 0.038, 0.0
 0.069 s by frontiers against 0.071, 0.345 and 0.104 s state by state."""
 
 
-@dataclass(frozen=True, order=True)
+@frozen(order=True)
 class Prohibition:
     """An order change the situation asks for and SUP refuses: ``event`` is ``↑Z``/``↓Z``."""
 
@@ -97,7 +98,7 @@ class Prohibition:
         return self.event.name
 
 
-@dataclass(frozen=True)
+@frozen
 class Node:
     """A state of the aggregated automaton: a situation and the settled plant state of its region."""
 
@@ -108,7 +109,7 @@ class Node:
     proh: tuple[Prohibition, ...]  # order changes SUP refuses here
 
 
-@dataclass(frozen=True)
+@frozen
 class Edge:
     """A transition of the aggregated SYNC: from node ``source`` to node ``target`` on ``event``."""
 
@@ -117,7 +118,7 @@ class Edge:
     target: int
 
 
-@dataclass(frozen=True)
+@frozen
 class Sync:
     """The aggregated view of SYNC, explored from the initial state (fully built:
     successors and predecessors are indexed on their first call)."""
