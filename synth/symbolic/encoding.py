@@ -45,9 +45,9 @@ class Copy(Enum):
     AUX = "''"
 
 
-def live_nodes(engine: Engine) -> int:
-    """The manager's live BDD nodes (:meth:`Engine.live_nodes`)."""
-    return engine.live_nodes()
+def live_nodes(engine: Engine, exact: bool = False) -> int:
+    """The manager's live BDD nodes (:meth:`Engine.live_nodes`; ``exact`` for a count that is printed)."""
+    return engine.live_nodes(exact)
 
 
 class NodeBudget:

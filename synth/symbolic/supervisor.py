@@ -155,7 +155,7 @@ class SymbolicSupervisor:
     @property
     def nodes(self) -> int:
         """Live BDD nodes in the manager (the engine's memory)."""
-        return live_nodes(self.enc.engine)
+        return live_nodes(self.enc.engine, exact=True)
 
     @cached_property
     def _counts(self) -> tuple[int, int, int]:

@@ -63,7 +63,7 @@ def engine_stats(enc: PlantEncoding, situations: int) -> EngineStats:
     """The engine's statistics: live BDD nodes, stable situations, and the elements in the
     BDD variable order (:func:`~synth.symbolic.encoding.element_order`)."""
     elements = enc.plant.elements
-    return {"bdd_nodes": live_nodes(enc.engine), "situations": situations,
+    return {"bdd_nodes": live_nodes(enc.engine, exact=True), "situations": situations,
             "variable_order": [elements[a].name for a in enc.order]}
 
 
