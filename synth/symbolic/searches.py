@@ -41,7 +41,7 @@ if TYPE_CHECKING:  # pragma: no cover - the explicit order needs the explicit en
     from synth.symbolic.ties import Settled
 
 __all__ = ["Path", "MAX_LISTED", "path_key", "deepest", "terminal_components", "layers", "greedy", "first_of",
-           "depth_of", "first_node", "first_among", "first_entered", "shortest_trace", "OneByOne", "Walk"]
+           "depth_of", "first_node", "first_among", "first_entered", "first_from", "shortest_trace", "OneByOne", "Walk"]
 
 MAX_LISTED = 100_000
 """At most this many nodes of one component are listed for the diagnosis."""
@@ -220,19 +220,27 @@ def first_among(g: SymbolicGraph[S, M], u: S, settled: "Settled | None" = None) 
 def first_entered(g: SymbolicGraph[S, M], u: S, parent: S, ring: S, settled: "Settled | None") -> S:
     """:func:`first_among` for nodes ``u`` of the ring after ``ring``, all successors of
     the single node ``parent``. Where no other node of ``ring`` leads into ``u``, the
-    explicit engine numbered them all from ``parent``: by its moves in exploration order,
-    then as their region settles (:func:`first_of`), no search from the initial nodes."""
+    explicit engine numbered them all from ``parent`` (:func:`first_from`), no search from
+    the initial nodes."""
     if g.count(u) == 1:
         return u
     if settled is not None and g.is_empty(g.minus(g.pre(u, within=ring), parent)):
-        by_key: dict[tuple[int, int, int], list[M]] = {}
-        for m in g.moves_from(parent):
-            by_key.setdefault(g.order(m), []).append(m)
-        for key in sorted(by_key):
-            v = g.meet(u, g.join(g.post_by(parent, m) for m in by_key[key]))
-            if not g.is_empty(v):
-                return first_of(g, v, (g.pick(parent), by_key[key]), settled)[0]
+        return first_from(g, u, parent, settled)
     return first_among(g, u, settled)
+
+
+def first_from(g: SymbolicGraph[S, M], u: S, parent: S, settled: "Settled") -> S:
+    """The node of ``u`` the explicit engine numbers first, ``u`` being nodes it found
+    first from the single node ``parent``: by ``parent``'s moves in exploration order,
+    then as their region settles (:func:`first_of`)."""
+    by_key: dict[tuple[int, int, int], list[M]] = {}
+    for m in g.moves_from(parent):
+        by_key.setdefault(g.order(m), []).append(m)
+    for key in sorted(by_key):
+        v = g.meet(u, g.join(g.post_by(parent, m) for m in by_key[key]))
+        if not g.is_empty(v):
+            return first_of(g, v, (g.pick(parent), by_key[key]), settled)[0]
+    return first_among(g, u, settled)  # pragma: no cover - every node of u is a successor of parent
 
 
 class OneByOne(Generic[S, M]):

@@ -48,7 +48,7 @@ from typing import TYPE_CHECKING, Callable, Sequence, TypeVar
 from synth.logic.bdd import Engine, Function
 from synth.logic.events import Event
 from synth.symbolic.interface import Key, PathKey
-from synth.symbolic.searches import Order, Path, depth_of, first_entered, first_of, path_key
+from synth.symbolic.searches import Order, Path, depth_of, first_from, first_of, path_key
 from synth.symbolic.steps.reach import Arc, StepReach
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -302,12 +302,12 @@ def _traces(r: StepReach, b: _Batch, wanted: dict[int, Key]) -> dict[Key, Path]:
         if not several:
             return current & mask
         found: dict[int, Function] = {}
-        if previous is not None and r.settled is not None:  # as searches.first_entered, tag by tag
+        if previous is not None and r.settled is not None:  # as searches.first_entered, one pre-image for all tags
             parents = b.tags.split(previous)
             feeding = b.tags.split(b.pre(current & mask) & r.s.rings[k - 1])
             for j, u in several.items():
                 if feeding[j] == parents[j]:
-                    found[j] = first_entered(r, u, parents[j], r.s.rings[k - 1], r.settled)
+                    found[j] = first_from(r, u, parents[j], r.settled)
         rest = list(dict.fromkeys(u for j, u in several.items() if j not in found))
         firsts = {u: r.cube(f[0]) for u, f in zip(rest, Findings(r, rest).firsts)} if rest else {}
         return r.s.engine.disjunction(b.tags.cube(j) & found.get(j, firsts.get(u, u)) for j, u in parts.items())
