@@ -50,6 +50,7 @@ from typing import Iterable, Mapping, Sequence
 
 from synth.errors import InputError
 from synth.logic.bdd import Cube
+from synth.logic.lanes import Cover, compiled, lane_mask
 from synth.filter.language import Filter
 from synth.logic.past import base_name, is_pre, pre_name
 from synth.filter.model import FilterFunctions, functions
@@ -61,8 +62,6 @@ if TYPE_CHECKING:
 __all__ = ["Algorithm", "Mode", "ACK", "Memory", "CycleResult", "Lanes", "FilterCycle", "Cover"]
 
 ACK = "Ack"
-
-Cover = tuple[tuple[tuple[str, bool], ...], ...]  # an OR of cubes, each an AND of (name, value)
 
 
 class Algorithm(StrEnum):
@@ -146,6 +145,21 @@ def _cover(cubes: Iterable[Cube]) -> Cover:
     return tuple(tuple(c.items()) for c in cubes)
 
 
+class _Compiled:
+    """A cycle's covers compiled for lanes (:mod:`synth.logic.lanes`): one function per
+    group the cycle evaluates at once, each giving its covers' values in order."""
+
+    def __init__(self, c: "FilterCycle") -> None:
+        late = {*c.requests, *c.outputs}  # the names that vary from lane to lane, as a rule
+        self.constraint = compiled(tuple(c.constraint.values()), late)
+        self.combined = compiled(tuple(c.constraint[i] for i in c.combined), late)
+        self.fs = compiled((*c.fs0.values(), *c.fs1.values()), late)
+        self.equations = tuple((o, compiled((u,), late)) for o, u in c.equations)
+        self.care = compiled((c.care,), late)
+        self.defined = tuple((n, compiled((u,), late)) for n, u in c.defined)
+        self.previous = tuple(pre_name(n) for n in c.remembered)
+
+
 class FilterCycle:
     """The cycle evaluator of one filter (see the module docstring)."""
 
@@ -197,6 +211,7 @@ class FilterCycle:
         base += [b for b in (base_name(n) for n in used) if b not in base]
         self.remembered: tuple[str, ...] = tuple(base)
         self.used: tuple[str, ...] = tuple(b for b in self.remembered if pre_name(b) in used)
+        self._run = _Compiled(self)
         computed = {n for n, _ in self.defined}
         self.reads: tuple[str, ...] = (*flt.inputs, *(n for n in flt.observer_names if n not in computed),
                                        *self.requests) + ((ACK,) if self.mode is Mode.BLOCKING else ())
@@ -211,43 +226,36 @@ class FilterCycle:
         requests ``R_o``, and ``Ack`` in blocking mode); returns its result and the new memory."""
         return self.lanes(memory, values, ()).lane(0)
 
-    def lanes(self, memory: Memory, fixed: Mapping[str, bool], free: Sequence[str]) -> Lanes:
+    def lanes(self, memory: Memory, fixed: Mapping[str, bool], free: Sequence[str], *,
+              diagnose: bool = True) -> Lanes:
         """The cycle for every valuation of the names ``free`` (lane j: bit i of j is the
-        value of ``free[i]``), the other names of :attr:`reads` given by ``fixed``."""
+        value of ``free[i]``), the other names of :attr:`reads` given by ``fixed``.
+
+        With ``diagnose=False`` the produced outputs are not checked against the
+        constraints: ``unsafe`` is empty, every other field the same (the closed loop reads
+        the outputs, the memory, the latch, the fallback, the care set and, as an outcome's
+        witness, the constraints the raw requests violate)."""
         if self.literal and free:
             raise ValueError("the literal published loop is evaluated one lane at a time")
         count = 1 << len(free)
         full = (1 << count) - 1
         values: dict[str, int] = {}
         for i, n in enumerate(free):
-            values[n] = sum(1 << j for j in range(count) if (j >> i) & 1)
+            values[n] = lane_mask(i, count)
         for n in self.reads:
             if n not in values:
                 if n not in fixed:
                     raise KeyError(f"no value for '{n}'")
                 values[n] = full if fixed[n] else 0
-        for n, v in zip(self.remembered, memory.previous):
-            values[pre_name(n)] = full if v else 0
-
-        def ev(cover: Cover, vals: Mapping[str, int]) -> int:
-            out = 0
-            for cube in cover:
-                m = full
-                for n, v in cube:
-                    m &= vals[n] if v else full ^ vals[n]
-                    if not m:
-                        break
-                out |= m
-                if out == full:
-                    break
-            return out
-
-        for n, cover in self.defined:  # from the inputs, the requests and the memory
-            values[n] = ev(cover, values)
+        run = self._run
+        for n, v in zip(run.previous, memory.previous):
+            values[n] = full if v else 0
+        for n, fn in run.defined:  # from the inputs, the requests and the memory
+            values[n] = fn(values, full)[0]
         requests = tuple(values[r] for r in self.requests)
         with_requests = dict(values)
         with_requests.update(zip(self.outputs, requests))
-        violated = {i: ev(c, with_requests) for i, c in self.constraint.items()}
+        violated = dict(zip(self.constraint, run.constraint(with_requests, full)))
         blocked = 0
         g1 = requests
         if self.mode is Mode.BLOCKING:
@@ -264,26 +272,25 @@ class FilterCycle:
         if self.algorithm is Algorithm.ALGEBRAIC:
             with_g1 = dict(values)
             with_g1.update(zip(self.requests, g1))
-            outside = full ^ ev(self.care, with_g1)
-            for o, cover in self.equations:  # in the block's order: each reads the outputs before it
-                with_g1[o] = ev(cover, with_g1)
+            outside = full ^ run.care(with_g1, full)[0]
+            for o, fn in run.equations:  # in the block's order: each reads the outputs before it
+                with_g1[o] = fn(with_g1, full)[0]
             outputs = tuple(with_g1[o] for o in self.outputs)
         else:
-            outputs, fallback = self._loop(values, g1, full, ev, iterations, rounds)
+            outputs, fallback = self._loop(values, g1, full, iterations, rounds)
         with_outputs = dict(values)
         with_outputs.update(zip(self.outputs, outputs))
-        unsafe = {i: ev(c, with_outputs) for i, c in self.constraint.items()}
+        unsafe = dict(zip(self.constraint, run.constraint(with_outputs, full))) if diagnose else {}
         previous = tuple(with_outputs[n] for n in self.remembered)
         return Lanes(count, requests, outputs, tuple(iterations), tuple(rounds), fallback,
-                     {i: m for i, m in violated.items()}, {i: m for i, m in unsafe.items()},
-                     outside, blocked, previous, self.outputs)
+                     violated, unsafe, outside, blocked, previous, self.outputs)
 
     # ------------------------------------------------------------------ the loop
-    def _loop(self, values: dict[str, int], g1: tuple[int, ...], full: int, ev, iterations: list, rounds: list
+    def _loop(self, values: dict[str, int], g1: tuple[int, ...], full: int, iterations: list, rounds: list
               ) -> tuple[tuple[int, ...], int]:
-        outs = self.outputs
-        fs0 = [ev(self.fs0[o], values) for o in outs]
-        fs1 = [ev(self.fs1[o], values) for o in outs]
+        outs, run = self.outputs, self._run
+        fs = run.fs(values, full)
+        fs0, fs1 = fs[:len(outs)], fs[len(outs):]
         fc0 = [0] * len(outs)
         fc1 = [0] * len(outs)
         ncsc = len(self.combined)
@@ -296,7 +303,7 @@ class FilterCycle:
             iterations.append(tuple(si))
             at = dict(values)
             at.update(zip(outs, si))
-            v = {i: ev(self.constraint[i], at) & flag for i in self.combined}
+            v = {i: m & flag for i, m in zip(self.combined, run.combined(at, full))}
             flag_now = 0
             for m in v.values():
                 flag_now |= m

@@ -5,8 +5,8 @@ outcome found so far, the distinct outcomes among the lanes of
 
 Example
 -------
->>> first_lanes([0b0110, 0b0100], 4), lane_bits(1, 4)
-([0, 1, 2], 12)
+>>> first_lanes([0b0110, 0b0100], 4)
+[0, 1, 2]
 >>> arrays = OutcomeArrays(2)
 >>> oc = Outcome((True, False), 0, False, False, (True, True), ("K",))
 >>> targets, fallback, outside, aux, requests = arrays.update([oc])
@@ -24,12 +24,13 @@ import numpy as np
 from synth.filter.cycle import ACK, Lanes, Memory, Mode
 from synth.filter.loop.verification import TraceRow
 from synth.logic.events import Event, EventKind
+from synth.logic.lanes import lane_mask
 
 TYPE_CHECKING = False
 if TYPE_CHECKING:
     from synth.filter.loop.product import Product
 
-__all__ = ["ClassLanes", "Outcome", "OutcomeArrays", "class_lanes", "distinct_lanes", "first_lanes", "lane_bits",
+__all__ = ["ClassLanes", "Outcome", "OutcomeArrays", "class_lanes", "distinct_lanes", "first_lanes",
            "react", "situation_text", "trace_row"]
 
 
@@ -126,19 +127,14 @@ def class_lanes(pr: "Product", ybits: int, aux: tuple, sit: Any) -> ClassLanes:
     previous = [False] * len(cyc.remembered)
     for i, v in zip(pr.used_index, mem_used):
         previous[i] = v
-    lanes = cyc.lanes(Memory(tuple(previous), blocked), fixed, free)
+    lanes = cyc.lanes(Memory(tuple(previous), blocked), fixed, free, diagnose=False)
     n = lanes.count
     out = dict(zip(cyc.outputs, lanes.outputs))  # lane masks
     for o in pr.passthrough:
-        out[o] = ((1 << n) - 1 if passed[o] else 0) if o in passed else lane_bits(free.index(o), n)
+        out[o] = ((1 << n) - 1 if passed[o] else 0) if o in passed else lane_mask(free.index(o), n)
     memory_after = [lanes.previous[i] for i in pr.used_index]
     masks = [*(out[o] for o in pr.orders), *memory_after, lanes.blocked, lanes.fallback, lanes.outside_care]
     return ClassLanes(lanes, out, memory_after, masks)
-
-
-def lane_bits(i: int, count: int) -> int:
-    """The lanes where free name ``i`` is true (bit i of the lane number)."""
-    return sum(1 << j for j in range(count) if (j >> i) & 1)
 
 
 class OutcomeArrays:
