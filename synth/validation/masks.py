@@ -96,11 +96,16 @@ def pack(bits: np.ndarray) -> np.ndarray:
     return out
 
 
+_BIT = np.left_shift(np.int64(1), np.arange(BITS, dtype=np.int64))
+
+
 def unpack(words: np.ndarray, k: int) -> np.ndarray:
-    """The first ``k`` bits of words (n × words) as Boolean columns (n × k)."""
-    shift = np.arange(BITS, dtype=np.int64)
-    bits = ((words[:, :, None] >> shift) & 1).astype(bool).reshape(len(words), words.shape[1] * BITS)
-    return bits[:, :k]
+    """The first ``k`` bits of words (n × words) as Boolean columns (n × k): only those
+    ``k`` bits are read (one pass when they fit one word)."""
+    if words.shape[1] == 1:
+        return (words & _BIT[:k]) != 0
+    j = np.arange(k, dtype=np.int64)
+    return (words[:, j // BITS] & _BIT[j % BITS]) != 0
 
 
 class Masks:
