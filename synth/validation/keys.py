@@ -39,9 +39,14 @@ class SortedKeys:
         """Insert absent, distinct ``keys``."""
         order = np.argsort(keys, kind="stable")
         keys, values = keys[order], values[order]
-        pos = np.searchsorted(self.keys, keys)
-        self.keys = np.insert(self.keys, pos, keys)
-        self.values = np.insert(self.values, pos, values)
+        n, m = self.keys.size, keys.size
+        at = np.searchsorted(self.keys, keys) + np.arange(m)  # the new keys' places in the merged table
+        old = np.ones(n + m, dtype=bool)
+        old[at] = False
+        merged, merged_values = np.empty(n + m, dtype=np.int64), np.empty(n + m, dtype=np.int64)
+        merged[at], merged_values[at] = keys, values
+        merged[old], merged_values[old] = self.keys, self.values
+        self.keys, self.values = merged, merged_values
 
 
 def _groups(perm: np.ndarray, change: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
