@@ -48,7 +48,7 @@ from synth.plant.composition import Plant
 from synth.plant.rules import Constraint
 from synth.sup.constraints import CompiledConstraints
 from synth.validation.conflicts import Conflict, ConflictLog
-from synth.validation.keys import SortedKeys, distinct, distinct_rows, first_occurrences, slices
+from synth.validation.keys import SortedKeys, distinct, distinct_rows, first_occurrences, row_codes, slices
 from synth.validation.regions import PlantCodes, Regions, regions
 from synth.validation.sync import Edge, Node, Partial, Sync, synchronous_product
 from synth.validation.words import Collision
@@ -105,19 +105,18 @@ class _Situations:
         self.vm, self.size = vm, size
         self.items: list[Situation] = []
         self.timers: list[tuple[Event, ...]] = []
-        self._ids: dict[bytes, int] = {}
+        self.timed = np.zeros(0, dtype=bool)  # the situations with timers to fire
+        self._ids: dict[int | bytes, int] = {}
         self.A = np.zeros((0, len(vm.step_names)), dtype=bool)
         self.T = np.zeros((0, vm.memory), dtype=bool)
 
     def number(self, A: np.ndarray, T: np.ndarray, given: list[Situation] | None = None) -> np.ndarray:
         """The numbers of the rows' situations (a new one numbered when first met)."""
         bits = np.hstack([A, T])
-        first, inverse = distinct_rows(bits)
-        packed = np.packbits(bits, axis=1)
+        first, inverse, keys = _distinct_keys(bits)
         ids = np.empty(len(first), dtype=np.int64)
         fresh = []
-        for u, r in enumerate(first.tolist()):
-            b = packed[r].tobytes()
+        for u, (r, b) in enumerate(zip(first.tolist(), keys)):
             hit = self._ids.get(b)
             if hit is None:
                 hit = self._ids[b] = len(self.items)
@@ -130,6 +129,7 @@ class _Situations:
         if fresh:
             self.A = np.vstack([self.A, A[fresh]])
             self.T = np.vstack([self.T, T[fresh]])
+            self.timed = np.concatenate([self.timed, np.array([bool(t) for t in self.timers[len(self.timed):]], dtype=bool)])
             if len(self.items) * self.size >= 1 << 62:
                 raise Unsupported("node keys past 64 bits")
         return out
@@ -167,13 +167,23 @@ def explore_frontier(
 T_ = TypeVar("T_")
 
 
-def _per_row(bits: np.ndarray, make: Callable[[np.ndarray], T_], made: dict[bytes, T_]) -> list[T_]:
+def _distinct_keys(bits: np.ndarray) -> tuple[np.ndarray, np.ndarray, list[int] | list[bytes]]:
+    """:func:`~synth.validation.keys.distinct_rows` of ``bits``, and each distinct row's
+    key for a dictionary: its integer code up to 62 columns, else its packed bytes."""
+    if bits.shape[1] <= 62:
+        codes = row_codes(bits)
+        first, inverse = distinct(codes)
+        return first, inverse, codes[first].tolist()
+    first, inverse = distinct_rows(bits)
+    return first, inverse, [r.tobytes() for r in np.packbits(bits[first], axis=1)]
+
+
+def _per_row(bits: np.ndarray, make: Callable[[np.ndarray], T_], made: dict[int | bytes, T_]) -> list[T_]:
     """``make`` of each row of ``bits``, called once per distinct row (``made``: the rows
     met before)."""
-    first, inverse = distinct_rows(bits)
+    first, inverse, keys = _distinct_keys(bits)
     out = []
-    for r in first.tolist():
-        key = bits[r].tobytes()
+    for r, key in zip(first.tolist(), keys):
         hit = made.get(key)
         if hit is None:
             hit = made[key] = make(bits[r])
@@ -191,7 +201,7 @@ class _Explorer:
         self.regions = Regions()
         self.entered = SortedKeys()  # (situation, entry) -> region
         self.by_wanted = SortedKeys()  # (wanted orders, entry) -> region
-        self._wanted: dict[bytes, int] = {}
+        self._wanted: dict[int | bytes, int] = {}
         self.index = SortedKeys()  # (situation, plant) -> node
         self.nodes: list[Node] = []
         self.node_sit = np.empty(0, dtype=np.int64)
@@ -201,10 +211,11 @@ class _Explorer:
         self.targets: list[np.ndarray] = []
         self.conflicts: list[Conflict] = []
         self.log = ConflictLog()
-        self._emitted: dict[bytes, frozenset[str]] = {}  # a node's orders, per row of bits
-        self._set: dict[bytes, tuple[str, ...]] = {}
+        self._emitted: dict[int | bytes, frozenset[str]] = {}  # a node's orders, per row of bits
+        self._set: dict[int | bytes, tuple[str, ...]] = {}
         self.pairs: list[np.ndarray] = []  # (situation, member) keys of the regions entered
         # the Grafcet's order columns in the regions' order of the plant's orders
+        self._move_events = [t.event for t in self.pc.uncontrollable]
         self._order_cols = [self.vm.order_names.index(o) if o in self.vm.order_names else -1 for o in self.pc.orders]
 
     # ------------------------------------------------------------------ helpers
@@ -225,14 +236,9 @@ class _Explorer:
             miss = np.flatnonzero(found < 0)
             first = miss[first_occurrences(keys[miss])]
             emitted = self.orders(sid[first], entry[first])
-            wanted = np.zeros((len(first), len(self._order_cols)), dtype=bool)
-            for j, c in enumerate(self._order_cols):
-                if c >= 0:
-                    wanted[:, j] = emitted[:, c]
-            rows, inverse = distinct_rows(wanted)
-            packed = np.packbits(wanted[rows], axis=1)
-            wid = np.array([self._wanted.setdefault(w.tobytes(), len(self._wanted)) for w in packed],
-                           dtype=np.int64)[inverse]
+            wanted = np.hstack([emitted, np.zeros((len(first), 1), dtype=bool)])[:, self._order_cols]
+            _, inverse, rows = _distinct_keys(wanted)
+            wid = np.array([self._wanted.setdefault(w, len(self._wanted)) for w in rows], dtype=np.int64)[inverse]
             if len(self._wanted) * self.P >= 1 << 62:
                 raise Unsupported("region keys past 64 bits")
             wkeys = wid * self.P + entry[first]
@@ -280,8 +286,8 @@ class _Explorer:
         set_ = _per_row(emitted & self.pc.values(names, digits), lambda row: tuple(names[i] for i in np.flatnonzero(row)),
                         self._set)
         items, prohs = self.sits.items, self.regions.prohibitions
-        self.nodes.extend(Node(items[s], tuple(local), w, o, prohs[pr])
-                          for s, local, w, o, pr in zip(sid.tolist(), digits.full().T.tolist(), wanted, set_, proh.tolist()))
+        self.nodes.extend(map(Node, [items[s] for s in sid.tolist()], map(tuple, digits.full().T.tolist()), wanted, set_,
+                              [prohs[pr] for pr in proh.tolist()]))
         self.node_sit = np.concatenate([self.node_sit, sid])
         self.node_code = np.concatenate([self.node_code, q])
         if self.max_states is not None and len(self.nodes) > self.max_states:
@@ -362,41 +368,42 @@ class _Explorer:
         nsid = sid[row]
         moved &= ~pending
         nsid[moved] = self.sits.number(A2[moved], T2[moved])
-        events: list[Event] = [self.pc.uncontrollable[k].event for k in rank.tolist()]
         traced: dict[int, Rounds] = {}  # candidate -> rounds fired, where the machine reacted
         items = self.sits.items
         for c in np.flatnonzero(pending).tolist():
             sit, traced[c] = self._machine(lambda: self.machine.react_with_trace(
                 items[sid[row[c]]], self.as_dict(before[row[c]]), self.as_dict(after[c])))
             nsid[c] = self.sits.of([sit])[0]
+        # each candidate's event, as an index into ``table``: the uncontrollable moves' own,
+        # then one per timer candidate
+        table, evid = list(self._move_events), [rank]
         rows, ranks, entries, sids = [row], [rank], [entry], [nsid]
-        first_timer = len(self.pc.uncontrollable)
-        for r in np.flatnonzero(self.has_timers()[sid]).tolist():
+        first_timer, candidates = len(self.pc.uncontrollable), len(row)
+        for r in np.flatnonzero(self.sits.timed[sid]).tolist():
             for j, timer in enumerate(self.sits.timers[sid[r]]):
                 sit, rounds = self._machine(lambda: self.machine.fire_timer_with_trace(
                     items[sid[r]], timer, self.as_dict(before[r])))
-                traced[len(events)] = rounds
-                events.append(timer)
+                traced[candidates] = rounds
+                candidates += 1
+                evid.append(np.array([len(table)]))
+                table.append(timer)
                 rows.append(np.array([r]))
                 ranks.append(np.array([first_timer + j]))
                 entries.append(codes[r:r + 1])
                 sids.append(self.sits.of([sit]))
-        row, rank, entry, nsid = (np.concatenate(x) for x in (rows, ranks, entries, sids))
+        row, rank, entry, nsid, ev = (np.concatenate(x) for x in (rows, ranks, entries, sids, evid))
         order = np.lexsort((rank, row))
-        where = np.empty(len(order), dtype=np.int64)
-        where[order] = np.arange(len(order))
-        for c in sorted(traced, key=lambda c: where[c]):
-            i = lo + int(row[c])
-            self.conflicts.extend(Conflict(i, events[c], st, names) for st, names in self.log.fresh(traced[c]))
-        row, entry, nsid = row[order], entry[order], nsid[order]
-        events = [events[c] for c in order.tolist()]
+        if traced:
+            where = np.empty(len(order), dtype=np.int64)
+            where[order] = np.arange(len(order))
+            for c in sorted(traced, key=lambda c: where[c]):
+                i = lo + int(row[c])
+                self.conflicts.extend(Conflict(i, table[ev[c]], st, names) for st, names in self.log.fresh(traced[c]))
+        row, entry, nsid, ev = row[order], entry[order], nsid[order], ev[order]
         node, src = self.enter(nsid, entry)
         self.sources.append(lo + row[src])
         self.targets.append(node)
-        self.edges.extend(map(Edge, self.sources[-1].tolist(), [events[c] for c in src.tolist()], node.tolist()))
-
-    def has_timers(self) -> np.ndarray:
-        return np.array([bool(t) for t in self.sits.timers], dtype=bool)
+        self.edges.extend(map(Edge, self.sources[-1].tolist(), [table[e] for e in ev[src].tolist()], node.tolist()))
 
     @staticmethod
     def _machine(call: Callable[[], tuple[Situation, Rounds]]) -> tuple[Situation, Rounds]:

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["SortedKeys", "distinct", "distinct_rows", "first_occurrences", "slices"]
+__all__ = ["SortedKeys", "distinct", "distinct_rows", "row_codes", "first_occurrences", "slices"]
 
 
 class SortedKeys:
@@ -67,11 +67,16 @@ def distinct(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return _groups(perm, change)
 
 
+def row_codes(bits: np.ndarray) -> np.ndarray:
+    """Each row of a Boolean matrix of at most 62 columns as one integer (column j: bit j)."""
+    return bits.astype(np.int64) @ (np.int64(1) << np.arange(bits.shape[1], dtype=np.int64))
+
+
 def distinct_rows(bits: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """:func:`distinct` for the rows of a Boolean matrix."""
     n, k = bits.shape
     if k <= 62:
-        return distinct(bits.astype(np.int64) @ (np.int64(1) << np.arange(k, dtype=np.int64)))
+        return distinct(row_codes(bits))
     packed = np.packbits(bits, axis=1)
     packed = np.hstack([packed, np.zeros((n, -packed.shape[1] % 8), dtype=np.uint8)])
     words = packed.view(np.uint64)
@@ -84,7 +89,11 @@ def distinct_rows(bits: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def first_occurrences(keys: np.ndarray) -> np.ndarray:
     """Positions of the first occurrence of each distinct key, in the order they occur."""
-    return np.sort(distinct(keys)[0])
+    perm = np.argsort(keys, kind="stable")
+    s = keys[perm]
+    change = np.ones(len(s), dtype=bool)
+    change[1:] = s[1:] != s[:-1]
+    return np.sort(perm[change])
 
 
 def slices(starts: np.ndarray, groups: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

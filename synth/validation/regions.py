@@ -35,7 +35,7 @@ import numpy as np
 
 from synth.plant.composition import LocalTransition, Plant
 from synth.sup.constraints import CompiledConstraints
-from synth.validation.keys import SortedKeys, distinct_rows, first_occurrences, slices
+from synth.validation.keys import SortedKeys, distinct, distinct_rows, first_occurrences, row_codes, slices
 from synth.validation.masks import Masks, Runs, pack, unpack
 from synth.validation.sync import Prohibition, moves_by_order
 from synth.validation.words import CAPACITY, Interned, Layout
@@ -130,7 +130,7 @@ class PlantCodes:
         self.order_starts = np.searchsorted(self._c.column, np.arange(len(self.orders) + 1))
         self._reach = [g.ravel() for g in oracle.reach_grids] if oracle.reach_grids is not None else None
         self.prohibitions: list[Prohibition] = []  # the refusals met: one move, its constraints responsible
-        self._why: dict[tuple[int, bytes], int] = {}
+        self._why: dict[int | tuple[int, bytes], int] = {}
         self._edge_width = max((len(oracle.edge_terms.get(t.event, ())) for t in controllable), default=0)
         self._threat_masks = Masks(self.runs, self._level_tables(), len(oracle.level_terms), conj=True)
         self._order_masks = Masks(self.runs, self._value_tables(self.orders), len(self.orders), conj=False)
@@ -270,13 +270,20 @@ class PlantCodes:
                 edge[at, j] = self.holds(term.factors, digits, row[at])
         level = unpack(threats, len(self.oracle.level_terms))
         bits = np.hstack([edge, level])
-        first, inverse = distinct_rows(np.hstack([bits, (rank[:, None] >> np.arange(32)) & 1 == 1]))
+        rank_bits = len(c.moves).bit_length()
+        keys: list[int] | list[tuple[int, bytes]]
+        if bits.shape[1] + rank_bits <= 62:  # (bits, move) as one integer
+            codes = (row_codes(bits) << rank_bits) | rank
+            first, inverse = distinct(codes)
+            keys = codes[first].tolist()
+        else:
+            first, inverse = distinct_rows(np.hstack([bits, (rank[:, None] >> np.arange(32)) & 1 == 1]))
+            keys = [(int(rank[r]), np.packbits(bits[r]).tobytes()) for r in first.tolist()]
         ids = np.empty(len(first), dtype=np.int64)
-        for u, r in enumerate(first.tolist()):
-            key = (int(rank[r]), np.packbits(bits[r]).tobytes())
+        for u, (r, key) in enumerate(zip(first.tolist(), keys)):
             hit = self._why.get(key)
             if hit is None:
-                t = c.moves[key[0]]
+                t = c.moves[int(rank[r])]
                 why = [terms[t.event][j].constraint for j in np.flatnonzero(edge[r]).tolist()]
                 why += [self.oracle.level_terms[i].constraint for i in np.flatnonzero(level[r]).tolist()]
                 hit = self._why[key] = len(self.prohibitions)
