@@ -13,6 +13,7 @@ Example
 
 from __future__ import annotations
 
+import gc
 from pathlib import Path
 from typing import Callable, Sequence
 
@@ -102,12 +103,20 @@ def validate_loaded(
     after each step of the exploration (:func:`explore`)."""
     conditions = home_conditions(homes, p, g)
     machine = GrafcetMachine(g)
-    sync = explore(p, rs.constraints, machine, max_states=max_states, progress=progress, watch=watch)
-    sup_empty = not sync.oracle.kept(p.initial)  # the constraints compiled once
-    analysis = analyse(sync, home_states(sync, conditions))
-    if not (analysis.blocking or analysis.never_starts or analysis.prohibited):  # a passing run imports no diagnosis
-        return Validation(rs, p, g, sync, analysis, {}, expert, sup_empty, tuple(homes), None)
-    from synth.validation.diagnosis import diagnose_all
+    # the run's objects (nodes, edges, situations, their indexes) make no reference cycles:
+    # the collector's passes over them free nothing (4-7 % of a run of 10^4 SYNC states)
+    collecting = gc.isenabled()
+    gc.disable()
+    try:
+        sync = explore(p, rs.constraints, machine, max_states=max_states, progress=progress, watch=watch)
+        sup_empty = not sync.oracle.kept(p.initial)  # the constraints compiled once
+        analysis = analyse(sync, home_states(sync, conditions))
+        if not (analysis.blocking or analysis.never_starts or analysis.prohibited):  # a passing run imports no diagnosis
+            return Validation(rs, p, g, sync, analysis, {}, expert, sup_empty, tuple(homes), None)
+        from synth.validation.diagnosis import diagnose_all
 
-    diagnoses, never, prohibitions = diagnose_all(sync, analysis, expert=expert)
-    return Validation(rs, p, g, sync, analysis, diagnoses, expert, sup_empty, tuple(homes), never, prohibitions)
+        diagnoses, never, prohibitions = diagnose_all(sync, analysis, expert=expert)
+        return Validation(rs, p, g, sync, analysis, diagnoses, expert, sup_empty, tuple(homes), never, prohibitions)
+    finally:
+        if collecting:
+            gc.enable()
