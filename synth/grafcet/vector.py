@@ -158,6 +158,8 @@ class VectorMachine:
                     cond = self._compile(a.condition) if a.kind == CONDITIONAL and a.condition is not None else None
                     self._actions.append((self._step[s.name], a.order, cond))
         self.order_names = tuple(sorted(orders))
+        self.conditional = any(cond is not None for _, _, cond in self._actions)
+        """Whether some action has a condition (the orders then read the inputs)."""
         self._order = {o: i for i, o in enumerate(self.order_names)}
         self._stored_cols = [(nt + i, self._order[o]) for i, o in enumerate(self.stored_names)]
         self._sorted: tuple[np.ndarray, tuple[str, ...], np.ndarray, tuple[str, ...]] | None = None  # situation()
@@ -288,15 +290,28 @@ class VectorMachine:
 
     def orders(self, A: np.ndarray, T: np.ndarray, I: np.ndarray) -> np.ndarray:
         """The orders each row emits (columns :attr:`order_names`) on the input levels ``I``."""
+        out = self.situation_orders(A, T)
+        self.add_conditional(out, A, T, I)
+        return out
+
+    def situation_orders(self, A: np.ndarray, T: np.ndarray) -> np.ndarray:
+        """What of :meth:`orders` the situation alone decides: the continuous actions without
+        a condition and the stored outputs (a situation's part, read once per situation)."""
         out = np.zeros((len(A), len(self.order_names)), dtype=bool)
-        Z = np.zeros(len(A), dtype=bool)
-        E = np.full(len(A), -1)
         for step, order, cond in self._actions:
-            col = A[:, step]
-            out[:, self._order[order]] |= col if cond is None else col & cond(I, A, T, E, Z)
+            if cond is None:
+                out[:, self._order[order]] |= A[:, step]
         for col_t, col_o in self._stored_cols:
             out[:, col_o] |= T[:, col_t]
         return out
+
+    def add_conditional(self, out: np.ndarray, A: np.ndarray, T: np.ndarray, I: np.ndarray) -> None:
+        """The conditional actions' orders on the input levels ``I``, added to ``out`` in place."""
+        Z = np.zeros(len(A), dtype=bool)
+        E = np.full(len(A), -1)
+        for step, order, cond in self._actions:
+            if cond is not None:
+                out[:, self._order[order]] |= A[:, step] & cond(I, A, T, E, Z)
 
 
 class _Lists:

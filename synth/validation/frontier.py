@@ -109,6 +109,7 @@ class _Situations:
         self._ids: dict[int | bytes, int] = {}
         self.A = np.zeros((0, len(vm.step_names)), dtype=bool)
         self.T = np.zeros((0, vm.memory), dtype=bool)
+        self.O = np.zeros((0, len(vm.order_names)), dtype=bool)  # the orders the situation emits whatever the inputs
 
     def number(self, A: np.ndarray, T: np.ndarray, given: list[Situation] | None = None) -> np.ndarray:
         """The numbers of the rows' situations (a new one numbered when first met)."""
@@ -129,6 +130,7 @@ class _Situations:
         if fresh:
             self.A = np.vstack([self.A, A[fresh]])
             self.T = np.vstack([self.T, T[fresh]])
+            self.O = np.vstack([self.O, self.vm.situation_orders(A[fresh], T[fresh])])
             self.timed = np.concatenate([self.timed, np.array([bool(t) for t in self.timers[len(self.timed):]], dtype=bool)])
             if len(self.items) * self.size >= 1 << 62:
                 raise Unsupported("node keys past 64 bits")
@@ -226,7 +228,10 @@ class _Explorer:
         return dict(zip(self.machine.inputs, bits.tolist()))
 
     def orders(self, sid: np.ndarray, codes: np.ndarray) -> np.ndarray:
-        return self.vm.orders(self.sits.A[sid], self.sits.T[sid], self.inputs(codes))
+        out = self.sits.O[sid]  # what the situations decide alone, read once per situation
+        if self.vm.conditional:
+            self.vm.add_conditional(out, self.sits.A[sid], self.sits.T[sid], self.inputs(codes))
+        return out
 
     def region_of(self, sid: np.ndarray, entry: np.ndarray) -> np.ndarray:
         """The region entered at each (situation, entry), searched when new."""
