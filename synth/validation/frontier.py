@@ -50,7 +50,7 @@ from synth.sup.constraints import CompiledConstraints
 from synth.validation.conflicts import Conflict, ConflictLog
 from synth.validation.keys import SortedKeys, distinct, distinct_rows, first_occurrences, row_codes, slices
 from synth.validation.regions import PlantCodes, Regions, regions
-from synth.validation.sync import Edge, Node, Partial, Sync, synchronous_product
+from synth.validation.sync import Edge, Node, Partial, Sync, many_edges, many_nodes, synchronous_product
 from synth.validation.words import Collision
 
 __all__ = ["explore_wide", "reason", "explore_frontier", "Unsupported"]
@@ -291,8 +291,8 @@ class _Explorer:
         set_ = _per_row(emitted & self.pc.values(names, digits), lambda row: tuple(names[i] for i in np.flatnonzero(row)),
                         self._set)
         items, prohs = self.sits.items, self.regions.prohibitions
-        self.nodes.extend(map(Node, [items[s] for s in sid.tolist()], map(tuple, digits.full().T.tolist()), wanted, set_,
-                              [prohs[pr] for pr in proh.tolist()]))
+        self.nodes.extend(many_nodes([items[s] for s in sid.tolist()], map(tuple, digits.full().T.tolist()), wanted, set_,
+                                     [prohs[pr] for pr in proh.tolist()]))
         self.node_sit = np.concatenate([self.node_sit, sid])
         self.node_code = np.concatenate([self.node_code, q])
         if self.max_states is not None and len(self.nodes) > self.max_states:
@@ -408,7 +408,7 @@ class _Explorer:
         node, src = self.enter(nsid, entry)
         self.sources.append(lo + row[src])
         self.targets.append(node)
-        self.edges.extend(map(Edge, self.sources[-1].tolist(), [table[e] for e in ev[src].tolist()], node.tolist()))
+        self.edges.extend(many_edges(self.sources[-1].tolist(), [table[e] for e in ev[src].tolist()], node.tolist()))
 
     @staticmethod
     def _machine(call: Callable[[], tuple[Situation, Rounds]]) -> tuple[Situation, Rounds]:
