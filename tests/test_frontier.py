@@ -192,7 +192,7 @@ def test_a_narrow_sync_stays_on_the_machines_path(tmp_path):
             "print(v.sync.sync_states, 'synth.validation.frontier' in sys.modules)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
                          env={**__import__("os").environ, "PYTHONPATH": str(ROOT)}).stdout.split()
-    assert int(out[0]) > 0 and out[1] == "False" and WIDE == 32
+    assert int(out[0]) > 0 and out[1] == "False" and WIDE == 16
 
 
 def test_a_wide_sync_goes_to_the_frontier(tmp_path, monkeypatch):

@@ -24,7 +24,7 @@ from synth.plant.composition import Plant
 from synth.plant.rules import Constraint, RuleSet
 from synth.validation.analysis import analyse
 from synth.validation.result import Validation, home_conditions, load_model
-from synth.validation.sync import WIDE, Sync, Wide, synchronous_product
+from synth.validation.sync import WATCHED_WIDE, WIDE, Sync, Wide, synchronous_product
 
 __all__ = ["validate", "validate_loaded", "home_states", "explore"]
 
@@ -62,10 +62,11 @@ def explore(
     (a narrow SYNC, a sequence, a small station), then a frontier at a time
     (:func:`synth.validation.frontier.explore_wide`, imported only then); ``watch(met,
     waiting)``: the aggregated states met and those waiting, after each state or frontier
-    expanded (it may raise to stop the run: ``validate --engine auto``)."""
+    expanded (it may raise to stop the run: ``validate --engine auto``; the frontier then
+    takes over past :data:`~synth.validation.sync.WATCHED_WIDE`)."""
     try:
-        return synchronous_product(p, constraints, machine, max_states=max_states, progress=progress, wide=WIDE,
-                                   watch=watch)
+        return synchronous_product(p, constraints, machine, max_states=max_states, progress=progress,
+                                   wide=WIDE if watch is None else WATCHED_WIDE, watch=watch)
     except Wide as wide:
         from synth.validation.frontier import explore_wide
 
