@@ -137,8 +137,12 @@ class _Situations:
         return out
 
     def of(self, sits: list[Situation]) -> np.ndarray:
-        A, T = self.vm.rows(sits)
-        return self.number(A, T, sits)
+        """The numbers of ``sits`` (each distinct one made a row once)."""
+        at: dict[Situation, int] = {}
+        where = [at.setdefault(s, len(at)) for s in sits]
+        distinct_sits = list(at)
+        A, T = self.vm.rows(distinct_sits)
+        return self.number(A, T, distinct_sits)[where]
 
 
 def explore_frontier(
