@@ -35,7 +35,7 @@ import numpy as np
 
 from synth.plant.composition import LocalTransition, Plant
 from synth.sup.constraints import CompiledConstraints
-from synth.validation.keys import SortedKeys, distinct, distinct_rows, first_occurrences, row_codes, slices
+from synth.validation.keys import distinct, distinct_rows, row_codes, slices
 from synth.validation.masks import Masks, Runs, pack, unpack
 from synth.validation.sync import Prohibition, moves_by_order
 from synth.validation.words import CAPACITY, Interned, Layout
@@ -350,8 +350,7 @@ def regions(pc: PlantCodes, store: Regions, entries: np.ndarray, wanted: np.ndar
         raise OverflowError("region keys")
     reg, cur = np.arange(R, dtype=np.int64), entries.astype(np.int64)
     wanted_bits, k = pack(wanted), len(pc.orders)
-    seen = SortedKeys()
-    seen.add(reg * pc.P + cur, reg)
+    seen = set((reg * pc.P + cur).tolist())  # (region, member) keys: a set, one look-up per move kept
     member_parts, settled_parts = [(reg, cur)], []
     while cur.size:
         digits = pc.digits(cur)
@@ -368,9 +367,8 @@ def regions(pc: PlantCodes, store: Regions, entries: np.ndarray, wanted: np.ndar
             at = np.flatnonzero(rank == k)
             if at.size:
                 ok[at] &= ~pc.forbidden(c.moves[k], digits, row[at])
-        progressed = np.zeros(cur.size, dtype=bool)
-        progressed[row[ok]] = True
-        still = ~progressed
+        still = np.ones(cur.size, dtype=bool)  # settled: no allowed move
+        still[row[ok]] = False
         proh = np.zeros(cur.size, dtype=np.int64)
         sel = np.flatnonzero(still[row])  # the moves from settled states: every one refused
         if sel.size:
@@ -380,11 +378,13 @@ def regions(pc: PlantCodes, store: Regions, entries: np.ndarray, wanted: np.ndar
         if not ok.any():
             break
         nreg, target = reg[row[ok]], target[ok]
-        keys = nreg * pc.P + target
-        first = first_occurrences(keys)
-        first = first[seen.find(keys[first]) < 0]
+        fresh = []  # the first move into each state not met before, in order
+        for i, key in enumerate((nreg * pc.P + target).tolist()):
+            if key not in seen:
+                seen.add(key)
+                fresh.append(i)
+        first = np.array(fresh, dtype=np.int64)
         reg, cur = nreg[first], target[first]
-        seen.add(reg * pc.P + cur, reg)
         member_parts.append((reg, cur))
     _store(store, R, member_parts, settled_parts)
 
