@@ -211,9 +211,9 @@ class VectorMachine:
                             np.array(timers, dtype=np.int64), tuple(self.timer_names[i] for i in timers))
         steps_at, step_names, timers_at, timer_names = self._sorted
         nt = len(self.timer_names)
-        return Situation(tuple(step_names[i] for i in np.flatnonzero(a[steps_at]).tolist()),
-                         tuple(self.stored_names[i] for i in np.flatnonzero(t[nt:]).tolist()),  # sorted names
-                         tuple(timer_names[i] for i in np.flatnonzero(t[timers_at]).tolist()), ())
+        return Situation(tuple(step_names[i] for i in a[steps_at].nonzero()[0].tolist()),
+                         tuple(self.stored_names[i] for i in t[nt:].nonzero()[0].tolist()),  # sorted names
+                         tuple(timer_names[i] for i in t[timers_at].nonzero()[0].tolist()), ())
 
     # ------------------------------------------------------------------ evolution
     def _fireable(self, A: np.ndarray, T: np.ndarray, I: np.ndarray, E: np.ndarray) -> np.ndarray:
@@ -224,7 +224,7 @@ class VectorMachine:
         out = np.asfortranarray(steps[:, self._first_source])  # the transitions enabled
         for j, s in self._more_sources:
             out[:, j] &= A[:, s]
-        for j in np.flatnonzero(out.any(axis=0)).tolist():
+        for j in out.any(axis=0).nonzero()[0].tolist():
             out[:, j] &= self._rec[j](I, A, T, E, Z)
         return out
 
@@ -325,8 +325,8 @@ class _Lists:
     def _spread(self, row: np.ndarray, item: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(row, column) for each column of each pair's ``item``."""
         counts = self.starts[item + 1] - self.starts[item]
-        at = np.repeat(self.starts[item] - np.cumsum(counts) + counts, counts) + np.arange(int(counts.sum()))
-        return np.repeat(row, counts), self.cols[at]
+        at = (self.starts[item] - counts.cumsum() + counts).repeat(counts) + np.arange(int(counts.sum()))
+        return row.repeat(counts), self.cols[at]
 
     def mark(self, row: np.ndarray, item: np.ndarray, n: int) -> np.ndarray:
         """An n-row matrix with the columns of ``item`` set in ``row``, for each pair."""

@@ -242,7 +242,7 @@ class _Explorer:
         keys = sid * self.P + entry
         found = self.entered.find(keys)
         if (found < 0).any():
-            miss = np.flatnonzero(found < 0)
+            miss = (found < 0).nonzero()[0]
             first = miss[first_occurrences(keys[miss])]
             emitted = self.orders(sid[first], entry[first])
             wanted = np.hstack([emitted, np.zeros((len(first), 1), dtype=bool)])[:, self._order_cols]
@@ -252,7 +252,7 @@ class _Explorer:
                 raise Unsupported("region keys past 64 bits")
             wkeys = wid * self.P + entry[first]
             gid = self.by_wanted.find(wkeys)
-            new = np.flatnonzero(gid < 0)
+            new = (gid < 0).nonzero()[0]
             if new.size:
                 new = new[first_occurrences(wkeys[new])]
                 base = self.regions.count
@@ -264,7 +264,7 @@ class _Explorer:
                 gid = self.by_wanted.find(wkeys)
             self.entered.add(keys[first], gid)
             counts, at = slices(self.regions.member_starts, gid)
-            self.pairs.append(np.repeat(sid[first], counts) * self.P + self.regions.members[at])
+            self.pairs.append(sid[first].repeat(counts) * self.P + self.regions.members[at])
             found = self.entered.find(keys)
         return found
 
@@ -273,12 +273,12 @@ class _Explorer:
         each of them the candidate it comes from."""
         gid = self.region_of(sid, entry)
         counts, at = slices(self.regions.settled_starts, gid)
-        src = np.repeat(np.arange(len(gid)), counts)
+        src = np.arange(len(gid)).repeat(counts)
         q, proh = self.regions.settled[at], self.regions.settled_proh[at]
         tsid = sid[src]
         keys = tsid * self.P + q
         node = self.index.find(keys)
-        miss = np.flatnonzero(node < 0)
+        miss = (node < 0).nonzero()[0]
         if miss.size:
             first = miss[first_occurrences(keys[miss])]
             ids = len(self.nodes) + np.arange(first.size)
@@ -291,8 +291,8 @@ class _Explorer:
         emitted = self.orders(sid, q)
         digits = self.pc.digits(q)
         names = self.vm.order_names
-        wanted = _per_row(emitted, lambda row: frozenset(names[i] for i in np.flatnonzero(row)), self._emitted)
-        set_ = _per_row(emitted & self.pc.values(names, digits), lambda row: tuple(names[i] for i in np.flatnonzero(row)),
+        wanted = _per_row(emitted, lambda row: frozenset(names[i] for i in row.nonzero()[0]), self._emitted)
+        set_ = _per_row(emitted & self.pc.values(names, digits), lambda row: tuple(names[i] for i in row.nonzero()[0]),
                         self._set)
         items, prohs = self.sits.items, self.regions.prohibitions
         self.nodes.extend(many_nodes([items[s] for s in sid.tolist()], map(tuple, digits.full().T.tolist()), wanted, set_,
@@ -379,7 +379,7 @@ class _Explorer:
         nsid[moved] = self.sits.number(A2[moved], T2[moved])
         traced: dict[int, Rounds] = {}  # candidate -> rounds fired, where the machine reacted
         items = self.sits.items
-        for c in np.flatnonzero(pending).tolist():
+        for c in pending.nonzero()[0].tolist():
             sit, traced[c] = self._machine(lambda: self.machine.react_with_trace(
                 items[sid[row[c]]], self.as_dict(before[row[c]]), self.as_dict(after[c])))
             nsid[c] = self.sits.of([sit])[0]
@@ -388,7 +388,7 @@ class _Explorer:
         table, evid = list(self._move_events), [rank]
         rows, ranks, entries, sids = [row], [rank], [entry], [nsid]
         first_timer, candidates = len(self.pc.uncontrollable), len(row)
-        for r in np.flatnonzero(self.sits.timed[sid]).tolist():
+        for r in self.sits.timed[sid].nonzero()[0].tolist():
             for j, timer in enumerate(self.sits.timers[sid[r]]):
                 sit, rounds = self._machine(lambda: self.machine.fire_timer_with_trace(
                     items[sid[r]], timer, self.as_dict(before[r])))

@@ -37,7 +37,7 @@ class SortedKeys:
 
     def add(self, keys: np.ndarray, values: np.ndarray) -> None:
         """Insert absent, distinct ``keys``."""
-        order = np.argsort(keys, kind="stable")
+        order = keys.argsort(kind="stable")
         keys, values = keys[order], values[order]
         n, m = self.keys.size, keys.size
         at = np.searchsorted(self.keys, keys) + np.arange(m)  # the new keys' places in the merged table
@@ -53,14 +53,14 @@ def _groups(perm: np.ndarray, change: np.ndarray) -> tuple[np.ndarray, np.ndarra
     """From a stable sorting permutation and where the sorted keys change (first True):
     each group's first position and each position's group."""
     inverse = np.empty(len(perm), dtype=np.int64)
-    inverse[perm] = np.cumsum(change) - 1
+    inverse[perm] = change.cumsum() - 1
     return perm[change], inverse
 
 
 def distinct(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The distinct keys, in increasing order, as the position of their first occurrence;
     and each position's rank among them."""
-    perm = np.argsort(keys, kind="stable")
+    perm = keys.argsort(kind="stable")
     s = keys[perm]
     change = np.ones(len(s), dtype=bool)
     change[1:] = s[1:] != s[:-1]
@@ -89,7 +89,7 @@ def distinct_rows(bits: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def first_occurrences(keys: np.ndarray) -> np.ndarray:
     """Positions of the first occurrence of each distinct key, in the order they occur."""
-    perm = np.argsort(keys, kind="stable")
+    perm = keys.argsort(kind="stable")
     s = keys[perm]
     change = np.ones(len(s), dtype=bool)
     change[1:] = s[1:] != s[:-1]
@@ -105,5 +105,5 @@ def slices(starts: np.ndarray, groups: np.ndarray) -> tuple[np.ndarray, np.ndarr
     ([3, 2], [2, 3, 4, 0, 1])
     """
     counts = starts[groups + 1] - starts[groups]
-    at = np.repeat(starts[groups] - np.cumsum(counts) + counts, counts) + np.arange(int(counts.sum()))
+    at = (starts[groups] - counts.cumsum() + counts).repeat(counts) + np.arange(int(counts.sum()))
     return counts, at

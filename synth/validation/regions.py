@@ -231,7 +231,7 @@ class PlantCodes:
         u = self._u
         ok = digits.full()[u.axis, :].T == u.src
         for k in u.guarded:
-            rows = np.flatnonzero(ok[:, k])
+            rows = ok[:, k].nonzero()[0]
             if rows.size:
                 ok[rows, k] = self._guard(k, digits, rows)
         row, rank = np.nonzero(ok)  # row-major: by row, then rank
@@ -265,7 +265,7 @@ class PlantCodes:
         c, terms = self._c, self.oracle.edge_terms
         edge = np.zeros((len(row), self._edge_width), dtype=bool)
         for k in c.forbidding:
-            at = np.flatnonzero(rank == k)
+            at = (rank == k).nonzero()[0]
             for j, term in enumerate(terms[c.moves[k].event] if at.size else ()):
                 edge[at, j] = self.holds(term.factors, digits, row[at])
         level = unpack(threats, len(self.oracle.level_terms))
@@ -284,8 +284,8 @@ class PlantCodes:
             hit = self._why.get(key)
             if hit is None:
                 t = c.moves[int(rank[r])]
-                why = [terms[t.event][j].constraint for j in np.flatnonzero(edge[r]).tolist()]
-                why += [self.oracle.level_terms[i].constraint for i in np.flatnonzero(level[r]).tolist()]
+                why = [terms[t.event][j].constraint for j in edge[r].nonzero()[0].tolist()]
+                why += [self.oracle.level_terms[i].constraint for i in level[r].nonzero()[0].tolist()]
                 hit = self._why[key] = len(self.prohibitions)
                 self.prohibitions.append(Prohibition(t.event, tuple(dict.fromkeys(why))))
             ids[u] = hit
@@ -322,7 +322,7 @@ class Regions:
         """Per state of ``rows`` (sorted, repeated once per refused move), its refusals
         (indices into ``met``) as one prohibition set: (the states, their set's index in
         :attr:`prohibitions`)."""
-        starts = np.flatnonzero(np.concatenate([[True], rows[1:] != rows[:-1]]))
+        starts = np.concatenate([[True], rows[1:] != rows[:-1]]).nonzero()[0]
         bounds, ids = np.append(starts, len(rows)).tolist(), refusals.tolist()
         out = np.empty(len(starts), dtype=np.int64)
         for u in range(len(starts)):
@@ -335,9 +335,9 @@ class Regions:
 
     def append(self, members: np.ndarray, member_counts: np.ndarray, settled: np.ndarray, proh: np.ndarray,
                settled_counts: np.ndarray) -> None:
-        self.member_starts = np.concatenate([self.member_starts, self.members.size + np.cumsum(member_counts)])
+        self.member_starts = np.concatenate([self.member_starts, self.members.size + member_counts.cumsum()])
         self.members = np.concatenate([self.members, members])
-        self.settled_starts = np.concatenate([self.settled_starts, self.settled.size + np.cumsum(settled_counts)])
+        self.settled_starts = np.concatenate([self.settled_starts, self.settled.size + settled_counts.cumsum()])
         self.settled = np.concatenate([self.settled, settled])
         self.settled_proh = np.concatenate([self.settled_proh, proh])
 
@@ -357,20 +357,20 @@ def regions(pc: PlantCodes, store: Regions, entries: np.ndarray, wanted: np.ndar
         c = pc.controllable_moves
         row, order = np.nonzero(unpack(pc.order_bits(digits) ^ wanted_bits[reg], k))  # the orders to change, row-major
         counts, rank = slices(pc.order_starts, order)  # their moves (the region's order of the moves)
-        row = np.repeat(row, counts)
+        row = row.repeat(counts)
         app = digits.full()[c.axis[rank], row] == c.src[rank]
         row, rank = row[app], rank[app]  # by row, then rank
         target = pc.step(cur[row], c, rank)
         threat = pc.threats(target)
         ok = np.logical_not(threat.any(axis=1))
         for k in c.forbidding:
-            at = np.flatnonzero(rank == k)
+            at = (rank == k).nonzero()[0]
             if at.size:
                 ok[at] &= ~pc.forbidden(c.moves[k], digits, row[at])
         still = np.ones(cur.size, dtype=bool)  # settled: no allowed move
         still[row[ok]] = False
         proh = np.zeros(cur.size, dtype=np.int64)
-        sel = np.flatnonzero(still[row])  # the moves from settled states: every one refused
+        sel = still[row].nonzero()[0]  # the moves from settled states: every one refused
         if sel.size:
             at, ids = store.refusal_sets(row[sel], pc.refused(digits, row[sel], rank[sel], threat[sel]), pc.prohibitions)
             proh[at] = ids
@@ -395,10 +395,10 @@ def _store(store: Regions, R: int, member_parts: list[tuple[np.ndarray, np.ndarr
     (breadth-first order kept)."""
     mreg = np.concatenate([r for r, _ in member_parts])
     mcode = np.concatenate([c for _, c in member_parts])
-    order = np.argsort(mreg, kind="stable")
+    order = mreg.argsort(kind="stable")
     sreg = np.concatenate([r for r, _, _ in settled_parts])
     scode = np.concatenate([c for _, c, _ in settled_parts])
     sproh = np.concatenate([f for _, _, f in settled_parts])
-    sorder = np.argsort(sreg, kind="stable")
+    sorder = sreg.argsort(kind="stable")
     sreg, scode, proh = sreg[sorder], scode[sorder], sproh[sorder]
     store.append(mcode[order], np.bincount(mreg, minlength=R), scode, proh, np.bincount(sreg, minlength=R))
