@@ -62,7 +62,8 @@ def distinct(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     and each position's rank among them."""
     perm = keys.argsort(kind="stable")
     s = keys[perm]
-    change = np.ones(len(s), dtype=bool)
+    change = np.empty(len(s), dtype=bool)
+    change[:1] = True
     change[1:] = s[1:] != s[:-1]
     return _groups(perm, change)
 
@@ -91,7 +92,8 @@ def first_occurrences(keys: np.ndarray) -> np.ndarray:
     """Positions of the first occurrence of each distinct key, in the order they occur."""
     perm = keys.argsort(kind="stable")
     s = keys[perm]
-    change = np.ones(len(s), dtype=bool)
+    change = np.empty(len(s), dtype=bool)
+    change[:1] = True
     change[1:] = s[1:] != s[:-1]
     return np.sort(perm[change])
 
