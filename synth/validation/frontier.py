@@ -48,10 +48,9 @@ from synth.plant.composition import Plant
 from synth.plant.rules import Constraint
 from synth.sup.constraints import CompiledConstraints
 from synth.validation.conflicts import Conflict, ConflictLog
-from synth.validation.keys import SortedKeys, distinct, distinct_rows, first_occurrences, row_codes, slices
+from synth.validation.keys import Collision, SortedKeys, distinct, distinct_rows, first_occurrences, row_codes, slices
 from synth.validation.regions import PlantCodes, Regions, regions
 from synth.validation.sync import Edge, Node, Partial, Sync, many_edges, many_nodes, synchronous_product
-from synth.validation.words import Collision
 
 __all__ = ["explore_wide", "reason", "explore_frontier", "Unsupported"]
 

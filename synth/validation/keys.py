@@ -17,7 +17,13 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["SortedKeys", "distinct", "distinct_rows", "row_codes", "first_occurrences", "slices"]
+__all__ = ["Collision", "SortedKeys", "distinct", "distinct_rows", "row_codes", "first_occurrences", "slices"]
+
+
+class Collision(Exception):
+    """Two different states under one key (:mod:`synth.validation.words`: two wide plant
+    states mixed to the same key, or more than its capacity met): the explorer leaves the
+    model to the machine's path."""
 
 
 class SortedKeys:

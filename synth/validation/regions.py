@@ -29,7 +29,7 @@ Example
 
 from __future__ import annotations
 
-from typing import Iterable
+from typing import TYPE_CHECKING, Iterable
 
 import numpy as np
 
@@ -38,7 +38,9 @@ from synth.sup.constraints import CompiledConstraints
 from synth.validation.keys import distinct, distinct_rows, row_codes, slices
 from synth.validation.masks import Masks, Runs, pack, unpack
 from synth.validation.sync import Prohibition, moves_by_order
-from synth.validation.words import CAPACITY, Interned, Layout
+
+if TYPE_CHECKING:  # imported for plants of WIDE states or more only
+    from synth.validation.words import Interned, Layout
 
 __all__ = ["Digits", "PlantCodes", "Regions", "regions", "WIDE"]
 
@@ -108,10 +110,16 @@ class PlantCodes:
 
     def __init__(self, p: Plant, oracle: CompiledConstraints) -> None:
         self.plant, self.oracle = p, oracle
-        self.layout = Layout(p.shape) if p.size >= WIDE else None
-        self.interned = Interned(self.layout.count) if self.layout is not None else None
-        self.P = CAPACITY if self.layout is not None else p.size
+        self.layout: Layout | None = None
+        self.interned: Interned | None = None
+        self.P = p.size
         """The radix of the explorer's keys (situation × code): more than any code."""
+        if p.size >= WIDE:
+            from synth.validation.words import CAPACITY, Interned, Layout
+
+            self.layout = Layout(p.shape)
+            self.interned = Interned(self.layout.count)
+            self.P = CAPACITY
         code_strides = self.layout.stride if self.layout is not None else np.array(p.strides, dtype=np.int64)
         word = self.layout.word if self.layout is not None else np.zeros(len(p.shape), dtype=np.int64)
         self.word_of, self.stride, self.radix = word.tolist(), code_strides.tolist(), p.shape
