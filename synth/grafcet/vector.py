@@ -224,7 +224,7 @@ class VectorMachine:
         out = np.asfortranarray(steps[:, self._first_source])  # the transitions enabled
         for j, s in self._more_sources:
             out[:, j] &= A[:, s]
-        for j in out.any(axis=0).nonzero()[0].tolist():
+        for j in np.logical_or.reduce(out, axis=0).nonzero()[0].tolist():
             out[:, j] &= self._rec[j](I, A, T, E, Z)
         return out
 

@@ -172,13 +172,14 @@ def explore_frontier(
 T_ = TypeVar("T_")
 
 
-def _distinct_keys(bits: np.ndarray) -> tuple[np.ndarray, np.ndarray, list[int] | list[bytes]]:
+def _distinct_keys(bits: np.ndarray) -> tuple[np.ndarray, np.ndarray, list[int | bytes]]:
     """:func:`~synth.validation.keys.distinct_rows` of ``bits``, and each distinct row's
     key for a dictionary: its integer code up to 62 columns, else its packed bytes."""
     if bits.shape[1] <= 62:
         codes = row_codes(bits)
         first, inverse = distinct(codes)
-        return first, inverse, codes[first].tolist()
+        keys: list[int | bytes] = codes[first].tolist()
+        return first, inverse, keys
     first, inverse = distinct_rows(bits)
     return first, inverse, [r.tobytes() for r in np.packbits(bits[first], axis=1)]
 

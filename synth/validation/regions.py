@@ -279,7 +279,7 @@ class PlantCodes:
         level = unpack(threats, len(self.oracle.level_terms))
         bits = np.hstack([edge, level])
         rank_bits = len(c.moves).bit_length()
-        keys: list[int] | list[tuple[int, bytes]]
+        keys: list[int | tuple[int, bytes]]
         if bits.shape[1] + rank_bits <= 62:  # (bits, move) as one integer
             codes = (row_codes(bits) << rank_bits) | rank
             first, inverse = distinct(codes)
