@@ -48,7 +48,7 @@ from synth.plant.composition import Plant
 from synth.plant.rules import Constraint
 from synth.sup.constraints import CompiledConstraints
 from synth.validation.conflicts import Conflict, ConflictLog
-from synth.validation.keys import Collision, SortedKeys, distinct, distinct_rows, first_occurrences, row_codes, slices
+from synth.validation.keys import ROW_BITS, Collision, SortedKeys, distinct, distinct_rows, first_occurrences, row_codes, slices
 from synth.validation.regions import PlantCodes, Regions, regions
 from synth.validation.sync import Edge, Node, Partial, Sync, many_edges, many_nodes, synchronous_product
 
@@ -174,8 +174,9 @@ T_ = TypeVar("T_")
 
 def _distinct_keys(bits: np.ndarray) -> tuple[np.ndarray, np.ndarray, list[int | bytes]]:
     """:func:`~synth.validation.keys.distinct_rows` of ``bits``, and each distinct row's
-    key for a dictionary: its integer code up to 62 columns, else its packed bytes."""
-    if bits.shape[1] <= 62:
+    key for a dictionary: its integer code up to :data:`~synth.validation.keys.ROW_BITS`
+    columns, else its packed bytes."""
+    if bits.shape[1] <= ROW_BITS:
         codes = row_codes(bits)
         first, inverse = distinct(codes)
         keys: list[int | bytes] = codes[first].tolist()

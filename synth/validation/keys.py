@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["Collision", "SortedKeys", "distinct", "distinct_rows", "row_codes", "first_occurrences", "slices"]
+__all__ = ["Collision", "SortedKeys", "ROW_BITS", "distinct", "distinct_rows", "row_codes", "first_occurrences", "slices"]
 
 
 class Collision(Exception):
@@ -74,15 +74,20 @@ def distinct(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return _groups(perm, change)
 
 
+ROW_BITS = 62
+"""Rows of at most this many Boolean columns are keyed by one integer each (:func:`row_codes`)."""
+
+
 def row_codes(bits: np.ndarray) -> np.ndarray:
-    """Each row of a Boolean matrix of at most 62 columns as one integer (column j: bit j)."""
+    """Each row of a Boolean matrix of at most :data:`ROW_BITS` columns as one integer
+    (column j: bit j)."""
     return bits.astype(np.int64) @ (np.int64(1) << np.arange(bits.shape[1], dtype=np.int64))
 
 
 def distinct_rows(bits: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """:func:`distinct` for the rows of a Boolean matrix."""
     n, k = bits.shape
-    if k <= 62:
+    if k <= ROW_BITS:
         return distinct(row_codes(bits))
     packed = np.packbits(bits, axis=1)
     packed = np.hstack([packed, np.zeros((n, -packed.shape[1] % 8), dtype=np.uint8)])

@@ -35,7 +35,7 @@ import numpy as np
 
 from synth.plant.composition import LocalTransition, Plant
 from synth.sup.constraints import CompiledConstraints
-from synth.validation.keys import distinct, distinct_rows, row_codes, slices
+from synth.validation.keys import ROW_BITS, distinct, distinct_rows, row_codes, slices
 from synth.validation.masks import Masks, Runs, pack, unpack
 from synth.validation.sync import Prohibition, moves_by_order
 
@@ -280,7 +280,7 @@ class PlantCodes:
         bits = np.hstack([edge, level])
         rank_bits = len(c.moves).bit_length()
         keys: list[int | tuple[int, bytes]]
-        if bits.shape[1] + rank_bits <= 62:  # (bits, move) as one integer
+        if bits.shape[1] + rank_bits <= ROW_BITS:  # (bits, move) as one integer
             codes = (row_codes(bits) << rank_bits) | rank
             first, inverse = distinct(codes)
             keys = codes[first].tolist()
