@@ -22,7 +22,7 @@ from synth.validation import validate as validate_mod
 from synth.validation.validate import explore
 from synth.validation.frontier import Unsupported, explore_frontier, reason
 from synth.validation.result import load_model
-from synth.validation.sync import WATCHED_WIDE, WIDE, synchronous_product
+from synth.validation.sync import WATCHED_WIDE, WIDE, Exploration, synchronous_product
 
 from conftest import ROOT
 from test_symbolic import CASES, _random_case
@@ -37,12 +37,12 @@ G = ROOT / "grafcets"
 P = ROOT / "plants"
 
 
-def _frontier_only(p, constraints, machine, **kw):
-    return explore_frontier(p, constraints, machine, **kw)
+def _frontier_only(p, constraints, machine, how=Exploration()):
+    return explore_frontier(p, constraints, machine, how)
 
 
-def _machine_only(p, constraints, machine, **kw):
-    return synchronous_product(p, constraints, machine, **kw)
+def _machine_only(p, constraints, machine, how=Exploration()):
+    return synchronous_product(p, constraints, machine, how)
 
 
 def _both(monkeypatch, g7: Path, rules: Path, homes=(), expert: bool = False) -> tuple:
@@ -219,7 +219,7 @@ def test_where_the_frontier_takes_over(tmp_path, monkeypatch):
     monkeypatch.setattr(frontier, "explore_frontier", lambda *a, **kw: taken.append(kw["partial"]) or real(*a, **kw))
     args = _loaded(tmp_path / "par_4.g7", tmp_path / "par_4.rules")
     watched: list[tuple[int, int]] = []
-    plain, seen, full = explore(*args), explore(*args, watch=lambda *counts: watched.append(counts)), synchronous_product(*args)
+    plain, seen, full = explore(*args), explore(*args, Exploration(watch=lambda *counts: watched.append(counts))), synchronous_product(*args)
     assert (WIDE, WATCHED_WIDE) == (16, 32) and len(taken) == 2
     waiting = [len(partial.nodes) - partial.next for partial in taken]
     assert waiting[0] > WIDE and waiting[1] > WATCHED_WIDE and taken[0].next < taken[1].next
@@ -279,11 +279,11 @@ def test_max_states_is_the_same_limit(tmp_path):
     from synth.errors import LimitExceeded
 
     with pytest.raises(LimitExceeded) as mine:
-        explore_frontier(*args, max_states=40)
+        explore_frontier(*args, Exploration(max_states=40))
     with pytest.raises(LimitExceeded) as theirs:
-        synchronous_product(*args, max_states=40)
+        synchronous_product(*args, Exploration(max_states=40))
     assert str(mine.value) == str(theirs.value) == "more than 40 aggregated states; raise --max-states or simplify the model"
-    assert len(explore_frontier(*args, max_states=1000).nodes) > 40
+    assert len(explore_frontier(*args, Exploration(max_states=1000)).nodes) > 40
 
 
 @pytest.mark.parametrize("wide", [1, 4])

@@ -40,7 +40,7 @@ from typing import Callable, Sequence, TypeVar
 
 import numpy as np
 
-from synth.errors import InputError, LimitExceeded
+from synth.errors import InputError
 from synth.grafcet.machine import GrafcetMachine, Situation
 from synth.grafcet.vector import VectorMachine, unsupported
 from synth.logic.events import Event
@@ -50,7 +50,7 @@ from synth.sup.constraints import CompiledConstraints
 from synth.validation.conflicts import Conflict, ConflictLog
 from synth.validation.keys import ROW_BITS, Collision, SortedKeys, distinct, distinct_rows, first_occurrences, row_codes, slices
 from synth.validation.regions import PlantCodes, Regions, regions
-from synth.validation.sync import Edge, Node, Partial, Sync, many_edges, many_nodes, synchronous_product
+from synth.validation.sync import Edge, Exploration, Node, Partial, Sync, many_edges, many_nodes, synchronous_product
 
 __all__ = ["explore_wide", "reason", "explore_frontier", "Unsupported"]
 
@@ -77,24 +77,21 @@ def explore_wide(
     p: Plant,
     constraints: Sequence[Constraint],
     machine: GrafcetMachine,
+    how: Exploration = Exploration(),
     *,
-    max_states: int | None = None,
-    progress: Callable[[int, int], None] | None = None,
     partial: Partial | None = None,
-    watch: Callable[[int, int], None] | None = None,
 ) -> Sync:
     """SYNC of a model whose search went wide (:data:`~synth.validation.sync.WIDE`): a
     frontier at a time when :func:`reason` allows it, else (or when the frontier path
     meets what it leaves to the machine) by the machine's path from the start;
-    ``partial``: how far the machine's path went before it went wide; ``watch(met,
-    waiting)``: after each frontier (or state, on the machine's path) expanded."""
+    ``partial``: how far the machine's path went before it went wide; ``how.watch``:
+    after each frontier (or state, on the machine's path) expanded."""
     if reason(p, machine) is None:
         try:
-            return explore_frontier(p, constraints, machine, max_states=max_states, progress=progress, partial=partial,
-                                    watch=watch)
+            return explore_frontier(p, constraints, machine, how, partial=partial)
         except Unsupported:
             pass
-    return synchronous_product(p, constraints, machine, max_states=max_states, progress=progress, watch=watch)
+    return synchronous_product(p, constraints, machine, how)
 
 
 class _Situations:
@@ -148,11 +145,9 @@ def explore_frontier(
     p: Plant,
     constraints: Sequence[Constraint],
     machine: GrafcetMachine,
+    how: Exploration = Exploration(),
     *,
-    max_states: int | None = None,
-    progress: Callable[[int, int], None] | None = None,
     partial: Partial | None = None,
-    watch: Callable[[int, int], None] | None = None,
 ) -> Sync:
     """SYNC a frontier at a time (see module doc), from the start or going on from where
     the machine's path stopped (``partial``); :class:`Unsupported` when it meets what it
@@ -164,7 +159,7 @@ def explore_frontier(
     if not oracle.kept(p.initial):
         return Sync(p, oracle, machine)
     try:
-        return _Explorer(p, oracle, machine, max_states).run(progress, partial, watch)
+        return _Explorer(p, oracle, machine, how).run(partial)
     except Collision as err:
         raise Unsupported(str(err)) from None
 
@@ -199,8 +194,8 @@ def _per_row(bits: np.ndarray, make: Callable[[np.ndarray], T_], made: dict[int 
 
 
 class _Explorer:
-    def __init__(self, p: Plant, oracle: CompiledConstraints, machine: GrafcetMachine, max_states: int | None) -> None:
-        self.p, self.oracle, self.machine, self.max_states = p, oracle, machine, max_states
+    def __init__(self, p: Plant, oracle: CompiledConstraints, machine: GrafcetMachine, how: Exploration) -> None:
+        self.p, self.oracle, self.machine, self.how = p, oracle, machine, how
         self.vm = VectorMachine(machine)
         self.pc = PlantCodes(p, oracle)
         self.P = self.pc.P
@@ -300,10 +295,7 @@ class _Explorer:
                                      [prohs[pr] for pr in proh.tolist()]))
         self.node_sit = np.concatenate([self.node_sit, sid])
         self.node_code = np.concatenate([self.node_code, q])
-        if self.max_states is not None and len(self.nodes) > self.max_states:
-            raise LimitExceeded(
-                f"more than {self.max_states} aggregated states; raise --max-states or simplify the model"
-            )
+        self.how.over(len(self.nodes))
 
     # ------------------------------------------------------------------ the search
     def resume(self, partial: Partial) -> tuple[tuple[int, ...], int]:
@@ -338,8 +330,7 @@ class _Explorer:
                               + self.pc.encode([m for _, m in seen]))
         return partial.initial, partial.next
 
-    def run(self, progress: Callable[[int, int], None] | None, partial: Partial | None = None,
-            watch: Callable[[int, int], None] | None = None) -> Sync:
+    def run(self, partial: Partial | None = None) -> Sync:
         if partial is not None:
             initial, lo = self.resume(partial)
         else:
@@ -352,10 +343,10 @@ class _Explorer:
             hi = len(self.nodes)
             self.expand(lo, hi)
             lo = hi
-            if watch is not None:
-                watch(len(self.nodes), len(self.nodes) - lo)
-            if progress is not None and time.monotonic() - last > 0.5:
-                progress(len(self.nodes), len(self.nodes) - lo)
+            if self.how.watch is not None:
+                self.how.watch(len(self.nodes), len(self.nodes) - lo)
+            if self.how.progress is not None and time.monotonic() - last > 0.5:
+                self.how.progress(len(self.nodes), len(self.nodes) - lo)
                 last = time.monotonic()
         states = len(distinct(np.concatenate(self.pairs))[0]) if self.pairs else 0
         arrays = (np.concatenate(self.sources), np.concatenate(self.targets)) if self.sources else None
