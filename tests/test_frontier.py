@@ -192,7 +192,7 @@ def test_a_narrow_sync_stays_on_the_machines_path(tmp_path):
             "print(v.sync.sync_states, 'synth.validation.frontier' in sys.modules)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
                          env={**__import__("os").environ, "PYTHONPATH": str(ROOT)}).stdout.split()
-    assert int(out[0]) > 0 and out[1] == "False" and WIDE == 16
+    assert int(out[0]) > 0 and out[1] == "False" and WIDE == 20
 
 
 def test_a_wide_sync_goes_to_the_frontier(tmp_path, monkeypatch):
@@ -208,7 +208,7 @@ def test_a_wide_sync_goes_to_the_frontier(tmp_path, monkeypatch):
 
 
 def test_where_the_frontier_takes_over(tmp_path, monkeypatch):
-    """An explicit run leaves the machine's path once more than WIDE (16) states wait; the
+    """An explicit run leaves the machine's path once more than WIDE (20) states wait; the
     run ``auto`` watches once more than WATCHED_WIDE (32) wait, so the counts it judges stay
     those its shares were measured on; the same SYNC either way."""
     write_par(4, tmp_path)
@@ -220,7 +220,7 @@ def test_where_the_frontier_takes_over(tmp_path, monkeypatch):
     args = _loaded(tmp_path / "par_4.g7", tmp_path / "par_4.rules")
     watched: list[tuple[int, int]] = []
     plain, seen, full = explore(*args), explore(*args, Exploration(watch=lambda *counts: watched.append(counts))), synchronous_product(*args)
-    assert (WIDE, WATCHED_WIDE) == (16, 32) and len(taken) == 2
+    assert (WIDE, WATCHED_WIDE) == (20, 32) and len(taken) == 2
     waiting = [len(partial.nodes) - partial.next for partial in taken]
     assert waiting[0] > WIDE and waiting[1] > WATCHED_WIDE and taken[0].next < taken[1].next
     machine_calls = watched[:taken[1].next]  # one call per state expanded on the machine's path

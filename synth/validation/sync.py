@@ -74,15 +74,15 @@ class Partial:
     seen: set[tuple[Situation, Local]]
 
 
-WIDE = 16
+WIDE = 20
 """The explicit engine explores SYNC state by state until more than this many states wait
 in its queue, then a frontier at a time from there (:mod:`synth.validation.frontier`):
 below, a frontier's numpy passes (and the frontier's modules, imported then) cost more
-than the states they carry. Measured (docs/performance.md, sessions 27 and 29): the box
-sorting (never 16 waiting) 0.013 s state by state, 0.026 s by frontiers; from 16 waiting
-rather than 32, par_5, steep_4, branches_3x3 and branches_4x2 validate 4-10 % faster (the
-machine's path costs about 0.3 ms per aggregated state on the branches, a frontier layer
-0.5-1 ms)."""
+than the states they carry. Measured (docs/performance.md, sessions 27 and 29): from 20
+waiting rather than 32, par_5, steep_4, branches_3x3 and branches_4x2 validate 4-10 %
+faster (the machine's path costs about 0.3 ms per aggregated state on the branches, a
+frontier layer 0.5-1 ms); the bundled Grafcets (at most 15 to 20 waiting) stay on the
+machine's path (tri_boxes, 17, took 25 ms more by frontiers)."""
 
 WATCHED_WIDE = 32
 """:data:`WIDE` for a watched run (``validate --engine auto``, :mod:`synth.probe`): the counts
