@@ -22,7 +22,7 @@ from synth.validation import validate as validate_mod
 from synth.validation.validate import explore
 from synth.validation.frontier import Unsupported, explore_frontier, reason
 from synth.validation.result import load_model
-from synth.validation.sync import WIDE, synchronous_product
+from synth.validation.sync import WATCHED_WIDE, WIDE, Exploration, synchronous_product
 
 from conftest import ROOT
 from test_symbolic import CASES, _random_case
@@ -37,12 +37,12 @@ G = ROOT / "grafcets"
 P = ROOT / "plants"
 
 
-def _frontier_only(p, constraints, machine, **kw):
-    return explore_frontier(p, constraints, machine, **kw)
+def _frontier_only(p, constraints, machine, how=Exploration()):
+    return explore_frontier(p, constraints, machine, how)
 
 
-def _machine_only(p, constraints, machine, **kw):
-    return synchronous_product(p, constraints, machine, **kw)
+def _machine_only(p, constraints, machine, how=Exploration()):
+    return synchronous_product(p, constraints, machine, how)
 
 
 def _both(monkeypatch, g7: Path, rules: Path, homes=(), expert: bool = False) -> tuple:
@@ -192,7 +192,7 @@ def test_a_narrow_sync_stays_on_the_machines_path(tmp_path):
             "print(v.sync.sync_states, 'synth.validation.frontier' in sys.modules)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
                          env={**__import__("os").environ, "PYTHONPATH": str(ROOT)}).stdout.split()
-    assert int(out[0]) > 0 and out[1] == "False" and WIDE == 32
+    assert int(out[0]) > 0 and out[1] == "False" and WIDE == 20
 
 
 def test_a_wide_sync_goes_to_the_frontier(tmp_path, monkeypatch):
@@ -207,17 +207,83 @@ def test_a_wide_sync_goes_to_the_frontier(tmp_path, monkeypatch):
     assert ran == [1] and (a.nodes, a.edges, a.sync_states) == (b.nodes, b.edges, b.sync_states)
 
 
+def test_where_the_frontier_takes_over(tmp_path, monkeypatch):
+    """An explicit run leaves the machine's path once more than WIDE (20) states wait; the
+    run ``auto`` watches once more than WATCHED_WIDE (32) wait, so the counts it judges stay
+    those its shares were measured on; the same SYNC either way."""
+    write_par(4, tmp_path)
+    import synth.validation.frontier as frontier
+
+    taken = []
+    real = frontier.explore_frontier
+    monkeypatch.setattr(frontier, "explore_frontier", lambda *a, **kw: taken.append(kw["partial"]) or real(*a, **kw))
+    args = _loaded(tmp_path / "par_4.g7", tmp_path / "par_4.rules")
+    watched: list[tuple[int, int]] = []
+    plain, seen, full = explore(*args), explore(*args, Exploration(watch=lambda *counts: watched.append(counts))), synchronous_product(*args)
+    assert (WIDE, WATCHED_WIDE) == (20, 32) and len(taken) == 2
+    waiting = [len(partial.nodes) - partial.next for partial in taken]
+    assert waiting[0] > WIDE and waiting[1] > WATCHED_WIDE and taken[0].next < taken[1].next
+    machine_calls = watched[:taken[1].next]  # one call per state expanded on the machine's path
+    assert all(w <= WATCHED_WIDE for _, w in machine_calls[:-1]) and machine_calls[-1][1] == waiting[1]
+    for sync in (plain, seen):
+        assert (sync.nodes, sync.edges, sync.conflicts, sync.sync_states) == (full.nodes, full.edges, full.conflicts,
+                                                                              full.sync_states)
+
+
+@pytest.mark.parametrize("case", ["par", "branches_3x1", "steep_missing", "tri", "or_conflict"])
+def test_rows_keyed_by_their_bytes(monkeypatch, tmp_path, case):
+    """Rows of more than ROW_BITS columns (situations, the orders wanted and set, refusals)
+    are keyed by their packed bytes instead of one integer: forced on every row here, the
+    same SYNC and reports as the machine's path."""
+    import synth.validation.frontier as frontier
+    import synth.validation.regions as regions_module
+
+    monkeypatch.setattr(frontier, "ROW_BITS", 0)
+    monkeypatch.setattr(regions_module, "ROW_BITS", 0)
+    if case == "par":
+        base, g7, _ = write_par(3, tmp_path)
+    elif case == "branches_3x1":
+        base, g7, _ = write_branches(3, 1, tmp_path)
+    elif case == "steep_missing":
+        base, _, g7 = write_steep(3, tmp_path)
+    elif case == "tri":
+        base, g7 = P / "tri.rules", G / "tri.g7"
+    else:
+        base, g7 = P / "tri.rules", ROOT / "tests" / "data" / "or_conflict.g7"
+    a, _ = _both(monkeypatch, g7, base)
+    assert a.sync.sync_states > 5
+
+
+def test_nodes_and_edges_made_in_bulk_are_the_constructors():
+    from synth.logic.events import Event
+    from synth.validation.sync import Edge, Node, Prohibition, many_edges, many_nodes
+
+    up, down = Event.rise("a"), Event.fall("b")
+    edges = many_edges([0, 3], [up, down], [1, 2])
+    assert edges == [Edge(0, up, 1), Edge(3, down, 2)] and [hash(e) for e in edges] == [hash(Edge(0, up, 1)),
+                                                                                        hash(Edge(3, down, 2))]
+    assert repr(edges[1]) == repr(Edge(3, down, 2))
+    sit = load_model(G / "tri.g7", P / "tri.rules")[2]
+    machine = GrafcetMachine(sit)
+    s0 = machine.initial({n: False for n in machine.inputs})
+    proh = (Prohibition(up, ("C1",)),)
+    nodes = many_nodes([s0, s0], [(0, 1), (1, 0)], [frozenset({"A"}), frozenset()], [("A",), ()], [proh, ()])
+    assert nodes == [Node(s0, (0, 1), frozenset({"A"}), ("A",), proh), Node(s0, (1, 0), frozenset(), (), ())]
+    with pytest.raises(AttributeError):
+        nodes[0].plant = (1, 1)  # frozen as the constructor's
+
+
 def test_max_states_is_the_same_limit(tmp_path):
     write_par(3, tmp_path)
     args = _loaded(tmp_path / "par_3.g7", tmp_path / "par_3.rules")
     from synth.errors import LimitExceeded
 
     with pytest.raises(LimitExceeded) as mine:
-        explore_frontier(*args, max_states=40)
+        explore_frontier(*args, Exploration(max_states=40))
     with pytest.raises(LimitExceeded) as theirs:
-        synchronous_product(*args, max_states=40)
+        synchronous_product(*args, Exploration(max_states=40))
     assert str(mine.value) == str(theirs.value) == "more than 40 aggregated states; raise --max-states or simplify the model"
-    assert len(explore_frontier(*args, max_states=1000).nodes) > 40
+    assert len(explore_frontier(*args, Exploration(max_states=1000)).nodes) > 40
 
 
 @pytest.mark.parametrize("wide", [1, 4])

@@ -55,7 +55,8 @@ def explored(monkeypatch: pytest.MonkeyPatch) -> list[int]:
     real = explicit.explore
 
     def counted(*args: Any, **kwargs: Any) -> Any:
-        runs.append(kwargs.get("max_states") or 0)
+        how = args[3] if len(args) > 3 else kwargs.get("how")
+        runs.append(how.max_states or 0 if how is not None else 0)
         return real(*args, **kwargs)
 
     monkeypatch.setattr(explicit, "explore", counted)

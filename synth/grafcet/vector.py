@@ -42,9 +42,9 @@ from typing import Callable
 import numpy as np
 
 from synth.grafcet.language import (CONDITIONAL, CONTINUOUS, ON_ACTIVATION, ON_DEACTIVATION, STORED, Semantics,
-                                   StoredWhen, step_of)
+                                   StoredWhen, step_key, step_of)
 from synth.grafcet.machine import GrafcetMachine
-from synth.grafcet.situation import Situation, sorted_steps
+from synth.grafcet.situation import Situation
 from synth.logic.expr import And, Compare, Edge, Expr, Not, Or, Var, evaluate, names
 
 __all__ = ["VectorMachine", "unsupported", "ROUNDS"]
@@ -119,7 +119,13 @@ class VectorMachine:
         for j, t in enumerate(trans):
             src[j, [self._step[s] for s in t.sources]] = 1
             dst[j, [self._step[s] for s in t.targets]] = 1
-        self._sources = [[self._step[s] for s in t.sources] for t in trans]
+        # each transition's first source step (a sourceless one reads the column of ones
+        # after the steps), and its further sources: which transitions are enabled, read in
+        # one gather for all of them
+        self._first_source = np.array([self._step[t.sources[0]] if t.sources else len(self.step_names)
+                                       for t in trans], dtype=np.int64)
+        self._sourceless = any(not t.sources for t in trans)
+        self._more_sources = [(j, self._step[s]) for j, t in enumerate(trans) for s in t.sources[1:]]
         self.stored_names = tuple(sorted({a.order for s in g.steps for a in s.actions if a.kind == STORED}))
         nt = len(self.timer_names)
         self.memory = nt + len(self.stored_names)
@@ -152,8 +158,11 @@ class VectorMachine:
                     cond = self._compile(a.condition) if a.kind == CONDITIONAL and a.condition is not None else None
                     self._actions.append((self._step[s.name], a.order, cond))
         self.order_names = tuple(sorted(orders))
+        self.conditional = any(cond is not None for _, _, cond in self._actions)
+        """Whether some action has a condition (the orders then read the inputs)."""
         self._order = {o: i for i, o in enumerate(self.order_names)}
         self._stored_cols = [(nt + i, self._order[o]) for i, o in enumerate(self.stored_names)]
+        self._sorted: tuple[np.ndarray, tuple[str, ...], np.ndarray, tuple[str, ...]] | None = None  # situation()
 
     # ------------------------------------------------------------------ compilation
     def _compile(self, e: Expr) -> Columns:
@@ -192,28 +201,31 @@ class VectorMachine:
         return A, T
 
     def situation(self, a: np.ndarray, t: np.ndarray) -> Situation:
-        """The situation of one row, as the machine builds it."""
-        steps = sorted_steps([self.step_names[i] for i in np.flatnonzero(a)])
+        """The situation of one row, as the machine builds it (steps, stored outputs and
+        timers in their sorted orders: the columns read in those orders)."""
+        if self._sorted is None:
+            steps = sorted(range(len(self.step_names)), key=lambda i: step_key(self.step_names[i]))
+            nt = len(self.timer_names)
+            timers = sorted(range(nt), key=lambda i: self.timer_names[i])
+            self._sorted = (np.array(steps, dtype=np.int64), tuple(self.step_names[i] for i in steps),
+                            np.array(timers, dtype=np.int64), tuple(self.timer_names[i] for i in timers))
+        steps_at, step_names, timers_at, timer_names = self._sorted
         nt = len(self.timer_names)
-        stored = tuple(sorted(self.stored_names[i] for i in np.flatnonzero(t[nt:])))
-        return Situation(steps, stored, tuple(sorted(self.timer_names[i] for i in np.flatnonzero(t[:nt]))), ())
+        return Situation(tuple(step_names[i] for i in a[steps_at].nonzero()[0].tolist()),
+                         tuple(self.stored_names[i] for i in t[nt:].nonzero()[0].tolist()),  # sorted names
+                         tuple(timer_names[i] for i in t[timers_at].nonzero()[0].tolist()), ())
 
     # ------------------------------------------------------------------ evolution
     def _fireable(self, A: np.ndarray, T: np.ndarray, I: np.ndarray, E: np.ndarray) -> np.ndarray:
         A, T, I = np.asfortranarray(A), np.asfortranarray(T), np.asfortranarray(I)
         n = len(A)
         Z = np.zeros(n, dtype=bool)
-        out = np.zeros((n, len(self._rec)), dtype=bool, order="F")
-        for j, rec in enumerate(self._rec):
-            sources = self._sources[j]
-            if sources:
-                col = A[:, sources[0]].copy()
-                for s in sources[1:]:
-                    col &= A[:, s]
-            else:
-                col = ~Z
-            if col.any():
-                out[:, j] = col & rec(I, A, T, E, Z)
+        steps = np.hstack([A, np.ones((n, 1), dtype=bool)]) if self._sourceless else A
+        out = np.asfortranarray(steps[:, self._first_source])  # the transitions enabled
+        for j, s in self._more_sources:
+            out[:, j] &= A[:, s]
+        for j in np.logical_or.reduce(out, axis=0).nonzero()[0].tolist():
+            out[:, j] &= self._rec[j](I, A, T, E, Z)
         return out
 
     def react(self, A: np.ndarray, T: np.ndarray, I: np.ndarray, E: np.ndarray
@@ -237,9 +249,8 @@ class VectorMachine:
             live, a, t = live[firing], a[firing], t[firing]
             moved[live] = True
             row, tr = np.nonzero(fire[firing])  # the firing pairs, by row
-            deact = self._sources_of.mark(row, tr, len(live))
+            deact, conflict = self._sources_of.mark_shared(row, tr, len(live))  # conflict: a step left twice
             act = self._targets_of.mark(row, tr, len(live))
-            conflict = self._sources_of.shared(row, tr, len(live))  # a step left by two transitions
             pending[live[conflict]] = True
             A[live] = (a & ~deact) | act
             left = deact & ~act
@@ -279,15 +290,28 @@ class VectorMachine:
 
     def orders(self, A: np.ndarray, T: np.ndarray, I: np.ndarray) -> np.ndarray:
         """The orders each row emits (columns :attr:`order_names`) on the input levels ``I``."""
+        out = self.situation_orders(A, T)
+        self.add_conditional(out, A, T, I)
+        return out
+
+    def situation_orders(self, A: np.ndarray, T: np.ndarray) -> np.ndarray:
+        """What of :meth:`orders` the situation alone decides: the continuous actions without
+        a condition and the stored outputs (a situation's part, read once per situation)."""
         out = np.zeros((len(A), len(self.order_names)), dtype=bool)
-        Z = np.zeros(len(A), dtype=bool)
-        E = np.full(len(A), -1)
         for step, order, cond in self._actions:
-            col = A[:, step]
-            out[:, self._order[order]] |= col if cond is None else col & cond(I, A, T, E, Z)
+            if cond is None:
+                out[:, self._order[order]] |= A[:, step]
         for col_t, col_o in self._stored_cols:
             out[:, col_o] |= T[:, col_t]
         return out
+
+    def add_conditional(self, out: np.ndarray, A: np.ndarray, T: np.ndarray, I: np.ndarray) -> None:
+        """The conditional actions' orders on the input levels ``I``, added to ``out`` in place."""
+        Z = np.zeros(len(A), dtype=bool)
+        E = np.full(len(A), -1)
+        for step, order, cond in self._actions:
+            if cond is not None:
+                out[:, self._order[order]] |= A[:, step] & cond(I, A, T, E, Z)
 
 
 class _Lists:
@@ -301,20 +325,22 @@ class _Lists:
     def _spread(self, row: np.ndarray, item: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(row, column) for each column of each pair's ``item``."""
         counts = self.starts[item + 1] - self.starts[item]
-        at = np.repeat(self.starts[item] - np.cumsum(counts) + counts, counts) + np.arange(int(counts.sum()))
-        return np.repeat(row, counts), self.cols[at]
+        at = (self.starts[item] - counts.cumsum() + counts).repeat(counts) + np.arange(int(counts.sum()))
+        return row.repeat(counts), self.cols[at]
 
     def mark(self, row: np.ndarray, item: np.ndarray, n: int) -> np.ndarray:
         """An n-row matrix with the columns of ``item`` set in ``row``, for each pair."""
-        out = np.zeros((n, self.width), dtype=bool)
-        r, c = self._spread(row, item)
-        out[r, c] = True
-        return out
+        return self._marked(*self._spread(row, item), n)
 
-    def shared(self, row: np.ndarray, item: np.ndarray, n: int) -> np.ndarray:
-        """The rows where two pairs' items share a column."""
+    def mark_shared(self, row: np.ndarray, item: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`mark`, and the rows where two pairs' items share a column."""
         r, c = self._spread(row, item)
         key = np.sort(r * self.width + c)
-        out = np.zeros(n, dtype=bool)
-        out[key[1:][key[1:] == key[:-1]] // max(self.width, 1)] = True
+        twice = np.zeros(n, dtype=bool)
+        twice[key[1:][key[1:] == key[:-1]] // max(self.width, 1)] = True
+        return self._marked(r, c, n), twice
+
+    def _marked(self, r: np.ndarray, c: np.ndarray, n: int) -> np.ndarray:
+        out = np.zeros((n, self.width), dtype=bool)
+        out[r, c] = True
         return out

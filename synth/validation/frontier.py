@@ -40,7 +40,7 @@ from typing import Callable, Sequence, TypeVar
 
 import numpy as np
 
-from synth.errors import InputError, LimitExceeded
+from synth.errors import InputError
 from synth.grafcet.machine import GrafcetMachine, Situation
 from synth.grafcet.vector import VectorMachine, unsupported
 from synth.logic.events import Event
@@ -48,10 +48,9 @@ from synth.plant.composition import Plant
 from synth.plant.rules import Constraint
 from synth.sup.constraints import CompiledConstraints
 from synth.validation.conflicts import Conflict, ConflictLog
-from synth.validation.keys import SortedKeys, distinct, distinct_rows, first_occurrences, slices
+from synth.validation.keys import ROW_BITS, Collision, SortedKeys, distinct, distinct_rows, first_occurrences, row_codes, slices
 from synth.validation.regions import PlantCodes, Regions, regions
-from synth.validation.sync import Edge, Node, Partial, Sync, synchronous_product
-from synth.validation.words import Collision
+from synth.validation.sync import Edge, Exploration, Node, Partial, Sync, many_edges, many_nodes, synchronous_product
 
 __all__ = ["explore_wide", "reason", "explore_frontier", "Unsupported"]
 
@@ -78,24 +77,21 @@ def explore_wide(
     p: Plant,
     constraints: Sequence[Constraint],
     machine: GrafcetMachine,
+    how: Exploration = Exploration(),
     *,
-    max_states: int | None = None,
-    progress: Callable[[int, int], None] | None = None,
     partial: Partial | None = None,
-    watch: Callable[[int, int], None] | None = None,
 ) -> Sync:
     """SYNC of a model whose search went wide (:data:`~synth.validation.sync.WIDE`): a
     frontier at a time when :func:`reason` allows it, else (or when the frontier path
     meets what it leaves to the machine) by the machine's path from the start;
-    ``partial``: how far the machine's path went before it went wide; ``watch(met,
-    waiting)``: after each frontier (or state, on the machine's path) expanded."""
+    ``partial``: how far the machine's path went before it went wide; ``how.watch``:
+    after each frontier (or state, on the machine's path) expanded."""
     if reason(p, machine) is None:
         try:
-            return explore_frontier(p, constraints, machine, max_states=max_states, progress=progress, partial=partial,
-                                    watch=watch)
+            return explore_frontier(p, constraints, machine, how, partial=partial)
         except Unsupported:
             pass
-    return synchronous_product(p, constraints, machine, max_states=max_states, progress=progress, watch=watch)
+    return synchronous_product(p, constraints, machine, how)
 
 
 class _Situations:
@@ -105,19 +101,19 @@ class _Situations:
         self.vm, self.size = vm, size
         self.items: list[Situation] = []
         self.timers: list[tuple[Event, ...]] = []
-        self._ids: dict[bytes, int] = {}
+        self.timed = np.zeros(0, dtype=bool)  # the situations with timers to fire
+        self._ids: dict[int | bytes, int] = {}
         self.A = np.zeros((0, len(vm.step_names)), dtype=bool)
         self.T = np.zeros((0, vm.memory), dtype=bool)
+        self.O = np.zeros((0, len(vm.order_names)), dtype=bool)  # the orders the situation emits whatever the inputs
 
     def number(self, A: np.ndarray, T: np.ndarray, given: list[Situation] | None = None) -> np.ndarray:
         """The numbers of the rows' situations (a new one numbered when first met)."""
         bits = np.hstack([A, T])
-        first, inverse = distinct_rows(bits)
-        packed = np.packbits(bits, axis=1)
+        first, inverse, keys = _distinct_keys(bits)
         ids = np.empty(len(first), dtype=np.int64)
         fresh = []
-        for u, r in enumerate(first.tolist()):
-            b = packed[r].tobytes()
+        for u, (r, b) in enumerate(zip(first.tolist(), keys)):
             hit = self._ids.get(b)
             if hit is None:
                 hit = self._ids[b] = len(self.items)
@@ -130,24 +126,28 @@ class _Situations:
         if fresh:
             self.A = np.vstack([self.A, A[fresh]])
             self.T = np.vstack([self.T, T[fresh]])
+            self.O = np.vstack([self.O, self.vm.situation_orders(A[fresh], T[fresh])])
+            self.timed = np.concatenate([self.timed, np.array([bool(t) for t in self.timers[len(self.timed):]], dtype=bool)])
             if len(self.items) * self.size >= 1 << 62:
                 raise Unsupported("node keys past 64 bits")
         return out
 
     def of(self, sits: list[Situation]) -> np.ndarray:
-        A, T = self.vm.rows(sits)
-        return self.number(A, T, sits)
+        """The numbers of ``sits`` (each distinct one made a row once)."""
+        at: dict[Situation, int] = {}
+        where = [at.setdefault(s, len(at)) for s in sits]
+        distinct_sits = list(at)
+        A, T = self.vm.rows(distinct_sits)
+        return self.number(A, T, distinct_sits)[where]
 
 
 def explore_frontier(
     p: Plant,
     constraints: Sequence[Constraint],
     machine: GrafcetMachine,
+    how: Exploration = Exploration(),
     *,
-    max_states: int | None = None,
-    progress: Callable[[int, int], None] | None = None,
     partial: Partial | None = None,
-    watch: Callable[[int, int], None] | None = None,
 ) -> Sync:
     """SYNC a frontier at a time (see module doc), from the start or going on from where
     the machine's path stopped (``partial``); :class:`Unsupported` when it meets what it
@@ -159,7 +159,7 @@ def explore_frontier(
     if not oracle.kept(p.initial):
         return Sync(p, oracle, machine)
     try:
-        return _Explorer(p, oracle, machine, max_states).run(progress, partial, watch)
+        return _Explorer(p, oracle, machine, how).run(partial)
     except Collision as err:
         raise Unsupported(str(err)) from None
 
@@ -167,13 +167,25 @@ def explore_frontier(
 T_ = TypeVar("T_")
 
 
-def _per_row(bits: np.ndarray, make: Callable[[np.ndarray], T_], made: dict[bytes, T_]) -> list[T_]:
+def _distinct_keys(bits: np.ndarray) -> tuple[np.ndarray, np.ndarray, list[int | bytes]]:
+    """:func:`~synth.validation.keys.distinct_rows` of ``bits``, and each distinct row's
+    key for a dictionary: its integer code up to :data:`~synth.validation.keys.ROW_BITS`
+    columns, else its packed bytes."""
+    if bits.shape[1] <= ROW_BITS:
+        codes = row_codes(bits)
+        first, inverse = distinct(codes)
+        keys: list[int | bytes] = codes[first].tolist()
+        return first, inverse, keys
+    first, inverse = distinct_rows(bits)
+    return first, inverse, [r.tobytes() for r in np.packbits(bits[first], axis=1)]
+
+
+def _per_row(bits: np.ndarray, make: Callable[[np.ndarray], T_], made: dict[int | bytes, T_]) -> list[T_]:
     """``make`` of each row of ``bits``, called once per distinct row (``made``: the rows
     met before)."""
-    first, inverse = distinct_rows(bits)
+    first, inverse, keys = _distinct_keys(bits)
     out = []
-    for r in first.tolist():
-        key = bits[r].tobytes()
+    for r, key in zip(first.tolist(), keys):
         hit = made.get(key)
         if hit is None:
             hit = made[key] = make(bits[r])
@@ -182,8 +194,8 @@ def _per_row(bits: np.ndarray, make: Callable[[np.ndarray], T_], made: dict[byte
 
 
 class _Explorer:
-    def __init__(self, p: Plant, oracle: CompiledConstraints, machine: GrafcetMachine, max_states: int | None) -> None:
-        self.p, self.oracle, self.machine, self.max_states = p, oracle, machine, max_states
+    def __init__(self, p: Plant, oracle: CompiledConstraints, machine: GrafcetMachine, how: Exploration) -> None:
+        self.p, self.oracle, self.machine, self.how = p, oracle, machine, how
         self.vm = VectorMachine(machine)
         self.pc = PlantCodes(p, oracle)
         self.P = self.pc.P
@@ -191,7 +203,7 @@ class _Explorer:
         self.regions = Regions()
         self.entered = SortedKeys()  # (situation, entry) -> region
         self.by_wanted = SortedKeys()  # (wanted orders, entry) -> region
-        self._wanted: dict[bytes, int] = {}
+        self._wanted: dict[int | bytes, int] = {}
         self.index = SortedKeys()  # (situation, plant) -> node
         self.nodes: list[Node] = []
         self.node_sit = np.empty(0, dtype=np.int64)
@@ -201,10 +213,11 @@ class _Explorer:
         self.targets: list[np.ndarray] = []
         self.conflicts: list[Conflict] = []
         self.log = ConflictLog()
-        self._emitted: dict[bytes, frozenset[str]] = {}  # a node's orders, per row of bits
-        self._set: dict[bytes, tuple[str, ...]] = {}
+        self._emitted: dict[int | bytes, frozenset[str]] = {}  # a node's orders, per row of bits
+        self._set: dict[int | bytes, tuple[str, ...]] = {}
         self.pairs: list[np.ndarray] = []  # (situation, member) keys of the regions entered
         # the Grafcet's order columns in the regions' order of the plant's orders
+        self._move_events = [t.event for t in self.pc.uncontrollable]
         self._order_cols = [self.vm.order_names.index(o) if o in self.vm.order_names else -1 for o in self.pc.orders]
 
     # ------------------------------------------------------------------ helpers
@@ -215,29 +228,27 @@ class _Explorer:
         return dict(zip(self.machine.inputs, bits.tolist()))
 
     def orders(self, sid: np.ndarray, codes: np.ndarray) -> np.ndarray:
-        return self.vm.orders(self.sits.A[sid], self.sits.T[sid], self.inputs(codes))
+        out = self.sits.O[sid]  # what the situations decide alone, read once per situation
+        if self.vm.conditional:
+            self.vm.add_conditional(out, self.sits.A[sid], self.sits.T[sid], self.inputs(codes))
+        return out
 
     def region_of(self, sid: np.ndarray, entry: np.ndarray) -> np.ndarray:
         """The region entered at each (situation, entry), searched when new."""
         keys = sid * self.P + entry
         found = self.entered.find(keys)
         if (found < 0).any():
-            miss = np.flatnonzero(found < 0)
+            miss = (found < 0).nonzero()[0]
             first = miss[first_occurrences(keys[miss])]
             emitted = self.orders(sid[first], entry[first])
-            wanted = np.zeros((len(first), len(self._order_cols)), dtype=bool)
-            for j, c in enumerate(self._order_cols):
-                if c >= 0:
-                    wanted[:, j] = emitted[:, c]
-            rows, inverse = distinct_rows(wanted)
-            packed = np.packbits(wanted[rows], axis=1)
-            wid = np.array([self._wanted.setdefault(w.tobytes(), len(self._wanted)) for w in packed],
-                           dtype=np.int64)[inverse]
+            wanted = np.hstack([emitted, np.zeros((len(first), 1), dtype=bool)])[:, self._order_cols]
+            _, inverse, rows = _distinct_keys(wanted)
+            wid = np.array([self._wanted.setdefault(w, len(self._wanted)) for w in rows], dtype=np.int64)[inverse]
             if len(self._wanted) * self.P >= 1 << 62:
                 raise Unsupported("region keys past 64 bits")
             wkeys = wid * self.P + entry[first]
             gid = self.by_wanted.find(wkeys)
-            new = np.flatnonzero(gid < 0)
+            new = (gid < 0).nonzero()[0]
             if new.size:
                 new = new[first_occurrences(wkeys[new])]
                 base = self.regions.count
@@ -249,7 +260,7 @@ class _Explorer:
                 gid = self.by_wanted.find(wkeys)
             self.entered.add(keys[first], gid)
             counts, at = slices(self.regions.member_starts, gid)
-            self.pairs.append(np.repeat(sid[first], counts) * self.P + self.regions.members[at])
+            self.pairs.append(sid[first].repeat(counts) * self.P + self.regions.members[at])
             found = self.entered.find(keys)
         return found
 
@@ -258,12 +269,12 @@ class _Explorer:
         each of them the candidate it comes from."""
         gid = self.region_of(sid, entry)
         counts, at = slices(self.regions.settled_starts, gid)
-        src = np.repeat(np.arange(len(gid)), counts)
+        src = np.arange(len(gid)).repeat(counts)
         q, proh = self.regions.settled[at], self.regions.settled_proh[at]
         tsid = sid[src]
         keys = tsid * self.P + q
         node = self.index.find(keys)
-        miss = np.flatnonzero(node < 0)
+        miss = (node < 0).nonzero()[0]
         if miss.size:
             first = miss[first_occurrences(keys[miss])]
             ids = len(self.nodes) + np.arange(first.size)
@@ -276,18 +287,15 @@ class _Explorer:
         emitted = self.orders(sid, q)
         digits = self.pc.digits(q)
         names = self.vm.order_names
-        wanted = _per_row(emitted, lambda row: frozenset(names[i] for i in np.flatnonzero(row)), self._emitted)
-        set_ = _per_row(emitted & self.pc.values(names, digits), lambda row: tuple(names[i] for i in np.flatnonzero(row)),
+        wanted = _per_row(emitted, lambda row: frozenset(names[i] for i in row.nonzero()[0]), self._emitted)
+        set_ = _per_row(emitted & self.pc.values(names, digits), lambda row: tuple(names[i] for i in row.nonzero()[0]),
                         self._set)
         items, prohs = self.sits.items, self.regions.prohibitions
-        self.nodes.extend(Node(items[s], tuple(local), w, o, prohs[pr])
-                          for s, local, w, o, pr in zip(sid.tolist(), digits.full().T.tolist(), wanted, set_, proh.tolist()))
+        self.nodes.extend(many_nodes([items[s] for s in sid.tolist()], map(tuple, digits.full().T.tolist()), wanted, set_,
+                                     [prohs[pr] for pr in proh.tolist()]))
         self.node_sit = np.concatenate([self.node_sit, sid])
         self.node_code = np.concatenate([self.node_code, q])
-        if self.max_states is not None and len(self.nodes) > self.max_states:
-            raise LimitExceeded(
-                f"more than {self.max_states} aggregated states; raise --max-states or simplify the model"
-            )
+        self.how.over(len(self.nodes))
 
     # ------------------------------------------------------------------ the search
     def resume(self, partial: Partial) -> tuple[tuple[int, ...], int]:
@@ -322,8 +330,7 @@ class _Explorer:
                               + self.pc.encode([m for _, m in seen]))
         return partial.initial, partial.next
 
-    def run(self, progress: Callable[[int, int], None] | None, partial: Partial | None = None,
-            watch: Callable[[int, int], None] | None = None) -> Sync:
+    def run(self, partial: Partial | None = None) -> Sync:
         if partial is not None:
             initial, lo = self.resume(partial)
         else:
@@ -336,10 +343,10 @@ class _Explorer:
             hi = len(self.nodes)
             self.expand(lo, hi)
             lo = hi
-            if watch is not None:
-                watch(len(self.nodes), len(self.nodes) - lo)
-            if progress is not None and time.monotonic() - last > 0.5:
-                progress(len(self.nodes), len(self.nodes) - lo)
+            if self.how.watch is not None:
+                self.how.watch(len(self.nodes), len(self.nodes) - lo)
+            if self.how.progress is not None and time.monotonic() - last > 0.5:
+                self.how.progress(len(self.nodes), len(self.nodes) - lo)
                 last = time.monotonic()
         states = len(distinct(np.concatenate(self.pairs))[0]) if self.pairs else 0
         arrays = (np.concatenate(self.sources), np.concatenate(self.targets)) if self.sources else None
@@ -362,41 +369,42 @@ class _Explorer:
         nsid = sid[row]
         moved &= ~pending
         nsid[moved] = self.sits.number(A2[moved], T2[moved])
-        events: list[Event] = [self.pc.uncontrollable[k].event for k in rank.tolist()]
         traced: dict[int, Rounds] = {}  # candidate -> rounds fired, where the machine reacted
         items = self.sits.items
-        for c in np.flatnonzero(pending).tolist():
+        for c in pending.nonzero()[0].tolist():
             sit, traced[c] = self._machine(lambda: self.machine.react_with_trace(
                 items[sid[row[c]]], self.as_dict(before[row[c]]), self.as_dict(after[c])))
             nsid[c] = self.sits.of([sit])[0]
+        # each candidate's event, as an index into ``table``: the uncontrollable moves' own,
+        # then one per timer candidate
+        table, evid = list(self._move_events), [rank]
         rows, ranks, entries, sids = [row], [rank], [entry], [nsid]
-        first_timer = len(self.pc.uncontrollable)
-        for r in np.flatnonzero(self.has_timers()[sid]).tolist():
+        first_timer, candidates = len(self.pc.uncontrollable), len(row)
+        for r in self.sits.timed[sid].nonzero()[0].tolist():
             for j, timer in enumerate(self.sits.timers[sid[r]]):
                 sit, rounds = self._machine(lambda: self.machine.fire_timer_with_trace(
                     items[sid[r]], timer, self.as_dict(before[r])))
-                traced[len(events)] = rounds
-                events.append(timer)
+                traced[candidates] = rounds
+                candidates += 1
+                evid.append(np.array([len(table)]))
+                table.append(timer)
                 rows.append(np.array([r]))
                 ranks.append(np.array([first_timer + j]))
                 entries.append(codes[r:r + 1])
                 sids.append(self.sits.of([sit]))
-        row, rank, entry, nsid = (np.concatenate(x) for x in (rows, ranks, entries, sids))
+        row, rank, entry, nsid, ev = (np.concatenate(x) for x in (rows, ranks, entries, sids, evid))
         order = np.lexsort((rank, row))
-        where = np.empty(len(order), dtype=np.int64)
-        where[order] = np.arange(len(order))
-        for c in sorted(traced, key=lambda c: where[c]):
-            i = lo + int(row[c])
-            self.conflicts.extend(Conflict(i, events[c], st, names) for st, names in self.log.fresh(traced[c]))
-        row, entry, nsid = row[order], entry[order], nsid[order]
-        events = [events[c] for c in order.tolist()]
+        if traced:
+            where = np.empty(len(order), dtype=np.int64)
+            where[order] = np.arange(len(order))
+            for c in sorted(traced, key=lambda c: where[c]):
+                i = lo + int(row[c])
+                self.conflicts.extend(Conflict(i, table[ev[c]], st, names) for st, names in self.log.fresh(traced[c]))
+        row, entry, nsid, ev = row[order], entry[order], nsid[order], ev[order]
         node, src = self.enter(nsid, entry)
         self.sources.append(lo + row[src])
         self.targets.append(node)
-        self.edges.extend(map(Edge, self.sources[-1].tolist(), [events[c] for c in src.tolist()], node.tolist()))
-
-    def has_timers(self) -> np.ndarray:
-        return np.array([bool(t) for t in self.sits.timers], dtype=bool)
+        self.edges.extend(many_edges(self.sources[-1].tolist(), [table[e] for e in ev[src].tolist()], node.tolist()))
 
     @staticmethod
     def _machine(call: Callable[[], tuple[Situation, Rounds]]) -> tuple[Situation, Rounds]:

@@ -17,7 +17,13 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["SortedKeys", "distinct", "distinct_rows", "first_occurrences", "slices"]
+__all__ = ["Collision", "SortedKeys", "ROW_BITS", "distinct", "distinct_rows", "row_codes", "first_occurrences", "slices"]
+
+
+class Collision(Exception):
+    """Two different states under one key (:mod:`synth.validation.words`: two wide plant
+    states mixed to the same key, or more than its capacity met): the explorer leaves the
+    model to the machine's path."""
 
 
 class SortedKeys:
@@ -37,36 +43,52 @@ class SortedKeys:
 
     def add(self, keys: np.ndarray, values: np.ndarray) -> None:
         """Insert absent, distinct ``keys``."""
-        order = np.argsort(keys, kind="stable")
+        order = keys.argsort(kind="stable")
         keys, values = keys[order], values[order]
-        pos = np.searchsorted(self.keys, keys)
-        self.keys = np.insert(self.keys, pos, keys)
-        self.values = np.insert(self.values, pos, values)
+        n, m = self.keys.size, keys.size
+        at = np.searchsorted(self.keys, keys) + np.arange(m)  # the new keys' places in the merged table
+        old = np.ones(n + m, dtype=bool)
+        old[at] = False
+        merged, merged_values = np.empty(n + m, dtype=np.int64), np.empty(n + m, dtype=np.int64)
+        merged[at], merged_values[at] = keys, values
+        merged[old], merged_values[old] = self.keys, self.values
+        self.keys, self.values = merged, merged_values
 
 
 def _groups(perm: np.ndarray, change: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """From a stable sorting permutation and where the sorted keys change (first True):
     each group's first position and each position's group."""
     inverse = np.empty(len(perm), dtype=np.int64)
-    inverse[perm] = np.cumsum(change) - 1
+    inverse[perm] = change.cumsum() - 1
     return perm[change], inverse
 
 
 def distinct(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The distinct keys, in increasing order, as the position of their first occurrence;
     and each position's rank among them."""
-    perm = np.argsort(keys, kind="stable")
+    perm = keys.argsort(kind="stable")
     s = keys[perm]
-    change = np.ones(len(s), dtype=bool)
+    change = np.empty(len(s), dtype=bool)
+    change[:1] = True
     change[1:] = s[1:] != s[:-1]
     return _groups(perm, change)
+
+
+ROW_BITS = 62
+"""Rows of at most this many Boolean columns are keyed by one integer each (:func:`row_codes`)."""
+
+
+def row_codes(bits: np.ndarray) -> np.ndarray:
+    """Each row of a Boolean matrix of at most :data:`ROW_BITS` columns as one integer
+    (column j: bit j)."""
+    return bits.astype(np.int64) @ (np.int64(1) << np.arange(bits.shape[1], dtype=np.int64))
 
 
 def distinct_rows(bits: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """:func:`distinct` for the rows of a Boolean matrix."""
     n, k = bits.shape
-    if k <= 62:
-        return distinct(bits.astype(np.int64) @ (np.int64(1) << np.arange(k, dtype=np.int64)))
+    if k <= ROW_BITS:
+        return distinct(row_codes(bits))
     packed = np.packbits(bits, axis=1)
     packed = np.hstack([packed, np.zeros((n, -packed.shape[1] % 8), dtype=np.uint8)])
     words = packed.view(np.uint64)
@@ -79,7 +101,12 @@ def distinct_rows(bits: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def first_occurrences(keys: np.ndarray) -> np.ndarray:
     """Positions of the first occurrence of each distinct key, in the order they occur."""
-    return np.sort(distinct(keys)[0])
+    perm = keys.argsort(kind="stable")
+    s = keys[perm]
+    change = np.empty(len(s), dtype=bool)
+    change[:1] = True
+    change[1:] = s[1:] != s[:-1]
+    return np.sort(perm[change])
 
 
 def slices(starts: np.ndarray, groups: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -91,5 +118,5 @@ def slices(starts: np.ndarray, groups: np.ndarray) -> tuple[np.ndarray, np.ndarr
     ([3, 2], [2, 3, 4, 0, 1])
     """
     counts = starts[groups + 1] - starts[groups]
-    at = np.repeat(starts[groups] - np.cumsum(counts) + counts, counts) + np.arange(int(counts.sum()))
+    at = (starts[groups] - counts.cumsum() + counts).repeat(counts) + np.arange(int(counts.sum()))
     return counts, at

@@ -87,20 +87,27 @@ class Runs:
         return (c // np.array(run.subs)) % np.array([self.shape[a] for a in run.members])
 
 
+_BIT = np.left_shift(np.int64(1), np.arange(BITS, dtype=np.int64))
+
+
 def pack(bits: np.ndarray) -> np.ndarray:
-    """Boolean columns (n × k) as ``int64`` words of 63 bits (n × words)."""
+    """Boolean columns (n × k) as ``int64`` words of 63 bits (n × words): a word is the
+    sum of its distinct bits, one product per word."""
     n, k = bits.shape
     out = np.zeros((n, max(1, -(-k // BITS))), dtype=np.int64)
-    for j in range(k):
-        out[:, j // BITS] |= bits[:, j].astype(np.int64) << (j % BITS)
+    for w in range(0, k, BITS):
+        part = bits[:, w:w + BITS]
+        out[:, w // BITS] = part.astype(np.int64) @ _BIT[:part.shape[1]]
     return out
 
 
 def unpack(words: np.ndarray, k: int) -> np.ndarray:
-    """The first ``k`` bits of words (n × words) as Boolean columns (n × k)."""
-    shift = np.arange(BITS, dtype=np.int64)
-    bits = ((words[:, :, None] >> shift) & 1).astype(bool).reshape(len(words), words.shape[1] * BITS)
-    return bits[:, :k]
+    """The first ``k`` bits of words (n × words) as Boolean columns (n × k): only those
+    ``k`` bits are read (one pass when they fit one word)."""
+    if words.shape[1] == 1:
+        return (words & _BIT[:k]) != 0
+    j = np.arange(k, dtype=np.int64)
+    return (words[:, j // BITS] & _BIT[j % BITS]) != 0
 
 
 class Masks:

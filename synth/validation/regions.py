@@ -29,16 +29,18 @@ Example
 
 from __future__ import annotations
 
-from typing import Iterable
+from typing import TYPE_CHECKING, Iterable
 
 import numpy as np
 
 from synth.plant.composition import LocalTransition, Plant
 from synth.sup.constraints import CompiledConstraints
-from synth.validation.keys import SortedKeys, distinct_rows, first_occurrences, slices
+from synth.validation.keys import ROW_BITS, distinct, distinct_rows, row_codes, slices
 from synth.validation.masks import Masks, Runs, pack, unpack
 from synth.validation.sync import Prohibition, moves_by_order
-from synth.validation.words import CAPACITY, Interned, Layout
+
+if TYPE_CHECKING:  # imported for plants of WIDE states or more only
+    from synth.validation.words import Interned, Layout
 
 __all__ = ["Digits", "PlantCodes", "Regions", "regions", "WIDE"]
 
@@ -108,10 +110,16 @@ class PlantCodes:
 
     def __init__(self, p: Plant, oracle: CompiledConstraints) -> None:
         self.plant, self.oracle = p, oracle
-        self.layout = Layout(p.shape) if p.size >= WIDE else None
-        self.interned = Interned(self.layout.count) if self.layout is not None else None
-        self.P = CAPACITY if self.layout is not None else p.size
+        self.layout: Layout | None = None
+        self.interned: Interned | None = None
+        self.P = p.size
         """The radix of the explorer's keys (situation × code): more than any code."""
+        if p.size >= WIDE:
+            from synth.validation.words import CAPACITY, Interned, Layout
+
+            self.layout = Layout(p.shape)
+            self.interned = Interned(self.layout.count)
+            self.P = CAPACITY
         code_strides = self.layout.stride if self.layout is not None else np.array(p.strides, dtype=np.int64)
         word = self.layout.word if self.layout is not None else np.zeros(len(p.shape), dtype=np.int64)
         self.word_of, self.stride, self.radix = word.tolist(), code_strides.tolist(), p.shape
@@ -130,7 +138,7 @@ class PlantCodes:
         self.order_starts = np.searchsorted(self._c.column, np.arange(len(self.orders) + 1))
         self._reach = [g.ravel() for g in oracle.reach_grids] if oracle.reach_grids is not None else None
         self.prohibitions: list[Prohibition] = []  # the refusals met: one move, its constraints responsible
-        self._why: dict[tuple[int, bytes], int] = {}
+        self._why: dict[int | tuple[int, bytes], int] = {}
         self._edge_width = max((len(oracle.edge_terms.get(t.event, ())) for t in controllable), default=0)
         self._threat_masks = Masks(self.runs, self._level_tables(), len(oracle.level_terms), conj=True)
         self._order_masks = Masks(self.runs, self._value_tables(self.orders), len(self.orders), conj=False)
@@ -231,7 +239,7 @@ class PlantCodes:
         u = self._u
         ok = digits.full()[u.axis, :].T == u.src
         for k in u.guarded:
-            rows = np.flatnonzero(ok[:, k])
+            rows = ok[:, k].nonzero()[0]
             if rows.size:
                 ok[rows, k] = self._guard(k, digits, rows)
         row, rank = np.nonzero(ok)  # row-major: by row, then rank
@@ -265,20 +273,27 @@ class PlantCodes:
         c, terms = self._c, self.oracle.edge_terms
         edge = np.zeros((len(row), self._edge_width), dtype=bool)
         for k in c.forbidding:
-            at = np.flatnonzero(rank == k)
+            at = (rank == k).nonzero()[0]
             for j, term in enumerate(terms[c.moves[k].event] if at.size else ()):
                 edge[at, j] = self.holds(term.factors, digits, row[at])
         level = unpack(threats, len(self.oracle.level_terms))
         bits = np.hstack([edge, level])
-        first, inverse = distinct_rows(np.hstack([bits, (rank[:, None] >> np.arange(32)) & 1 == 1]))
+        rank_bits = len(c.moves).bit_length()
+        keys: list[int | tuple[int, bytes]]
+        if bits.shape[1] + rank_bits <= ROW_BITS:  # (bits, move) as one integer
+            codes = (row_codes(bits) << rank_bits) | rank
+            first, inverse = distinct(codes)
+            keys = codes[first].tolist()
+        else:
+            first, inverse = distinct_rows(np.hstack([bits, (rank[:, None] >> np.arange(32)) & 1 == 1]))
+            keys = [(int(rank[r]), np.packbits(bits[r]).tobytes()) for r in first.tolist()]
         ids = np.empty(len(first), dtype=np.int64)
-        for u, r in enumerate(first.tolist()):
-            key = (int(rank[r]), np.packbits(bits[r]).tobytes())
+        for u, (r, key) in enumerate(zip(first.tolist(), keys)):
             hit = self._why.get(key)
             if hit is None:
-                t = c.moves[key[0]]
-                why = [terms[t.event][j].constraint for j in np.flatnonzero(edge[r]).tolist()]
-                why += [self.oracle.level_terms[i].constraint for i in np.flatnonzero(level[r]).tolist()]
+                t = c.moves[int(rank[r])]
+                why = [terms[t.event][j].constraint for j in edge[r].nonzero()[0].tolist()]
+                why += [self.oracle.level_terms[i].constraint for i in level[r].nonzero()[0].tolist()]
                 hit = self._why[key] = len(self.prohibitions)
                 self.prohibitions.append(Prohibition(t.event, tuple(dict.fromkeys(why))))
             ids[u] = hit
@@ -315,7 +330,7 @@ class Regions:
         """Per state of ``rows`` (sorted, repeated once per refused move), its refusals
         (indices into ``met``) as one prohibition set: (the states, their set's index in
         :attr:`prohibitions`)."""
-        starts = np.flatnonzero(np.concatenate([[True], rows[1:] != rows[:-1]]))
+        starts = np.concatenate([[True], rows[1:] != rows[:-1]]).nonzero()[0]
         bounds, ids = np.append(starts, len(rows)).tolist(), refusals.tolist()
         out = np.empty(len(starts), dtype=np.int64)
         for u in range(len(starts)):
@@ -328,9 +343,9 @@ class Regions:
 
     def append(self, members: np.ndarray, member_counts: np.ndarray, settled: np.ndarray, proh: np.ndarray,
                settled_counts: np.ndarray) -> None:
-        self.member_starts = np.concatenate([self.member_starts, self.members.size + np.cumsum(member_counts)])
+        self.member_starts = np.concatenate([self.member_starts, self.members.size + member_counts.cumsum()])
         self.members = np.concatenate([self.members, members])
-        self.settled_starts = np.concatenate([self.settled_starts, self.settled.size + np.cumsum(settled_counts)])
+        self.settled_starts = np.concatenate([self.settled_starts, self.settled.size + settled_counts.cumsum()])
         self.settled = np.concatenate([self.settled, settled])
         self.settled_proh = np.concatenate([self.settled_proh, proh])
 
@@ -343,29 +358,27 @@ def regions(pc: PlantCodes, store: Regions, entries: np.ndarray, wanted: np.ndar
         raise OverflowError("region keys")
     reg, cur = np.arange(R, dtype=np.int64), entries.astype(np.int64)
     wanted_bits, k = pack(wanted), len(pc.orders)
-    seen = SortedKeys()
-    seen.add(reg * pc.P + cur, reg)
+    seen = set((reg * pc.P + cur).tolist())  # (region, member) keys: a set, one look-up per move kept
     member_parts, settled_parts = [(reg, cur)], []
     while cur.size:
         digits = pc.digits(cur)
         c = pc.controllable_moves
         row, order = np.nonzero(unpack(pc.order_bits(digits) ^ wanted_bits[reg], k))  # the orders to change, row-major
         counts, rank = slices(pc.order_starts, order)  # their moves (the region's order of the moves)
-        row = np.repeat(row, counts)
+        row = row.repeat(counts)
         app = digits.full()[c.axis[rank], row] == c.src[rank]
         row, rank = row[app], rank[app]  # by row, then rank
         target = pc.step(cur[row], c, rank)
         threat = pc.threats(target)
         ok = np.logical_not(threat.any(axis=1))
         for k in c.forbidding:
-            at = np.flatnonzero(rank == k)
+            at = (rank == k).nonzero()[0]
             if at.size:
                 ok[at] &= ~pc.forbidden(c.moves[k], digits, row[at])
-        progressed = np.zeros(cur.size, dtype=bool)
-        progressed[row[ok]] = True
-        still = ~progressed
+        still = np.ones(cur.size, dtype=bool)  # settled: no allowed move
+        still[row[ok]] = False
         proh = np.zeros(cur.size, dtype=np.int64)
-        sel = np.flatnonzero(still[row])  # the moves from settled states: every one refused
+        sel = still[row].nonzero()[0]  # the moves from settled states: every one refused
         if sel.size:
             at, ids = store.refusal_sets(row[sel], pc.refused(digits, row[sel], rank[sel], threat[sel]), pc.prohibitions)
             proh[at] = ids
@@ -373,11 +386,13 @@ def regions(pc: PlantCodes, store: Regions, entries: np.ndarray, wanted: np.ndar
         if not ok.any():
             break
         nreg, target = reg[row[ok]], target[ok]
-        keys = nreg * pc.P + target
-        first = first_occurrences(keys)
-        first = first[seen.find(keys[first]) < 0]
+        fresh = []  # the first move into each state not met before, in order
+        for i, key in enumerate((nreg * pc.P + target).tolist()):
+            if key not in seen:
+                seen.add(key)
+                fresh.append(i)
+        first = np.array(fresh, dtype=np.int64)
         reg, cur = nreg[first], target[first]
-        seen.add(reg * pc.P + cur, reg)
         member_parts.append((reg, cur))
     _store(store, R, member_parts, settled_parts)
 
@@ -388,10 +403,10 @@ def _store(store: Regions, R: int, member_parts: list[tuple[np.ndarray, np.ndarr
     (breadth-first order kept)."""
     mreg = np.concatenate([r for r, _ in member_parts])
     mcode = np.concatenate([c for _, c in member_parts])
-    order = np.argsort(mreg, kind="stable")
+    order = mreg.argsort(kind="stable")
     sreg = np.concatenate([r for r, _, _ in settled_parts])
     scode = np.concatenate([c for _, c, _ in settled_parts])
     sproh = np.concatenate([f for _, _, f in settled_parts])
-    sorder = np.argsort(sreg, kind="stable")
+    sorder = sreg.argsort(kind="stable")
     sreg, scode, proh = sreg[sorder], scode[sorder], sproh[sorder]
     store.append(mcode[order], np.bincount(mreg, minlength=R), scode, proh, np.bincount(sreg, minlength=R))

@@ -28,7 +28,7 @@ from __future__ import annotations
 import time
 from collections import deque
 from dataclasses import InitVar, field
-from typing import Callable, Sequence
+from typing import Callable, Iterable, Sequence
 
 import numpy as np
 
@@ -43,7 +43,7 @@ from synth.plant.rules import Constraint
 from synth.sup.constraints import CompiledConstraints
 from synth.validation.conflicts import Conflict, ConflictLog
 
-__all__ = ["WIDE", "Wide", "Partial", "Prohibition", "Node", "Edge", "Sync", "synchronous_product", "region", "grafcet_inputs", "moves_by_order"]
+__all__ = ["WIDE", "WATCHED_WIDE", "Exploration", "Wide", "Partial", "Prohibition", "Node", "Edge", "many_nodes", "many_edges", "Sync", "synchronous_product", "region", "grafcet_inputs", "moves_by_order"]
 
 Local = tuple[int, ...]
 
@@ -74,16 +74,36 @@ class Partial:
     seen: set[tuple[Situation, Local]]
 
 
-WIDE = 32
+WIDE = 20
 """The explicit engine explores SYNC state by state until more than this many states wait
 in its queue, then a frontier at a time from there (:mod:`synth.validation.frontier`):
 below, a frontier's numpy passes (and the frontier's modules, imported then) cost more
-than the states they carry. Measured, CPU seconds of whole explorations: the box sorting
-(never 16 states waiting) 0.013 s state by state, 0.026 s by frontiers; the four-cylinder
-station (never 32 waiting) 0.09 s state by state, 0.076 s by frontiers plus their
-modules' import (30-50 ms here, where no bytecode is cached); par_4, steep_4 and
-branches_2x4 pass 32 waiting after 0.009, 0.007 and 0.045 s, and take 0.038, 0.061 and
-0.069 s by frontiers against 0.071, 0.345 and 0.104 s state by state."""
+than the states they carry. Measured (docs/performance.md, sessions 27 and 29): from 20
+waiting rather than 32, par_5, steep_4, branches_3x3 and branches_4x2 validate 4-10 %
+faster (the machine's path costs about 0.3 ms per aggregated state on the branches, a
+frontier layer 0.5-1 ms); the bundled Grafcets (at most 15 to 20 waiting) stay on the
+machine's path (tri_boxes, 17, took 25 ms more by frontiers)."""
+
+WATCHED_WIDE = 32
+""":data:`WIDE` for a watched run (``validate --engine auto``, :mod:`synth.probe`): the counts
+it judges depend on where the frontier takes over; its shares were measured from 32."""
+
+
+@frozen
+class Exploration:
+    """How SYNC is explored, whichever path explores it: past ``max_states`` aggregated
+    states :class:`~synth.errors.LimitExceeded`; ``progress(met, waiting)`` now and then
+    (aggregated states met, and those waiting to be expanded); ``watch(met, waiting)``
+    after each state or frontier expanded (it may raise to stop the run: ``validate
+    --engine auto``)."""
+
+    max_states: int | None = None
+    progress: Callable[[int, int], None] | None = None
+    watch: Callable[[int, int], None] | None = None
+
+    def over(self, met: int) -> None:
+        if self.max_states is not None and met > self.max_states:  # the one message of both paths
+            raise LimitExceeded(f"more than {self.max_states} aggregated states; raise --max-states or simplify the model")
 
 
 @frozen(order=True)
@@ -116,6 +136,31 @@ class Edge:
     source: int
     event: Event  # ↑v11, ↓dcy, 2s/X101
     target: int
+
+
+def many_nodes(situations: list[Situation], plants: Iterable[Local], emitted: list[frozenset[str]],
+               ords: list[tuple[str, ...]], prohs: list[tuple[Prohibition, ...]]) -> list[Node]:
+    """``Node(*row)`` for each row of the columns given, made in bulk: the same objects,
+    their attributes written once each without a call of ``__init__`` per node (a frontier
+    makes thousands at once; the call was half their cost)."""
+    new, out = object.__new__, []
+    for a, b, c, d, e in zip(situations, plants, emitted, ords, prohs):
+        node = new(Node)
+        attrs = node.__dict__
+        attrs["situation"], attrs["plant"], attrs["emitted"], attrs["ord"], attrs["proh"] = a, b, c, d, e
+        out.append(node)
+    return out
+
+
+def many_edges(sources: list[int], events: list[Event], targets: list[int]) -> list[Edge]:
+    """``Edge(*row)`` for each row of the columns given, made in bulk (as :func:`many_nodes`)."""
+    new, out = object.__new__, []
+    for a, b, c in zip(sources, events, targets):
+        edge = new(Edge)
+        attrs = edge.__dict__
+        attrs["source"], attrs["event"], attrs["target"] = a, b, c
+        out.append(edge)
+    return out
 
 
 @frozen
@@ -263,16 +308,14 @@ def synchronous_product(
     p: Plant,
     constraints: Sequence[Constraint],
     machine: GrafcetMachine,
+    how: Exploration = Exploration(),
     *,
-    max_states: int | None = None,
-    progress: Callable[[int, int], None] | None = None,
     wide: int | None = None,
-    watch: Callable[[int, int], None] | None = None,
 ) -> Sync:
     """Explore SYNC from (initial plant state, initial situation), aggregated per region,
     state by state; :class:`Wide` once more than ``wide`` states wait in the queue (the
-    frontier path, :mod:`synth.validation.frontier`, is then the faster); ``watch(met,
-    waiting)`` after each aggregated state expanded (it may raise to stop the run)."""
+    frontier path, :mod:`synth.validation.frontier`, is then the faster); ``how.watch``
+    after each aggregated state expanded."""
     oracle = CompiledConstraints(p, constraints)
     nodes: list[Node] = []
     edges: list[Edge] = []
@@ -324,10 +367,7 @@ def synchronous_product(
                 index[nk] = len(nodes)
                 nodes.append(Node(sit, q, frozenset(wanted), ords, proh))
                 queue.append(index[nk])
-                if max_states is not None and len(nodes) > max_states:
-                    raise LimitExceeded(
-                        f"more than {max_states} aggregated states; raise --max-states or simplify the model"
-                    )
+                how.over(len(nodes))
             out.append(index[nk])
         return out
 
@@ -383,12 +423,12 @@ def synchronous_product(
         while queue:
             i = queue.popleft()
             expand(i)
-            if watch is not None:
-                watch(len(nodes), len(queue))
+            if how.watch is not None:
+                how.watch(len(nodes), len(queue))
             if wide is not None and len(queue) > wide:
                 raise Wide(Partial(oracle, nodes, edges, conflicts, log, initial, i + 1, region_cache, sync_seen))
-            if progress is not None and time.monotonic() - last > 0.5:
-                progress(len(nodes), len(queue))
+            if how.progress is not None and time.monotonic() - last > 0.5:
+                how.progress(len(nodes), len(queue))
                 last = time.monotonic()
     except OutOfRange as err:
         raise with_trace(err, [str(e) for e in path_events(edges, initial, i) + happening]) from None

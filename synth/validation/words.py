@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from synth.validation.keys import SortedKeys, first_occurrences
+from synth.validation.keys import Collision, SortedKeys, first_occurrences
 
 __all__ = ["Layout", "Interned", "Collision", "CAPACITY"]
 
@@ -39,10 +39,6 @@ CAPACITY = 1 << 32
 
 _MIX = np.array([0x9E3779B97F4A7C15, 0xC2B2AE3D27D4EB4F, 0x165667B19E3779F9, 0x27D4EB2F165667C5,
                  0x94D049BB133111EB, 0xBF58476D1CE4E5B9, 0xFF51AFD7ED558CCD, 0xC4CEB9FE1A85EC53], dtype=np.uint64)
-
-
-class Collision(Exception):
-    """Two different plant states mixed to the same key, or more than :data:`CAPACITY` met."""
 
 
 class Layout:
