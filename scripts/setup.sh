@@ -110,4 +110,7 @@ else
   echo "== installing synth into $VENV" >&2
   pip_install "synth and its dependencies" -e .
 fi
+# the package's bytecode, once: an editable install leaves it to the first run of each module, and
+# an environment with PYTHONDONTWRITEBYTECODE set would compile them again in every process
+"$VENV/bin/python" -m compileall -q synth >/dev/null 2>&1 || echo "== note: synth's bytecode not compiled ahead" >&2
 echo "== ready: $VENV/bin/synth (or: export PATH=\"$(cd "$VENV" && pwd)/bin:\$PATH\")" >&2
