@@ -40,8 +40,9 @@ from typing import Generic, Mapping, Protocol, Sequence, TypeVar
 from synth.filter.model import FilterFunctions
 from synth.filter.narrowing import layout
 from synth.logic.bdd import Engine, Function
+from synth.logic.partition import Partition
 
-__all__ = ["Bag", "Plan", "plan", "Algebra", "AtPoint", "Symbolic", "Outcome", "run"]
+__all__ = ["Bag", "Plan", "plan", "plan_of", "Algebra", "AtPoint", "Symbolic", "Outcome", "run"]
 
 V = TypeVar("V")
 
@@ -85,7 +86,11 @@ def plan(m: FilterFunctions, goods: Sequence[Function], order: Sequence[str] | N
     :func:`~synth.filter.narrowing.layout` gives (``order``: its elimination order)."""
     if not m.outputs:
         raise ValueError("a plan needs at least one output")
-    p = layout(m, goods, order)
+    return plan_of(m, layout(m, goods, order), goods)
+
+
+def plan_of(m: FilterFunctions, p: Partition, goods: Sequence[Function]) -> Plan:
+    """The plan of the chain of ``goods`` on the partition ``p`` of ``m``'s constraints."""
     n = len(p.anchors)
     relations = [m.engine.true] * n
     for u in [~c for c in m.constraint.values()] + [m.assumed]:
