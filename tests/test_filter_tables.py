@@ -18,6 +18,7 @@ from synth.codegen.filter_st import filter_block
 from synth.codegen.program import StProgram
 from synth.errors import LimitExceeded
 from synth.filter import local
+from synth.filter.block import algebraic_equations
 from synth.filter.cycle import Algorithm, FilterCycle
 from synth.filter.language_check import parse_filter
 from synth.filter.solve import CHAIN_WORK, synthesis
@@ -58,10 +59,23 @@ def test_past_the_limit_every_output_needs_its_sim():
         synthesis(f, chain_work=-1)
 
 
-def test_filter_run_refuses_the_tables():
+def test_filter_run_evaluates_the_tables():
+    """``filter run`` (and the explicit closed loop) evaluate the block on tables: the same outputs as the
+    equations of the synthesis below the limit, cycle after cycle (past values included)."""
     f, s = _grid()
-    with pytest.raises(LimitExceeded, match="filter run and verify do not evaluate it yet"):
-        FilterCycle(s, Algorithm.ALGEBRAIC)
+    tables, equations = FilterCycle(s, Algorithm.ALGEBRAIC), FilterCycle(f, Algorithm.ALGEBRAIC)
+    assert tables.plan is not None and equations.plan is None and tables.used == equations.used
+    rng = random.Random(16)
+    rows = [{n: rng.random() < 0.5 for n in tables.reads} for _ in range(200)]
+    mine, theirs = tables.initial(), equations.initial()
+    on = 0
+    for values in rows:
+        (a, mine), (b, theirs) = tables.step(mine, values), equations.step(theirs, values)
+        assert a == b
+        on += sum(a.outputs)
+    assert on == 516
+    with pytest.raises(LimitExceeded, match="it has no equations"):
+        algebraic_equations(s)
 
 
 @pytest.mark.skipif(find_iec2c() is None or shutil.which("gcc") is None, reason="MATIEC's iec2c (and gcc) are not on PATH")

@@ -40,8 +40,7 @@ def algebraic_equations(s: Synthesis) -> Equations:
     filter on truth tables (``s.plan``) has none: :class:`LimitExceeded`."""
     if s.plan is not None:
         raise LimitExceeded(f"{s.functions.filter.file}: the filter is its chain of narrowings on truth tables "
-                            "(too large for equations: see synth filter solve); filter st writes that block, "
-                            "filter run and verify do not evaluate it yet")
+                            "(too large for equations: see synth filter solve); it has no equations")
     return tuple((o, filter_expression(text, f"equation {o}")) for o, text in s.chained.items())
 
 
