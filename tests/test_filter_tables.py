@@ -14,6 +14,7 @@ import pytest
 
 from conftest import ROOT
 from iec2c import CompiledProgram, find_iec2c
+from schemas import assert_valid
 from synth.codegen.filter_st import filter_block
 from synth.codegen.program import StProgram
 from synth.errors import LimitExceeded
@@ -50,6 +51,7 @@ def test_past_the_limit_solve_prints_the_criteria_and_says_why():
     assert j["form"] == {"kind": "tables", "bags": 16, "width": 3, "entries": 118}
     assert j["equations"] == {} and j["chained"] == {"order": [], "equations": {}}
     assert {(c["narrows"], c["effect"]) for c in j["criteria"]} == {(None, None)}
+    assert_valid("filter_solve", j)
     assert synthesis(f, chain_work=CHAIN_WORK).plan is None  # below the limit: the equations, as before
 
 
