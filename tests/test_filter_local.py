@@ -108,14 +108,13 @@ def _random_filter(rng: random.Random) -> str:
 
 def test_random_filters_plan_is_the_synthesis():
     rng = random.Random(29)
-    seen = {"filters": 0, "inside": 0, "not functional": 0}
-    for _ in range(60):
-        text = _random_filter(rng)
+    texts = [_random_filter(rng) for _ in range(60)]
+    inside, free = 0, 0
+    for text in texts:  # each compared on every Y, then at 8 points
         m, p, out = _same_as_the_chain(parse_filter(text, "random.filter"))
-        seen["filters"] += 1
-        seen["inside"] += _points_agree(m, p, out, 8, len(text))
-        seen["not functional"] += any((out.ones[o] & out.zeros[o]) != m.engine.false for o in m.outputs)
-    assert seen == {"filters": 60, "inside": 420, "not functional": 18}
+        inside += _points_agree(m, p, out, 8, len(text))
+        free += any((out.ones[o] & out.zeros[o]) != m.engine.false for o in m.outputs)
+    assert (len(texts), inside, free) == (60, 420, 18)  # 18 filters leave an output free somewhere
 
 
 def test_a_lost_narrowing_is_caught():
