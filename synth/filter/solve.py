@@ -210,7 +210,7 @@ def synthesis(f: Filter | FilterFunctions, order: Sequence[str] | None = None, *
     of :func:`criteria` (a cluster's share of its whole filter's, :mod:`synth.filter.clusters`).
     ``partitioned``: keep each admissible set as a conjunction of factors, one BDD otherwise
     (:mod:`synth.filter.narrowing`; the same result). ``chain_work``: past this BDD work the
-    partitioned chain stops and the filter is its chain on truth tables (:func:`on_tables`),
+    partitioned chain stops and the filter is its chain on truth tables (:mod:`synth.filter.local`),
     unless ``flat`` asks for the equations."""
     m = f if isinstance(f, FilterFunctions) else functions(f)
     e = m.engine
