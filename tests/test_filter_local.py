@@ -59,7 +59,7 @@ def _points_agree(m: FilterFunctions, p: local.Plan, out: local.Outcome[Function
     return inside
 
 
-@pytest.mark.parametrize("n, width, entries", [(16, 3, 118), (24, 4, 334)])
+@pytest.mark.parametrize("n, width, entries", [(16, 3, 118), pytest.param(24, 4, 334, marks=pytest.mark.slow)])
 def test_grid_edges_plan_is_the_synthesis(n, width, entries):
     m, p, out = _same_as_the_chain(parse_filter(grid_edges_filter(n), "grid_edges.filter"))
     assert (p.width, p.entries, len(p.steps)) == (width, entries, {16: 38, 24: 61}[n])

@@ -80,6 +80,7 @@ def test_filter_run_evaluates_the_tables():
         algebraic_equations(s)
 
 
+@pytest.mark.slow  # 5-10 s a case: iec2c and gcc, then the model at each of 300 cycles
 @pytest.mark.skipif(find_iec2c() is None or shutil.which("gcc") is None, reason="MATIEC's iec2c (and gcc) are not on PATH")
 @pytest.mark.parametrize("case", ["grid_edges_16", "ring_4"])
 def test_the_compiled_tables_block_is_the_synthesis(case, tmp_path):
