@@ -186,7 +186,7 @@ class FilterCycle:
             if s.plan is not None:  # the chain on truth tables (synth.filter.local), as the block runs it
                 self.plan = s.plan
                 tables = (*(b.relation for b in s.plan.bags), *(g for _, g in s.plan.steps))
-                self.care = ((),) if s.care == e.true else _cover(e.cover(s.care))
+                self.care = _cover(e.cover(s.care))
                 past = {n for u in tables for n in e.support(u) if is_pre(n)}
             else:
                 self.equations = tuple((o, _cover(e.cover(e.expr(x)))) for o, x in algebraic_equations(s))
