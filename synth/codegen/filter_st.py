@@ -218,7 +218,9 @@ def filter_block(f: Filter, algorithm: Algorithm | str = Algorithm.ALGEBRAIC, mo
         body += [f"{_GATED}{o} := R_{o} AND NOT {BLOCKED};" for o in f.outputs]
         local += [Declaration(_GATED + o, comment=f"request of {o} after the blocking latch") for o in f.outputs]
     if algorithm is Algorithm.ALGEBRAIC:
-        body += _algebraic(f, w, notes, order, synthesis)
+        lines, decls = _algebraic(f, w, notes, order, synthesis, extra)
+        body += lines
+        local += decls
     else:
         lines, decls = _loop(f, w, synthesis)
         body += lines
@@ -284,19 +286,27 @@ def _requested(e: Expr, outputs: tuple[str, ...]) -> Expr:
 
 
 def _algebraic(f: Filter, w: _Writer, notes: list[str], order: list[str] | None,
-               solved: "Synthesis | None") -> list[str]:
+               solved: "Synthesis | None", extra: tuple[str, ...]) -> tuple[list[str], list[Declaration]]:
     from synth.filter.block import algebraic_equations
     from synth.filter.solve import synthesis
     from synth.logic.bdd import cube_text
 
     s = solved if solved is not None else synthesis(f, order)
+    if s.plan is not None:  # too large for equations: the chain on truth tables
+        from synth.codegen.filter_tables import TABLE_NAMES, bit_names, tables_body
+
+        _check_names(f, extra + TABLE_NAMES + bit_names(s.plan.width))
+        notes += s.notes[-1:]
+        if not s.consistent:
+            notes.append(f"no safe output vector exists when {s.inconsistent_text}; there the outputs are all FALSE")
+        return tables_body(s.plan, s.functions.engine, w.expression, [a.text() for a in s.applied])
     if not s.functional:
         free = "; ".join(f"{o} is free when {cube_text(c)}" for o, c in s.free.items())
         raise ModelError(f"{f.file}: the synthesis is not functional ({free}); add a criterion that decides it")
     if not s.consistent:
         notes.append(f"no safe output vector exists when {s.inconsistent_text or cube_text(s.inconsistent or {})}; "
                      "the equations are those of the care set")
-    return [f"{o} := {w.expression(e)};" for o, e in algebraic_equations(s)]
+    return [f"{o} := {w.expression(e)};" for o, e in algebraic_equations(s)], []
 
 
 def _loop(f: Filter, w: _Writer, solved: "Synthesis | None") -> tuple[list[str], list[Declaration]]:

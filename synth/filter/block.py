@@ -24,6 +24,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from synth.errors import LimitExceeded
 from synth.filter.language_reader import filter_expression
 from synth.filter.model import FilterFunctions
 from synth.filter.solve import Synthesis
@@ -35,7 +36,11 @@ Equations = tuple[tuple[str, Expr], ...]  # (output, expression), in evaluation 
 
 
 def algebraic_equations(s: Synthesis) -> Equations:
-    """The block's assignments ``o := expr``, in order (the determined outputs only)."""
+    """The block's assignments ``o := expr``, in order (the determined outputs only); a
+    filter on truth tables (``s.plan``) has none: :class:`LimitExceeded`."""
+    if s.plan is not None:
+        raise LimitExceeded(f"{s.functions.filter.file}: the filter is its chain of narrowings on truth tables "
+                            "(too large for equations: see synth filter solve); it has no equations")
     return tuple((o, filter_expression(text, f"equation {o}")) for o, text in s.chained.items())
 
 

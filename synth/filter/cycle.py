@@ -57,6 +57,7 @@ from synth.filter.model import FilterFunctions, functions
 
 TYPE_CHECKING = False
 if TYPE_CHECKING:
+    from synth.filter.local import Plan
     from synth.filter.solve import Synthesis
 
 __all__ = ["Algorithm", "Mode", "ACK", "Memory", "CycleResult", "Lanes", "FilterCycle", "Cover"]
@@ -187,15 +188,23 @@ class FilterCycle:
         self.mc0 = {o: tuple(i for i, on in zip(self.combined, row) if on) for o, row in zip(self.outputs, loop.mc0)}
         self.mc1 = {o: tuple(i for i, on in zip(self.combined, row) if on) for o, row in zip(self.outputs, loop.mc1)}
         self.equations: tuple[tuple[str, Cover], ...] = ()  # the block's assignments, in order
+        self.plan: "Plan | None" = None  # or the block's chain on truth tables
         self.care: Cover = ((),)
+        past: set[str] = set()  # the past values the plan reads
         if self.algorithm is Algorithm.ALGEBRAIC:
             s = solved if solved is not None else synthesis(m)
             if s.free:
                 o = next(iter(s.free))
                 raise InputError(f"the algebraic filter of {flt.file} is not functional: {o} is free "
                                  f"(solve reports the witness); add criteria or use --algorithm loop", None)
-            self.equations = tuple((o, _cover(e.cover(e.expr(x)))) for o, x in algebraic_equations(s))
-            self.care = _cover(e.cover(s.care))
+            if s.plan is not None:  # the chain on truth tables (synth.filter.local), as the block runs it
+                self.plan = s.plan
+                tables = (*(b.relation for b in s.plan.bags), *(g for _, g in s.plan.steps))
+                self.care = _cover(e.cover(s.care))
+                past = {n for u in tables for n in e.support(u) if is_pre(n)}
+            else:
+                self.equations = tuple((o, _cover(e.cover(e.expr(x)))) for o, x in algebraic_equations(s))
+                self.care = _cover(e.cover(s.care))
         else:
             for c in flt.combined:
                 if not c.has_priority:
@@ -206,7 +215,7 @@ class FilterCycle:
             (d.name, _cover(e.cover(e.expr(d.definition)))) for d in flt.observers if d.definition is not None)
         covers = [*self.constraint.values(), *self.fs0.values(), *self.fs1.values(),
                   *(c for _, c in self.equations), self.care, *(c for _, c in self.defined)]
-        used = sorted({n for cover in covers for cube in cover for n, _ in cube if is_pre(n)})
+        used = sorted({n for cover in covers for cube in cover for n, _ in cube if is_pre(n)} | past)
         base = [*flt.inputs, *flt.observer_names, *self.outputs]
         base += [b for b in (base_name(n) for n in used) if b not in base]
         self.remembered: tuple[str, ...] = tuple(base)
@@ -275,7 +284,7 @@ class FilterCycle:
             outside = full ^ run.care(with_g1, full)[0]
             for o, fn in run.equations:  # in the block's order: each reads the outputs before it
                 with_g1[o] = fn(with_g1, full)[0]
-            outputs = tuple(with_g1[o] for o in self.outputs)
+            outputs = tuple(with_g1[o] for o in self.outputs) if self.plan is None else self._tables(with_g1, count)
         else:
             outputs, fallback = self._loop(values, g1, full, iterations, rounds)
         with_outputs = dict(values)
@@ -284,6 +293,18 @@ class FilterCycle:
         previous = tuple(with_outputs[n] for n in self.remembered)
         return Lanes(count, requests, outputs, tuple(iterations), tuple(rounds), fallback,
                      violated, unsafe, outside, blocked, previous, self.outputs)
+
+    def _tables(self, values: Mapping[str, int], count: int) -> tuple[int, ...]:
+        """The outputs of the block on truth tables (:func:`synth.filter.local.run`), lane by lane."""
+        from synth.filter.local import AtPoint, run
+
+        assert self.plan is not None
+        outs = [0] * len(self.outputs)
+        for j in range(count):
+            ones = run(self.plan, AtPoint(self.functions.engine, {n: bool(v >> j & 1) for n, v in values.items()})).ones
+            for k, o in enumerate(self.outputs):
+                outs[k] |= ones[o] << j
+        return tuple(outs)
 
     # ------------------------------------------------------------------ the loop
     def _loop(self, values: dict[str, int], g1: tuple[int, ...], full: int, iterations: list, rounds: list

@@ -39,7 +39,16 @@ from synth.filter.model import FilterFunctions
 from synth.logic.bdd import Function
 from synth.logic.partition import Partition, State
 
-__all__ = ["Narrowing", "monolithic", "partitioned", "layout", "decided"]
+__all__ = ["Narrowing", "ChainTooLarge", "monolithic", "partitioned", "layout", "decided"]
+
+
+class ChainTooLarge(Exception):
+    """The chain of narrowings passed its BDD work ``budget`` (:func:`partitioned`) at
+    criterion ``step`` (from 1) of ``steps``."""
+
+    def __init__(self, budget: int, step: int, steps: int) -> None:
+        super().__init__(f"more than {budget} BDD lookups at criterion {step} of {steps}")
+        self.budget, self.step, self.steps = budget, step, steps
 
 
 @dataclass(eq=False)
@@ -106,10 +115,13 @@ def _race_monolithic(i: int, goods: Sequence[Function], states: Sequence[Functio
     return True
 
 
-def partitioned(m: FilterFunctions, goods: Sequence[Function], order: Sequence[str] | None = None) -> Narrowing:
+def partitioned(m: FilterFunctions, goods: Sequence[Function], order: Sequence[str] | None = None,
+                budget: int | None = None) -> Narrowing:
     """The chain with each ``S_j`` a partition state, the same BDDs as :func:`monolithic`.
     The outputs are eliminated in ``order``, by default in the order the criteria name them
-    (so that a race moves along it), unless the BDDs' variable order gives smaller bags."""
+    (so that a race moves along it), unless the BDDs' variable order gives smaller bags.
+    ``budget``: :class:`ChainTooLarge` when the criteria's narrowings pass this BDD work
+    (CUDD's computed-table lookups, :meth:`~synth.logic.bdd.Engine.work`), checked after each."""
     e, outs = m.engine, m.outputs
     if not outs:
         return monolithic(m, goods)
@@ -119,7 +131,10 @@ def partitioned(m: FilterFunctions, goods: Sequence[Function], order: Sequence[s
     states: list[State] = [p.initial]
     bests: list[Function] = []
     drops: list[Function] = []
+    start = e.work()
     for g, k in zip(goods, where):
+        if budget is not None and e.work() - start > budget:
+            raise ChainTooLarge(budget, len(bests) + 1, len(goods))
         s = states[-1]
         best = p.project(s, k, g)
         bests.append(best)

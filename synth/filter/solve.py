@@ -32,11 +32,11 @@ from synth.errors import InputError, LimitExceeded
 from synth.logic.bdd import CoverTooLarge, Cube, Function, cube_text
 from synth.filter.language import Criterion, Filter, Safety, Sense, SimCriterion, request_name
 from synth.logic.past import pre_name
-from synth.filter import narrowing
+from synth.filter import local, narrowing
 from synth.filter.model import FilterFunctions, equation_functions, functions
 from synth.logic.expr import And, Const, Edge, Expr, Not, Or, Var
 
-__all__ = ["IMPLICIT", "FLAT_PROBE", "FLAT_LIMIT", "Applied", "Synthesis", "synthesis", "chained_equations", "criteria", "priority_criteria", "priority_criterion", "requested", "sim_expr",
+__all__ = ["IMPLICIT", "FLAT_PROBE", "FLAT_LIMIT", "CHAIN_WORK", "Applied", "Synthesis", "synthesis", "chained_equations", "criteria", "priority_criteria", "priority_criterion", "requested", "sim_expr",
            "differences", "printed"]
 
 
@@ -45,6 +45,11 @@ FLAT_PROBE = 64
 """Cubes: a Y-only (flat) equation is written only when its cover is this small, unless asked."""
 FLAT_LIMIT = 4096
 """Cubes: past this, a flat equation asked for (``solve --flat``) is refused (exit 2)."""
+CHAIN_WORK = 10_000_000
+"""BDD work (CUDD's lookups) of the symbolic chain of narrowings: past it, the filter is
+its chain run on truth tables (:mod:`synth.filter.local`), no equations (grid_edges 8 × 5:
+18 M; the grid of 64 and grid_edges 8 × 4 3.5–3.8 M, the ring of 32 2.8 M, the chain of 256
+0.9 M)."""
 
 
 def sim_expr(output: str) -> Expr:
@@ -125,11 +130,12 @@ def criteria(f: Filter, order: Sequence[str] | None = None) -> list[Criterion]:
 @dataclass(frozen=True)
 class Applied:
     """A criterion as applied: does it narrow the admissible set where it stands
-    (``narrows``), and would the final filter differ without it (``effect``)?"""
+    (``narrows``), and would the final filter differ without it (``effect``)? None: not
+    decided (the filter on tables: the chain is not run symbolically)."""
 
     criterion: Criterion
-    narrows: bool
-    effect: bool
+    narrows: bool | None
+    effect: bool | None
 
     @property
     def implicit(self) -> bool:
@@ -158,6 +164,7 @@ class Synthesis:
     inconsistent: Cube | None = None
     inconsistent_text: str = ""
     notes: list[str] = field(default_factory=list)
+    plan: local.Plan | None = None  # the filter on tables (past CHAIN_WORK): no equations
 
     @property
     def admissible(self) -> Function:
@@ -184,7 +191,7 @@ class Synthesis:
 
     @property
     def warnings(self) -> list[str]:
-        return [a.warning(i) for i, a in enumerate(self.applied, 1) if not a.effect and not a.implicit]
+        return [a.warning(i) for i, a in enumerate(self.applied, 1) if a.effect is False and not a.implicit]
 
     def output(self, o: str) -> Function:
         """The synthesised output ``o`` as a function of Y."""
@@ -195,19 +202,28 @@ class Synthesis:
 
 
 def synthesis(f: Filter | FilterFunctions, order: Sequence[str] | None = None, *, flat: bool = False,
-              applied: Sequence[Criterion] | None = None, partitioned: bool = True) -> Synthesis:
+              applied: Sequence[Criterion] | None = None, partitioned: bool = True,
+              chain_work: int | None = CHAIN_WORK) -> Synthesis:
     """Solve the filter's constraints with its criteria (the relational semantics of 004).
     ``flat``: write every Y-only equation (:class:`LimitExceeded` past FLAT_LIMIT cubes),
     not only those of at most FLAT_PROBE cubes. ``applied``: the criteria to apply instead
     of :func:`criteria` (a cluster's share of its whole filter's, :mod:`synth.filter.clusters`).
     ``partitioned``: keep each admissible set as a conjunction of factors, one BDD otherwise
-    (:mod:`synth.filter.narrowing`; the same result)."""
+    (:mod:`synth.filter.narrowing`; the same result). ``chain_work``: past this BDD work the
+    partitioned chain stops and the filter is its chain on truth tables (:mod:`synth.filter.local`),
+    unless ``flat`` asks for the equations."""
     m = f if isinstance(f, FilterFunctions) else functions(f)
     e = m.engine
     steps = [(c, e.expr(c.expr)) for c in (criteria(m.filter, order) if applied is None else applied)]
 
     goods = [u if c.sense is Sense.MAX else ~u for c, u in steps]  # Min(c) is Max(!c)
-    chain = (narrowing.partitioned if partitioned else narrowing.monolithic)(m, goods)
+    if not partitioned:
+        chain = narrowing.monolithic(m, goods)
+    else:
+        try:
+            chain = narrowing.partitioned(m, goods, budget=None if flat or not m.outputs else chain_work)
+        except narrowing.ChainTooLarge as big:
+            return _on_tables(m, steps, goods, big)
     verdicts = [Applied(c, narrows, effect) for (c, _), narrows, effect in zip(steps, chain.narrows, chain.effects)]
     result = Synthesis(m, chain, chain.care, verdicts)
     stated = any(isinstance(c, Criterion) for c in m.filter.criteria)
@@ -224,6 +240,37 @@ def synthesis(f: Filter | FilterFunctions, order: Sequence[str] | None = None, *
         result.inconsistent_text = e.text(stuck, stuck | ~m.assumed)
     printed(result, chain.ones, chain.zeros, flat)
     return result
+
+
+def _on_tables(m: FilterFunctions, steps: Sequence[tuple[Criterion, Function]], goods: Sequence[Function],
+               big: narrowing.ChainTooLarge) -> Synthesis:
+    """The filter as its chain of narrowings on truth tables (:mod:`synth.filter.local`): the
+    criteria in order, the care set ``∃O.S_0`` (the narrowings keep it), no equations, the
+    criteria's verdicts not decided. Functional by construction when every output has its
+    Sim criterion (it fixes that output at every Y); otherwise refused."""
+    e, file = m.engine, m.filter.file
+    why = f"the chain of narrowings passed {big.budget} BDD lookups at criterion {big.step} of {big.steps}"
+    sims = {c.origin.rpartition(" ")[2] for c, _ in steps if c.origin.split(" ")[-2:-1] == ["sim"]}
+    missing = [o for o in m.outputs if o not in sims]
+    if missing:
+        raise LimitExceeded(f"{file}: {why}, and {missing[0]} has no similarity criterion: the filter on "
+                            "truth tables needs one per output (maximize sim)")
+    p = narrowing.layout(m, goods)
+    plan = local.plan_of(m, p, goods)
+    care = p.project(p.initial, 0)
+    chain = narrowing.Narrowing([], [], care, {}, {}, lambda: _no_relation(file))
+    result = Synthesis(m, chain, care, [Applied(c, None, None) for c, _ in steps], plan=plan)
+    result.notes.append(f"{why}: the filter is its chain run on truth tables each cycle ({len(plan.bags)} bags, "
+                        f"{plan.entries} entries; filter st writes it); no equations, the criteria's effects not decided")
+    stuck = m.assumed & ~care
+    if stuck != e.false:
+        result.inconsistent = e.witness(stuck, m.assumed)
+        result.inconsistent_text = e.text(stuck, stuck | ~m.assumed)
+    return result
+
+
+def _no_relation(file: str) -> Function:
+    raise LimitExceeded(f"{file}: the filter is its chain on truth tables: its admissible set is not built")
 
 
 Text = Callable[[Function, Function, "int | None"], str]

@@ -63,6 +63,8 @@ def synthesis_text(s: Synthesis, flat: bool = False) -> str:
     """The chained equations (``flat``: the Y-only ones, in output order), then why the
     synthesis may have failed."""
     lines = [f"equation {o} = {t}" for o, t in (s.equations if flat else s.chained).items()]
+    if s.plan is not None:  # too large for equations: the chain the block runs on truth tables
+        lines = [f"criterion {i}: {a.text()}" for i, a in enumerate(s.applied, 1)]
     for o, cube in s.free.items():
         lines.append(f"not functional: {o} is free when {cube_text(cube)}")
     if s.inconsistent is not None:
@@ -73,6 +75,8 @@ def synthesis_text(s: Synthesis, flat: bool = False) -> str:
 
 
 def synthesis_json(file: str, s: Synthesis) -> dict[str, Any]:
+    form = {} if s.plan is None else {"form": {"kind": "tables", "bags": len(s.plan.bags), "width": s.plan.width,
+                                               "entries": s.plan.entries}}
     return {
         "file": file,
         "functional": s.functional,
@@ -90,6 +94,7 @@ def synthesis_json(file: str, s: Synthesis) -> dict[str, Any]:
         "inconsistent": None if s.inconsistent is None else {
             "counterexample": {n: int(v) for n, v in s.inconsistent.items()},
             "expression": s.inconsistent_text},
+        **form,
     }
 
 

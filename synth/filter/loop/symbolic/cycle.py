@@ -36,7 +36,7 @@ from typing import Callable, Iterable, Mapping
 
 import numpy as np
 
-from synth.errors import InputError
+from synth.errors import InputError, LimitExceeded
 from synth.filter.cycle import Algorithm, Cover, FilterCycle, Mode
 from synth.filter.language import Filter
 from synth.logic.bdd import Function
@@ -105,6 +105,9 @@ class SymbolicCycle:
         check_filter(f, p, rs.path)
         self.plant, self.rules, self.atomic = p, rs, atomic
         self.cycle = cyc = FilterCycle(f, algorithm, mode)
+        if cyc.plan is not None:
+            raise LimitExceeded(f"{f.file}: the filter is its chain of narrowings on truth tables (too large for "
+                                "equations): filter verify runs it on the explicit engine only (--engine explicit)")
         self.enc = enc = PlantEncoding(_without_reads(p), constraints=rs.constraints)
         self.engine = e = enc.engine
         self.orders: tuple[str, ...] = p.outputs

@@ -1,0 +1,115 @@
+"""The filter on truth tables, past the symbolic chain's work limit (``synth.filter.solve``'s
+``CHAIN_WORK``, lowered here so that small filters take that form): what ``solve`` says, the
+block ``filter st`` writes (compiled by MATIEC's ``iec2c`` and gcc, cycle by cycle equal to
+the synthesis's functions and to ``synth.filter.local``'s model, past values included), and
+``filter run``'s refusal."""
+
+from __future__ import annotations
+
+import random
+import shutil
+import sys
+
+import pytest
+
+from conftest import ROOT
+from iec2c import CompiledProgram, find_iec2c
+from schemas import assert_valid
+from synth.codegen.filter_st import filter_block
+from synth.codegen.program import StProgram
+from synth.errors import LimitExceeded
+from synth.filter import local
+from synth.filter.block import algebraic_equations
+from synth.filter.cycle import Algorithm, FilterCycle
+from synth.filter.language_check import parse_filter
+from synth.filter.solve import CHAIN_WORK, synthesis
+from synth.logic.past import pre_name
+from synth.output.filter_text import synthesis_json, synthesis_text
+
+sys.path.insert(0, str(ROOT / "bench"))
+from filter_scale import grid_edges_filter, ring_filter  # noqa: E402
+
+NOTE = ("the chain of narrowings passed 1000 BDD lookups at criterion 3 of 38: the filter is its chain run on "
+        "truth tables each cycle (16 bags, 118 entries; filter st writes it); no equations, the criteria's effects "
+        "not decided")
+
+
+def _grid() -> tuple[object, object]:
+    f = parse_filter(grid_edges_filter(16), "grid_edges.filter")
+    return f, synthesis(f, chain_work=1000)
+
+
+def test_past_the_limit_solve_prints_the_criteria_and_says_why():
+    f, s = _grid()
+    assert s.plan is not None and s.plan.entries == 118
+    assert s.functional and s.consistent and s.notes == [NOTE] and s.warnings == []
+    text = synthesis_text(s).splitlines()
+    assert len(text) == 38
+    assert text[0] == "criterion 1: minimize R_o1_1 & R_o1_2 & !o1_1  (priority of H1_1)"
+    assert text[-1] == "criterion 38: maximize R_o8_2 & o8_2 | !R_o8_2 & !o8_2  (implicit sim o8_2)"
+    j = synthesis_json("grid_edges.filter", s)
+    assert j["form"] == {"kind": "tables", "bags": 16, "width": 3, "entries": 118}
+    assert j["equations"] == {} and j["chained"] == {"order": [], "equations": {}}
+    assert {(c["narrows"], c["effect"]) for c in j["criteria"]} == {(None, None)}
+    assert_valid("filter_solve", j)
+    assert synthesis(f, chain_work=CHAIN_WORK).plan is None  # below the limit: the equations, as before
+
+
+def test_past_the_limit_every_output_needs_its_sim():
+    f = parse_filter("outputs a, b\nsafety K: a & b keep a\nmaximize sim a\n", "partial.filter")
+    with pytest.raises(LimitExceeded, match="b has no similarity criterion"):
+        synthesis(f, chain_work=-1)
+
+
+def test_filter_run_evaluates_the_tables():
+    """``filter run`` (and the explicit closed loop) evaluate the block on tables: the same outputs as the
+    equations of the synthesis below the limit, cycle after cycle (past values included)."""
+    f, s = _grid()
+    tables, equations = FilterCycle(s, Algorithm.ALGEBRAIC), FilterCycle(f, Algorithm.ALGEBRAIC)
+    assert tables.plan is not None and equations.plan is None and tables.used == equations.used
+    rng = random.Random(16)
+    rows = [{n: rng.random() < 0.5 for n in tables.reads} for _ in range(200)]
+    mine, theirs = tables.initial(), equations.initial()
+    on = 0
+    for values in rows:
+        (a, mine), (b, theirs) = tables.step(mine, values), equations.step(theirs, values)
+        assert a == b
+        on += sum(a.outputs)
+    assert on == 516
+    with pytest.raises(LimitExceeded, match="it has no equations"):
+        algebraic_equations(s)
+
+
+@pytest.mark.slow  # 5-10 s a case: iec2c and gcc, then the model at each of 300 cycles
+@pytest.mark.skipif(find_iec2c() is None or shutil.which("gcc") is None, reason="MATIEC's iec2c (and gcc) are not on PATH")
+@pytest.mark.parametrize("case", ["grid_edges_16", "ring_4"])
+def test_the_compiled_tables_block_is_the_synthesis(case, tmp_path):
+    f = parse_filter(grid_edges_filter(16) if case == "grid_edges_16" else ring_filter(4), f"{case}.filter")
+    solved = synthesis(f)  # the equations: the oracle
+    s = synthesis(f, chain_work=-1)
+    assert solved.plan is None and s.plan is not None
+    block = filter_block(f, synthesis=s)
+    plc = CompiledProgram(StProgram(block.text, block.name, (), (block.pou,)), tmp_path, pou=block.name)
+    e, oracle, rng = s.functions.engine, solved.functions.engine, random.Random(case)
+    previous = {n: False for n in (*f.inputs, *f.outputs)}
+    seen = {"cycles": 0, "outside the care set": 0, "outputs on": 0}
+    try:
+        for _ in range(300):
+            values = {n: rng.random() < 0.5 for n in (*f.requests, *f.inputs)}
+            point = {**values, **{pre_name(n): v for n, v in previous.items()}}
+            plc.cycle(values)
+            got = {o: plc[o] for o in f.outputs}
+            model = local.run(s.plan, local.AtPoint(e, point))
+            assert got == model.ones
+            if oracle.value(solved.care, point):
+                assert got == {o: oracle.value(solved.outputs[o], point) for o in f.outputs}
+            else:
+                seen["outside the care set"] += 1
+                assert not any(got.values())
+            seen["cycles"] += 1
+            seen["outputs on"] += sum(got.values())
+            previous = {**{n: values[n] for n in f.inputs}, **got}
+    finally:
+        plc.close()
+    assert seen == {"grid_edges_16": {"cycles": 300, "outside the care set": 0, "outputs on": 781},
+                    "ring_4": {"cycles": 300, "outside the care set": 0, "outputs on": 296}}[case]
