@@ -262,26 +262,61 @@ class _Chain:
     def differ(self, n: int) -> list[str] | None:
         """The outputs alternative ``n`` drives differently (another ``∃O.(S∧o)`` or
         ``∃O.(S∧!o)``; every output when only the care set differs), None when the two
-        spellings give the same filter."""
+        spellings give the same filter.
+
+        Its chain runs from ``S_i`` on a :class:`~synth.logic.partition.Walk`, whose messages
+        are keyed by value: where one equals the file's chain's at the same step (the walk
+        of :attr:`_walked` computed them), the messages after it are that chain's too and are
+        not computed again. It stops where its domains are the chain's (it rejoined); at the
+        end, an output whose bag sees the same messages and domain as in the file's filter is
+        not projected (its functions are the file's)."""
         alternative = self.alternatives[n]
         if alternative is None:  # the criteria are the file's: the spelling changes none
             return None
         i, g = alternative
         base = self.base  # before the mark: the chain's messages are kept
-        mark = self.p.mark()
-        s, _ = self._step(self.states[i], self.p.position(g), g)
-        for j in range(i + 1, len(self.goods) + 1):
-            if s.domains == self.states[j].domains:  # the chain rejoined: the same filter from here
-                self.p.forget(mark)
+        final = self._walked
+        p, states, where, goods = self.p, self.states, self.where, self.goods
+        mark = p.mark()
+        try:
+            w = p.walk(states[i])
+            k = p.position(g)
+            w.refine(k, g.equiv(w.project(k, g)))
+            apart = {m for m in (k, where[i]) if w.domains[m] != states[i + 1].domains[m]}
+            for j in range(i + 1, len(goods)):
+                if not apart:  # the chain rejoined: the same filter from here
+                    return None
+                m = where[j]
+                w.refine(m, goods[j].equiv(w.project(m, goods[j])))
+                if w.domains[m] == states[j + 1].domains[m]:
+                    apart.discard(m)
+                else:
+                    apart.add(m)
+            if not apart:
                 return None
-            if j < len(self.goods):
-                s, _ = self._step(s, self.where[j], self.goods[j])
-        care, ones, zeros = self._outcome(s)
-        self.p.forget(mark)
-        differ = [o for o in self.m.outputs if ones[o] != base[1][o] or zeros[o] != base[2][o]]
+            same = [w.around(m) == there for m, there in enumerate(final)]
+            care = base[0] if same[0] else w.project(0)
+            differ = []
+            for o in self.m.outputs:
+                m = p.anchor_position(o)
+                if same[m]:
+                    continue
+                x = self.m.engine.var(o)
+                if w.project(m, x) != base[1][o] or w.project(m, ~x) != base[2][o]:
+                    differ.append(o)
+        finally:
+            p.forget(mark)
         if not differ and care == base[0]:
             return None
         return differ or list(self.m.outputs)
+
+    @functools.cached_property
+    def _walked(self) -> list[tuple[Function, Function, Function]]:
+        """The file's chain run once more on a :class:`~synth.logic.partition.Walk`, so that
+        its messages at every step are kept by value (the alternatives of :meth:`differ`
+        meet them); what each bag's local relation is made of at its end."""
+        w = self.p.walk(self.states[len(self.goods)])
+        return [w.around(m) for m in range(len(w.domains))]
 
 
 class _TooWide(Exception):
