@@ -203,8 +203,10 @@ class _Chain:
         shown: dict[int, dict[str, bool]] = {}
 
         def run(point: dict[str, bool]) -> int:
-            here = AtPoint(at, point)
-            found = [n for n in todo if n not in shown and self._differ_at(here, n)]
+            # outside its region an alternative leaves S_i as the file's criterion does: no chain needed
+            asked = [n for n in todo if n not in shown and at.holds(self._region(n), point)]
+            here = AtPoint(at, point) if asked else None
+            found = [n for n in asked if here is not None and self._differ_at(here, n)]
             shown.update((n, point) for n in found)
             return len(found)
 
@@ -236,8 +238,10 @@ class _Chain:
         outputs it drives differently at the point left."""
         point = dict(point)
 
+        region = self._region(n)
+
         def differs() -> list[str]:
-            return self._differ_at(AtPoint(at, point), n)
+            return self._differ_at(AtPoint(at, point), n) if at.holds(region, point) else []
 
         groups = [[v for v in at.others if point[v]]]  # a stack, not a recursive closure (no cycle to collect)
         while groups:
