@@ -78,14 +78,14 @@ def other_spellings(f: Filter) -> list[Spelling]:
 
 
 SPELLING_SIZE = 125_000_000
-"""How much comparing on every input ``filter check`` does, once the first relief is compared,
-for the reliefs no sparse point showed different, in :meth:`SpellingChain.size` (nodes × variables),
-a measure of the filter and its chain, not of the comparison's own work: a faster comparison
-compares the same reliefs. Every bundled filter and bench case up to grid_edges 8 × 3, the ring
-of 16 and the chain of 256 stays under it (grid_edges 8 × 3: 0.8·10^8, the chain of 256:
-0.3·10^8); it stops the ring of 32 after K19 (1.31·10^8 with it) and grid_edges 8 × 4 after
-V3_2 (1.44·10^8 with V3_3), where the lookups of CUDD's computed table, the limit before
-(10^7 of them), stopped them too."""
+"""How much ``filter check`` compares on every input, once the first relief is compared, of the
+reliefs no sparse point showed different: the sum of their :meth:`SpellingChain.size` (BDD
+nodes × variables), a measure of the filter and its chain, not of the work the comparison
+does, so that a faster comparison compares the same reliefs. The bundled filters, the chain
+of 256 outputs, the ring of 16 and grid_edges 8 × 3 are compared in full (3.0·10^7, 5.1·10^7
+and 7.9·10^7 spent before their last relief); it stops the ring of 32 after K19 (1.31·10^8 with it) and grid_edges
+8 × 4 after V3_2 (1.44·10^8 with it), where 10^7 lookups of CUDD's computed table, the limit
+before, stopped them too."""
 
 REGION_WORK = 10_000_000
 """The BDD work ``filter check`` spends on running the chain of narrowings up to the last
