@@ -256,19 +256,18 @@ class Partition:
     # ---- messages keyed by their values (:class:`Walk`)
     def forward_value(self, k: int, before: Function, domain: Function) -> Function:
         """``F_k`` from ``F_{k-1}`` (``before``) and bag ``k``'s ``domain``, kept by these values."""
-        key = (k, before, domain)
-        found = self._fvalues.get(key)
-        if found is None:
-            found = self._fvalues[key] = self.engine.and_exists(before, self._block_of(k, domain), self._fwd_vars[k])
-            self.steps += 1
-        return found
+        return self._message(self._fvalues, self._fwd_vars[k], k, before, domain)
 
     def backward_value(self, k: int, after: Function, domain: Function) -> Function:
         """``B_k`` from ``B_{k+1}`` (``after``) and bag ``k``'s ``domain``, kept by these values."""
-        key = (k, after, domain)
-        found = self._bvalues.get(key)
+        return self._message(self._bvalues, self._bwd_vars[k], k, after, domain)
+
+    def _message(self, values: dict[tuple[int, Function, Function], Function], inner: list[str], k: int,
+                 other: Function, domain: Function) -> Function:
+        key = (k, other, domain)
+        found = values.get(key)
         if found is None:
-            found = self._bvalues[key] = self.engine.and_exists(after, self._block_of(k, domain), self._bwd_vars[k])
+            found = values[key] = self.engine.and_exists(other, self._block_of(k, domain), inner)
             self.steps += 1
         return found
 
