@@ -113,7 +113,7 @@ class SpellingChain:
         """:meth:`at_points` with the free variables 0, its regions on the chain's ``S_i``
         while running the chain that far costs at most ``work``; past it, on ``S_0``
         (:meth:`_initial_region`, :attr:`coarse`: the chain is not run, and
-        :func:`spelling_warnings` compares nothing on every input)."""
+        :func:`synth.filter.reliefs.spelling_warnings` compares nothing on every input)."""
         self.budget = self.m.engine.work() + work
         try:
             return self.at_points(candidates, points.POINT_DEFAULTS[:1], 0)
