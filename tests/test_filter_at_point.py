@@ -19,7 +19,8 @@ from synth.filter.at_point import AtPoint, Fixed
 from synth.filter.language_check import load_filter, parse_filter
 from synth.filter.model import functions
 from synth.filter.narrowing import layout
-from synth.filter.reliefs import _Chain, _other
+from synth.filter.reliefs import _other
+from synth.filter.spelling_chain import SpellingChain as _Chain
 from synth.filter.solve import criteria
 from synth.filter.language import Filter, Sense
 from synth.logic.bdd import Function
@@ -102,7 +103,7 @@ def test_the_spellings_at_points_as_on_single_bdds(case: str) -> None:
     at = points.Points(chain.p, chain.goods)
     regions = [chain._region(n) for n, a in enumerate(chain.alternatives) if a is not None]
     picked = [at.point(at.bdd.pick(r), d) for r in regions if r != at.engine.false for d in (False, True)]
-    compared = shown = 0
+    compared = shown = skipped = 0
     for point in _points(at, 6) + picked:
         here = AtPoint(at, point)
         for alternative in chain.alternatives:
@@ -111,9 +112,29 @@ def test_the_spellings_at_points_as_on_single_bdds(case: str) -> None:
             i, g = alternative
             mine = here.differ(i, g, chain.m.outputs)
             assert mine == _differ_on_single_bdds(at, point, i, g, chain.m.outputs)
+            if not at.holds(chain._region(chain.alternatives.index(alternative)), point):
+                assert mine == []  # outside its region: the points skip it (SpellingChain.at_points)
+                skipped += 1
             compared += 1
             shown += bool(mine)
-    assert compared > 0 and shown > 0
+    assert compared > 0 and shown > 0 and skipped > 0
+
+
+def test_a_region_is_read_at_a_point_as_its_restriction() -> None:
+    """``Points.holds`` (one path walked, complement edges counted) against dd's ``let``."""
+    f = parse_filter(ring_filter(4), "ring.filter")
+    at, _ = _setup(f)
+    rng = random.Random(7)
+    names = at.others
+    functions = [at.bdd.var(v) for v in names]
+    for _ in range(200):
+        u = functions[rng.randrange(len(functions))]
+        for _ in range(rng.randrange(1, 10)):
+            v = functions[rng.randrange(len(functions))]
+            u = (u & ~v) if rng.random() < 0.5 else (u | v)
+            u = ~u if rng.random() < 0.3 else u
+        point = {v: rng.random() < 0.5 for v in names}
+        assert at.holds(u, point) == (at.bdd.let(point, u) == at.bdd.true)
 
 
 def test_same_relation_whatever_the_outputs_kept_apart() -> None:

@@ -118,3 +118,39 @@ def test_partition_projects_as_the_whole_relation():
         for k, o in enumerate(outs):
             assert p.project(s, k, e.var(o)) == e.exists(outs, whole & e.var(o))
         assert p.project(s, 0) == e.exists(outs, whole)
+
+
+def test_a_walk_projects_as_the_states_over_the_same_domains():
+    """``Partition.walk``: messages keyed by value, shared with the states' and with other
+    walks wherever they agree; each projection the states' over the same domains, and the
+    walk's domains changed only by a narrowing that narrows."""
+    rng = random.Random(11)
+    names = ["y1", "a", "y2", "b", "c", "y3", "d", "e"]
+    e = Engine(names)
+    outs = ["a", "b", "c", "d", "e"]
+    shared = 0
+    for _ in range(30):
+        factors = []
+        for _ in range(rng.randint(2, 6)):
+            picked = rng.sample(names, rng.randint(1, 3))
+            factors.append(~e.conjunction([e.var(n) if rng.random() < 0.5 else ~e.var(n) for n in picked]))
+        p = Partition(e, outs, factors)
+        s = p.initial
+        for _ in range(3):  # the states' messages, by domains, for the walks to meet
+            k = rng.randrange(len(outs))
+            s = p.refine(s, k, e.var(outs[k]).equiv(e.var(rng.choice(["y1", "y2", "y3"]))))
+            p.project(s, k, e.var(outs[k]))
+        w, t = p.walk(s), s
+        for _ in range(6):
+            k = rng.randrange(len(outs))
+            u = e.var(outs[k]) | ~e.var(rng.choice(["y1", "y2", "y3"]))
+            before = p.steps
+            assert w.project(k, u) == p.project(t, k, u)
+            shared += p.steps == before
+            assert w.refine(k, u) == (p.refine(t, k, u) is not t)
+            t = p.refine(t, k, u)
+            assert tuple(w.domains) == t.domains
+            for j, o in enumerate(outs):
+                assert w.project(j, e.var(o)) == p.project(t, j, e.var(o))
+            assert w.project(0) == p.project(t, 0)
+    assert shared > 0

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from synth.cli.main import main
 from synth.filter.language_check import load_filter, parse_filter
-from synth.filter.reliefs import SPELLING_WORK, spelling_warnings
+from synth.filter.reliefs import SPELLING_SIZE, spelling_warnings
 
 from conftest import ROOT
 
@@ -120,7 +120,7 @@ def test_the_warnings_follow_their_definition_on_the_bench_families():
 
 
 def test_the_points_witnesses_hold_on_the_syntheses():
-    """The same reliefs warned as by definition (past a work limit of 1, some are listed
+    """The same reliefs warned as by definition (past a size limit of 1, some are listed
     instead); where a point shows the difference (the sparse points first, the others
     past the limit), the two syntheses evaluated there differ on exactly the outputs named."""
     witnessed = 0
@@ -128,10 +128,10 @@ def test_the_points_witnesses_hold_on_the_syntheses():
         f = parse_filter(text, f"f{n}.filter")
         base, others = _syntheses(f)
         definition = dict(_by_definition(f))
-        for limit in (SPELLING_WORK, 1):
+        for limit in (SPELLING_SIZE, 1):
             found = spelling_warnings(f, limit=limit)
             warned = [w.message.split("'")[0] for w in found.warnings]
-            if limit == SPELLING_WORK:
+            if limit == SPELLING_SIZE:
                 assert warned == list(definition) and not found.skipped, n
             assert set(warned) <= set(definition) <= set(warned) | {s.id for s in found.skipped}, n
             for w in found.warnings:
@@ -179,7 +179,7 @@ def test_past_the_work_limit_the_other_reliefs_are_listed_not_compared(capsys, m
     assert [s.id for s in found.skipped] == ["CSc2", "CSc3", "CSc4"]
     last = found.reports()[-1].render().splitlines()
     assert last[0].endswith(":46:34: warning: the keep/force spellings of 3 relief(s) (CSc2, CSc3, CSc4) were not "
-                            "compared: over the work limit of the comparison (1 BDD steps)")
+                            "compared: over the size limit of the comparison (1 BDD nodes × variables)")
     assert last[-1] == "  = note: `synth filter check --all-spellings` compares them all, whatever it costs"
     assert spelling_warnings(f, limit=None).skipped == ()
     assert main(["filter", "check", "--all-spellings", str(ROOT / "plants/four_cylinders.filter")]) in (0, 1)
@@ -187,7 +187,7 @@ def test_past_the_work_limit_the_other_reliefs_are_listed_not_compared(capsys, m
 
 
 def test_a_relief_a_point_shows_is_warned_past_the_limit():
-    """Points come before the work limit: on the four cylinders, two reliefs are shown at
+    """Points come before the size limit: on the four cylinders, two reliefs are shown at
     points and the other two compared on every input, one past a limit of 1."""
     found = spelling_warnings(load_filter(ROOT / "plants/four_cylinders.filter"), limit=1)
     assert [(w.message.split("'")[0], " when only " in w.message) for w in found.warnings] == [
@@ -206,3 +206,32 @@ def test_a_witness_gives_the_integer_observers_as_integers():
     base, others = _syntheses(f)
     ones = ["R_push", "ready", "R_lift"]  # the bits of cpt and cpt^-1 at 0
     assert (_at(base, ones)["push"], _at(others["BOTH"], ones)["push"]) == ((True, False), (False, True))
+
+
+def test_the_size_limit_is_read_on_the_filter(monkeypatch):
+    """``SPELLING_SIZE`` counts, per relief compared on every input, the nodes of the chain's
+    local relations from its criterion to the last times the variables its region reads:
+    numbers of the filter and its chain (pinned here), not of the work the comparison does.
+    Without points, the first relief is compared, then each while the sizes of those
+    compared so far stay under the limit."""
+    import dataclasses
+
+    from synth.filter import points
+    from synth.filter.reliefs import _other
+    from synth.filter.spelling_chain import SpellingChain
+
+    monkeypatch.setattr(points, "POINT_DEFAULTS", ())
+    monkeypatch.setattr(points, "POINT_ROUNDS", 0)
+    f = load_filter(ROOT / "plants/four_cylinders.filter")
+    swapped = [(s, dataclasses.replace(s, keep=o.keep, force=o.force)) for s in f.combined for o in (_other(s),)]
+    chain = SpellingChain(f, swapped)
+    sizes = [chain.size(n) for n in range(4)]
+    assert sizes == [83410, 81620, 83145, 68418]
+    assert sizes[0] == sum(len(chain.p.local(s, k)) for s, k in zip(chain.states, chain.where)) * 19
+    for limit, skipped in ((1, ["CSc2", "CSc3", "CSc4"]), (83409, ["CSc2", "CSc3", "CSc4"]),
+                           (83410, ["CSc3", "CSc4"]), (165029, ["CSc3", "CSc4"]), (165030, ["CSc4"]),
+                           (248175, [])):
+        found = spelling_warnings(f, limit=limit)
+        assert [s.id for s in found.skipped] == skipped, limit
+        assert [w.message.split("'")[0] for w in found.warnings] == ["CSc1", "CSc2", "CSc3", "CSc4"][:4 - len(skipped)]
+    assert [w.render() for w in found.reports()] == [w.render() for w in spelling_warnings(f, limit=None).reports()]

@@ -109,10 +109,10 @@ def cmd_check(args: argparse.Namespace) -> int:
         f = assumed(f, inv)
     show("coherence: P1-P4, GO, pair conditions, global consistency")
     c = check(f)
-    from synth.filter.reliefs import SPELLING_WORK, spelling_warnings
+    from synth.filter.reliefs import SPELLING_SIZE, spelling_warnings
 
     show("the keep/force spellings of the reliefs")
-    warnings = spelling_warnings(f, limit=None if args.all_spellings else SPELLING_WORK).reports()
+    warnings = spelling_warnings(f, limit=None if args.all_spellings else SPELLING_SIZE).reports()
     clear_progress(show)
     for w in warnings:
         print(w.render(), file=sys.stderr)

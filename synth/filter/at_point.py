@@ -29,7 +29,7 @@ Example
 
 from __future__ import annotations
 
-from typing import Any, Mapping, Sequence
+from typing import Any, Iterable, Mapping, Sequence
 
 from synth.filter.points import Points
 from synth.logic.bdd import Function
@@ -40,14 +40,16 @@ __all__ = ["Fixed", "AtPoint"]
 class Fixed:
     """A relation on the outputs at a point: ``⋀ fixed ∧ rest``, ``rest`` reading none of
     the outputs ``fixed`` (internal names) fixes; ``horizon``: the last step of the chain
-    that reads one of them (-1 for none)."""
+    that reads one of them (-1 for none); ``added``: the output this relation fixes that the
+    one it was narrowed from did not (its ``fixed`` is then a new dictionary), else None."""
 
-    __slots__ = ("fixed", "rest", "horizon")
+    __slots__ = ("fixed", "rest", "horizon", "added")
 
-    def __init__(self, fixed: dict[str, bool], rest: Function, horizon: int = -1) -> None:
+    def __init__(self, fixed: dict[str, bool], rest: Function, horizon: int = -1, added: str | None = None) -> None:
         self.fixed = fixed
         self.rest = rest
         self.horizon = horizon
+        self.added = added
 
     def relation(self, bdd: Any) -> Function:
         """The relation as one BDD."""
@@ -105,7 +107,7 @@ class AtPoint:
         return self.engine.and_exists(g, cube, [v for v, _ in values])
 
     def _fixing(self, s: Fixed, v: str, value: bool, rest: Function) -> Fixed:
-        return Fixed({**s.fixed, v: value}, rest, max(s.horizon, self._last[v]))
+        return Fixed({**s.fixed, v: value}, rest, max(s.horizon, self._last[v]), v)
 
     def narrow(self, s: Fixed, g: Function) -> tuple[Fixed, bool]:
         """``Max(g)`` on ``s`` (:func:`synth.filter.points.narrow`): ``s ∧ g`` where it is
@@ -139,14 +141,19 @@ class AtPoint:
     def same(self, a: Fixed, b: Fixed) -> bool:
         """Whether ``a`` and ``b`` are the same relation. Where one fixes an output the other
         does not, the other must force it to that value (its rest false at the other one)."""
-        false = self.bdd.false
         if a is b:
             return True
         if a.fixed == b.fixed:
             return bool(a.rest == b.rest)
+        return self._same_apart(a, b, a.fixed.items() ^ b.fixed.items())
+
+    def _same_apart(self, a: Fixed, b: Fixed, apart: Iterable[tuple[str, bool]]) -> bool:
+        """:meth:`same` given the outputs fixed by one and not the other or to other values,
+        ``apart`` (each with its value in the one that fixes it), ``a.fixed`` and ``b.fixed``
+        not equal."""
+        false = self.bdd.false
         if a.rest == false or b.rest == false:
             return a.rest == false and b.rest == false
-        apart = a.fixed.items() ^ b.fixed.items()
         rests = []
         for x, y in ((a, b), (b, a)):
             rest = y.rest
@@ -237,12 +244,25 @@ class AtPoint:
         if g == self.there[i]:  # the same criterion at the point: the chain itself
             return []
         z, _ = self.narrow(states[i], g)
+        # the outputs z and the chain fix apart, kept step by step: each narrowing fixes one at most
+        # (a shortcut only: a chain that rejoins gives the same relation at the end); where
+        # they fix outputs apart, asked at steps i+1, i+2, i+4, … only (each asking costs
+        # cofactors), where they fix the same ones, at every step (their rests compared)
+        apart: set[str] = set()
+        _moved(apart, z, states[i], states[i + 1], states[i])
+        ask = i + 1
         for j in range(i + 1, len(self.there)):
-            if self.same(z, states[j]):
+            s = states[j]
+            if z is s or (not apart and z.rest == s.rest):
                 return []
-            z, _ = self.narrow(z, self.there[j])
+            if apart and j == ask:
+                if self._same_apart(z, s, _items(apart, z, s)):
+                    return []
+                ask += ask - i
+            before, (z, _) = z, self.narrow(z, self.there[j])
+            _moved(apart, z, before, states[j + 1], s)
         last = states[-1]
-        if self.same(z, last):
+        if z is last or (self._same_apart(z, last, _items(apart, z, last)) if apart else z.rest == last.rest):
             return []
         out = []
         for o in outputs:
@@ -250,3 +270,20 @@ class AtPoint:
             if (self.can(z, v, True), self.can(z, v, False)) != (self.can(last, v, True), self.can(last, v, False)):
                 out.append(o)
         return out
+
+
+def _moved(apart: set[str], z: Fixed, z_before: Fixed, s: Fixed, s_before: Fixed) -> None:
+    """``apart`` (the outputs ``z_before`` and ``s_before`` fix apart) made those ``z`` and ``s``
+    fix apart, each narrowed from its ``_before`` (fixing one output more at most)."""
+    for x, before in ((z, z_before), (s, s_before)):
+        v = x.added if x.fixed is not before.fixed else None
+        if v is not None:
+            if z.fixed.get(v) != s.fixed.get(v):
+                apart.add(v)
+            else:
+                apart.discard(v)
+
+
+def _items(apart: set[str], a: Fixed, b: Fixed) -> list[tuple[str, bool]]:
+    """The fixed items of ``a`` and ``b`` on the outputs ``apart``: their symmetric difference."""
+    return [(v, x.fixed[v]) for v in sorted(apart) for x in (a, b) if v in x.fixed]

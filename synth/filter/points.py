@@ -109,6 +109,15 @@ class Points:
         self._last = (dict(point), tuple(there))
         return there
 
+    def holds(self, u: Function, point: Mapping[str, bool]) -> bool:
+        """Whether ``u`` (a function of :attr:`others`) is true at ``point``: its one path
+        there walked, no BDD operation."""
+        flips = u.negated  # dd's cofactors are the node's, its complement edges read on the way
+        while u.var is not None:
+            u = u.high if point[u.var] else u.low
+            flips ^= u.negated
+        return not flips  # the one terminal is true, reached through an even number of complements
+
     def random(self, region: Function, rng: random.Random) -> dict[str, bool]:
         """A random point in ``region`` (not false, a function of :attr:`others`)."""
         return random_point(self.bdd, region, self.others, rng)

@@ -34,7 +34,7 @@ from typing import Any, Iterable, Sequence
 
 from synth.logic.bdd import Engine, Function
 
-__all__ = ["Partition", "State"]
+__all__ = ["Partition", "State", "Walk"]
 
 
 class State:
@@ -92,6 +92,10 @@ class Partition:
         self._local: dict[tuple[int, int, int], Function] = {}
         self._blocks: dict[tuple[int, Function], Function] = {}
         self._where: dict[Function, int] = {}
+        self._fvalues: dict[tuple[int, Function, Function], Function] = {}  # (k, F_{k-1}, domain k) -> F_k
+        self._bvalues: dict[tuple[int, Function, Function], Function] = {}  # (k, B_{k+1}, domain k) -> B_k
+        self._lvalues: dict[tuple[int, Function, Function, Function], Function] = {}  # (k, F_{k-1}, domain, B_{k+1})
+        self._pvalues: dict[tuple[int, Function, Function | None], Function] = {}  # (k, local, g) -> ∃bag k.(local ∧ g)
         self.initial = State(tuple(engine.true for _ in range(n)), [None] * n, [None] * n)
         self.steps = 0
         """Messages computed so far (forward and backward), for benchmarks."""
@@ -175,8 +179,8 @@ class Partition:
             j -= 1
         msg = e.true if j < 0 else self._fwd[self._fkey(s, j)]
         for i in range(j + 1, k + 1):
-            msg = e.and_exists(msg, self._block(s, i), self._fwd_vars[i])
-            self._fwd[self._fkey(s, i)] = msg
+            before, msg = msg, e.and_exists(msg, self._block(s, i), self._fwd_vars[i])
+            self._fwd[self._fkey(s, i)] = self._fvalues[(i, before, s.domains[i])] = msg
             self.steps += 1
         return msg
 
@@ -189,17 +193,20 @@ class Partition:
             j += 1
         msg = e.true if j >= n else self._bwd[self._bkey(s, j)]
         for i in range(j - 1, k - 1, -1):
-            msg = e.and_exists(msg, self._block(s, i), self._bwd_vars[i])
-            self._bwd[self._bkey(s, i)] = msg
+            after, msg = msg, e.and_exists(msg, self._block(s, i), self._bwd_vars[i])
+            self._bwd[self._bkey(s, i)] = self._bvalues[(i, after, s.domains[i])] = msg
             self.steps += 1
         return msg
 
     def _block(self, s: State, k: int) -> Function:
         """Bag ``k``'s factors and domain."""
-        key = (k, s.domains[k])
+        return self._block_of(k, s.domains[k])
+
+    def _block_of(self, k: int, domain: Function) -> Function:
+        key = (k, domain)
         found = self._blocks.get(key)
         if found is None:
-            found = self._blocks[key] = self._base[k] & s.domains[k]
+            found = self._blocks[key] = self._base[k] & domain
         return found
 
     def local(self, s: State, k: int) -> Function:
@@ -208,8 +215,9 @@ class Partition:
         key = (self._fkey(s, k - 1), self._fkey(s, k), self._bkey(s, k + 1))
         found = self._local.get(key)
         if found is None:
-            found = (self.forward(s, k - 1) & self._block(s, k)) & self.backward(s, k + 1)
-            self._local[key] = found
+            before, after = self.forward(s, k - 1), self.backward(s, k + 1)
+            found = (before & self._block(s, k)) & after
+            self._local[key] = self._lvalues[(k, before, s.domains[k], after)] = found
         return found
 
     def project(self, s: State, k: int, g: Function | None = None) -> Function:
@@ -217,8 +225,11 @@ class Partition:
         (``∃anchors.s`` without ``g``)."""
         local = self.local(s, k)
         if g is None:
-            return self.engine.bdd.exist(self._bag_vars[k], local)
-        return self.engine.and_exists(local, g, self._bag_vars[k])
+            found = self.engine.bdd.exist(self._bag_vars[k], local)
+        else:
+            found = self.engine.and_exists(local, g, self._bag_vars[k])
+        self._pvalues[(k, local, g)] = found
+        return found
 
     def relation(self, s: State) -> Function:
         """The relation as one BDD (as large as it is)."""
@@ -236,4 +247,119 @@ class Partition:
                 cache.popitem()
 
     def _caches(self) -> tuple[dict[Any, Function], ...]:
-        return self._fwd, self._bwd, self._local, self._blocks
+        return self._fwd, self._bwd, self._local, self._blocks, self._fvalues, self._bvalues, self._lvalues, self._pvalues
+
+    def walk(self, s: State) -> Walk:
+        """A :class:`Walk` from ``s``."""
+        return Walk(self, s.domains)
+
+    # ---- messages keyed by their values (:class:`Walk`)
+    def forward_value(self, k: int, before: Function, domain: Function) -> Function:
+        """``F_k`` from ``F_{k-1}`` (``before``) and bag ``k``'s ``domain``, kept by these values."""
+        return self._message(self._fvalues, self._fwd_vars[k], k, before, domain)
+
+    def backward_value(self, k: int, after: Function, domain: Function) -> Function:
+        """``B_k`` from ``B_{k+1}`` (``after``) and bag ``k``'s ``domain``, kept by these values."""
+        return self._message(self._bvalues, self._bwd_vars[k], k, after, domain)
+
+    def _message(self, values: dict[tuple[int, Function, Function], Function], inner: list[str], k: int,
+                 other: Function, domain: Function) -> Function:
+        key = (k, other, domain)
+        found = values.get(key)
+        if found is None:
+            found = values[key] = self.engine.and_exists(other, self._block_of(k, domain), inner)
+            self.steps += 1
+        return found
+
+    def local_value(self, k: int, before: Function, domain: Function, after: Function) -> Function:
+        """Bag ``k``'s local relation (:meth:`local`) from its messages and domain, kept by these values."""
+        key = (k, before, domain, after)
+        found = self._lvalues.get(key)
+        if found is None:
+            found = self._lvalues[key] = (before & self._block_of(k, domain)) & after
+        return found
+
+    def project_local(self, k: int, local: Function, g: Function | None) -> Function:
+        """``∃bag k.(local ∧ g)`` (``∃bag k.local`` without ``g``), kept by these values."""
+        key = (k, local, g)
+        found = self._pvalues.get(key)
+        if found is None:
+            if g is None:
+                found = self.engine.bdd.exist(self._bag_vars[k], local)
+            else:
+                found = self.engine.and_exists(local, g, self._bag_vars[k])
+            self._pvalues[key] = found
+        return found
+
+
+class Walk:
+    """One value of a :class:`Partition`'s relation changed in place, a bag's domain at a
+    time (:meth:`refine`), as a chain of narrowings does; its messages are keyed by their
+    *values*: ``F_k`` by ``(F_{k-1}, domain k)``, ``B_k`` by ``(B_{k+1}, domain k)``. Where a
+    walk's message equals one computed before (by another walk, or by this one at an
+    earlier step), every message after it over the same domains is that one's too, and is
+    not computed again: a walk that differs from another at one bag recomputes the
+    messages its difference reaches, not every message past that bag (the keys of
+    :class:`State` are the domains, so such a state recomputes them all). The same
+    functions as :meth:`Partition.project` on the same domains, by other keys.
+
+    >>> from synth.logic.bdd import Engine
+    >>> e = Engine(["y", "a", "b", "c"])
+    >>> a, b, c, y = (e.var(n) for n in "abcy")
+    >>> p = Partition(e, ["a", "b", "c"], [~(a & b), ~(b & c)])
+    >>> w = p.walk(p.initial)
+    >>> w.refine(0, a.equiv(y)), e.text(w.project(1, b)), w.project(1, b) == p.project(p.refine(p.initial, 0, a.equiv(y)), 1, b)
+    (True, '!y', True)
+    """
+
+    __slots__ = ("p", "domains", "_f", "_b", "_fvalid", "_bvalid")
+
+    def __init__(self, p: Partition, domains: Sequence[Function]) -> None:
+        self.p = p
+        self.domains = list(domains)
+        n = len(self.domains)
+        self._f: list[Function] = [p.engine.true] * n  # F_k, valid for k <= _fvalid
+        self._b: list[Function] = [p.engine.true] * n  # B_k, valid for k >= _bvalid
+        self._fvalid, self._bvalid = -1, n
+
+    def refine(self, k: int, u: Function) -> bool:
+        """The relation ``∧ u`` (``u`` on the anchors of bag ``k`` and other variables); whether
+        it changed."""
+        old = self.domains[k]
+        new = old & u
+        if new == old:
+            return False
+        self.domains[k] = new
+        self._fvalid = min(self._fvalid, k - 1)
+        self._bvalid = max(self._bvalid, k + 1)
+        return True
+
+    def forward(self, k: int) -> Function:
+        """``F_k`` (true for k = -1)."""
+        if k < 0:
+            return self.p.engine.true
+        f, d = self._f, self.domains
+        for i in range(self._fvalid + 1, k + 1):
+            f[i] = self.p.forward_value(i, f[i - 1] if i else self.p.engine.true, d[i])
+        self._fvalid = max(self._fvalid, k)
+        return f[k]
+
+    def backward(self, k: int) -> Function:
+        """``B_k`` (true past the last bag)."""
+        n = len(self.domains)
+        if k >= n:
+            return self.p.engine.true
+        b, d = self._b, self.domains
+        for i in range(self._bvalid - 1, k - 1, -1):
+            b[i] = self.p.backward_value(i, b[i + 1] if i + 1 < n else self.p.engine.true, d[i])
+        self._bvalid = min(self._bvalid, k)
+        return b[k]
+
+    def around(self, k: int) -> tuple[Function, Function, Function]:
+        """``F_{k-1}``, bag ``k``'s domain and ``B_{k+1}``: what bag ``k``'s local relation is made of."""
+        return self.forward(k - 1), self.domains[k], self.backward(k + 1)
+
+    def project(self, k: int, g: Function | None = None) -> Function:
+        """:meth:`Partition.project` of this relation."""
+        before, domain, after = self.around(k)
+        return self.p.project_local(k, self.p.local_value(k, before, domain, after), g)
