@@ -16,7 +16,11 @@ NAMES = [f"x{i}" for i in range(10)]
 
 
 class PlainCovers(Covers):
-    """The textbook recursion: every split variable's three parts computed."""
+    """The textbook recursion: every split variable's three parts computed, each split
+    variable found among dd's support by its rank."""
+
+    def _first(self, u):  # type: ignore[no-untyped-def]
+        return None if u.var is None else min(self.bdd.support(u), key=self._ranks.__getitem__)
 
     def _isop(self, lower, upper, memo, limit, after=False):  # type: ignore[no-untyped-def]
         bdd = self.bdd

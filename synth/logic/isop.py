@@ -90,6 +90,11 @@ class Covers:
         self.native = type(source).__module__ == "dd.cudd"  # complemented edges, low and high of the regular node
         # CUDD's containment test u ≤ v in the cover's manager (no BDD built; None: dd's operations)
         self._leq: Callable[[Function, Function], bool] | None = None
+        # CUDD's support as indices (None: dd's support); a cover's manager's variables by index, their ranks
+        self._indices: Callable[[Function], list[int]] | None = None
+        self._by_index: list[str] = []
+        self._rank_of_index: list[int] = []
+        self._aligned = False  # the indices follow the text order: the first of a support is its smallest
         # the manager of the cover being computed: dd.autoref's, the engine's; CUDD's, one per cover (:meth:`_opened`)
         self.bdd = source
         self._firsts: dict[Function, str] = {}  # during one cover: no function outlives it
@@ -111,9 +116,13 @@ class Covers:
         # a small cache to start with (it grows with its hits)
         bdd = self.bdd = type(source)(memory_estimate=MEMORY, initial_cache_size=CACHE)
         bdd.configure(reordering=False, loose_up_to=LOOSE)
-        bdd.declare(*sorted(names, key=source.level_of_var))
+        self._by_index = sorted(names, key=source.level_of_var)
+        bdd.declare(*self._by_index)  # index i: the i-th of the support in the engine's order
+        self._rank_of_index = [self._ranks[v] for v in self._by_index]
+        self._aligned = all(a < b for a, b in zip(self._rank_of_index, self._rank_of_index[1:]))
         calls = native(bdd)
         self._leq = None if calls is None else calls.leq
+        self._indices = None if calls is None else calls.support_indices
         lower_here = source.copy(lower, bdd)
         return lower_here, lower_here if upper == lower else source.copy(upper, bdd)
 
@@ -126,6 +135,7 @@ class Covers:
             kept = self._covered(*self._opened(lower, lower if upper is None else upper), limit)
         finally:
             self._firsts.clear()
+            self._indices = None
             self.bdd, self._leq = self.source, None  # the cover's own manager goes with its last function
         if kept is None:
             raise CoverTooLarge(limit or 0)  # from a frame without the cover's BDDs
@@ -166,7 +176,13 @@ class Covers:
             return None
         first = self._firsts.get(u)
         if first is None:
-            first = self._firsts[u] = min(self.bdd.support(u), key=self._ranks.__getitem__)
+            if self._indices is None:
+                first = min(self.bdd.support(u), key=self._ranks.__getitem__)
+            else:  # CUDD's indices, ascending
+                indices = self._indices(u)
+                at = indices[0] if self._aligned else min(indices, key=self._rank_of_index.__getitem__)
+                first = self._by_index[at]
+            self._firsts[u] = first
         return first
 
     def _cofactors(self, u: Function, v: str) -> tuple[Function, Function]:

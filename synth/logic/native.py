@@ -1,7 +1,8 @@
-"""Direct calls into CUDD for the three things dd makes slow: the relational product
+"""Direct calls into CUDD for the four things dd makes slow: the relational product
 ``∃V. u ∧ v`` over a cube built once, the test ``u ≤ v`` (dd has none: ``u & ~v == false``
-builds the conjunction, ``let`` of a cube builds the cofactor), and the count of
-computed-table lookups.
+builds the conjunction, ``let`` of a cube builds the cofactor), the count of
+computed-table lookups, and the indices of a support (dd's ``support`` builds a set of
+names).
 
 dd's ``and_exists(u, v, names)`` builds the cube of ``names`` on every call by walking
 every variable the manager declares (a Python loop: 10 µs at 400 variables, against 1 µs
@@ -24,6 +25,8 @@ Example
 >>> n is None or (n.product(u, v, b.cube({"x"})) == cudd.and_exists(u, v, ["x"]) and n.lookups() > 0)
 True
 >>> n is None or (n.leq(u, b.add_expr("y")), n.leq(b.add_expr("y"), u)) == (True, False)
+True
+>>> n is None or (n.support_indices(b.add_expr("z & y")), n.support_indices(b.true)) == ([1, 2], [])
 True
 """
 
@@ -55,6 +58,12 @@ class Native:
         self._leq.restype = ctypes.c_int
         self._leq.argtypes = [ctypes.c_void_p] * 3
         self._fallback = module.and_exists
+        self._indices = library.Cudd_SupportIndices
+        self._indices.restype = ctypes.c_int
+        self._indices.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.POINTER(ctypes.POINTER(ctypes.c_int))]
+        self._array = ctypes.POINTER(ctypes.c_int)()
+        self._array_ref = ctypes.byref(self._array)
+        self._free = _free()
 
     def product(self, u: Function, v: Function, cube: Function) -> Function:
         """``∃cube. u ∧ v`` in one pass (``cube``: a positive cube of the manager)."""
@@ -67,6 +76,19 @@ class Native:
         """``u ≤ v`` (``u`` implies ``v``): CUDD's containment test, which builds no BDD and
         stops at the first point of ``u`` outside ``v``."""
         return bool(self._leq(self.manager, int(u) - 2, int(v) - 2))
+
+    def support_indices(self, u: Function) -> list[int]:
+        """The CUDD indices of the variables ``u`` depends on, ascending (CUDD sorts them, in
+        an array of its own, freed here): dd's ``support`` names them in a set, 30–60 µs
+        for 128 variables."""
+        n = self._indices(self.manager, int(u) - 2, self._array_ref)
+        if n < 0:
+            raise MemoryError("CUDD could not list a support")
+        if n == 0:  # CUDD allocated nothing
+            return []
+        indices = self._array[:n]
+        self._free(self._array)
+        return indices
 
     def lookups(self) -> int:
         """The manager's computed-table lookups so far."""
@@ -86,6 +108,17 @@ def native(bdd: Any) -> Native | None:
         return Native(bdd, int(fields[3] or 0), _library(module.__file__), module)
     except (AttributeError, ImportError, OSError, TypeError, ValueError):
         return None
+
+
+@lru_cache(maxsize=None)
+def _free() -> Any:
+    """The C library's ``free``, which releases the arrays CUDD allocates for its caller."""
+    import ctypes
+
+    free = ctypes.CDLL(None).free
+    free.argtypes = [ctypes.c_void_p]
+    free.restype = None
+    return free
 
 
 @lru_cache(maxsize=None)
