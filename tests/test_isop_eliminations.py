@@ -137,3 +137,36 @@ def test_one_pass_factoring_is_the_recursive_one(seed: int) -> None:
         terms = [sorted(rng.sample(lits, rng.randint(1, 6))) for _ in range(rng.randint(1, 12))]
         for top in (True, False):
             assert factored(terms, top) == _factored_recursive(terms, top)
+
+
+def _nested(rng: random.Random, lits: list, depth: int) -> list:
+    """Terms ``a & (b & (… | t3) | t2) | t1``, a chain of nested factors as on the chain of
+    outputs, each level with a few terms of its own."""
+    terms: list = []
+    prefix: list = []
+    pool = lits[:]
+    rng.shuffle(pool)
+    for level in range(depth):
+        if len(pool) < 3:
+            break
+        prefix.append(pool.pop())
+        for _ in range(rng.randint(1, 2)):
+            terms.append(sorted(set(prefix) | set(rng.sample(pool, rng.randint(1, min(2, len(pool)))))))
+    return terms
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_one_pass_factoring_on_larger_and_nested_covers(seed: int) -> None:
+    """Wider covers (up to 40 terms over 80 literals) and nested chains of factors: the
+    counts split between the two sides of a literal, either side counted afresh."""
+    from synth.logic.factoring import factored
+
+    rng = random.Random(100 + seed)
+    for _ in range(60):
+        n = rng.randint(1, 40)
+        lits = [(k, ("!" if k % 2 else "") + f"x{k // 2}") for k in range(2 * n)]
+        terms = [sorted(rng.sample(lits, rng.randint(1, min(len(lits), 10)))) for _ in range(rng.randint(1, 40))]
+        nested = _nested(rng, lits, rng.randint(1, 30))
+        for case in (terms, nested, terms + nested):
+            for top in (True, False):
+                assert factored(case, top) == _factored_recursive(case, top)
