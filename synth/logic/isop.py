@@ -94,7 +94,7 @@ class Covers:
         self._indices: Callable[[Function], list[int]] | None = None
         self._by_index: list[str] = []
         self._rank_of_index: list[int] = []
-        self._aligned = False  # the indices follow the text order: the first of a support is its smallest
+        self._aligned = False  # a cover's manager's order is the text order: a function's first variable is its top one
         # the manager of the cover being computed: dd.autoref's, the engine's; CUDD's, one per cover (:meth:`_opened`)
         self.bdd = source
         self._firsts: dict[Function, str] = {}  # during one cover: no function outlives it
@@ -135,7 +135,7 @@ class Covers:
             kept = self._covered(*self._opened(lower, lower if upper is None else upper), limit)
         finally:
             self._firsts.clear()
-            self._indices = None
+            self._indices, self._aligned = None, False
             self.bdd, self._leq = self.source, None  # the cover's own manager goes with its last function
         if kept is None:
             raise CoverTooLarge(limit or 0)  # from a frame without the cover's BDDs
@@ -176,12 +176,12 @@ class Covers:
             return None
         first = self._firsts.get(u)
         if first is None:
-            if self._indices is None:
+            if self._aligned:  # the top variable: its level is its rank among the support's
+                first = u.var
+            elif self._indices is None:
                 first = min(self.bdd.support(u), key=self._ranks.__getitem__)
-            else:  # CUDD's indices, ascending
-                indices = self._indices(u)
-                at = indices[0] if self._aligned else min(indices, key=self._rank_of_index.__getitem__)
-                first = self._by_index[at]
+            else:  # CUDD's indices
+                first = self._by_index[min(self._indices(u), key=self._rank_of_index.__getitem__)]
             self._firsts[u] = first
         return first
 
