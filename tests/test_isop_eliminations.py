@@ -71,10 +71,12 @@ def _outcome(covers: Covers, lower, upper, limit):  # type: ignore[no-untyped-de
 def test_the_covers_are_the_plain_recursions(seed: int) -> None:
     """Random intervals whose don't-care part hides variables (``f`` on a care set that ties
     further variables to functions, as a chained equation's ``agree`` does), with a text
-    order unlike the variable order: the same cubes, the same probes refused."""
+    order unlike the variable order (one seed in four: the same order): the same cubes, the
+    same probes refused."""
     rng = random.Random(seed)
     order = NAMES[:]
-    rng.shuffle(order)
+    if seed % 4:  # else the text order: a function's first variable is its top one
+        rng.shuffle(order)
     e = Engine(order, text_order=NAMES)
     f = _random_function(e, rng, NAMES[:6], rng.randint(1, 6))
     care = e.true

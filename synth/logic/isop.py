@@ -28,7 +28,7 @@ from __future__ import annotations
 
 from typing import Any, Callable, Mapping
 
-from synth.logic.native import native
+from synth.logic.native import Native, native
 
 __all__ = ["Covers", "CoverTooLarge", "Cube", "expanded"]
 
@@ -92,6 +92,7 @@ class Covers:
         self._leq: Callable[[Function, Function], bool] | None = None
         # CUDD's support as indices (None: dd's support); a cover's manager's variables by index, their ranks
         self._indices: Callable[[Function], list[int]] | None = None
+        self._calls: Native | None = None  # a cover's manager's direct calls into CUDD
         self._by_index: list[str] = []
         self._rank_of_index: list[int] = []
         self._aligned = False  # a cover's manager's order is the text order: a function's first variable is its top one
@@ -123,6 +124,7 @@ class Covers:
         calls = native(bdd)
         self._leq = None if calls is None else calls.leq
         self._indices = None if calls is None else calls.support_indices
+        self._calls = calls
         lower_here = source.copy(lower, bdd)
         return lower_here, lower_here if upper == lower else source.copy(upper, bdd)
 
@@ -135,7 +137,7 @@ class Covers:
             kept = self._covered(*self._opened(lower, lower if upper is None else upper), limit)
         finally:
             self._firsts.clear()
-            self._indices, self._aligned = None, False
+            self._indices, self._aligned, self._calls = None, False, None
             self.bdd, self._leq = self.source, None  # the cover's own manager goes with its last function
         if kept is None:
             raise CoverTooLarge(limit or 0)  # from a frame without the cover's BDDs
@@ -190,6 +192,8 @@ class Covers:
         if self.native and u.var == v:
             low, high = u.low, u.high  # the regular node's children
             return (~low, ~high) if u.negated else (low, high)
+        if self._calls is not None:
+            return self._calls.cofactor(u, v, False), self._calls.cofactor(u, v, True)
         return self.bdd.let({v: False}, u), self.bdd.let({v: True}, u)
 
     def _eliminated(self, lower: Function, upper: Function) -> tuple[Function, Function]:
