@@ -28,6 +28,7 @@ from __future__ import annotations
 
 from typing import Any, Callable, Mapping
 
+from synth.logic.cover_bound import cubes_at_least, path_bound
 from synth.logic.native import Native, native
 
 __all__ = ["Covers", "CoverTooLarge", "Cube", "expanded"]
@@ -145,6 +146,8 @@ class Covers:
 
     def _covered(self, lower: Function, upper: Function, limit: int | None) -> list[Cube] | None:
         """:meth:`cover` in the cover's manager; None past ``limit``."""
+        if limit is not None and self._leq is not None and self._too_many(lower, upper, limit):
+            return None
         try:
             cubes, _ = self._isop(lower, upper, {}, limit)
         except CoverTooLarge:
@@ -168,6 +171,16 @@ class Covers:
                 kept.append(c)
                 before |= functions[i]
         return kept
+
+    def _too_many(self, lower: Function, upper: Function, limit: int) -> bool:
+        """Every cover of ``[lower, upper]`` has more than ``limit`` cubes, by the lower bounds of
+        :mod:`synth.logic.cover_bound`: along one path, then (where the manager's order is not
+        the text order, so that the recursion's cofactors are not its nodes' children and
+        cost more than the bound) on a few pairs of nodes."""
+        assert self._leq is not None
+        if path_bound(self.bdd, lower, upper, self._leq) > limit:
+            return True
+        return not self._aligned and cubes_at_least(self.bdd, lower, upper, self._leq, limit) > limit
 
     def _ordered(self, cube: Mapping[str, bool]) -> Cube:
         return dict(sorted(cube.items(), key=lambda kv: self._ranks[kv[0]]))
