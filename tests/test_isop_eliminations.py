@@ -172,3 +172,28 @@ def test_one_pass_factoring_on_larger_and_nested_covers(seed: int) -> None:
         for case in (terms, nested, terms + nested):
             for top in (True, False):
                 assert factored(case, top) == _factored_recursive(case, top)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_a_kept_manager_gives_the_covers_of_new_ones(seed: int) -> None:
+    """One :class:`Covers` asked for a sequence of intervals whose supports grow, shrink
+    and jump (its manager kept and extended, or replaced): each cover and each probe's
+    outcome is that of the plain recursion in a manager of its own."""
+    rng = random.Random(200 + seed)
+    order = NAMES[:]
+    if seed % 2:
+        rng.shuffle(order)
+    e = Engine(order, text_order=NAMES)
+    mine = Covers(e.bdd, e.inner_ranks().__getitem__)
+    for step in range(12):
+        width = rng.choice((4, 5, 7, 8, 10)) if step % 3 else 4 + step % 7
+        names = NAMES[:width] if rng.random() < 0.7 else rng.sample(NAMES, width)
+        f = _random_function(e, rng, names, rng.randint(1, 5))
+        care = _random_function(e, rng, names, rng.randint(2, 6)) if rng.random() < 0.5 else e.true
+        lower, upper = f & care, f | ~care
+        plain = PlainCovers(e.bdd, e.inner_ranks().__getitem__)
+        full = plain.cover(lower, upper)
+        assert mine.cover(lower, upper) == full
+        limit = rng.choice((0, 1, len(full) - 1, len(full)))
+        if limit >= 0:
+            assert _outcome(mine, lower, upper, limit) == _outcome(plain, lower, upper, limit)

@@ -43,6 +43,9 @@ LOOSE = 2 ** 18
 """Unique-table slots up to which a cover's manager grows its table instead of collecting its
 dead nodes (dd's default, 6.7·10^6, let the eliminations' intermediate BDDs pile up: 200 MiB
 and slower covers at 64 outputs)."""
+REUSE = 2
+"""A cover reuses the last cover's manager when it declares at most this many times the
+variables the cover needs (dd's substitutions and quantifications walk every declared one)."""
 Function = Any  # a dd Function
 
 
@@ -94,8 +97,11 @@ class Covers:
         # CUDD's support as indices (None: dd's support); a cover's manager's variables by index, their ranks
         self._indices: Callable[[Function], list[int]] | None = None
         self._calls: Native | None = None  # a cover's manager's direct calls into CUDD
-        self._by_index: list[str] = []
+        # the last cover's manager and its direct calls, kept for the next cover (:meth:`_manager`)
+        self._kept: tuple[Any, Native | None] | None = None
+        self._by_index: list[str] = []  # the kept manager's variables by index, their ranks, their indices
         self._rank_of_index: list[int] = []
+        self._declared: dict[str, int] = {}
         self._aligned = False  # a cover's manager's order is the text order: a function's first variable is its top one
         # the manager of the cover being computed: dd.autoref's, the engine's; CUDD's, one per cover (:meth:`_opened`)
         self.bdd = source
@@ -115,19 +121,45 @@ class Covers:
                 self._ranks[v] = self.rank(v)
         if not self.native:
             return lower, upper
-        # a small cache to start with (it grows with its hits)
-        bdd = self.bdd = type(source)(memory_estimate=MEMORY, initial_cache_size=CACHE)
-        bdd.configure(reordering=False, loose_up_to=LOOSE)
-        self._by_index = sorted(names, key=source.level_of_var)
-        bdd.declare(*self._by_index)  # index i: the i-th of the support in the engine's order
-        self._rank_of_index = [self._ranks[v] for v in self._by_index]
-        self._aligned = all(a < b for a, b in zip(self._rank_of_index, self._rank_of_index[1:]))
-        calls = native(bdd)
+        bdd, calls = self._manager(names)
+        ranks = [self._ranks[v] for v in sorted(names, key=source.level_of_var)]
+        self._aligned = all(a < b for a, b in zip(ranks, ranks[1:]))
+        self.bdd = bdd
         self._leq = None if calls is None else calls.leq
         self._indices = None if calls is None else calls.support_indices
         self._calls = calls
         lower_here = source.copy(lower, bdd)
         return lower_here, lower_here if upper == lower else source.copy(upper, bdd)
+
+    def _manager(self, names: set[str]) -> tuple[Any, Native | None]:
+        """A CUDD manager that declares ``names`` in the engine's order: the last cover's when
+        it declares them all, or all but some that come after every variable it declares
+        (declared then at its end), and declares at most twice as many as ``names``; else a
+        new one. Index ``i`` is the ``i``-th variable in the engine's order either way."""
+        source = self.source
+        if self._kept is not None:
+            new = sorted((v for v in names if v not in self._declared), key=source.level_of_var)
+            declared = self._by_index
+            if (len(declared) + len(new) <= REUSE * len(names)
+                    and (not new or not declared or source.level_of_var(new[0]) > source.level_of_var(declared[-1]))):
+                self._declare(new)
+                return self._kept
+        # a small cache to start with (it grows with its hits)
+        bdd = type(source)(memory_estimate=MEMORY, initial_cache_size=CACHE)
+        bdd.configure(reordering=False, loose_up_to=LOOSE)
+        self._kept = (bdd, native(bdd))
+        self._by_index, self._rank_of_index, self._declared = [], [], {}
+        self._declare(sorted(names, key=source.level_of_var))
+        return self._kept
+
+    def _declare(self, names: list[str]) -> None:
+        """Declare ``names`` (in the engine's order, after every variable declared) in the kept manager."""
+        assert self._kept is not None
+        self._kept[0].declare(*names)  # index i: the i-th variable in the engine's order
+        for v in names:
+            self._declared[v] = len(self._by_index)
+            self._by_index.append(v)
+            self._rank_of_index.append(self._ranks[v])
 
     def cover(self, lower: Function, upper: Function | None = None, limit: int | None = None) -> list[Cube]:
         """An irredundant cover of prime implicants of some function between ``lower`` and
@@ -139,7 +171,7 @@ class Covers:
         finally:
             self._firsts.clear()
             self._indices, self._aligned, self._calls = None, False, None
-            self.bdd, self._leq = self.source, None  # the cover's own manager goes with its last function
+            self.bdd, self._leq = self.source, None  # the manager stays (kept), its functions go
         if kept is None:
             raise CoverTooLarge(limit or 0)  # from a frame without the cover's BDDs
         return kept
