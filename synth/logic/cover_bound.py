@@ -122,7 +122,9 @@ class _Bound:
         best = 1
         for half_lower, half_upper, x, x_upper in options:
             side = self.at_least(x, x_upper, need, depth + 1)
-            best = max(best, side + self.at_least(half_lower, half_upper, need - side, depth + 1))
+            if side <= need:  # else enough already
+                side += self.at_least(half_lower, half_upper, need - side, depth + 1)
+            best = max(best, side)
             if best > need:
                 break
         self.known[key] = best

@@ -253,7 +253,7 @@ class Covers:
         bdd = self.bdd
         if lower == bdd.false or upper == bdd.true:
             return lower, upper
-        names = sorted(bdd.support(lower) | bdd.support(upper), key=self._ranks.__getitem__)
+        names = self._support_in_text_order(lower, upper)
         done, failed = 0, len(names) + 1  # the prefix taken; a longer one known to fail
         # ∀V.upper depends on no variable of V, so ∃V.lower ≤ ∀V.upper iff lower ≤ ∀V.upper: each
         # trial tests the given lower (∃V.lower, often larger, is built once, for the prefix taken)
@@ -267,6 +267,13 @@ class Covers:
         if done == 0 or upper == bdd.true:  # the cover of [lower, true] is that of [∃V.lower, true]
             return lower, upper
         return bdd.exist(names[:done], lower), upper
+
+    def _support_in_text_order(self, lower: Function, upper: Function) -> list[str]:
+        """The variables ``lower`` or ``upper`` depends on, in the text order."""
+        if self._indices is None:
+            return sorted(self.bdd.support(lower) | self.bdd.support(upper), key=self._ranks.__getitem__)
+        indices = set(self._indices(lower)).union(self._indices(upper))
+        return [self._by_index[i] for i in sorted(indices, key=self._rank_of_index.__getitem__)]
 
     def _below(self, lower: Function, upper: Function) -> bool:
         """``lower ≤ upper``: with CUDD its containment test, which builds nothing and stops at
