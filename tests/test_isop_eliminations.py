@@ -10,17 +10,20 @@ import random
 import pytest
 
 from synth.logic.bdd import Engine
-from synth.logic.isop import CoverTooLarge, Covers
+from synth.logic.isop import CoverTooLarge, Covers, expanded
 
 NAMES = [f"x{i}" for i in range(10)]
 
 
 class PlainCovers(Covers):
     """The textbook recursion: every split variable's three parts computed, each split
-    variable found among dd's support by its rank."""
+    variable found among dd's support by its rank, each cube expanded literal by literal."""
 
     def _first(self, u):  # type: ignore[no-untyped-def]
         return None if u.var is None else min(self.bdd.support(u), key=self._ranks.__getitem__)
+
+    def _prime(self, cube, upper):  # type: ignore[no-untyped-def]
+        return expanded(self.bdd, cube, upper)  # literal by literal, with dd's substitution
 
     def _isop(self, lower, upper, memo, limit, after=False):  # type: ignore[no-untyped-def]
         bdd = self.bdd
@@ -197,3 +200,29 @@ def test_a_kept_manager_gives_the_covers_of_new_ones(seed: int) -> None:
         limit = rng.choice((0, 1, len(full) - 1, len(full)))
         if limit >= 0:
             assert _outcome(mine, lower, upper, limit) == _outcome(plain, lower, upper, limit)
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_cudd_s_prime_is_the_expansion_in_the_order_of_the_levels(seed: int) -> None:
+    """Where a cover's manager orders its variables as the text order, a cube is made prime
+    by CUDD (:meth:`synth.logic.native.Native.prime`): the literals dropped are those
+    :func:`expanded` drops, trying them in that order."""
+    from synth.logic.native import native
+
+    rng = random.Random(300 + seed)
+    e = Engine(NAMES, text_order=NAMES)
+    calls = native(e.bdd)
+    if calls is None:
+        pytest.skip("CUDD's expansion")
+    inner = {n: e.var(n).var for n in NAMES}
+    dropped = 0
+    for _ in range(40):
+        upper = _random_function(e, rng, NAMES, rng.randint(1, 8))
+        point = {inner[n]: rng.random() < 0.5 for n in NAMES}
+        if (e.bdd.cube(point) & ~upper) != e.false:
+            continue
+        mine = calls.prime(e.bdd.cube(point), upper)
+        theirs = expanded(e.bdd, point, upper)
+        assert mine == e.bdd.cube(theirs)
+        dropped += len(theirs) < len(point)
+    assert dropped > 0

@@ -187,7 +187,7 @@ class Covers:
         if limit is not None and len(cubes) > limit:
             return None
         primes: list[Cube] = []
-        for c in (expanded(self.bdd, self._ordered(c), upper, self._leq) for c in cubes):
+        for c in (self._prime(self._ordered(c), upper) for c in cubes):
             if c not in primes:
                 primes.append(c)
         # drop, in order, each cube the others (the kept ones before it, all after it) cover
@@ -213,6 +213,16 @@ class Covers:
         if path_bound(self.bdd, lower, upper, self._leq) > limit:
             return True
         return not self._aligned and cubes_at_least(self.bdd, lower, upper, self._leq, limit) > limit
+
+    def _prime(self, cube: Cube, upper: Function) -> Cube:
+        """:func:`expanded`; where the manager's order is the text order, by CUDD's own
+        expansion (the same literals tried in the same order, in one call)."""
+        if self._aligned and self._calls is not None and self._indices is not None:
+            prime = self._calls.prime(self.bdd.cube(cube), upper)
+            if prime is not None:
+                kept = {self._by_index[i] for i in self._indices(prime)}
+                return {n: v for n, v in cube.items() if n in kept}
+        return expanded(self.bdd, cube, upper, self._leq)
 
     def _ordered(self, cube: Mapping[str, bool]) -> Cube:
         return dict(sorted(cube.items(), key=lambda kv: self._ranks[kv[0]]))

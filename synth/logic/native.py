@@ -1,8 +1,9 @@
 """Direct calls into CUDD for what dd makes slow: the relational product ``∃V. u ∧ v`` over
 a cube built once, the test ``u ≤ v`` (dd has none: ``u & ~v == false`` builds the
 conjunction, ``let`` of a cube builds the cofactor), the count of computed-table lookups,
-the indices of a support (dd's ``support`` builds a set of names) and the cofactor on one
-literal (dd's ``let`` first fills an array over every declared variable).
+the indices of a support (dd's ``support`` builds a set of names), the cofactor on one
+literal (dd's ``let`` first fills an array over every declared variable) and the expansion
+of a cube to a prime implicant.
 
 dd's ``and_exists(u, v, names)`` builds the cube of ``names`` on every call by walking
 every variable the manager declares (a Python loop: 10 µs at 400 variables, against 1 µs
@@ -29,6 +30,8 @@ True
 >>> n is None or (n.support_indices(b.add_expr("z & y")), n.support_indices(b.true)) == ([1, 2], [])
 True
 >>> n is None or (n.cofactor(v, "x", False), n.cofactor(v, "x", True)) == (b.true, b.add_expr("z"))
+True
+>>> n is None or n.prime(b.add_expr("x & y & z"), u | b.add_expr("z")) == b.add_expr("z")
 True
 """
 
@@ -64,6 +67,9 @@ class Native:
         self._cofactor.restype = ctypes.c_void_p
         self._cofactor.argtypes = [ctypes.c_void_p] * 3
         self._literals: dict[str, tuple[Function, Function]] = {}
+        self._prime = library.Cudd_bddMakePrime
+        self._prime.restype = ctypes.c_void_p
+        self._prime.argtypes = [ctypes.c_void_p] * 3
         self._indices = library.Cudd_SupportIndices
         self._indices.restype = ctypes.c_int
         self._indices.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.POINTER(ctypes.POINTER(ctypes.c_int))]
@@ -94,6 +100,13 @@ class Native:
         if not r:  # CUDD gave up (memory): dd's call reports it
             return self.bdd.let({name: value}, u)
         return self._wrapped(r)
+
+    def prime(self, cube: Function, u: Function) -> Function | None:
+        """CUDD's prime implicant of ``u`` from the implicant ``cube``: each of the cube's
+        literals, from its top variable down, dropped while the cube still implies ``u``
+        (None if CUDD gave up)."""
+        r = self._prime(self.manager, int(cube) - 2, int(u) - 2)
+        return self._wrapped(r) if r else None
 
     def support_indices(self, u: Function) -> list[int]:
         """The CUDD indices of the variables ``u`` depends on, ascending (CUDD sorts them, in
