@@ -226,3 +226,35 @@ def test_cudd_s_prime_is_the_expansion_in_the_order_of_the_levels(seed: int) -> 
         assert mine == e.bdd.cube(theirs)
         dropped += len(theirs) < len(point)
     assert dropped > 0
+
+
+def _cube_literals_before(cube: dict, order: dict) -> list:
+    """The literals of a cube as written before session 29 (every name marked done)."""
+    lits = []
+    done: set = set()
+    for n, v in cube.items():
+        if n in done:
+            continue
+        if n.endswith("^-1"):
+            now = n[:-3]
+            if now in cube and cube[now] != v:
+                done.update((n, now))
+                lits.append((order.get(now, 0), ("↓" if v else "↑") + now))
+                continue
+        elif n + "^-1" in cube and cube[n + "^-1"] != v:
+            continue
+        done.add(n)
+        lits.append((order.get(n, 0), n if v else "!" + n))
+    return sorted(lits)
+
+
+def test_a_cube_s_literals_and_edges_are_those_written_before() -> None:
+    from synth.logic.factoring import cube_literals
+
+    rng = random.Random(7)
+    names = [f"x{i}{'^-1' * k}" for i in range(5) for k in range(3)]
+    order = {n: i for i, n in enumerate(names) if not n.endswith("^-1")}
+    for _ in range(2000):
+        chosen = rng.sample(names, rng.randint(0, len(names)))
+        cube = {n: rng.random() < 0.5 for n in chosen}
+        assert cube_literals(cube, order) == _cube_literals_before(cube, order)

@@ -17,7 +17,7 @@ from __future__ import annotations
 from typing import Mapping, Sequence
 
 from synth.logic.isop import Cube
-from synth.logic.past import PRE_SUFFIX, pre_name
+from synth.logic.past import PRE_SUFFIX
 
 __all__ = ["cube_literals", "factored"]
 
@@ -26,19 +26,22 @@ _Lit = tuple[int, str]  # (sort key, text)
 
 def cube_literals(cube: Cube, order: Mapping[str, int]) -> list[_Lit]:
     lits: list[_Lit] = []
-    done: set[str] = set()
+    done: set[str] = set()  # the names an edge took
+    cut = len(PRE_SUFFIX)
     for n, v in cube.items():
-        if n in done:
+        if done and n in done:
             continue
         if n.endswith(PRE_SUFFIX):
-            now = n[: -len(PRE_SUFFIX)]
-            if now in cube and cube[now] != v:  # !x^-1 & x is ↑x, x^-1 & !x is ↓x
+            now = n[:-cut]
+            w = cube.get(now)
+            if w is not None and w != v:  # !x^-1 & x is ↑x, x^-1 & !x is ↓x
                 done.update((n, now))
                 lits.append((order.get(now, 0), ("↓" if v else "↑") + now))
                 continue
-        elif pre_name(n) in cube and cube[pre_name(n)] != v:
-            continue  # printed with its past value above
-        done.add(n)
+        else:
+            w = cube.get(n + PRE_SUFFIX)
+            if w is not None and w != v:
+                continue  # printed with its past value above
         lits.append((order.get(n, 0), n if v else "!" + n))
     return sorted(lits)
 
@@ -88,13 +91,14 @@ def _factored(terms: list[_Term], counts: dict[_Lit, int], removed: frozenset[_L
     term has them all), none left empty; ``counts``: their other literals' counts (consumed)."""
     heads: list[str] = []
     while True:
-        best = min(counts, key=lambda lit: (-counts[lit], lit)) if counts else None
-        if best is None or counts[best] < 2:
+        most = max(counts.values()) if counts else 0
+        if most < 2:
             out = " | ".join(" & ".join(lit[1] for lit in t if lit not in removed) for t, _ in terms)
             if not heads:
                 return out if top or len(terms) == 1 else f"({out})"
             heads.append(out)
             break
+        best = min(lit for lit, n in counts.items() if n == most)  # the first of those common to most terms
         inner = [t for t in terms if best in t[1]]
         rest = [t for t in terms if best not in t[1]]
         depth = len(removed) + 1  # the literals a term of inner has that are not left
