@@ -36,9 +36,11 @@ __all__ = ["Covers", "CoverTooLarge", "Cube", "expanded"]
 Cube = dict[str, bool]  # a name -> its value
 CACHE = 2 ** 14
 """A cover's manager's first computed-table slots (CUDD's default, 2^18, is 8 MiB more)."""
-MEMORY = 2 ** 28
+MEMORY = 2 ** 24
 """A cover's manager's memory target in bytes (past it, CUDD collects its dead nodes more
-eagerly; no limit): dd's default, 1 GiB, takes 1.3 ms to open a manager, 2^28 0.35 ms."""
+eagerly; no limit): CUDD sets aside a part of it when a manager opens, so that opening
+takes time with it: dd's default, 1 GiB, 1.3 ms; 2^28, 0.35–0.6 ms; 2^24, 0.09 ms (the
+chain of 256 opens 257 managers)."""
 LOOSE = 2 ** 18
 """Unique-table slots up to which a cover's manager grows its table instead of collecting its
 dead nodes (dd's default, 6.7·10^6, let the eliminations' intermediate BDDs pile up: 200 MiB
