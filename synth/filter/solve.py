@@ -269,7 +269,8 @@ def chained_equations(s: Synthesis, text: Text | None = None) -> dict[str, str]:
     agree = e.true  # the earlier outputs equal their functions
     for o in order:
         f = s.output(o)
-        mine = text(f & agree & s.care, f | ~agree | ~s.care, None)
+        known = agree & s.care  # where the earlier outputs are known and the filter is asked
+        mine = text(f & known, f | ~known, None)
         flat = s.equations.get(o)
         chained[o] = mine if flat is None or len(mine) < len(flat) else flat
         agree &= e.var(o).equiv(f)

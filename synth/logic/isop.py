@@ -26,6 +26,7 @@ Example
 
 from __future__ import annotations
 
+import ctypes
 from typing import Any, Callable, Mapping
 
 from synth.logic.cover_bound import cubes_at_least, path_bound
@@ -99,6 +100,10 @@ class Covers:
         # CUDD's support as indices (None: dd's support); a cover's manager's variables by index, their ranks
         self._indices: Callable[[Function], list[int]] | None = None
         self._calls: Native | None = None  # a cover's manager's direct calls into CUDD
+        # the engine's direct calls into CUDD, its variables by index and their indices
+        self._source_calls: Native | None = None
+        self._source_names: dict[int, str] = {}
+        self._source_index: dict[str, int] = {}
         # the last cover's manager and its direct calls, kept for the next cover (:meth:`_manager`)
         self._kept: tuple[Any, Native | None] | None = None
         self._by_index: list[str] = []  # the kept manager's variables by index, their ranks, their indices
@@ -117,7 +122,13 @@ class Covers:
         declared, whatever the function (a cube of all of them, in Python): the flat probes'
         small functions over 336 variables at 64 outputs spent more there than in CUDD."""
         source = self.source
-        names = source.support(lower) | source.support(upper)
+        if self.native and self._source_calls is None:
+            self._source_calls = native(source)
+        given = self._source_calls
+        if given is None:
+            names = source.support(lower) | source.support(upper)
+        else:  # the engine's indices named
+            names = {self._source_name(i) for i in set(given.support_indices(lower)).union(given.support_indices(upper))}
         for v in names:
             if v not in self._ranks:
                 self._ranks[v] = self.rank(v)
@@ -130,8 +141,24 @@ class Covers:
         self._leq = None if calls is None else calls.leq
         self._indices = None if calls is None else calls.support_indices
         self._calls = calls
-        lower_here = source.copy(lower, bdd)
-        return lower_here, lower_here if upper == lower else source.copy(upper, bdd)
+        if given is None or calls is None:
+            lower_here = source.copy(lower, bdd)
+            return lower_here, lower_here if upper == lower else source.copy(upper, bdd)
+        renaming = (ctypes.c_int * given.size())()  # the engine's index -> the cover manager's
+        for v in names:
+            renaming[self._source_index[v]] = self._declared[v]
+        lower_here = given.transfer(lower, calls, renaming)
+        return lower_here, lower_here if upper == lower else given.transfer(upper, calls, renaming)
+
+    def _source_name(self, index: int) -> str:
+        """The engine's variable of CUDD index ``index``."""
+        name = self._source_names.get(index)
+        if name is None:  # a variable declared since: name them all again
+            assert self._source_calls is not None
+            self._source_index = {v: self._source_calls.index(self.source.var(v)) for v in self.source.vars}
+            self._source_names = {i: v for v, i in self._source_index.items()}
+            name = self._source_names[index]
+        return name
 
     def _manager(self, names: set[str]) -> tuple[Any, Native | None]:
         """A CUDD manager that declares ``names`` in the engine's order: the last cover's when

@@ -2,8 +2,9 @@
 a cube built once, the test ``u ≤ v`` (dd has none: ``u & ~v == false`` builds the
 conjunction, ``let`` of a cube builds the cofactor), the count of computed-table lookups,
 the indices of a support (dd's ``support`` builds a set of names), the cofactor on one
-literal (dd's ``let`` first fills an array over every declared variable) and the expansion
-of a cube to a prime implicant.
+literal (dd's ``let`` first fills an array over every declared variable), the expansion
+of a cube to a prime implicant, and the transfer of a function to another manager (dd's
+``copy`` first lists its support by name).
 
 dd's ``and_exists(u, v, names)`` builds the cube of ``names`` on every call by walking
 every variable the manager declares (a Python loop: 10 µs at 400 variables, against 1 µs
@@ -67,6 +68,15 @@ class Native:
         self._cofactor.restype = ctypes.c_void_p
         self._cofactor.argtypes = [ctypes.c_void_p] * 3
         self._literals: dict[str, tuple[Function, Function]] = {}
+        self._transfer = library.Cudd_bddTransferRename  # dd's own addendum to CUDD
+        self._transfer.restype = ctypes.c_void_p
+        self._transfer.argtypes = [ctypes.c_void_p] * 4
+        self._read_index = library.Cudd_NodeReadIndex
+        self._read_index.restype = ctypes.c_uint
+        self._read_index.argtypes = [ctypes.c_void_p]
+        self._size = library.Cudd_ReadSize
+        self._size.restype = ctypes.c_int
+        self._size.argtypes = [ctypes.c_void_p]
         self._prime = library.Cudd_bddMakePrime
         self._prime.restype = ctypes.c_void_p
         self._prime.argtypes = [ctypes.c_void_p] * 3
@@ -82,7 +92,7 @@ class Native:
         r = self._product(self.manager, int(u) - 2, int(v) - 2, int(cube) - 2)
         if not r:  # CUDD gave up (memory): dd's call reports it
             return self._fallback(u, v, self.bdd.support(cube))
-        return self._wrapped(r)
+        return self.wrapped(r)
 
     def leq(self, u: Function, v: Function) -> bool:
         """``u ≤ v`` (``u`` implies ``v``): CUDD's containment test, which builds no BDD and
@@ -99,14 +109,14 @@ class Native:
         r = self._cofactor(self.manager, int(u) - 2, int(pair[value]) - 2)
         if not r:  # CUDD gave up (memory): dd's call reports it
             return self.bdd.let({name: value}, u)
-        return self._wrapped(r)
+        return self.wrapped(r)
 
     def prime(self, cube: Function, u: Function) -> Function | None:
         """CUDD's prime implicant of ``u`` from the implicant ``cube``: each of the cube's
         literals, from its top variable down, dropped while the cube still implies ``u``
         (None if CUDD gave up)."""
         r = self._prime(self.manager, int(cube) - 2, int(u) - 2)
-        return self._wrapped(r) if r else None
+        return self.wrapped(r) if r else None
 
     def support_indices(self, u: Function) -> list[int]:
         """The CUDD indices of the variables ``u`` depends on, ascending (CUDD sorts them, in
@@ -121,7 +131,24 @@ class Native:
         self._free(self._array)
         return indices
 
-    def _wrapped(self, r: int) -> Function:
+    def index(self, u: Function) -> int:
+        """The CUDD index of ``u``'s top variable (of a variable's own function: that variable's)."""
+        return int(self._read_index(int(u) - 2))
+
+    def size(self) -> int:
+        """The number of variables the manager declares (its indices are below it)."""
+        return int(self._size(self.manager))
+
+    def transfer(self, u: Function, target: Native, renaming: Any) -> Function:
+        """``u`` in the manager of ``target``, the variable of index ``i`` (of ``u``'s support)
+        renamed to index ``renaming[i]`` there (an array of C ints), as dd's ``copy`` does
+        after listing ``u``'s support by name."""
+        r = self._transfer(self.manager, target.manager, int(u) - 2, renaming)
+        if not r:  # CUDD gave up (memory): dd's call reports it
+            return self.bdd.copy(u, target.bdd)
+        return target.wrapped(r)
+
+    def wrapped(self, r: int) -> Function:
         """The dd function of the node CUDD returned at ``r`` (referenced)."""
         return self.bdd._add_int(r + 2)
 
