@@ -269,8 +269,7 @@ def chained_equations(s: Synthesis, text: Text | None = None) -> dict[str, str]:
     agree = e.true  # the earlier outputs equal their functions
     for o in order:
         f = s.output(o)
-        known = agree & s.care  # where the earlier outputs are known and the filter is asked
-        mine = text(f & known, f | ~known, None)
+        mine = text(f & agree & s.care, f | ~agree | ~s.care, None)
         flat = s.equations.get(o)
         chained[o] = mine if flat is None or len(mine) < len(flat) else flat
         agree &= e.var(o).equiv(f)
