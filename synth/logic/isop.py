@@ -298,14 +298,20 @@ class Covers:
         # trial tests the given lower (∃V.lower, often larger, is built once, for the prefix taken)
         while failed - done > 1 and upper != bdd.true:  # lower is not false, nor is ∃V.lower
             size = (done + failed) // 2
-            every = bdd.forall(names[done:size], upper)
+            every = self._quantified(names[done:size], upper, True)
             if self._below(lower, every):
                 upper, done = every, size
             else:
                 failed = size
         if done == 0 or upper == bdd.true:  # the cover of [lower, true] is that of [∃V.lower, true]
             return lower, upper
-        return bdd.exist(names[:done], lower), upper
+        return self._quantified(names[:done], lower, False), upper
+
+    def _quantified(self, names: list[str], u: Function, every: bool) -> Function:
+        """``∀`` (``every``) or ``∃`` of ``names`` in ``u``, by CUDD directly where it can."""
+        if self._calls is None:
+            return self.bdd.forall(names, u) if every else self.bdd.exist(names, u)
+        return self._calls.quantified(u, sorted(self._declared[v] for v in names), every)
 
     def _support_in_text_order(self, lower: Function, upper: Function) -> list[str]:
         """The variables ``lower`` or ``upper`` depends on, in the text order."""

@@ -34,6 +34,8 @@ True
 True
 >>> n is None or n.prime(b.add_expr("x & y & z"), u | b.add_expr("z")) == b.add_expr("z")
 True
+>>> n is None or (n.quantified(v, [0, 2], True), n.quantified(v, [0, 2], False)) == (b.false, b.true)
+True
 """
 
 from __future__ import annotations
@@ -77,6 +79,13 @@ class Native:
         self._size = library.Cudd_ReadSize
         self._size.restype = ctypes.c_int
         self._size.argtypes = [ctypes.c_void_p]
+        self._to_cube = library.Cudd_IndicesToCube
+        self._to_cube.restype = ctypes.c_void_p
+        self._to_cube.argtypes = [ctypes.c_void_p, ctypes.POINTER(ctypes.c_int), ctypes.c_int]
+        self._abstract = {False: library.Cudd_bddExistAbstract, True: library.Cudd_bddUnivAbstract}
+        for call in self._abstract.values():
+            call.restype = ctypes.c_void_p
+            call.argtypes = [ctypes.c_void_p] * 3
         self._prime = library.Cudd_bddMakePrime
         self._prime.restype = ctypes.c_void_p
         self._prime.argtypes = [ctypes.c_void_p] * 3
@@ -130,6 +139,22 @@ class Native:
         indices = self._array[:n]
         self._free(self._array)
         return indices
+
+    def quantified(self, u: Function, indices: list[int], every: bool) -> Function:
+        """``∀`` (``every``) or ``∃`` of the variables of CUDD indices ``indices`` (ascending,
+        in a manager whose indices are its levels) in ``u``: their cube built by CUDD from
+        the bottom up (dd's ``forall`` and ``exist`` fill an array over every declared
+        variable in Python first)."""
+        import ctypes
+
+        r = self._to_cube(self.manager, (ctypes.c_int * len(indices))(*indices), len(indices))
+        if not r:
+            raise MemoryError("CUDD could not build a cube")
+        cube = self.wrapped(r)  # referenced while the abstraction runs
+        r = self._abstract[every](self.manager, int(u) - 2, int(cube) - 2)
+        if not r:
+            raise MemoryError("CUDD could not quantify")
+        return self.wrapped(r)
 
     def index(self, u: Function) -> int:
         """The CUDD index of ``u``'s top variable (of a variable's own function: that variable's)."""
