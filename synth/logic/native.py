@@ -56,42 +56,21 @@ class Native:
 
         self.bdd = bdd
         self.manager = manager
-        self._product = library.Cudd_bddAndAbstract
-        self._product.restype = ctypes.c_void_p
-        self._product.argtypes = [ctypes.c_void_p] * 4
-        self._lookups = library.Cudd_ReadCacheLookUps
-        self._lookups.restype = ctypes.c_double
-        self._lookups.argtypes = [ctypes.c_void_p]
-        self._leq = library.Cudd_bddLeq
-        self._leq.restype = ctypes.c_int
-        self._leq.argtypes = [ctypes.c_void_p] * 3
+        ptr, c_int = ctypes.c_void_p, ctypes.c_int
+        self._product = _typed(library.Cudd_bddAndAbstract, ptr, ptr, ptr, ptr, ptr)
+        self._lookups = _typed(library.Cudd_ReadCacheLookUps, ctypes.c_double, ptr)
+        self._leq = _typed(library.Cudd_bddLeq, c_int, ptr, ptr, ptr)
         self._fallback = module.and_exists
-        self._cofactor = library.Cudd_Cofactor
-        self._cofactor.restype = ctypes.c_void_p
-        self._cofactor.argtypes = [ctypes.c_void_p] * 3
+        self._cofactor = _typed(library.Cudd_Cofactor, ptr, ptr, ptr, ptr)
         self._literals: dict[str, tuple[Function, Function]] = {}
-        self._transfer = library.Cudd_bddTransferRename  # dd's own addendum to CUDD
-        self._transfer.restype = ctypes.c_void_p
-        self._transfer.argtypes = [ctypes.c_void_p] * 4
-        self._read_index = library.Cudd_NodeReadIndex
-        self._read_index.restype = ctypes.c_uint
-        self._read_index.argtypes = [ctypes.c_void_p]
-        self._size = library.Cudd_ReadSize
-        self._size.restype = ctypes.c_int
-        self._size.argtypes = [ctypes.c_void_p]
-        self._to_cube = library.Cudd_IndicesToCube
-        self._to_cube.restype = ctypes.c_void_p
-        self._to_cube.argtypes = [ctypes.c_void_p, ctypes.POINTER(ctypes.c_int), ctypes.c_int]
-        self._abstract = {False: library.Cudd_bddExistAbstract, True: library.Cudd_bddUnivAbstract}
-        for call in self._abstract.values():
-            call.restype = ctypes.c_void_p
-            call.argtypes = [ctypes.c_void_p] * 3
-        self._prime = library.Cudd_bddMakePrime
-        self._prime.restype = ctypes.c_void_p
-        self._prime.argtypes = [ctypes.c_void_p] * 3
-        self._indices = library.Cudd_SupportIndices
-        self._indices.restype = ctypes.c_int
-        self._indices.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.POINTER(ctypes.POINTER(ctypes.c_int))]
+        self._transfer = _typed(library.Cudd_bddTransferRename, ptr, ptr, ptr, ptr, ptr)  # dd's own addendum to CUDD
+        self._read_index = _typed(library.Cudd_NodeReadIndex, ctypes.c_uint, ptr)
+        self._size = _typed(library.Cudd_ReadSize, c_int, ptr)
+        self._to_cube = _typed(library.Cudd_IndicesToCube, ptr, ptr, ctypes.POINTER(c_int), c_int)
+        self._abstract = {False: _typed(library.Cudd_bddExistAbstract, ptr, ptr, ptr, ptr),
+                          True: _typed(library.Cudd_bddUnivAbstract, ptr, ptr, ptr, ptr)}
+        self._prime = _typed(library.Cudd_bddMakePrime, ptr, ptr, ptr, ptr)
+        self._indices = _typed(library.Cudd_SupportIndices, c_int, ptr, ptr, ctypes.POINTER(ctypes.POINTER(c_int)))
         self._array = ctypes.POINTER(ctypes.c_int)()
         self._array_ref = ctypes.byref(self._array)
         self._free = _free()
@@ -195,6 +174,13 @@ def native(bdd: Any) -> Native | None:
         return Native(bdd, int(fields[3] or 0), _library(module.__file__), module)
     except (AttributeError, ImportError, OSError, TypeError, ValueError):
         return None
+
+
+def _typed(call: Any, restype: Any, *argtypes: Any) -> Any:
+    """The C function ``call`` with its result and argument types set."""
+    call.restype = restype
+    call.argtypes = list(argtypes)
+    return call
 
 
 @lru_cache(maxsize=None)
