@@ -4,15 +4,19 @@ cube then expanded to a prime implicant (literals dropped in text order) and the
 irredundant (each cube the others cover dropped, in order). A cover depends on the
 interval and the text order only, never on the manager's variable order.
 
-Each cover is computed in a manager of its own (:class:`Covers`) that declares the
-interval's support only, in the engine's variable order: a transfer there is linear (the
+Each cover is computed in a manager apart from the engine's (:class:`Covers`) that declares
+the interval's support (the last cover's manager when it declares that support, or can
+add it at its end, at most twice over), in the engine's variable order: a transfer there is linear (the
 text order would make the functions exponentially larger: a request first, each output's
 constraints last), the cofactors and conjunctions of the recursion run on a small unique
 table, away from the engine's millions of nodes, and dd's substitutions, quantifications
 and supports, whose cost grows with the variables declared, see a few dozen rather than all
 of the engine's. The recursion splits on the first variable, in the text order, that
-``lower`` or ``upper`` depends on, and remembers each function's first variable and each
-interval's cover (memoised on the pair of nodes).
+``lower`` or ``upper`` depends on (its top variable where the manager's order on the
+support is the text order), and remembers each function's first variable and each
+interval's cover (memoised on the pair of nodes). A probe (a cover asked for with at most
+N cubes) is refused first by the lower bounds of :mod:`synth.logic.cover_bound` where they
+exceed N.
 
 Example
 -------
@@ -135,7 +139,8 @@ class Covers:
         if not self.native:
             return lower, upper
         bdd, calls = self._manager(names)
-        ranks = [self._ranks[v] for v in sorted(names, key=source.level_of_var)]
+        # the cover's manager never reorders: its indices are its levels
+        ranks = [self._ranks[v] for v in sorted(names, key=self._declared.__getitem__)]
         self._aligned = all(a < b for a, b in zip(ranks, ranks[1:]))
         self.bdd = bdd
         self._leq = None if calls is None else calls.leq
