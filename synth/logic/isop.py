@@ -4,15 +4,19 @@ cube then expanded to a prime implicant (literals dropped in text order) and the
 irredundant (each cube the others cover dropped, in order). A cover depends on the
 interval and the text order only, never on the manager's variable order.
 
-Each cover is computed in a manager of its own (:class:`Covers`) that declares the
-interval's support only, in the engine's variable order: a transfer there is linear (the
+Each cover is computed in a manager apart from the engine's (:class:`Covers`) that declares
+the interval's support (the last cover's manager when it declares that support, or can
+add it at its end, at most twice over), in the engine's variable order: a transfer there is linear (the
 text order would make the functions exponentially larger: a request first, each output's
 constraints last), the cofactors and conjunctions of the recursion run on a small unique
 table, away from the engine's millions of nodes, and dd's substitutions, quantifications
 and supports, whose cost grows with the variables declared, see a few dozen rather than all
 of the engine's. The recursion splits on the first variable, in the text order, that
-``lower`` or ``upper`` depends on, and remembers each function's first variable and each
-interval's cover (memoised on the pair of nodes).
+``lower`` or ``upper`` depends on (its top variable where the manager's order on the
+support is the text order), and remembers each function's first variable and each
+interval's cover (memoised on the pair of nodes). A probe (a cover asked for with at most
+N cubes) is refused first by the lower bounds of :mod:`synth.logic.cover_bound` where they
+exceed N.
 
 Example
 -------
@@ -26,22 +30,29 @@ Example
 
 from __future__ import annotations
 
+import ctypes
 from typing import Any, Callable, Mapping
 
-from synth.logic.native import native
+from synth.logic.cover_bound import cubes_at_least, path_bound
+from synth.logic.native import Native, native
 
 __all__ = ["Covers", "CoverTooLarge", "Cube", "expanded"]
 
 Cube = dict[str, bool]  # a name -> its value
 CACHE = 2 ** 14
 """A cover's manager's first computed-table slots (CUDD's default, 2^18, is 8 MiB more)."""
-MEMORY = 2 ** 28
+MEMORY = 2 ** 24
 """A cover's manager's memory target in bytes (past it, CUDD collects its dead nodes more
-eagerly; no limit): dd's default, 1 GiB, takes 1.3 ms to open a manager, 2^28 0.35 ms."""
+eagerly; no limit): CUDD sets aside a part of it when a manager opens, so that opening
+takes time with it: dd's default, 1 GiB, 1.3 ms; 2^28, 0.35–0.6 ms; 2^24, 0.09 ms (the
+chain of 256 opens 257 managers)."""
 LOOSE = 2 ** 18
 """Unique-table slots up to which a cover's manager grows its table instead of collecting its
 dead nodes (dd's default, 6.7·10^6, let the eliminations' intermediate BDDs pile up: 200 MiB
 and slower covers at 64 outputs)."""
+REUSE = 2
+"""A cover reuses the last cover's manager when it declares at most this many times the
+variables the cover needs (dd's substitutions and quantifications walk every declared one)."""
 Function = Any  # a dd Function
 
 
@@ -90,6 +101,19 @@ class Covers:
         self.native = type(source).__module__ == "dd.cudd"  # complemented edges, low and high of the regular node
         # CUDD's containment test u ≤ v in the cover's manager (no BDD built; None: dd's operations)
         self._leq: Callable[[Function, Function], bool] | None = None
+        # CUDD's support as indices (None: dd's support); a cover's manager's variables by index, their ranks
+        self._indices: Callable[[Function], list[int]] | None = None
+        self._calls: Native | None = None  # a cover's manager's direct calls into CUDD
+        # the engine's direct calls into CUDD, its variables by index and their indices
+        self._source_calls: Native | None = None
+        self._source_names: dict[int, str] = {}
+        self._source_index: dict[str, int] = {}
+        # the last cover's manager and its direct calls, kept for the next cover (:meth:`_manager`)
+        self._kept: tuple[Any, Native | None] | None = None
+        self._by_index: list[str] = []  # the kept manager's variables by index, their ranks, their indices
+        self._rank_of_index: list[int] = []
+        self._declared: dict[str, int] = {}
+        self._aligned = False  # a cover's manager's order is the text order: a function's first variable is its top one
         # the manager of the cover being computed: dd.autoref's, the engine's; CUDD's, one per cover (:meth:`_opened`)
         self.bdd = source
         self._firsts: dict[Function, str] = {}  # during one cover: no function outlives it
@@ -102,20 +126,74 @@ class Covers:
         declared, whatever the function (a cube of all of them, in Python): the flat probes'
         small functions over 336 variables at 64 outputs spent more there than in CUDD."""
         source = self.source
-        names = source.support(lower) | source.support(upper)
+        if self.native and self._source_calls is None:
+            self._source_calls = native(source)
+        given = self._source_calls
+        if given is None:
+            names = source.support(lower) | source.support(upper)
+        else:  # the engine's indices named
+            names = {self._source_name(i) for i in set(given.support_indices(lower)).union(given.support_indices(upper))}
         for v in names:
             if v not in self._ranks:
                 self._ranks[v] = self.rank(v)
         if not self.native:
             return lower, upper
-        # a small cache to start with (it grows with its hits)
-        bdd = self.bdd = type(source)(memory_estimate=MEMORY, initial_cache_size=CACHE)
-        bdd.configure(reordering=False, loose_up_to=LOOSE)
-        bdd.declare(*sorted(names, key=source.level_of_var))
-        calls = native(bdd)
+        bdd, calls = self._manager(names)
+        # the cover's manager never reorders: its indices are its levels
+        ranks = [self._ranks[v] for v in sorted(names, key=self._declared.__getitem__)]
+        self._aligned = all(a < b for a, b in zip(ranks, ranks[1:]))
+        self.bdd = bdd
         self._leq = None if calls is None else calls.leq
-        lower_here = source.copy(lower, bdd)
-        return lower_here, lower_here if upper == lower else source.copy(upper, bdd)
+        self._indices = None if calls is None else calls.support_indices
+        self._calls = calls
+        if given is None or calls is None:
+            lower_here = source.copy(lower, bdd)
+            return lower_here, lower_here if upper == lower else source.copy(upper, bdd)
+        renaming = (ctypes.c_int * given.size())()  # the engine's index -> the cover manager's
+        for v in names:
+            renaming[self._source_index[v]] = self._declared[v]
+        lower_here = given.transfer(lower, calls, renaming)
+        return lower_here, lower_here if upper == lower else given.transfer(upper, calls, renaming)
+
+    def _source_name(self, index: int) -> str:
+        """The engine's variable of CUDD index ``index``."""
+        name = self._source_names.get(index)
+        if name is None:  # a variable declared since: name them all again
+            assert self._source_calls is not None
+            self._source_index = {v: self._source_calls.index(self.source.var(v)) for v in self.source.vars}
+            self._source_names = {i: v for v, i in self._source_index.items()}
+            name = self._source_names[index]
+        return name
+
+    def _manager(self, names: set[str]) -> tuple[Any, Native | None]:
+        """A CUDD manager that declares ``names`` in the engine's order: the last cover's when
+        it declares them all, or all but some that come after every variable it declares
+        (declared then at its end), and declares at most twice as many as ``names``; else a
+        new one. Index ``i`` is the ``i``-th variable in the engine's order either way."""
+        source = self.source
+        if self._kept is not None:
+            new = sorted((v for v in names if v not in self._declared), key=source.level_of_var)
+            declared = self._by_index
+            if (len(declared) + len(new) <= REUSE * len(names)
+                    and (not new or not declared or source.level_of_var(new[0]) > source.level_of_var(declared[-1]))):
+                self._declare(new)
+                return self._kept
+        # a small cache to start with (it grows with its hits)
+        bdd = type(source)(memory_estimate=MEMORY, initial_cache_size=CACHE)
+        bdd.configure(reordering=False, loose_up_to=LOOSE)
+        self._kept = (bdd, native(bdd))
+        self._by_index, self._rank_of_index, self._declared = [], [], {}
+        self._declare(sorted(names, key=source.level_of_var))
+        return self._kept
+
+    def _declare(self, names: list[str]) -> None:
+        """Declare ``names`` (in the engine's order, after every variable declared) in the kept manager."""
+        assert self._kept is not None
+        self._kept[0].declare(*names)  # index i: the i-th variable in the engine's order
+        for v in names:
+            self._declared[v] = len(self._by_index)
+            self._by_index.append(v)
+            self._rank_of_index.append(self._ranks[v])
 
     def cover(self, lower: Function, upper: Function | None = None, limit: int | None = None) -> list[Cube]:
         """An irredundant cover of prime implicants of some function between ``lower`` and
@@ -126,13 +204,16 @@ class Covers:
             kept = self._covered(*self._opened(lower, lower if upper is None else upper), limit)
         finally:
             self._firsts.clear()
-            self.bdd, self._leq = self.source, None  # the cover's own manager goes with its last function
+            self._indices, self._aligned, self._calls = None, False, None
+            self.bdd, self._leq = self.source, None  # the manager stays (kept), its functions go
         if kept is None:
             raise CoverTooLarge(limit or 0)  # from a frame without the cover's BDDs
         return kept
 
     def _covered(self, lower: Function, upper: Function, limit: int | None) -> list[Cube] | None:
         """:meth:`cover` in the cover's manager; None past ``limit``."""
+        if limit is not None and self._leq is not None and self._too_many(lower, upper, limit):
+            return None
         try:
             cubes, _ = self._isop(lower, upper, {}, limit)
         except CoverTooLarge:
@@ -140,7 +221,7 @@ class Covers:
         if limit is not None and len(cubes) > limit:
             return None
         primes: list[Cube] = []
-        for c in (expanded(self.bdd, self._ordered(c), upper, self._leq) for c in cubes):
+        for c in (self._prime(self._ordered(c), upper) for c in cubes):
             if c not in primes:
                 primes.append(c)
         # drop, in order, each cube the others (the kept ones before it, all after it) cover
@@ -157,6 +238,26 @@ class Covers:
                 before |= functions[i]
         return kept
 
+    def _too_many(self, lower: Function, upper: Function, limit: int) -> bool:
+        """Every cover of ``[lower, upper]`` has more than ``limit`` cubes, by the lower bounds of
+        :mod:`synth.logic.cover_bound`: along one path, then (where the manager's order is not
+        the text order, so that the recursion's cofactors are not its nodes' children and
+        cost more than the bound) on a few pairs of nodes."""
+        assert self._leq is not None
+        if path_bound(self.bdd, lower, upper, self._leq) > limit:
+            return True
+        return not self._aligned and cubes_at_least(self.bdd, lower, upper, self._leq, limit) > limit
+
+    def _prime(self, cube: Cube, upper: Function) -> Cube:
+        """:func:`expanded`; where the manager's order is the text order, by CUDD's own
+        expansion (the same literals tried in the same order, in one call)."""
+        if self._aligned and self._calls is not None and self._indices is not None:
+            prime = self._calls.prime(self.bdd.cube(cube), upper)
+            if prime is not None:
+                kept = {self._by_index[i] for i in self._indices(prime)}
+                return {n: v for n, v in cube.items() if n in kept}
+        return expanded(self.bdd, cube, upper, self._leq)
+
     def _ordered(self, cube: Mapping[str, bool]) -> Cube:
         return dict(sorted(cube.items(), key=lambda kv: self._ranks[kv[0]]))
 
@@ -166,7 +267,13 @@ class Covers:
             return None
         first = self._firsts.get(u)
         if first is None:
-            first = self._firsts[u] = min(self.bdd.support(u), key=self._ranks.__getitem__)
+            if self._aligned:  # the top variable: its level is its rank among the support's
+                first = u.var
+            elif self._indices is None:
+                first = min(self.bdd.support(u), key=self._ranks.__getitem__)
+            else:  # CUDD's indices
+                first = self._by_index[min(self._indices(u), key=self._rank_of_index.__getitem__)]
+            self._firsts[u] = first
         return first
 
     def _cofactors(self, u: Function, v: str) -> tuple[Function, Function]:
@@ -174,6 +281,8 @@ class Covers:
         if self.native and u.var == v:
             low, high = u.low, u.high  # the regular node's children
             return (~low, ~high) if u.negated else (low, high)
+        if self._calls is not None:
+            return self._calls.cofactor(u, v, False), self._calls.cofactor(u, v, True)
         return self.bdd.let({v: False}, u), self.bdd.let({v: True}, u)
 
     def _eliminated(self, lower: Function, upper: Function) -> tuple[Function, Function]:
@@ -188,20 +297,33 @@ class Covers:
         bdd = self.bdd
         if lower == bdd.false or upper == bdd.true:
             return lower, upper
-        names = sorted(bdd.support(lower) | bdd.support(upper), key=self._ranks.__getitem__)
+        names = self._support_in_text_order(lower, upper)
         done, failed = 0, len(names) + 1  # the prefix taken; a longer one known to fail
         # ∀V.upper depends on no variable of V, so ∃V.lower ≤ ∀V.upper iff lower ≤ ∀V.upper: each
         # trial tests the given lower (∃V.lower, often larger, is built once, for the prefix taken)
         while failed - done > 1 and upper != bdd.true:  # lower is not false, nor is ∃V.lower
             size = (done + failed) // 2
-            every = bdd.forall(names[done:size], upper)
+            every = self._quantified(names[done:size], upper, True)
             if self._below(lower, every):
                 upper, done = every, size
             else:
                 failed = size
         if done == 0 or upper == bdd.true:  # the cover of [lower, true] is that of [∃V.lower, true]
             return lower, upper
-        return bdd.exist(names[:done], lower), upper
+        return self._quantified(names[:done], lower, False), upper
+
+    def _quantified(self, names: list[str], u: Function, every: bool) -> Function:
+        """``∀`` (``every``) or ``∃`` of ``names`` in ``u``, by CUDD directly where it can."""
+        if self._calls is None:
+            return self.bdd.forall(names, u) if every else self.bdd.exist(names, u)
+        return self._calls.quantified(u, sorted(self._declared[v] for v in names), every)
+
+    def _support_in_text_order(self, lower: Function, upper: Function) -> list[str]:
+        """The variables ``lower`` or ``upper`` depends on, in the text order."""
+        if self._indices is None:
+            return sorted(self.bdd.support(lower) | self.bdd.support(upper), key=self._ranks.__getitem__)
+        indices = set(self._indices(lower)).union(self._indices(upper))
+        return [self._by_index[i] for i in sorted(indices, key=self._rank_of_index.__getitem__)]
 
     def _below(self, lower: Function, upper: Function) -> bool:
         """``lower ≤ upper``: with CUDD its containment test, which builds nothing and stops at
