@@ -1,8 +1,8 @@
 """The proof by execution: generated ST run by the interpreter equals ``synth run``, cycle by cycle.
 
 Bundled Grafcets are explored exhaustively (every input event and the next timer, to a
-bounded depth); 15 random Grafcets (1 025 more nightly) (``tests/randgrafcet.py``) likewise; deliberately broken
-generators (one emitted operator flipped) must be caught.
+bounded depth); 15 random Grafcets (``tests/randgrafcet.py``; 1 025 more nightly) likewise;
+deliberately broken generators (one emitted operator flipped) must be caught.
 """
 
 from __future__ import annotations
