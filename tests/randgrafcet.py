@@ -118,3 +118,55 @@ def check_seed(seed: int, depth: int = 3, data: bool = False, semantics: str = "
     g = parse_grafcet(random_grafcet(seed, data), f"random{seed}.g7", semantics=semantics)
     report = differential_check(g, depth=depth, program=generate_program(g, version="test", comments=False))
     return seed, report.sequences, report.cycles, "" if report.ok else report.text()
+
+
+def constructs(text: str) -> set[str]:
+    """The constructs of the generator found in one of its Grafcets (``random_grafcet``'s
+    text): what the differential's sample must cover.
+
+    >>> sorted(constructs("grafcet G1 {\\n  initial step 10: P, set M on ↑a\\n  step 11\\n"
+    ...                   "  transition 10 -> 11 when 1s/X10 . !b\\n  transition -> 11 when ↓c\\n}\\n"))
+    ['AND in a receptivity', 'a negation', 'a source transition', 'a stored action on an event', 'a timer in a receptivity', 'a timer of 1s', 'an OR convergence', 'an edge receptivity', 'continuous action']
+    """
+    import re
+
+    found: set[str] = set()
+    trans = [line.split("transition ", 1)[1] for line in text.splitlines() if line.startswith("  transition ")]
+    moves = [tuple(tuple(side.strip().split(", ")) if side.strip() else () for side in t.split(" when ")[0].split("->"))
+             for t in trans]
+    sources = [src for src, _ in moves if src]
+    targets = [dst for _, dst in moves if dst]
+    checks = {
+        "an AND divergence": any(len(dst) > 1 for _, dst in moves),
+        "an AND convergence": any(len(src) > 1 for src, _ in moves),
+        "an OR divergence": len(set(sources)) < len(sources),
+        "an OR convergence": len(set(targets)) < len(targets),
+        "a source transition": any(not src for src, _ in moves),
+        "a sink transition": any(not dst for _, dst in moves),
+        "partial grafcets": text.count("grafcet G") > 1,
+    }
+    found |= {name for name, held in checks.items() if held}
+    for t in trans:
+        rec = t.split(" when ", 1)[1]
+        found |= {name for name, pattern in (
+            ("an edge receptivity", "[↑↓][abc]"), ("a step variable in a receptivity", r"(^|[ !(])X\d"),
+            ("a timer in a receptivity", "/X"), ("a constant", r"(^|[ (])[01]($|[ )])"), ("a negation", "!"),
+            ("(a + b) . c", r"\("), ("OR in a receptivity", r" \+ "), ("AND in a receptivity", r" \. "),
+        ) if re.search(pattern, rec)}
+    found |= {f"a timer of {d}" for d in DURATIONS if re.search(rf"\b{d}/X", text)}
+    for line in text.splitlines():
+        if not re.match(r"  (initial )?step \d+: ", line):
+            continue
+        for action in line.split(": ", 1)[1].split(", "):
+            if action in ASSIGNED:
+                found.add("continuous action")
+            elif " if " in action:
+                found.add("a conditional action")
+                condition = action.split(" if ", 1)[1]
+                found |= {"a timer in a condition"} if "/X" in condition else set()
+                found |= {"a step variable in a condition"} if re.search(r"(^|[ !(])X\d", condition) else set()
+            elif action.startswith(("set ", "reset ")):
+                when = action.split(" on ", 1)[1] if " on " in action else ""
+                found.add({"": "a stored action while active", "activation": "a stored action on activation",
+                           "deactivation": "a stored action on deactivation"}.get(when, "a stored action on an event"))
+    return found

@@ -10,7 +10,7 @@ import shutil
 import pytest
 
 from iec2c import CompiledProgram, find_iec2c
-from st_blocks import interpreted
+from synth.codegen.filter_st import filter_block
 from synth.codegen.program import StProgram
 from synth.filter.cycle import Algorithm, FilterCycle, Mode
 from synth.filter.language_check import load_filter
@@ -26,7 +26,7 @@ def test_the_compiled_block_is_filter_run(name: str, algorithm: Algorithm, mode:
     if not _runnable(name, algorithm):
         pytest.skip("not functional / a combined constraint without priority: no block")
     f = load_filter(ROOT / "plants" / f"{name}.filter")
-    block, _ = interpreted(name, algorithm.value, mode.value)
+    block = filter_block(f, algorithm.value, mode.value)  # its text only: no blark parse (about 4 s a block)
     plc = CompiledProgram(StProgram(block.text, block.name, (), (block.pou,)), tmp_path, pou=block.name)
     cycle = FilterCycle(f, algorithm, mode)
     rows = _rows(cycle.reads, f"{name}{algorithm}{mode}")
@@ -42,7 +42,6 @@ def test_the_box_sorting_program_with_its_filter_runs_compiled_as_interpreted(fi
     same 2 000 random PLC cycles (every input drawn each cycle, the clock moving 10 ms)."""
     import random
 
-    from synth.codegen.filter_st import filter_block
     from synth.codegen.grafcet_st import generate_program
     from synth.codegen.interpreter.machine import load_st
     from synth.codegen.program import filter_call
