@@ -279,7 +279,6 @@ class RulesChecker(Checker):
     def check_reads(self, e: ElementSpec, owner: Mapping[str, tuple[ElementSpec, VarDecl]]) -> set[str]:
         """The valid ``reads`` of ``e``: each a variable of another element, declared once."""
         valid: set[str] = set()
-        foreign = [n for n, (el, _) in owner.items() if el.name != e.name]
         for r in e.reads:
             if r.name in valid:
                 self.fail(f"element {e.name} reads '{r.name}' twice", r.loc)
@@ -287,7 +286,7 @@ class RulesChecker(Checker):
                 self.fail(
                     f"element {e.name} reads unknown variable '{r.name}'",
                     r.loc,
-                    suggestions=close_names(r.name, foreign),
+                    suggestions=close_names(r.name, [n for n, (el, _) in owner.items() if el.name != e.name]),
                     notes=("`reads` names variables of other elements",),
                 )
             elif owner[r.name][0].name == e.name:
