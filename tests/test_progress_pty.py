@@ -109,8 +109,11 @@ def test_ctrl_c_during_a_long_run_says_how_far_it_went():
 
     env = dict(os.environ, PYTHONPATH=str(ROOT))
     master, slave = os.openpty()
+    # three events per cycle: 767 224 cycles (about 5 s), seconds of work left when the first level shows
+    # (at one event the loop ends within a second, and a loaded machine may deliver the signal after it)
     proc = subprocess.Popen([sys.executable, "-m", "synth", "filter", "verify", "plants/four_cylinders.filter",
-                             "--plant", "plants/four_cylinders.rules", "--any-control", "--engine", "explicit"],
+                             "--plant", "plants/four_cylinders.rules", "--any-control", "--engine", "explicit",
+                             "--events-per-cycle", "3"],
                             cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=slave)
     os.close(slave)
     seen = b""
