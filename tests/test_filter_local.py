@@ -2,7 +2,7 @@
 functions of Y (``Symbolic``) it gives the chain's own BDDs (``synth.filter.narrowing``: the
 care set, each output's ``∃O.(S ∧ o)`` and ``∃O.(S ∧ !o)``, each criterion's ``b_j``) on the
 grid_edges family, the other bench families, every bundled filter and random filters; run
-at one valuation of Y (``AtPoint``, what a PLC block computes in one cycle) it gives those
+at one valuation of Y (``Booleans``, what a PLC block computes in one cycle) it gives those
 functions' values there."""
 
 from __future__ import annotations
@@ -51,7 +51,7 @@ def _points_agree(m: FilterFunctions, p: local.Plan, out: local.Outcome[Function
     inside = 0
     for _ in range(count):
         point = {y: rng.random() < 0.5 for y in ys}
-        here = local.run(p, local.AtPoint(e, point))
+        here = local.run(p, local.Booleans(e, point))
         assert here.care == e.value(out.care, point)
         assert here.ones == {o: e.value(u, point) for o, u in out.ones.items()}
         assert here.zeros == {o: e.value(u, point) for o, u in out.zeros.items()}

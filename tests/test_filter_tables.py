@@ -99,7 +99,7 @@ def test_the_compiled_tables_block_is_the_synthesis(case, tmp_path):
             point = {**values, **{pre_name(n): v for n, v in previous.items()}}
             plc.cycle(values)
             got = {o: plc[o] for o in f.outputs}
-            model = local.run(s.plan, local.AtPoint(e, point))
+            model = local.run(s.plan, local.Booleans(e, point))
             assert got == model.ones
             if oracle.value(solved.care, point):
                 assert got == {o: oracle.value(solved.outputs[o], point) for o in f.outputs}

@@ -296,12 +296,12 @@ class FilterCycle:
 
     def _tables(self, values: Mapping[str, int], count: int) -> tuple[int, ...]:
         """The outputs of the block on truth tables (:func:`synth.filter.local.run`), lane by lane."""
-        from synth.filter.local import AtPoint, run
+        from synth.filter.local import Booleans, run
 
         assert self.plan is not None
         outs = [0] * len(self.outputs)
         for j in range(count):
-            ones = run(self.plan, AtPoint(self.functions.engine, {n: bool(v >> j & 1) for n, v in values.items()})).ones
+            ones = run(self.plan, Booleans(self.functions.engine, {n: bool(v >> j & 1) for n, v in values.items()})).ones
             for k, o in enumerate(self.outputs):
                 outs[k] |= ones[o] << j
         return tuple(outs)

@@ -8,7 +8,7 @@ without running the chain: per bag (the output eliminated there, then its fronti
 conjunction of the constraints' complements and assumptions whose first output it is, and
 per criterion ``Max(g)`` (``Min(c)`` read as ``Max(!c)``) its bag. :func:`run` evaluates the
 plan in an :class:`Algebra`: each table entry is the bag's relation at one valuation of the
-bag's outputs, a boolean at one valuation of Y (:class:`AtPoint`, what a PLC block would
+bag's outputs, a boolean at one valuation of Y (:class:`Booleans`, what a PLC block would
 compute each cycle) or a function of Y (:class:`Symbolic`, every Y at once). Then, criterion
 after criterion, ``b_j = ⋁_v F_{k-1} ∧ D_k ∧ g_j ∧ B_{k+1}`` (``F``/``B`` the forward and
 backward messages as tables over the frontiers, recomputed past a narrowed bag when next
@@ -26,7 +26,7 @@ Example
 >>> p = plan(m, [m.engine.var("a"), m.engine.var("b") & m.engine.var("i")])
 >>> [b.anchors for b in p.bags], p.entries
 ([('a', 'b'), ('b',)], 6)
->>> run(p, AtPoint(m.engine, {"i": True})).ones
+>>> run(p, Booleans(m.engine, {"i": True})).ones
 {'a': True, 'b': False}
 >>> m.engine.text(run(p, Symbolic(m.engine)).ones["b"])
 '0'
@@ -42,7 +42,7 @@ from synth.filter.narrowing import layout
 from synth.logic.bdd import Engine, Function
 from synth.logic.partition import Partition
 
-__all__ = ["Bag", "Plan", "plan", "plan_of", "Algebra", "AtPoint", "Symbolic", "Outcome", "run"]
+__all__ = ["Bag", "Plan", "plan", "plan_of", "Algebra", "Booleans", "Symbolic", "Outcome", "run"]
 
 V = TypeVar("V")
 
@@ -161,7 +161,7 @@ class Symbolic:
         return _tabulate(self.engine, u, anchors)
 
 
-class AtPoint:
+class Booleans:
     """Tables of booleans at one valuation ``point`` of Y (names: values), what the block
     computes in one PLC cycle; a name the point does not give is read false."""
 
