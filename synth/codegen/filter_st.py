@@ -200,6 +200,7 @@ def filter_block(f: Filter, algorithm: Algorithm | str = Algorithm.ALGEBRAIC, mo
     notes: list[str] = []
     body: list[str] = []
     local: list[Declaration] = []
+    constants: list[Declaration] = []  # the tables form's data
     defined = [d for d in f.observers if d.definition is not None]
     if defined:
         observed = _Writer(f, False)
@@ -218,7 +219,7 @@ def filter_block(f: Filter, algorithm: Algorithm | str = Algorithm.ALGEBRAIC, mo
         body += [f"{_GATED}{o} := R_{o} AND NOT {BLOCKED};" for o in f.outputs]
         local += [Declaration(_GATED + o, comment=f"request of {o} after the blocking latch") for o in f.outputs]
     if algorithm is Algorithm.ALGEBRAIC:
-        lines, decls = _algebraic(f, w, notes, order, synthesis, extra)
+        lines, decls, constants = _algebraic(f, w, notes, order, synthesis, extra)
         body += lines
         local += decls
     else:
@@ -246,7 +247,8 @@ def filter_block(f: Filter, algorithm: Algorithm | str = Algorithm.ALGEBRAIC, mo
         outputs.append(Declaration(BLOCKED, comment="a request violated a constraint; cleared by Ack"))
     details = [f"Algorithm {algorithm.value}, mode {mode.value}."] + [f"Note: {n}" for n in notes]
     sections = tuple(VarSection(kind, tuple(decls)) for kind, decls in
-                     ((SectionKind.INPUT, inputs), (SectionKind.OUTPUT, outputs), (SectionKind.LOCAL, local)) if decls)
+                     ((SectionKind.INPUT, inputs), (SectionKind.OUTPUT, outputs), (SectionKind.LOCAL, local),
+                      (SectionKind.CONSTANT, constants)) if decls)
     pou = Pou(PouKind.FUNCTION_BLOCK, fb, sections, tuple(body))
     lines = [*header(f"Safety logic filter {fb}", [f.file], details), *pou_lines(pou), ""]
     return FilterBlock(fb, tuple(d.name for d in inputs), tuple(d.name for d in outputs), "\n".join(lines), pou, notes)
@@ -286,16 +288,18 @@ def _requested(e: Expr, outputs: tuple[str, ...]) -> Expr:
 
 
 def _algebraic(f: Filter, w: _Writer, notes: list[str], order: list[str] | None,
-               solved: "Synthesis | None", extra: tuple[str, ...]) -> tuple[list[str], list[Declaration]]:
+               solved: "Synthesis | None", extra: tuple[str, ...]
+               ) -> tuple[list[str], list[Declaration], list[Declaration]]:
+    """The body and its local variables, and its constants (the tables form's data)."""
     from synth.filter.block import algebraic_equations
     from synth.filter.solve import synthesis
     from synth.logic.bdd import cube_text
 
     s = solved if solved is not None else synthesis(f, order)
     if s.plan is not None:  # too large for equations: the chain on truth tables
-        from synth.codegen.filter_tables import TABLE_NAMES, bit_names, tables_body
+        from synth.codegen.filter_tables import table_names, tables_body
 
-        _check_names(f, extra + TABLE_NAMES + bit_names(s.plan.width))
+        _check_names(f, extra + table_names())
         notes += s.notes[-1:]
         if not s.consistent:
             notes.append(f"no safe output vector exists when {s.inconsistent_text}; there the outputs are all FALSE")
@@ -306,7 +310,7 @@ def _algebraic(f: Filter, w: _Writer, notes: list[str], order: list[str] | None,
     if not s.consistent:
         notes.append(f"no safe output vector exists when {s.inconsistent_text or cube_text(s.inconsistent or {})}; "
                      "the equations are those of the care set")
-    return [f"{o} := {w.expression(e)};" for o, e in algebraic_equations(s)], []
+    return [f"{o} := {w.expression(e)};" for o, e in algebraic_equations(s)], [], []
 
 
 def _loop(f: Filter, w: _Writer, solved: "Synthesis | None") -> tuple[list[str], list[Declaration]]:

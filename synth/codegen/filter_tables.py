@@ -1,172 +1,292 @@
 """The body of a filter block that runs the synthesis's chain of narrowings each cycle on
 truth tables (:mod:`synth.filter.local`), for filters whose equations are too large to
-print (docs/filter.md, "The chain on tables").
+print (docs/filter.md, "The chain on tables"): one fixed loop nest driven by constant
+tables, so its length does not grow with the filter's.
 
-Three ``ARRAY OF BOOL``: ``TabD`` holds each bag's table (entry ``v``: the bag's relation
-with its outputs at the bits of ``v``, ``TabX0`` the output eliminated there, then its
-frontier), ``TabF`` and ``TabB`` the forward and backward messages (``F_{-1}`` and ``B_n``
-one entry each, TRUE). The body tabulates every bag from the cycle's inputs, then, per
-criterion ``Max(g)`` of bag ``k``, sets ``TabBest`` when some entry of bag ``k`` with its
-messages and ``g`` is true (the loop exits there) and narrows the bag by ``g = TabBest``;
-a message is computed again before it is read when a bag it depends on may have been
-narrowed since (a schedule fixed here, not at run time: recomputing a message that has
-not changed gives it again). Each output is then TRUE when an entry of its bag with the
-output at 1 is left with its messages: the value :func:`synth.filter.local.run` gives at
-that cycle's point, FALSE everywhere when no safe vector exists.
+The data (``VAR CONSTANT``, written once per block):
 
-Loop indices are ``INT`` (``TabV`` the entry, ``TabI`` a message's); the bits of an index are
-``(TabV / 2^i) MOD 2``. No generated loop runs once (MATIEC's releases of June to November
-2024 skip a ``FOR i := 0 TO 0``): one-entry loops are written without ``FOR``.
+- per bag ``k``: ``TabKD[k]``, the offset of its table in ``TabD`` (entry ``v``: the bag's
+  relation with its outputs at the bits of ``v``, bit 0 the output eliminated there, then
+  its frontier; ``TabKD[n]`` the end), ``TabKF[k]`` the offset of the forward message
+  ``F_{k-1}`` in ``TabF`` (``F_{-1}`` one entry, TRUE), ``TabKB[k]`` that of the backward
+  message ``B_k`` in ``TabB`` (``B_n`` one entry, TRUE), ``TabKP[k]`` that of the
+  projection giving, for each ``v``, the index of the previous bag's frontier valuation in
+  it (where ``F_{k-1}`` and ``B_k`` are read and written);
+- the functions the loop reads (each bag's relation, each criterion's ``g``, and the
+  output itself for the outputs' search): ``TabUR[u]``, the offset of the function's row in
+  ``TabR`` (the function at each valuation of the bag's outputs it reads, bit ``j`` the
+  ``j``-th of them), ``TabUP[u]``, that of the projection of ``v`` on those outputs;
+- ``TabP``: the projections, each once per tuple of bit positions;
+- per step (each criterion ``Max(g)`` in order, then one per bag for its output):
+  ``TabSK[s]`` its bag and ``TabSU[s]`` its function.
+
+Each cycle the rows that depend on the cycle's inputs are computed (``TabR[i] := …``, one
+line per cofactor that is not a constant: the constants are ``TabR``'s initial values), each
+bag's table is read from its relation's row, then step after step: the messages the step's
+bag reads are brought up to date (``TabVF``/``TabVB``: the last valid ones, a message being
+computed again when a bag before (after) it may have been narrowed since), ``TabBest`` is
+set when some entry of the bag with its messages and ``g`` is true, and for a criterion the
+bag keeps the entries where ``g`` equals ``TabBest``; an output's step keeps ``TabBest`` in
+``TabO``. Each output is then TRUE when an entry of its bag with the output at 1 is left
+with its messages: the value :func:`synth.filter.local.run` gives at that cycle's point,
+FALSE everywhere when no safe vector exists.
+
+Every index is a ``DINT``; every loop is a ``WHILE`` (MATIEC's releases of June to November
+2024 skip a ``FOR i := 0 TO 0``, and these bounds are read at run time).
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Callable
 
 from synth.codegen.st import Declaration
 from synth.filter.language_reader import filter_expression
-from synth.filter.local import Bag, Plan
+from synth.filter.local import Plan, Symbolic
 from synth.logic.bdd import Engine, Function
 from synth.logic.expr import Expr
 
-__all__ = ["TABLE_NAMES", "tables_body"]
+__all__ = ["table_names", "tables_body"]
 
-TABLE_NAMES = ("TabD", "TabF", "TabB", "TabV", "TabI", "TabBest")
-"""The block's own variables (with ``TabX0``, ``TabX1``, … the bits of an entry)."""
+_DATA = ("TabKD", "TabKF", "TabKB", "TabKP", "TabUR", "TabUP", "TabP", "TabSK", "TabSU")
+_STATE = ("TabR", "TabD", "TabF", "TabB", "TabO", "TabS", "TabK", "TabU", "TabV", "TabJ", "TabE", "TabA",
+          "TabPF", "TabPB", "TabPP", "TabPR", "TabPU", "TabVF", "TabVB", "TabBest")
+_PER_LINE = 32
+"""Values per line of a constant array's initial value."""
 
 Writer = Callable[[Expr, dict[str, str]], str]
 """An expression in ST, the outputs at t mapped to other ST places."""
 
 
-def bit_names(width: int) -> tuple[str, ...]:
-    """The names of an entry's bits."""
-    return tuple(f"TabX{i}" for i in range(width))
+def table_names() -> tuple[str, ...]:
+    """The block's own variables (a filter's names must differ from them)."""
+    return _DATA + _STATE
 
 
-class _Body:
+@dataclass(frozen=True)
+class _Row:
+    """A function's cofactors at each valuation of the outputs it reads (``None``: read from
+    the cycle's inputs) and where its line is printed."""
+
+    offset: int
+    values: tuple[bool | None, ...]
+
+
+class _Data:
+    """The constant tables of a plan (module docstring)."""
+
     def __init__(self, p: Plan, engine: Engine, write: Writer) -> None:
         self.plan, self.engine, self.write = p, engine, write
         sizes = [1 << len(b.anchors) for b in p.bags]
-        self.dom = [sum(sizes[:k]) for k in range(len(sizes) + 1)]
-        fsizes = [1] + [s >> 1 for s in sizes]  # F_{-1}, F_0 … F_{n-1}
-        self.fwd = [sum(fsizes[:k]) for k in range(len(fsizes) + 1)]
-        bsizes = [1] + [s >> 1 for s in sizes]  # B_0 (over an empty frontier), B_1 … B_n
-        self.bwd = [sum(bsizes[:k]) for k in range(len(bsizes) + 1)]
-        self.lines: list[str] = []
-        self.valid_f, self.valid_b = -1, len(p.bags)  # F_k valid for k ≤ valid_f, B_k for k ≥ valid_b
-        self.texts: dict[Function, Expr] = {}
+        self.dom = _offsets(sizes)
+        self.fwd = _offsets([1] + [s >> 1 for s in sizes])  # F_{-1} … F_{n-1}
+        self.bwd = _offsets([1] + [s >> 1 for s in sizes])  # B_0 (one entry) … B_n
+        self.projections: dict[tuple[int, ...], int] = {}
+        self.projection_size: dict[tuple[int, ...], int] = {}
+        self.rows: dict[tuple[Function, tuple[str, ...]], _Row] = {}
+        self.row_values: list[bool | None] = []
+        self.row_lines: list[str] = []
+        self.functions: list[tuple[_Row, tuple[int, ...]]] = []
+        self.function_of: dict[tuple[int, Function], int] = {}
+        self.before = [self.positions(k) for k in range(len(p.bags))]
+        for k, bag in enumerate(p.bags):
+            self.function(k, bag.relation, f"bag {k + 1}'s relation")
+        self.steps = [(k, self.function(k, g, f"criterion {n}")) for n, (k, g) in enumerate(p.steps, 1)]
+        self.steps += [(k, self.function(k, engine.var(b.anchors[0]), b.anchors[0])) for k, b in enumerate(p.bags)]
 
-    # ---- places
-    def d(self, k: int, index: str) -> str:
-        return f"TabD[{self.dom[k]} + {index}]" if self.dom[k] else f"TabD[{index}]"
+    def positions(self, k: int) -> tuple[int, ...]:
+        """The bit positions in bag ``k`` of the previous bag's frontier, registered."""
+        anchors = self.plan.bags[k].anchors
+        return self.projection(tuple(anchors.index(a) for a in self.plan.bags[k - 1].anchors[1:]) if k else (), k)
 
-    def f(self, k: int, index: str) -> str:
-        """``F_k`` (``k`` = -1: the constant first message)."""
-        return f"TabF[{self.fwd[k + 1]} + {index}]" if self.fwd[k + 1] else f"TabF[{index}]"
+    def projection(self, bits: tuple[int, ...], k: int) -> tuple[int, ...]:
+        size = 1 << len(self.plan.bags[k].anchors)
+        self.projection_size[bits] = max(size, self.projection_size.get(bits, 0))
+        return bits
 
-    def b(self, k: int, index: str) -> str:
-        return f"TabB[{self.bwd[k]} + {index}]" if self.bwd[k] else f"TabB[{index}]"
-
-    def before(self, k: int) -> str:
-        """The index of ``F_{k-1}`` (and ``B_k``) of entry ``TabV`` of bag ``k``."""
-        bag = self.plan.bags[k]
-        if k == 0:
-            return "0"
-        positions = [bag.anchors.index(a) for a in self.plan.bags[k - 1].anchors[1:]]
-        terms = [_bit("TabV", b) + ("" if i == 0 else f" * {1 << i}") for i, b in enumerate(positions)]
-        return " + ".join(terms) or "0"
-
-    def expression(self, u: Function, bag: Bag) -> str:
-        e = self.engine
-        x = self.texts.get(u)
-        if x is None:
-            x = self.texts[u] = filter_expression(e.text(u), "table")
-        return self.write(x, dict(zip(bag.anchors, bit_names(len(bag.anchors)))))
-
-    def bits(self, u: Function, bag: Bag) -> list[str]:
-        """The assignments of the bits of ``TabV`` that ``u`` reads."""
+    def function(self, k: int, u: Function, what: str) -> int:
+        """The number of ``u`` read in bag ``k`` (its row and projection made once)."""
+        key = (k, u)
+        if key in self.function_of:
+            return self.function_of[key]
+        anchors = self.plan.bags[k].anchors
         read = set(self.engine.support(u))
-        return [f"{name} := {_bit('TabV', i)} = 1;" for i, (a, name) in
-                enumerate(zip(bag.anchors, bit_names(len(bag.anchors)))) if a in read]
+        bits = tuple(i for i, a in enumerate(anchors) if a in read)
+        names = tuple(anchors[i] for i in bits)
+        row = self.rows.get((u, names))
+        if row is None:
+            row = self.rows[(u, names)] = self.row(u, names, what)
+        self.functions.append((row, self.projection(bits, k)))
+        self.function_of[key] = len(self.functions) - 1
+        return len(self.functions) - 1
 
-    # ---- statements
-    def loop(self, var: str, count: int, body: list[str]) -> None:
-        if count == 1:
-            self.lines += [line.replace(var, "0") for line in body]
-        else:
-            self.lines += [f"FOR {var} := 0 TO {count - 1} DO", *("    " + line for line in body), "END_FOR;"]
+    def row(self, u: Function, names: tuple[str, ...], what: str) -> _Row:
+        """``u``'s cofactors on ``names``: constants kept as data, the others one line each."""
+        e, offset = self.engine, len(self.row_values)
+        values: list[bool | None] = []
+        for w, c in enumerate(Symbolic(e).table(u, names)):
+            if c in (e.true, e.false):
+                values.append(c == e.true)
+                continue
+            values.append(None)
+            at = ", ".join(f"{n}={(w >> j) & 1}" for j, n in enumerate(names))
+            text = self.write(filter_expression(e.text(c), "table"), {})
+            self.row_lines.append(f"TabR[{offset + w}] := {text}; (* {what}{' at ' + at if at else ''} *)")
+        self.row_values += values
+        return _Row(offset, tuple(values))
 
-    def tabulate(self, k: int) -> None:
-        bag = self.plan.bags[k]
-        self.lines.append(f"(* bag {k + 1}: {', '.join(bag.anchors)} *)")
-        self.loop("TabV", 1 << len(bag.anchors),
-                  [*self.bits(bag.relation, bag), f"{self.d(k, 'TabV')} := {self.expression(bag.relation, bag)};"])
-
-    def forward(self, k: int) -> None:
-        n = len(self.plan.bags[k].anchors)
-        self.loop("TabI", 1 << (n - 1), [f"{self.f(k, 'TabI')} := FALSE;"])
-        self.loop("TabV", 1 << n, [f"IF {self.d(k, 'TabV')} AND {self.f(k - 1, self.before(k))} THEN",
-                                   f"    {self.f(k, 'TabV / 2')} := TRUE;", "END_IF;"])
-
-    def backward(self, k: int) -> None:
-        n = len(self.plan.bags[k].anchors)
-        self.loop("TabI", 1 << (len(self.plan.bags[k - 1].anchors) - 1) if k else 1, [f"{self.b(k, 'TabI')} := FALSE;"])
-        self.loop("TabV", 1 << n, [f"IF {self.d(k, 'TabV')} AND {self.b(k + 1, 'TabV / 2')} THEN",
-                                   f"    {self.b(k, self.before(k))} := TRUE;", "END_IF;"])
-
-    def messages(self, k: int) -> None:
-        """Make ``F_{k-1}`` and ``B_{k+1}`` valid."""
-        for i in range(self.valid_f + 1, k):
-            self.forward(i)
-        self.valid_f = max(self.valid_f, k - 1)
-        for i in range(self.valid_b - 1, k, -1):
-            self.backward(i)
-        self.valid_b = min(self.valid_b, k + 1)
-
-    def entry(self, k: int) -> str:
-        """Entry ``TabV`` of bag ``k`` with its messages."""
-        return f"{self.d(k, 'TabV')} AND {self.f(k - 1, self.before(k))} AND {self.b(k + 1, 'TabV / 2')}"
-
-    def criterion(self, number: int, k: int, g: Function, label: str) -> None:
-        bag, size = self.plan.bags[k], 1 << len(self.plan.bags[k].anchors)
-        self.messages(k)
-        good = self.expression(g, bag)
-        self.lines += [f"(* criterion {number}: {label} *)", "TabBest := FALSE;"]
-        self.loop("TabV", size, [*self.bits(g, bag), f"IF {self.entry(k)} AND ({good}) THEN",
-                                 "    TabBest := TRUE;", "    EXIT;", "END_IF;"] if size > 1 else
-                  [*self.bits(g, bag), f"TabBest := {self.entry(k)} AND ({good});"])
-        self.loop("TabV", size, [*self.bits(g, bag), f"{self.d(k, 'TabV')} := {self.d(k, 'TabV')} AND NOT (({good}) XOR TabBest);"])
-        self.valid_f, self.valid_b = min(self.valid_f, k - 1), max(self.valid_b, k + 1)
-
-    def output(self, k: int) -> None:
-        o, size = self.plan.bags[k].anchors[0], 1 << len(self.plan.bags[k].anchors)
-        self.messages(k)
-        self.lines.append(f"{o} := FALSE;")
-        self.loop("TabI", size >> 1, ["TabV := 2 * TabI + 1;", f"IF {self.entry(k)} THEN",
-                                      f"    {o} := TRUE;", "    EXIT;", "END_IF;"] if size > 2 else
-                  ["TabV := 1;", f"{o} := {self.entry(k)};"])
+    def projection_data(self) -> tuple[list[int], dict[tuple[int, ...], int]]:
+        """``TabP`` and each projection's offset in it."""
+        data: list[int] = []
+        where: dict[tuple[int, ...], int] = {}
+        for bits, size in sorted(self.projection_size.items(), key=lambda x: (len(x[0]), x[0])):
+            where[bits] = len(data)
+            data += [sum(((v >> b) & 1) << j for j, b in enumerate(bits)) for v in range(size)]
+        return data, where
 
 
-def _bit(index: str, i: int) -> str:
-    return f"{index} MOD 2" if i == 0 else f"({index} / {1 << i}) MOD 2"
+def _offsets(sizes: list[int]) -> list[int]:
+    out = [0]
+    for s in sizes:
+        out.append(out[-1] + s)
+    return out
 
 
-def tables_body(p: Plan, engine: Engine, write: Writer, labels: list[str]) -> tuple[list[str], list[Declaration]]:
-    """The statements and local variables of the block's body (module docstring); ``write``
-    renders an expression (outputs at t mapped to the entry's bits); ``labels``: one comment
-    per criterion."""
-    body = _Body(p, engine, write)
-    body.lines += [f"{body.f(-1, '0')} := TRUE;", f"{body.b(len(p.bags), '0')} := TRUE;"]
-    for k in range(len(p.bags)):
-        body.tabulate(k)
-    for number, ((k, g), label) in enumerate(zip(p.steps, labels), 1):
-        body.criterion(number, k, g, label)
-    for k in range(len(p.bags)):
-        body.output(k)
-    decls = [Declaration("TabD", f"ARRAY[0..{body.dom[-1] - 1}] OF BOOL", comment="each bag's table"),
-             Declaration("TabF", f"ARRAY[0..{body.fwd[-1] - 1}] OF BOOL", comment="the forward messages"),
-             Declaration("TabB", f"ARRAY[0..{body.bwd[-1] - 1}] OF BOOL", comment="the backward messages"),
-             Declaration("TabV", "INT", comment="an entry of a bag"), Declaration("TabI", "INT"),
-             Declaration("TabBest", comment="the criterion finds a solution")]
-    decls += [Declaration(x) for x in bit_names(p.width)]
-    return body.lines, decls
+def _array(name: str, values: list[int] | list[bool], comment: str, kind: str = "DINT") -> Declaration:
+    texts = [("TRUE" if v else "FALSE") if kind == "BOOL" else str(v) for v in values]
+    chunks = [", ".join(texts[i:i + _PER_LINE]) for i in range(0, len(texts), _PER_LINE)]
+    init = "[" + ",\n        ".join(chunks) + "]" if len(chunks) > 1 else f"[{chunks[0]}]"
+    return Declaration(name, f"ARRAY[0..{len(values) - 1}] OF {kind}", init, comment=comment)
+
+
+_LOOP = """\
+TabF[0] := TRUE;
+TabB[{last_b}] := TRUE;
+(* each bag's table from its relation's row *)
+TabK := 0;
+WHILE TabK < {bags} DO
+    TabA := TabKD[TabK];
+    TabE := TabKD[TabK + 1] - TabA;
+    TabPR := TabUR[TabK];
+    TabPU := TabUP[TabK];
+    TabV := 0;
+    WHILE TabV < TabE DO
+        TabD[TabA + TabV] := TabR[TabPR + TabP[TabPU + TabV]];
+        TabV := TabV + 1;
+    END_WHILE;
+    TabK := TabK + 1;
+END_WHILE;
+(* the criteria in order, then each bag's output *)
+TabVF := -1;
+TabVB := {bags};
+TabS := 0;
+WHILE TabS < {steps} DO
+    TabK := TabSK[TabS];
+    WHILE TabVF < TabK - 1 DO (* F_(VF+1) from F_VF *)
+        TabVF := TabVF + 1;
+        TabA := TabKD[TabVF];
+        TabE := TabKD[TabVF + 1] - TabA;
+        TabPF := TabKF[TabVF];
+        TabPB := TabKF[TabVF + 1];
+        TabPP := TabKP[TabVF];
+        TabJ := TabPB;
+        WHILE TabJ < TabKF[TabVF + 2] DO
+            TabF[TabJ] := FALSE;
+            TabJ := TabJ + 1;
+        END_WHILE;
+        TabV := 0;
+        WHILE TabV < TabE DO
+            IF TabD[TabA + TabV] AND TabF[TabPF + TabP[TabPP + TabV]] THEN
+                TabF[TabPB + TabV / 2] := TRUE;
+            END_IF;
+            TabV := TabV + 1;
+        END_WHILE;
+    END_WHILE;
+    WHILE TabVB > TabK + 1 DO (* B_(VB-1) from B_VB *)
+        TabVB := TabVB - 1;
+        TabA := TabKD[TabVB];
+        TabE := TabKD[TabVB + 1] - TabA;
+        TabPF := TabKB[TabVB];
+        TabPB := TabKB[TabVB + 1];
+        TabPP := TabKP[TabVB];
+        TabJ := TabPF;
+        WHILE TabJ < TabPB DO
+            TabB[TabJ] := FALSE;
+            TabJ := TabJ + 1;
+        END_WHILE;
+        TabV := 0;
+        WHILE TabV < TabE DO
+            IF TabD[TabA + TabV] AND TabB[TabPB + TabV / 2] THEN
+                TabB[TabPF + TabP[TabPP + TabV]] := TRUE;
+            END_IF;
+            TabV := TabV + 1;
+        END_WHILE;
+    END_WHILE;
+    TabU := TabSU[TabS];
+    TabA := TabKD[TabK];
+    TabE := TabKD[TabK + 1] - TabA;
+    TabPF := TabKF[TabK];
+    TabPB := TabKB[TabK + 1];
+    TabPP := TabKP[TabK];
+    TabPR := TabUR[TabU];
+    TabPU := TabUP[TabU];
+    TabBest := FALSE;
+    TabV := 0;
+    WHILE TabV < TabE AND NOT TabBest DO
+        TabBest := TabD[TabA + TabV] AND TabR[TabPR + TabP[TabPU + TabV]] AND TabF[TabPF + TabP[TabPP + TabV]]
+                   AND TabB[TabPB + TabV / 2];
+        TabV := TabV + 1;
+    END_WHILE;
+    IF TabS < {criteria} THEN (* a criterion: the bag keeps the entries where g = TabBest *)
+        TabV := 0;
+        WHILE TabV < TabE DO
+            TabD[TabA + TabV] := TabD[TabA + TabV] AND (TabR[TabPR + TabP[TabPU + TabV]] = TabBest);
+            TabV := TabV + 1;
+        END_WHILE;
+        IF TabVF > TabK - 1 THEN
+            TabVF := TabK - 1;
+        END_IF;
+        IF TabVB < TabK + 1 THEN
+            TabVB := TabK + 1;
+        END_IF;
+    ELSE
+        TabO[TabK] := TabBest;
+    END_IF;
+    TabS := TabS + 1;
+END_WHILE;"""
+
+
+def tables_body(p: Plan, engine: Engine, write: Writer,
+                labels: list[str]) -> tuple[list[str], list[Declaration], list[Declaration]]:
+    """The statements, local variables and constants of the block's body (module docstring);
+    ``write`` renders an expression of the cycle's inputs; ``labels``: one comment per criterion."""
+    d = _Data(p, engine, write)
+    data, where = d.projection_data()
+    n, steps = len(p.bags), len(d.steps)
+    lines = [f"(* the criteria, steps 1 to {len(p.steps)} (then one step per bag for its output):",
+             *[f"   {i}. bag {k + 1}: {label}" for i, ((k, _), label) in enumerate(zip(p.steps, labels), 1)],
+             "*)", "(* the rows read from this cycle's inputs *)", *d.row_lines]
+    lines += _LOOP.format(last_b=d.bwd[n], bags=n, steps=steps, criteria=len(p.steps)).splitlines()
+    lines += [f"{b.anchors[0]} := TabO[{k}];" for k, b in enumerate(p.bags)]
+    decls = [
+        _array("TabKD", d.dom, "each bag's table in TabD (and the end)"),
+        _array("TabKF", d.fwd, "F_(k-1) in TabF, F_(-1) first"),
+        _array("TabKB", d.bwd, "B_k in TabB, B_n last"),
+        _array("TabKP", [where[b] for b in d.before], "each bag's projection on the previous frontier, in TabP"),
+        _array("TabUR", [r.offset for r, _ in d.functions], "each function's row in TabR"),
+        _array("TabUP", [where[b] for _, b in d.functions], "each function's projection in TabP"),
+        _array("TabP", data, "the projections: entry v to the index of some of its bits"),
+        _array("TabSK", [k for k, _ in d.steps], "each step's bag"),
+        _array("TabSU", [u for _, u in d.steps], "each step's function"),
+    ]
+    state = [
+        _array("TabR", [bool(v) for v in d.row_values], "the functions' rows (constants; the others each cycle)",
+               "BOOL"),
+        Declaration("TabD", f"ARRAY[0..{d.dom[-1] - 1}] OF BOOL", comment="each bag's table"),
+        Declaration("TabF", f"ARRAY[0..{d.fwd[-1] - 1}] OF BOOL", comment="the forward messages"),
+        Declaration("TabB", f"ARRAY[0..{d.bwd[-1] - 1}] OF BOOL", comment="the backward messages"),
+        Declaration("TabO", f"ARRAY[0..{n - 1}] OF BOOL", comment="each bag's output"),
+        *[Declaration(x, "DINT") for x in _STATE[5:-1]],
+        Declaration("TabBest", comment="the step finds an entry"),
+    ]
+    return lines, state, decls
