@@ -1,33 +1,40 @@
 """The filter on truth tables, past the symbolic chain's work limit (``synth.filter.solve``'s
 ``CHAIN_WORK``, lowered here so that small filters take that form): what ``solve`` says, the
-block ``filter st`` writes (compiled by MATIEC's ``iec2c`` and gcc, cycle by cycle equal to
-the synthesis's functions and to ``synth.filter.local``'s model, past values included), and
-``filter run``'s refusal."""
+block ``filter st`` writes (a fixed loop nest over constant tables; compiled by MATIEC's
+``iec2c`` and gcc, directly and through Beremiz's generator from ``filter st --xml``, cycle by
+cycle equal to the synthesis's functions and to ``synth.filter.local``'s model, past values
+included), and ``filter run``'s refusal."""
 
 from __future__ import annotations
 
 import random
+import re
 import shutil
 import sys
 
 import pytest
 
+from beremiz import find_beremiz
 from conftest import ROOT
 from iec2c import CompiledProgram, find_iec2c
 from schemas import assert_valid
 from synth.codegen.filter_st import filter_block
 from synth.codegen.program import StProgram
-from synth.errors import LimitExceeded
+from synth.codegen.st import SectionKind
+from synth.codegen.targets import Target, render
+from synth.errors import InputError, LimitExceeded
 from synth.filter import local
 from synth.filter.block import algebraic_equations
 from synth.filter.cycle import Algorithm, FilterCycle
+from synth.filter.language import Filter
 from synth.filter.language_check import parse_filter
-from synth.filter.solve import CHAIN_WORK, synthesis
+from synth.filter.solve import CHAIN_WORK, Synthesis, synthesis
 from synth.logic.past import pre_name
 from synth.output.filter_text import synthesis_json, synthesis_text
 
 sys.path.insert(0, str(ROOT / "bench"))
 from filter_scale import grid_edges_filter, ring_filter  # noqa: E402
+from test_sfc_beremiz import beremiz_text  # noqa: E402
 
 NOTE = ("the chain of narrowings passed 1000 BDD lookups at criterion 3 of 38: the filter is its chain run on "
         "truth tables each cycle (16 bags, 118 entries; filter st writes it); no equations, the criteria's effects "
@@ -80,36 +87,115 @@ def test_filter_run_evaluates_the_tables():
         algebraic_equations(s)
 
 
+def _filter(case: str) -> Filter:
+    return parse_filter(grid_edges_filter(16) if case == "grid_edges_16" else ring_filter(4), f"{case}.filter")
+
+
+def _cases(case: str) -> tuple[Filter, Synthesis, Synthesis]:
+    """The filter of ``case``, its equations (the oracle) and its tables form."""
+    f = _filter(case)
+    solved = synthesis(f)
+    s = synthesis(f, chain_work=-1)
+    assert solved.plan is None and s.plan is not None
+    return f, solved, s
+
+
+def _drive(plc: CompiledProgram, f: Filter, solved: Synthesis, s: Synthesis, seed: str) -> dict[str, int]:
+    """300 random cycles of the compiled block against the tables' model and the equations."""
+    e, oracle, rng = s.functions.engine, solved.functions.engine, random.Random(seed)
+    previous = {n: False for n in (*f.inputs, *f.outputs)}
+    seen = {"cycles": 0, "outside the care set": 0, "outputs on": 0}
+    for _ in range(300):
+        values = {n: rng.random() < 0.5 for n in (*f.requests, *f.inputs)}
+        point = {**values, **{pre_name(n): v for n, v in previous.items()}}
+        plc.cycle(values)
+        got = {o: plc[o] for o in f.outputs}
+        model = local.run(s.plan, local.Booleans(e, point))
+        assert got == model.ones
+        if oracle.value(solved.care, point):
+            assert got == {o: oracle.value(solved.outputs[o], point) for o in f.outputs}
+        else:
+            seen["outside the care set"] += 1
+            assert not any(got.values())
+        seen["cycles"] += 1
+        seen["outputs on"] += sum(got.values())
+        previous = {**{n: values[n] for n in f.inputs}, **got}
+    return seen
+
+
+SEEN = {"grid_edges_16": {"cycles": 300, "outside the care set": 0, "outputs on": 781},
+        "ring_4": {"cycles": 300, "outside the care set": 0, "outputs on": 296}}
+"""What the 300 cycles of each case saw (the same on every path to the PLC)."""
+
+
+def _loop_nest(body: tuple[str, ...]) -> list[str]:
+    """The statements from the bags' tables to the outputs, numbers made ``N``."""
+    start = body.index("(* each bag's table from its relation's row *)")
+    end = next(i for i, line in enumerate(body) if " := TabO[" in line and not line.startswith(" "))
+    return [re.sub(r"\d+", "N", line) for line in body[start:end]]
+
+
+def test_the_tables_are_data_and_the_loop_is_fixed():
+    """The block's statements do not grow with the filter: a fixed loop nest, one row line per
+    cofactor that reads the cycle's inputs, one line per output; the rest is constant data."""
+    f = _filter("grid_edges_16")
+    block = filter_block(f, synthesis=synthesis(f, chain_work=-1))
+    body = block.pou.body
+    rows = [line for line in body if line.startswith("TabR[")]
+    assert len(rows) == 16 + 22 + 2 * 16  # each bag's relation once, each priority once, each sim twice
+    assert rows[0] == ("TabR[1] := b1_1 AND (h1_1_1 OR NOT h1_1) OR o1_1_1 AND (h1_1_1 OR NOT h1_1); "
+                       "(* bag 1's relation at o1_1=1, o1_2=0, o2_1=0 *)")
+    assert rows[-1] == "TabR[165] := R_o8_2; (* criterion 38 at o8_2=1 *)"
+    assert [line for line in body if " := TabO[" in line] == [f"{o} := TabO[{k}];" for k, o in enumerate(
+        ["o1_1", "o1_2", "o2_1", "o2_2", "o3_1", "o3_2", "o4_1", "o4_2", "o5_1", "o5_2", "o6_1", "o6_2", "o7_1",
+         "o7_2", "o8_1", "o8_2"])]
+    assert not any(line.startswith("FOR") for line in body)  # MATIEC skips some one-pass FOR loops: WHILE only
+    loop = _loop_nest(body)
+    constant = next(x for x in block.pou.sections if x.kind is SectionKind.CONSTANT)
+    assert [d.name for d in constant.declarations] == ["TabKD", "TabKF", "TabKB", "TabKP", "TabUR", "TabUP", "TabP",
+                                                       "TabSK", "TabSU"]
+    assert constant.declarations[0].init == "[0, 8, 16, 24, 32, 40, 48, 56, 64, 72, 80, 88, 96, 104, 112, 116, 118]"
+    ring = _filter("ring_4")
+    other = filter_block(ring, synthesis=synthesis(ring, chain_work=-1)).pou.body
+    assert len(loop) == 92 and loop == _loop_nest(other)  # the same statements but for the counts of bags and steps
+    assert sum(x.lstrip().startswith("WHILE") for x in loop) == 11
+
+
+def test_a_filter_name_the_tables_need_is_refused():
+    f = parse_filter("inputs TabVF\noutputs a, b\nsafety K: a & b & TabVF keep a\n", "clash.filter")
+    with pytest.raises(InputError, match="TabVF is a name the generated block needs for itself"):
+        filter_block(f, synthesis=synthesis(f, chain_work=-1))
+
+
 @pytest.mark.slow  # 5-10 s a case: iec2c and gcc, then the model at each of 300 cycles
 @pytest.mark.skipif(find_iec2c() is None or shutil.which("gcc") is None, reason="MATIEC's iec2c (and gcc) are not on PATH")
 @pytest.mark.parametrize("case", ["grid_edges_16", "ring_4"])
 def test_the_compiled_tables_block_is_the_synthesis(case, tmp_path):
-    f = parse_filter(grid_edges_filter(16) if case == "grid_edges_16" else ring_filter(4), f"{case}.filter")
-    solved = synthesis(f)  # the equations: the oracle
-    s = synthesis(f, chain_work=-1)
-    assert solved.plan is None and s.plan is not None
+    f, solved, s = _cases(case)
     block = filter_block(f, synthesis=s)
     plc = CompiledProgram(StProgram(block.text, block.name, (), (block.pou,)), tmp_path, pou=block.name)
-    e, oracle, rng = s.functions.engine, solved.functions.engine, random.Random(case)
-    previous = {n: False for n in (*f.inputs, *f.outputs)}
-    seen = {"cycles": 0, "outside the care set": 0, "outputs on": 0}
     try:
-        for _ in range(300):
-            values = {n: rng.random() < 0.5 for n in (*f.requests, *f.inputs)}
-            point = {**values, **{pre_name(n): v for n, v in previous.items()}}
-            plc.cycle(values)
-            got = {o: plc[o] for o in f.outputs}
-            model = local.run(s.plan, local.Booleans(e, point))
-            assert got == model.ones
-            if oracle.value(solved.care, point):
-                assert got == {o: oracle.value(solved.outputs[o], point) for o in f.outputs}
-            else:
-                seen["outside the care set"] += 1
-                assert not any(got.values())
-            seen["cycles"] += 1
-            seen["outputs on"] += sum(got.values())
-            previous = {**{n: values[n] for n in f.inputs}, **got}
+        assert _drive(plc, f, solved, s, case) == SEEN[case]
     finally:
         plc.close()
-    assert seen == {"grid_edges_16": {"cycles": 300, "outside the care set": 0, "outputs on": 781},
-                    "ring_4": {"cycles": 300, "outside the care set": 0, "outputs on": 296}}[case]
+
+
+@pytest.mark.slow  # about 10 s: Beremiz's generator, iec2c and gcc, then 300 cycles
+@pytest.mark.skipif(find_beremiz() is None or find_iec2c() is None or shutil.which("gcc") is None,
+                    reason="Beremiz (SYNTH_BEREMIZ, SYNTH_BEREMIZ_PYTHON), iec2c and gcc are not here")
+def test_the_plcopen_tables_block_built_by_beremiz_is_the_synthesis(tmp_path):
+    """``filter st --xml`` of the tables form opened by Beremiz, whose generator writes the
+    program it hands to MATIEC; that program compiled and run equals the synthesis (on the
+    ring; the grid takes the same path, tested above without Beremiz)."""
+    case = "ring_4"
+    f, solved, s = _cases(case)
+    block = filter_block(f, synthesis=s)
+    [(name, xml)] = render(Target.PLCOPEN, [block.pou], text=block.text, name=block.name, header=["test"])
+    (tmp_path / name).write_bytes(xml)
+    text = beremiz_text(tmp_path / name, tmp_path / "generated.st")
+    assert "VAR CONSTANT" in text and "TabSU : ARRAY [0.." in text
+    plc = CompiledProgram(StProgram(text, block.name, (), (block.pou,)), tmp_path / "c", pou=block.name)
+    try:
+        assert _drive(plc, f, solved, s, case) == SEEN[case]
+    finally:
+        plc.close()
