@@ -1,6 +1,7 @@
 """Whether two or more synth trees print the same filter reports, byte for byte: the CLI's
 ``filter check --json``, ``check``, ``solve --json``, ``solve``, ``st`` and
-``st --algorithm loop`` (its file) on the bundled filters and on bench families.
+``st --algorithm loop``, each ``st`` also with ``--xml`` (its file), on the bundled filters and
+on bench families.
 
     python3 bench/filter_same.py --tree BEFORE --tree AFTER [--cases ring:4,8 chain:16 ...]
                                  [--bundled/--no-bundled] [--timeout 600] [--json FILE]
@@ -37,8 +38,10 @@ DEFAULT_CASES = ("ring:4,8", "chain:16,64", "grid:16,32", "grid_edges:8,16,24")
 
 COMMANDS: tuple[tuple[str, ...], ...] = (
     ("check", "--json"), ("check",), ("solve", "--json"), ("solve",),
-    ("st", "-o", "out.st"), ("st", "--algorithm", "loop", "-o", "out.st"))
-"""The ``synth filter`` commands run on every filter (``out.st``: the file compared)."""
+    ("st", "-o", "out.st"), ("st", "--algorithm", "loop", "-o", "out.st"),
+    ("st", "--xml", "-o", "out.st"), ("st", "--algorithm", "loop", "--xml", "-o", "out.st"))
+"""The ``synth filter`` commands run on every filter (``out.st``: the file compared, PLCopen XML
+with ``--xml``)."""
 
 
 def bundled() -> list[Path]:

@@ -161,6 +161,21 @@ def test_the_tables_are_data_and_the_loop_is_fixed():
     assert sum(x.lstrip().startswith("WHILE") for x in loop) == 11
 
 
+def test_the_plcopen_tables_block_is_valid_tc6_with_its_data_constant():
+    from lxml import etree
+
+    from tc6schema import validation_errors
+
+    f = _filter("ring_4")
+    block = filter_block(f, synthesis=synthesis(f, chain_work=-1))
+    [(_, xml)] = render(Target.PLCOPEN, [block.pou], text=block.text, name=block.name, header=["test"])
+    assert validation_errors(xml) == []
+    ns = {"tc6": "http://www.plcopen.org/xml/tc6_0201"}
+    sections = etree.fromstring(xml).findall(".//tc6:interface/tc6:localVars", ns)
+    assert [(x.get("constant"), [v.get("name") for v in x.findall("tc6:variable", ns)][-1]) for x in sections] == [
+        (None, "TabBest"), ("true", "TabSU")]
+
+
 def test_a_filter_name_the_tables_need_is_refused():
     f = parse_filter("inputs TabVF\noutputs a, b\nsafety K: a & b & TabVF keep a\n", "clash.filter")
     with pytest.raises(InputError, match="TabVF is a name the generated block needs for itself"):
