@@ -157,7 +157,7 @@ def test_the_tables_are_data_and_the_loop_is_fixed():
     assert constant.declarations[0].init == "[0, 8, 16, 24, 32, 40, 48, 56, 64, 72, 80, 88, 96, 104, 112, 116, 118]"
     ring = _filter("ring_4")
     other = filter_block(ring, synthesis=synthesis(ring, chain_work=-1)).pou.body
-    assert len(loop) == 92 and loop == _loop_nest(other)  # the same statements but for the counts of bags and steps
+    assert len(loop) == 96 and loop == _loop_nest(other)  # the same statements but for the counts of bags and steps
     assert sum(x.lstrip().startswith("WHILE") for x in loop) == 11
 
 
@@ -173,7 +173,7 @@ def test_the_plcopen_tables_block_is_valid_tc6_with_its_data_constant():
     ns = {"tc6": "http://www.plcopen.org/xml/tc6_0201"}
     sections = etree.fromstring(xml).findall(".//tc6:interface/tc6:localVars", ns)
     assert [(x.get("constant"), [v.get("name") for v in x.findall("tc6:variable", ns)][-1]) for x in sections] == [
-        (None, "TabBest"), ("true", "TabSU")]
+        (None, "TabCut"), ("true", "TabSU")]
 
 
 def test_a_filter_name_the_tables_need_is_refused():

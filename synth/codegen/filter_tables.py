@@ -24,7 +24,8 @@ Each cycle the rows that depend on the cycle's inputs are computed (``TabR[i] :=
 line per cofactor that is not a constant: the constants are ``TabR``'s initial values), each
 bag's table is read from its relation's row, then step after step: the messages the step's
 bag reads are brought up to date (``TabVF``/``TabVB``: the last valid ones, a message being
-computed again when a bag before (after) it may have been narrowed since), ``TabBest`` is
+computed again when a criterion removed an entry of a bag before (after) it since: ``TabCut``,
+as :mod:`synth.filter.local` drops a message only when a bag changed), ``TabBest`` is
 set when some entry of the bag with its messages and ``g`` is true, and for a criterion the
 bag keeps the entries where ``g`` equals ``TabBest``; an output's step keeps ``TabBest`` in
 ``TabO``. Each output is then TRUE when an entry of its bag with the output at 1 is left
@@ -50,7 +51,7 @@ __all__ = ["table_names", "tables_body"]
 
 _DATA = ("TabKD", "TabKF", "TabKB", "TabKP", "TabUR", "TabUP", "TabP", "TabSK", "TabSU")
 _STATE = ("TabR", "TabD", "TabF", "TabB", "TabO", "TabS", "TabK", "TabU", "TabV", "TabJ", "TabE", "TabA",
-          "TabPF", "TabPB", "TabPP", "TabPR", "TabPU", "TabVF", "TabVB", "TabBest")
+          "TabPF", "TabPB", "TabPP", "TabPR", "TabPU", "TabVF", "TabVB", "TabBest", "TabCut")
 _PER_LINE = 32
 """Values per line of a constant array's initial value."""
 
@@ -238,15 +239,19 @@ WHILE TabS < {steps} DO
         TabV := TabV + 1;
     END_WHILE;
     IF TabS < {criteria} THEN (* a criterion: the bag keeps the entries where g = TabBest *)
+        TabCut := FALSE;
         TabV := 0;
         WHILE TabV < TabE DO
-            TabD[TabA + TabV] := TabD[TabA + TabV] AND (TabR[TabPR + TabP[TabPU + TabV]] = TabBest);
+            IF TabD[TabA + TabV] AND (TabR[TabPR + TabP[TabPU + TabV]] <> TabBest) THEN
+                TabD[TabA + TabV] := FALSE;
+                TabCut := TRUE;
+            END_IF;
             TabV := TabV + 1;
         END_WHILE;
-        IF TabVF > TabK - 1 THEN
+        IF TabCut AND TabVF > TabK - 1 THEN (* the messages past a narrowed bag *)
             TabVF := TabK - 1;
         END_IF;
-        IF TabVB < TabK + 1 THEN
+        IF TabCut AND TabVB < TabK + 1 THEN
             TabVB := TabK + 1;
         END_IF;
     ELSE
@@ -286,7 +291,8 @@ def tables_body(p: Plan, engine: Engine, write: Writer,
         Declaration("TabF", f"ARRAY[0..{d.fwd[-1] - 1}] OF BOOL", comment="the forward messages"),
         Declaration("TabB", f"ARRAY[0..{d.bwd[-1] - 1}] OF BOOL", comment="the backward messages"),
         Declaration("TabO", f"ARRAY[0..{n - 1}] OF BOOL", comment="each bag's output"),
-        *[Declaration(x, "DINT") for x in _STATE[5:-1]],
+        *[Declaration(x, "DINT") for x in _STATE[5:-2]],
         Declaration("TabBest", comment="the step finds an entry"),
+        Declaration("TabCut", comment="the criterion removed an entry"),
     ]
     return lines, state, decls
