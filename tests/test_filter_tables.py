@@ -152,7 +152,7 @@ def test_the_tables_are_data_and_the_loop_is_fixed():
     assert not any(line.startswith("FOR") for line in body)  # MATIEC skips some one-pass FOR loops: WHILE only
     loop = _loop_nest(body)
     constant = next(x for x in block.pou.sections if x.kind is SectionKind.CONSTANT)
-    assert [d.name for d in constant.declarations] == ["TabKD", "TabKF", "TabKB", "TabKP", "TabUR", "TabUP", "TabP",
+    assert [d.name for d in constant.declarations] == ["TabKD", "TabKM", "TabKP", "TabUR", "TabUP", "TabP",
                                                        "TabSK", "TabSU"]
     assert constant.declarations[0].init == "[0, 8, 16, 24, 32, 40, 48, 56, 64, 72, 80, 88, 96, 104, 112, 116, 118]"
     ring = _filter("ring_4")

@@ -7,11 +7,11 @@ The data (``VAR CONSTANT``, written once per block):
 
 - per bag ``k``: ``TabKD[k]``, the offset of its table in ``TabD`` (entry ``v``: the bag's
   relation with its outputs at the bits of ``v``, bit 0 the output eliminated there, then
-  its frontier; ``TabKD[n]`` the end), ``TabKF[k]`` the offset of the forward message
-  ``F_{k-1}`` in ``TabF`` (``F_{-1}`` one entry, TRUE), ``TabKB[k]`` that of the backward
-  message ``B_k`` in ``TabB`` (``B_n`` one entry, TRUE), ``TabKP[k]`` that of the
-  projection giving, for each ``v``, the index of the previous bag's frontier valuation in
-  it (where ``F_{k-1}`` and ``B_k`` are read and written);
+  its frontier; ``TabKD[n]`` the end), ``TabKM[k]`` the offset of the forward message
+  ``F_{k-1}`` in ``TabF`` and of the backward message ``B_k`` in ``TabB`` (both tables over
+  the previous bag's frontier; ``F_{-1}`` and ``B_n`` one entry each, TRUE), ``TabKP[k]``
+  that of the projection giving, for each ``v``, the index of the previous bag's frontier
+  valuation in it (where ``F_{k-1}`` and ``B_k`` are read and written);
 - the functions the loop reads (each bag's relation, each criterion's ``g``, and the
   output itself for the outputs' search): ``TabUR[u]``, the offset of the function's row in
   ``TabR`` (the function at each valuation of the bag's outputs it reads, bit ``j`` the
@@ -38,7 +38,6 @@ Every index is a ``DINT``; every loop is a ``WHILE`` (MATIEC's releases of June 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Callable
 
 from synth.codegen.st import Declaration
@@ -49,7 +48,7 @@ from synth.logic.expr import Expr
 
 __all__ = ["table_names", "tables_body"]
 
-_DATA = ("TabKD", "TabKF", "TabKB", "TabKP", "TabUR", "TabUP", "TabP", "TabSK", "TabSU")
+_DATA = ("TabKD", "TabKM", "TabKP", "TabUR", "TabUP", "TabP", "TabSK", "TabSU")
 _STATE = ("TabR", "TabD", "TabF", "TabB", "TabO", "TabS", "TabK", "TabU", "TabV", "TabJ", "TabE", "TabA",
           "TabPF", "TabPB", "TabPP", "TabPR", "TabPU", "TabVF", "TabVB", "TabBest", "TabCut")
 _PER_LINE = 32
@@ -64,15 +63,6 @@ def table_names() -> tuple[str, ...]:
     return _DATA + _STATE
 
 
-@dataclass(frozen=True)
-class _Row:
-    """A function's cofactors at each valuation of the outputs it reads (``None``: read from
-    the cycle's inputs) and where its line is printed."""
-
-    offset: int
-    values: tuple[bool | None, ...]
-
-
 class _Data:
     """The constant tables of a plan (module docstring)."""
 
@@ -80,14 +70,12 @@ class _Data:
         self.plan, self.engine, self.write = p, engine, write
         sizes = [1 << len(b.anchors) for b in p.bags]
         self.dom = _offsets(sizes)
-        self.fwd = _offsets([1] + [s >> 1 for s in sizes])  # F_{-1} … F_{n-1}
-        self.bwd = _offsets([1] + [s >> 1 for s in sizes])  # B_0 (one entry) … B_n
-        self.projections: dict[tuple[int, ...], int] = {}
+        self.messages = _offsets([1] + [s >> 1 for s in sizes])  # F_{-1} and B_0, then F_k and B_(k+1)
         self.projection_size: dict[tuple[int, ...], int] = {}
-        self.rows: dict[tuple[Function, tuple[str, ...]], _Row] = {}
-        self.row_values: list[bool | None] = []
+        self.rows: dict[tuple[Function, tuple[str, ...]], int] = {}  # each row's offset in TabR
+        self.row_values: list[bool] = []
         self.row_lines: list[str] = []
-        self.functions: list[tuple[_Row, tuple[int, ...]]] = []
+        self.functions: list[tuple[int, tuple[int, ...]]] = []
         self.function_of: dict[tuple[int, Function], int] = {}
         self.before = [self.positions(k) for k in range(len(p.bags))]
         for k, bag in enumerate(p.bags):
@@ -121,20 +109,18 @@ class _Data:
         self.function_of[key] = len(self.functions) - 1
         return len(self.functions) - 1
 
-    def row(self, u: Function, names: tuple[str, ...], what: str) -> _Row:
-        """``u``'s cofactors on ``names``: constants kept as data, the others one line each."""
+    def row(self, u: Function, names: tuple[str, ...], what: str) -> int:
+        """``u``'s cofactors on ``names`` (its offset in ``TabR``): the constants kept as
+        initial values, the others one line each (initially FALSE)."""
         e, offset = self.engine, len(self.row_values)
-        values: list[bool | None] = []
         for w, c in enumerate(Symbolic(e).table(u, names)):
+            self.row_values.append(c == e.true)
             if c in (e.true, e.false):
-                values.append(c == e.true)
                 continue
-            values.append(None)
             at = ", ".join(f"{n}={(w >> j) & 1}" for j, n in enumerate(names))
             text = self.write(filter_expression(e.text(c), "table"), {})
             self.row_lines.append(f"TabR[{offset + w}] := {text}; (* {what}{' at ' + at if at else ''} *)")
-        self.row_values += values
-        return _Row(offset, tuple(values))
+        return offset
 
     def projection_data(self) -> tuple[list[int], dict[tuple[int, ...], int]]:
         """``TabP`` and each projection's offset in it."""
@@ -187,11 +173,11 @@ WHILE TabS < {steps} DO
         TabVF := TabVF + 1;
         TabA := TabKD[TabVF];
         TabE := TabKD[TabVF + 1] - TabA;
-        TabPF := TabKF[TabVF];
-        TabPB := TabKF[TabVF + 1];
+        TabPF := TabKM[TabVF];
+        TabPB := TabKM[TabVF + 1];
         TabPP := TabKP[TabVF];
         TabJ := TabPB;
-        WHILE TabJ < TabKF[TabVF + 2] DO
+        WHILE TabJ < TabKM[TabVF + 2] DO
             TabF[TabJ] := FALSE;
             TabJ := TabJ + 1;
         END_WHILE;
@@ -207,8 +193,8 @@ WHILE TabS < {steps} DO
         TabVB := TabVB - 1;
         TabA := TabKD[TabVB];
         TabE := TabKD[TabVB + 1] - TabA;
-        TabPF := TabKB[TabVB];
-        TabPB := TabKB[TabVB + 1];
+        TabPF := TabKM[TabVB];
+        TabPB := TabKM[TabVB + 1];
         TabPP := TabKP[TabVB];
         TabJ := TabPF;
         WHILE TabJ < TabPB DO
@@ -226,8 +212,8 @@ WHILE TabS < {steps} DO
     TabU := TabSU[TabS];
     TabA := TabKD[TabK];
     TabE := TabKD[TabK + 1] - TabA;
-    TabPF := TabKF[TabK];
-    TabPB := TabKB[TabK + 1];
+    TabPF := TabKM[TabK];
+    TabPB := TabKM[TabK + 1];
     TabPP := TabKP[TabK];
     TabPR := TabUR[TabU];
     TabPU := TabUP[TabU];
@@ -271,25 +257,24 @@ def tables_body(p: Plan, engine: Engine, write: Writer,
     lines = [f"(* the criteria, steps 1 to {len(p.steps)} (then one step per bag for its output):",
              *[f"   {i}. bag {k + 1}: {label}" for i, ((k, _), label) in enumerate(zip(p.steps, labels), 1)],
              "*)", "(* the rows read from this cycle's inputs *)", *d.row_lines]
-    lines += _LOOP.format(last_b=d.bwd[n], bags=n, steps=steps, criteria=len(p.steps)).splitlines()
+    lines += _LOOP.format(last_b=d.messages[n], bags=n, steps=steps, criteria=len(p.steps)).splitlines()
     lines += [f"{b.anchors[0]} := TabO[{k}];" for k, b in enumerate(p.bags)]
     decls = [
         _array("TabKD", d.dom, "each bag's table in TabD (and the end)"),
-        _array("TabKF", d.fwd, "F_(k-1) in TabF, F_(-1) first"),
-        _array("TabKB", d.bwd, "B_k in TabB, B_n last"),
+        _array("TabKM", d.messages, "F_(k-1) in TabF and B_k in TabB (F_(-1) first, B_n last)"),
         _array("TabKP", [where[b] for b in d.before], "each bag's projection on the previous frontier, in TabP"),
-        _array("TabUR", [r.offset for r, _ in d.functions], "each function's row in TabR"),
+        _array("TabUR", [r for r, _ in d.functions], "each function's row in TabR"),
         _array("TabUP", [where[b] for _, b in d.functions], "each function's projection in TabP"),
         _array("TabP", data, "the projections: entry v to the index of some of its bits"),
         _array("TabSK", [k for k, _ in d.steps], "each step's bag"),
         _array("TabSU", [u for _, u in d.steps], "each step's function"),
     ]
     state = [
-        _array("TabR", [bool(v) for v in d.row_values], "the functions' rows (constants; the others each cycle)",
+        _array("TabR", d.row_values, "the functions' rows (constants; the others each cycle)",
                "BOOL"),
         Declaration("TabD", f"ARRAY[0..{d.dom[-1] - 1}] OF BOOL", comment="each bag's table"),
-        Declaration("TabF", f"ARRAY[0..{d.fwd[-1] - 1}] OF BOOL", comment="the forward messages"),
-        Declaration("TabB", f"ARRAY[0..{d.bwd[-1] - 1}] OF BOOL", comment="the backward messages"),
+        Declaration("TabF", f"ARRAY[0..{d.messages[-1] - 1}] OF BOOL", comment="the forward messages"),
+        Declaration("TabB", f"ARRAY[0..{d.messages[-1] - 1}] OF BOOL", comment="the backward messages"),
         Declaration("TabO", f"ARRAY[0..{n - 1}] OF BOOL", comment="each bag's output"),
         *[Declaration(x, "DINT") for x in _STATE[5:-2]],
         Declaration("TabBest", comment="the step finds an entry"),
