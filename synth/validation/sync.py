@@ -273,32 +273,27 @@ def region(
     seen = {entry}
     settled: list[tuple[Local, tuple[Prohibition, ...]]] = []
     queue = deque([entry])
+    orders = sorted(moves)
     while queue:
         cur = queue.popleft()
         val = p.valuation(cur)
         progressed = False
         refused: list[Prohibition] = []
-        for order in sorted(moves):
-            want = order in wanted
-            if val[order] == want:
+        ts = [t for order in orders if val[order] != (order in wanted) for t in moves[order] if t.src == cur[t.axis]]
+        for t, (ok, why) in zip(ts, oracle.moves(ts, cur)):
+            if not ok:
+                refused.append(Prohibition(t.event, tuple(why)))
                 continue
-            for t in moves[order]:
-                if t.src != cur[t.axis]:
-                    continue
-                ok, why = oracle.move(t, cur)
-                if not ok:
-                    refused.append(Prohibition(t.event, tuple(why)))
-                    continue
-                progressed = True
-                nxt = list(cur)
-                nxt[t.axis] = t.dst
-                n = tuple(nxt)
-                if n not in seen:
-                    seen.add(n)
-                    members.append(n)
-                    queue.append(n)
-                    if limit is not None and len(members) > limit:
-                        raise LimitExceeded(f"a region of more than {limit} states")
+            progressed = True
+            nxt = list(cur)
+            nxt[t.axis] = t.dst
+            n = tuple(nxt)
+            if n not in seen:
+                seen.add(n)
+                members.append(n)
+                queue.append(n)
+                if limit is not None and len(members) > limit:
+                    raise LimitExceeded(f"a region of more than {limit} states")
         if not progressed:
             settled.append((cur, tuple(sorted(refused))))
     return members, settled
