@@ -213,8 +213,7 @@ class _Explorer:
         self.targets: list[np.ndarray] = []
         self.conflicts: list[Conflict] = []
         self.log = ConflictLog()
-        self._emitted: dict[int | bytes, frozenset[str]] = {}  # a node's orders, per row of bits
-        self._set: dict[int | bytes, tuple[str, ...]] = {}
+        self._orders: dict[int | bytes, tuple[frozenset[str], tuple[str, ...]]] = {}  # a node's orders, per row of bits
         self.pairs: list[np.ndarray] = []  # (situation, member) keys of the regions entered
         # the Grafcet's order columns in the regions' order of the plant's orders
         self._move_events = [t.event for t in self.pc.uncontrollable]
@@ -287,9 +286,12 @@ class _Explorer:
         emitted = self.orders(sid, q)
         digits = self.pc.digits(q)
         names = self.vm.order_names
-        wanted = _per_row(emitted, lambda row: frozenset(names[i] for i in row.nonzero()[0]), self._emitted)
-        set_ = _per_row(emitted & self.pc.values(names, digits), lambda row: tuple(names[i] for i in row.nonzero()[0]),
-                        self._set)
+        k = len(names)
+
+        def made(row: np.ndarray) -> tuple[frozenset[str], tuple[str, ...]]:  # the orders emitted, and those set
+            return frozenset(names[i] for i in row[:k].nonzero()[0]), tuple(names[i] for i in row[k:].nonzero()[0])
+
+        wanted, set_ = zip(*_per_row(np.hstack([emitted, emitted & self.pc.values(names, digits)]), made, self._orders))
         items, prohs = self.sits.items, self.regions.prohibitions
         self.nodes.extend(many_nodes([items[s] for s in sid.tolist()], map(tuple, digits.full().T.tolist()), wanted, set_,
                                      [prohs[pr] for pr in proh.tolist()]))
@@ -357,8 +359,8 @@ class _Explorer:
         """Every event from the nodes ``lo:hi``, in the machine's path's order."""
         sid, codes = self.node_sit[lo:hi], self.node_code[lo:hi]
         row, rank, entry = self.pc.successors(codes)
-        before = self.inputs(codes)
-        after = self.inputs(entry)
+        inputs = self.inputs(np.concatenate([codes, entry]))  # before and after, one pass
+        before, after = inputs[:len(codes)], inputs[len(codes):]
         changed = before[row] ^ after
         count = changed.sum(axis=1)
         if (count > 1).any():
@@ -392,15 +394,20 @@ class _Explorer:
                 ranks.append(np.array([first_timer + j]))
                 entries.append(codes[r:r + 1])
                 sids.append(self.sits.of([sit]))
-        row, rank, entry, nsid, ev = (np.concatenate(x) for x in (rows, ranks, entries, sids, evid))
-        order = np.lexsort((rank, row))
+        if len(rows) > 1:  # timers: their candidates put in the order of their nodes
+            row, rank, entry, nsid, ev = (np.concatenate(x) for x in (rows, ranks, entries, sids, evid))
+            order = np.lexsort((rank, row))
+        else:  # the moves alone, sorted by node then rank already
+            ev, order = rank, None
         if traced:
-            where = np.empty(len(order), dtype=np.int64)
-            where[order] = np.arange(len(order))
+            where = np.arange(len(row))
+            if order is not None:
+                where[order] = np.arange(len(order))
             for c in sorted(traced, key=lambda c: where[c]):
                 i = lo + int(row[c])
                 self.conflicts.extend(Conflict(i, table[ev[c]], st, names) for st, names in self.log.fresh(traced[c]))
-        row, entry, nsid, ev = row[order], entry[order], nsid[order], ev[order]
+        if order is not None:
+            row, entry, nsid, ev = row[order], entry[order], nsid[order], ev[order]
         node, src = self.enter(nsid, entry)
         self.sources.append(lo + row[src])
         self.targets.append(node)

@@ -245,6 +245,8 @@ class PlantCodes:
         row, rank = np.nonzero(ok)  # row-major: by row, then rank
         target = self.step(codes[row], u, rank)
         keep = self.kept(target)  # cannot fail from a SUP state; kept for safety, as the machine's path
+        if keep.all():
+            return row, rank, target
         return row[keep], rank[keep], target[keep]
 
     def _guard(self, k: int, digits: Digits, rows: np.ndarray) -> np.ndarray:
@@ -386,12 +388,9 @@ def regions(pc: PlantCodes, store: Regions, entries: np.ndarray, wanted: np.ndar
         if not ok.any():
             break
         nreg, target = reg[row[ok]], target[ok]
-        fresh = []  # the first move into each state not met before, in order
-        for i, key in enumerate((nreg * pc.P + target).tolist()):
-            if key not in seen:
-                seen.add(key)
-                fresh.append(i)
-        first = np.array(fresh, dtype=np.int64)
+        add = seen.add  # the first move into each state not met before, in order
+        first = np.array([i for i, key in enumerate((nreg * pc.P + target).tolist()) if key not in seen and not add(key)],
+                         dtype=np.int64)
         reg, cur = nreg[first], target[first]
         member_parts.append((reg, cur))
     _store(store, R, member_parts, settled_parts)

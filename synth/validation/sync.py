@@ -138,8 +138,8 @@ class Edge:
     target: int
 
 
-def many_nodes(situations: list[Situation], plants: Iterable[Local], emitted: list[frozenset[str]],
-               ords: list[tuple[str, ...]], prohs: list[tuple[Prohibition, ...]]) -> list[Node]:
+def many_nodes(situations: list[Situation], plants: Iterable[Local], emitted: Sequence[frozenset[str]],
+               ords: Sequence[tuple[str, ...]], prohs: list[tuple[Prohibition, ...]]) -> list[Node]:
     """``Node(*row)`` for each row of the columns given, made in bulk: the same objects,
     their attributes written once each without a call of ``__init__`` per node (a frontier
     makes thousands at once; the call was half their cost)."""
