@@ -125,10 +125,10 @@ class VectorMachine:
         self._first_source = np.array([self._step[t.sources[0]] if t.sources else len(self.step_names)
                                        for t in trans], dtype=np.int64)
         self._sourceless = any(not t.sources for t in trans)
-        more = [(j, [self._step[s] for s in t.sources[1:]]) for j, t in enumerate(trans) if len(t.sources) > 1]
-        self._more_cols = np.array([j for j, _ in more], dtype=np.int64)  # the transitions with further sources
-        self._more_steps = np.array([s for _, steps in more for s in steps], dtype=np.int64)
-        self._more_starts = np.cumsum([0] + [len(steps) for _, steps in more[:-1]]).astype(np.int64)
+        # the k-th further source of every transition that has one, one pass per k
+        self._more_sources = [(np.array([j for j, t in enumerate(trans) if len(t.sources) > k], dtype=np.int64),
+                               np.array([self._step[t.sources[k]] for t in trans if len(t.sources) > k], dtype=np.int64))
+                              for k in range(1, max((len(t.sources) for t in trans), default=0))]
         self.stored_names = tuple(sorted({a.order for s in g.steps for a in s.actions if a.kind == STORED}))
         nt = len(self.timer_names)
         self.memory = nt + len(self.stored_names)
@@ -225,8 +225,8 @@ class VectorMachine:
         Z = np.zeros(n, dtype=bool)
         steps = np.hstack([A, np.ones((n, 1), dtype=bool)]) if self._sourceless else A
         out = np.asfortranarray(steps[:, self._first_source])  # the transitions enabled
-        if self._more_cols.size:  # the further sources of each, ANDed in one pass
-            out[:, self._more_cols] &= np.logical_and.reduceat(A[:, self._more_steps], self._more_starts, axis=1)
+        for cols, steps in self._more_sources:
+            out[:, cols] &= A[:, steps]
         for j in np.logical_or.reduce(out, axis=0).nonzero()[0].tolist():
             out[:, j] &= self._rec[j](I, A, T, E, Z)
         return out

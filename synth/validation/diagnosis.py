@@ -182,13 +182,9 @@ def _fewest_changes(a: ElementAutomaton, k: int, event: Event, orders: Sequence[
 
 
 def _emitting_steps(sync: Sync, node: Node, order: str) -> tuple[str, ...]:
-    g = sync.machine.grafcet
-    out = []
-    for s in node.situation.steps:
-        step = g.step(s)
-        if any(act.order == order for act in step.actions):
-            out.append(s)
-    return tuple(out)
+    """The active steps of ``node`` with an action on ``order``."""
+    emitting = {s.name for s in sync.machine.grafcet.steps if any(act.order == order for act in s.actions)}
+    return tuple(s for s in node.situation.steps if s in emitting)
 
 
 def _labels(sync: Sync) -> dict[str, str]:
