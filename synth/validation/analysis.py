@@ -23,6 +23,7 @@ Example
 from __future__ import annotations
 
 from collections import deque
+from operator import attrgetter
 from typing import Iterable
 
 import numpy as np
@@ -124,7 +125,7 @@ def shortest_paths_by_layers(sync: Sync) -> tuple[dict[int, int], dict[int, tupl
     distances and parents, in the same order)."""
     src, dst = sync.edge_arrays()
     n = len(sync.nodes)
-    events = [e.event for e in sync.edges]
+    events = list(map(attrgetter("event"), sync.edges))
     rank = {ev: r for r, ev in enumerate(sorted(set(events)))}
     event = np.fromiter(map(rank.__getitem__, events), dtype=np.int64, count=len(events))
     order = np.lexsort((dst, event, src))  # each node's edges by (event, target)

@@ -36,7 +36,9 @@ def home_states(sync: Sync, conditions: Sequence[Expr]) -> frozenset[int]:
     plant values)."""
     homes = set(sync.initial)
     start = {(n.situation.steps, n.situation.stored, n.plant) for n in (sync.nodes[i] for i in sync.initial)}
-    homes.update(i for i, n in enumerate(sync.nodes) if (n.situation.steps, n.situation.stored, n.plant) in start)
+    plants = {q for _, _, q in start}  # read first: most nodes are elsewhere
+    homes.update(i for i, n in enumerate(sync.nodes)
+                 if n.plant in plants and (n.situation.steps, n.situation.stored, n.plant) in start)
     for i, n in enumerate(sync.nodes if conditions else ()):
         val = sync.plant.valuation(n.plant)
         steps = set(n.situation.step_variables)
