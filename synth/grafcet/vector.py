@@ -225,8 +225,8 @@ class VectorMachine:
         Z = np.zeros(n, dtype=bool)
         steps = np.hstack([A, np.ones((n, 1), dtype=bool)]) if self._sourceless else A
         out = np.asfortranarray(steps[:, self._first_source])  # the transitions enabled
-        for cols, steps in self._more_sources:
-            out[:, cols] &= A[:, steps]
+        for cols, further in self._more_sources:
+            out[:, cols] &= A[:, further]
         for j in np.logical_or.reduce(out, axis=0).nonzero()[0].tolist():
             out[:, j] &= self._rec[j](I, A, T, E, Z)
         return out
@@ -251,7 +251,7 @@ class VectorMachine:
             firing = fire.any(axis=1)
             live, a, t = live[firing], a[firing], t[firing]
             moved[live] = True
-            row, tr = np.nonzero(fire[firing])  # the firing pairs, by row
+            row, tr = fire[firing].nonzero()  # the firing pairs, by row
             deact, conflict = self._sources_of.mark_shared(row, tr, len(live))  # conflict: a step left twice
             act = self._targets_of.mark(row, tr, len(live))
             pending[live[conflict]] = True
@@ -265,7 +265,8 @@ class VectorMachine:
                 t = self._stored_phase(t, act & ~a, ON_ACTIVATION)
             T[live] = t
             live = live[~conflict]
-            ev = np.full(len(live), -1)
+            ev = np.empty(len(live), dtype=np.int64)
+            ev.fill(-1)
         pending[live] = True
         return A, T, moved, pending
 
@@ -328,7 +329,8 @@ class _Lists:
     def _spread(self, row: np.ndarray, item: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(row, column) for each column of each pair's ``item``."""
         counts = self.starts[item + 1] - self.starts[item]
-        at = (self.starts[item] - counts.cumsum() + counts).repeat(counts) + np.arange(int(counts.sum()))
+        ends = counts.cumsum()
+        at = (self.starts[item] - ends + counts).repeat(counts) + np.arange(int(ends[-1]) if ends.size else 0)
         return row.repeat(counts), self.cols[at]
 
     def mark(self, row: np.ndarray, item: np.ndarray, n: int) -> np.ndarray:
@@ -338,7 +340,8 @@ class _Lists:
     def mark_shared(self, row: np.ndarray, item: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
         """:meth:`mark`, and the rows where two pairs' items share a column."""
         r, c = self._spread(row, item)
-        key = np.sort(r * self.width + c)
+        key = r * self.width + c
+        key.sort()
         twice = np.zeros(n, dtype=bool)
         twice[key[1:][key[1:] == key[:-1]] // max(self.width, 1)] = True
         return self._marked(r, c, n), twice

@@ -109,7 +109,7 @@ class _Situations:
 
     def number(self, A: np.ndarray, T: np.ndarray, given: list[Situation] | None = None) -> np.ndarray:
         """The numbers of the rows' situations (a new one numbered when first met)."""
-        bits = np.hstack([A, T])
+        bits = np.concatenate([A, T], axis=1)
         first, inverse, keys = _distinct_keys(bits)
         ids = np.empty(len(first), dtype=np.int64)
         fresh = []
@@ -240,7 +240,7 @@ class _Explorer:
             miss = (found < 0).nonzero()[0]
             first = miss[first_occurrences(keys[miss])]
             emitted = self.orders(sid[first], entry[first])
-            wanted = np.hstack([emitted, np.zeros((len(first), 1), dtype=bool)])[:, self._order_cols]
+            wanted = np.concatenate([emitted, np.zeros((len(first), 1), dtype=bool)], axis=1)[:, self._order_cols]
             _, inverse, rows = _distinct_keys(wanted)
             wid = np.array([self._wanted.setdefault(w, len(self._wanted)) for w in rows], dtype=np.int64)[inverse]
             if len(self._wanted) * self.P >= 1 << 62:
@@ -291,7 +291,8 @@ class _Explorer:
         def made(row: np.ndarray) -> tuple[frozenset[str], tuple[str, ...]]:  # the orders emitted, and those set
             return frozenset(names[i] for i in row[:k].nonzero()[0]), tuple(names[i] for i in row[k:].nonzero()[0])
 
-        wanted, set_ = zip(*_per_row(np.hstack([emitted, emitted & self.pc.values(names, digits)]), made, self._orders))
+        wanted, set_ = zip(*_per_row(np.concatenate([emitted, emitted & self.pc.values(names, digits)], axis=1), made,
+                                     self._orders))
         items, prohs = self.sits.items, self.regions.prohibitions
         self.nodes.extend(many_nodes([items[s] for s in sid.tolist()], map(tuple, digits.full().T.tolist()), wanted, set_,
                                      [prohs[pr] for pr in proh.tolist()]))

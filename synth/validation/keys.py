@@ -38,7 +38,8 @@ class SortedKeys:
         """The value of each key, -1 where absent."""
         if not self.keys.size:
             return np.full(len(keys), -1, dtype=np.int64)
-        pos = np.minimum(np.searchsorted(self.keys, keys), self.keys.size - 1)
+        pos = self.keys.searchsorted(keys)
+        np.minimum(pos, self.keys.size - 1, out=pos)
         return np.where(self.keys[pos] == keys, self.values[pos], -1)
 
     def add(self, keys: np.ndarray, values: np.ndarray) -> None:
@@ -46,7 +47,7 @@ class SortedKeys:
         order = keys.argsort(kind="stable")
         keys, values = keys[order], values[order]
         n, m = self.keys.size, keys.size
-        at = np.searchsorted(self.keys, keys) + np.arange(m)  # the new keys' places in the merged table
+        at = self.keys.searchsorted(keys) + np.arange(m)  # the new keys' places in the merged table
         old = np.ones(n + m, dtype=bool)
         old[at] = False
         merged, merged_values = np.empty(n + m, dtype=np.int64), np.empty(n + m, dtype=np.int64)
@@ -106,7 +107,9 @@ def first_occurrences(keys: np.ndarray) -> np.ndarray:
     change = np.empty(len(s), dtype=bool)
     change[:1] = True
     change[1:] = s[1:] != s[:-1]
-    return np.sort(perm[change])
+    out = perm[change]
+    out.sort()
+    return out
 
 
 def slices(starts: np.ndarray, groups: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -118,5 +121,6 @@ def slices(starts: np.ndarray, groups: np.ndarray) -> tuple[np.ndarray, np.ndarr
     ([3, 2], [2, 3, 4, 0, 1])
     """
     counts = starts[groups + 1] - starts[groups]
-    at = (starts[groups] - counts.cumsum() + counts).repeat(counts) + np.arange(int(counts.sum()))
+    ends = counts.cumsum()
+    at = (starts[groups] - ends + counts).repeat(counts) + np.arange(int(ends[-1]) if ends.size else 0)
     return counts, at

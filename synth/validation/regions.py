@@ -242,7 +242,7 @@ class PlantCodes:
             rows = ok[:, k].nonzero()[0]
             if rows.size:
                 ok[rows, k] = self._guard(k, digits, rows)
-        row, rank = np.nonzero(ok)  # row-major: by row, then rank
+        row, rank = ok.nonzero()  # row-major: by row, then rank
         target = self.step(codes[row], u, rank)
         keep = self.kept(target)  # cannot fail from a SUP state; kept for safety, as the machine's path
         if keep.all():
@@ -365,7 +365,7 @@ def regions(pc: PlantCodes, store: Regions, entries: np.ndarray, wanted: np.ndar
     while cur.size:
         digits = pc.digits(cur)
         c = pc.controllable_moves
-        row, order = np.nonzero(unpack(pc.order_bits(digits) ^ wanted_bits[reg], k))  # the orders to change, row-major
+        row, order = unpack(pc.order_bits(digits) ^ wanted_bits[reg], k).nonzero()  # the orders to change, row-major
         counts, rank = slices(pc.order_starts, order)  # their moves (the region's order of the moves)
         row = row.repeat(counts)
         app = digits.full()[c.axis[rank], row] == c.src[rank]
