@@ -55,7 +55,7 @@ def test_masks_answer_as_the_factors():
             ts = [t for t in p.transitions if t.src == local[t.axis]]
             rng.shuffle(ts)
             expected = [_plain_move(cc, t, local) for t in ts]
-            assert cc.moves(ts, local) == expected, name
+            assert cc.verdicts(ts, local) == expected, name
             assert [cc.move(t, local) for t in ts] == expected, name
             asked += len(ts)
             refused += sum(not ok for ok, _ in expected)

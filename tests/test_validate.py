@@ -173,7 +173,7 @@ class _GridOracle:
             ok = ok and not self.sup.forbid[t.event][local]
         return ok, ([] if ok else self.lazy.move(t, local)[1])
 
-    def moves(self, ts, local):
+    def verdicts(self, ts, local):
         return [self.move(t, local) for t in ts]
 
     def __getattr__(self, name):

@@ -173,9 +173,9 @@ class CompiledConstraints:
     def move(self, t: LocalTransition, local: tuple[int, ...]) -> tuple[bool, list[str]]:
         """Whether SUP allows transition ``t`` from ``local`` (a source in SUP), and if
         not, the ids of the constraints responsible."""
-        return self.moves([t], local)[0]
+        return self.verdicts([t], local)[0]
 
-    def moves(self, ts: Sequence[LocalTransition], local: tuple[int, ...]) -> list[tuple[bool, list[str]]]:
+    def verdicts(self, ts: Sequence[LocalTransition], local: tuple[int, ...]) -> list[tuple[bool, list[str]]]:
         """:meth:`move` of each of ``ts`` from ``local``, the state's masks read once."""
         bits = self._bits()
         edges = bits.edges(local) if bits.of_event else 0

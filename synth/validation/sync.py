@@ -280,7 +280,7 @@ def region(
         progressed = False
         refused: list[Prohibition] = []
         ts = [t for order in orders if val[order] != (order in wanted) for t in moves[order] if t.src == cur[t.axis]]
-        for t, (ok, why) in zip(ts, oracle.moves(ts, cur)):
+        for t, (ok, why) in zip(ts, oracle.verdicts(ts, cur)):
             if not ok:
                 refused.append(Prohibition(t.event, tuple(why)))
                 continue

@@ -77,7 +77,7 @@ def validate(
 ) -> Validation:
     """Run the whole method on a Grafcet and a plant; ``homes`` are ``--home`` conditions."""
     rs, p, g = load_model(grafcet_path, rules_path)
-    return validate_loaded(rs, p, g, expert=expert, homes=homes, max_states=max_states, progress=progress)
+    return validate_loaded(rs, p, g, expert=expert, homes=homes, how=Exploration(max_states, progress))
 
 
 def validate_loaded(
@@ -87,13 +87,10 @@ def validate_loaded(
     *,
     expert: bool = False,
     homes: Sequence[str] = (),
-    max_states: int | None = None,
-    progress: Callable[[int, int], None] | None = None,
-    watch: Callable[[int, int], None] | None = None,
+    how: Exploration = Exploration(),
 ) -> Validation:
-    """:func:`validate` on a rule set, its plant and a Grafcet already loaded;
-    ``progress(aggregated states, states to visit)`` is called now and then, ``watch``
-    after each step of the exploration (:func:`explore`)."""
+    """:func:`validate` on a rule set, its plant and a Grafcet already loaded, SYNC explored
+    as ``how`` says (its limit, progress and watch: :func:`explore`)."""
     conditions = home_conditions(homes, p, g)
     machine = GrafcetMachine(g)
     # the run's objects (nodes, edges, situations, their indexes) make no reference cycles:
@@ -101,7 +98,7 @@ def validate_loaded(
     collecting = gc.isenabled()
     gc.disable()
     try:
-        sync = explore(p, rs.constraints, machine, Exploration(max_states, progress, watch))
+        sync = explore(p, rs.constraints, machine, how)
         sup_empty = not sync.oracle.kept(p.initial)  # the constraints compiled once
         analysis = analyse(sync, home_states(sync, conditions))
         if not (analysis.blocking or analysis.never_starts or analysis.prohibited):  # a passing run imports no diagnosis
