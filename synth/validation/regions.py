@@ -65,6 +65,8 @@ class Digits:
         """Each word of the codes, one column per word (the flat codes themselves when not wide)."""
 
     def __getitem__(self, axis: int) -> np.ndarray:
+        if self._full is not None:
+            return self._full[axis]
         hit = self._axes.get(axis)
         if hit is None:
             pc = self._pc
@@ -86,20 +88,28 @@ class Digits:
             else:
                 lay, words = self._wide
                 self._full = np.ascontiguousarray(lay.decode(words).T)
-            self._axes = dict(enumerate(self._full))
         return self._full
+
+    def moved(self, moves: _Moves, rank: np.ndarray, row: np.ndarray) -> np.ndarray:
+        """The index of the element of move ``rank[i]`` (of ``moves``) at state ``row[i]``."""
+        if self._full is not None:
+            return self._full[moves.axis[rank], row]
+        w = self.codes[row] if self._wide is None else self._wide[1][row, moves.word[rank]]
+        return (w // moves.stride[rank]) % moves.radix[rank]
 
 
 class _Moves:
     """Local transitions as columns: element, source, code difference, order column."""
 
     def __init__(self, moves: list[LocalTransition], strides: tuple[int, ...] | np.ndarray, column: list[int],
-                 word: np.ndarray | None = None) -> None:
+                 word: np.ndarray, shape: tuple[int, ...]) -> None:
         self.moves = moves
         self.axis = np.array([t.axis for t in moves], dtype=np.int64)
         self.src = np.array([t.src for t in moves], dtype=np.int64)
+        self.stride = np.array([int(strides[t.axis]) for t in moves], dtype=np.int64)  # its element's, in its word
+        self.radix = np.array([shape[t.axis] for t in moves], dtype=np.int64)
         self.delta = np.array([(t.dst - t.src) * int(strides[t.axis]) for t in moves], dtype=np.int64)
-        self.word = word[self.axis] if word is not None else np.zeros(len(moves), dtype=np.int64)
+        self.word = word[self.axis]
         self.column = np.array(column, dtype=np.int64)
         self.guarded = [k for k, t in enumerate(moves) if t.guard is not None]
         self.forbidding: list[int] = []  # moves an edge constraint may forbid
@@ -130,9 +140,10 @@ class PlantCodes:
         self.orders = tuple(sorted(self.moves))  # the region's order of the orders
         self._values: dict[tuple[str, ...], Masks] = {}
         self._guards: dict[int, tuple[list[tuple[int, np.ndarray]], np.ndarray]] = {}
-        self._u = _Moves(self.uncontrollable, code_strides, [0] * len(self.uncontrollable), word)
+        self._u = _Moves(self.uncontrollable, code_strides, [0] * len(self.uncontrollable), word, p.shape)
         controllable = [t for o in self.orders for t in self.moves[o]]
-        self._c = _Moves(controllable, code_strides, [j for j, o in enumerate(self.orders) for _ in self.moves[o]], word)
+        self._c = _Moves(controllable, code_strides, [j for j, o in enumerate(self.orders) for _ in self.moves[o]], word,
+                         p.shape)
         self._c.forbidding = [k for k, t in enumerate(controllable) if oracle.edge_terms.get(t.event)]
         self.controllable_moves = self._c
         self.order_starts = np.searchsorted(self._c.column, np.arange(len(self.orders) + 1))
@@ -368,7 +379,7 @@ def regions(pc: PlantCodes, store: Regions, entries: np.ndarray, wanted: np.ndar
         row, order = unpack(pc.order_bits(digits) ^ wanted_bits[reg], k).nonzero()  # the orders to change, row-major
         counts, rank = slices(pc.order_starts, order)  # their moves (the region's order of the moves)
         row = row.repeat(counts)
-        app = digits.full()[c.axis[rank], row] == c.src[rank]
+        app = digits.moved(c, rank, row) == c.src[rank]
         row, rank = row[app], rank[app]  # by row, then rank
         target = pc.step(cur[row], c, rank)
         threat = pc.threats(target)
