@@ -178,9 +178,9 @@ class PlantCodes:
 
     def encode(self, states: list[tuple[int, ...]]) -> np.ndarray:
         """The codes of plant states given as element-local tuples."""
-        if self.layout is None or self.interned is None:
-            return np.array([self.plant.index(q) for q in states], dtype=np.int64)
         local = np.array(states, dtype=np.int64).reshape(len(states), len(self.radix))
+        if self.layout is None or self.interned is None:  # below 2^40 states: the flat code fits
+            return (local * self.strides).sum(axis=1)
         return self.interned.find_or_add(self.layout.encode(local))
 
     def step(self, codes: np.ndarray, moves: _Moves, rank: np.ndarray) -> np.ndarray:
