@@ -128,7 +128,10 @@ def shortest_paths_by_layers(sync: Sync) -> tuple[dict[int, int], dict[int, tupl
     events = list(map(attrgetter("event"), sync.edges))
     rank = {ev: r for r, ev in enumerate(sorted(set(events)))}
     event = np.fromiter(map(rank.__getitem__, events), dtype=np.int64, count=len(events))
-    order = np.lexsort((dst, event, src))  # each node's edges by (event, target)
+    if n * n * max(1, len(rank)) < 1 << 62:  # each node's edges by (event, target): one key, one stable sort
+        order = ((src * len(rank) + event) * n + dst).argsort(kind="stable")
+    else:
+        order = np.lexsort((dst, event, src))
     starts = np.searchsorted(src[order], np.arange(n + 1))
     known = np.zeros(n, dtype=bool)
     layer = np.array(list(dict.fromkeys(sync.initial)), dtype=np.int64)

@@ -397,7 +397,7 @@ class _Explorer:
                 sids.append(self.sits.of([sit]))
         if len(rows) > 1:  # timers: their candidates put in the order of their nodes
             row, rank, entry, nsid, ev = (np.concatenate(x) for x in (rows, ranks, entries, sids, evid))
-            order = np.lexsort((rank, row))
+            order = (row * (int(rank.max()) + 1) + rank).argsort(kind="stable")  # by node, then rank
         else:  # the moves alone, sorted by node then rank already
             ev, order = rank, None
         if traced:
