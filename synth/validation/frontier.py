@@ -48,7 +48,7 @@ from synth.plant.composition import Plant
 from synth.plant.rules import Constraint
 from synth.sup.constraints import CompiledConstraints
 from synth.validation.conflicts import Conflict, ConflictLog
-from synth.validation.keys import ROW_BITS, Collision, SortedKeys, distinct, distinct_rows, first_occurrences, row_codes, slices
+from synth.validation.keys import ROW_BITS, Collision, SortedKeys, distinct, distinct_rows, occurrences, row_codes, slices
 from synth.validation.regions import PlantCodes, Regions, regions
 from synth.validation.sync import Edge, Exploration, Node, Partial, Sync, many_edges, many_nodes, synchronous_product
 
@@ -238,7 +238,8 @@ class _Explorer:
         found = self.entered.find(keys)
         if (found < 0).any():
             miss = (found < 0).nonzero()[0]
-            first = miss[first_occurrences(keys[miss])]
+            first, again = occurrences(keys[miss])
+            first = miss[first]
             emitted = self.orders(sid[first], entry[first])
             wanted = np.concatenate([emitted, np.zeros((len(first), 1), dtype=bool)], axis=1)[:, self._order_cols]
             _, inverse, rows = _distinct_keys(wanted)
@@ -247,20 +248,21 @@ class _Explorer:
                 raise Unsupported("region keys past 64 bits")
             wkeys = wid * self.P + entry[first]
             gid = self.by_wanted.find(wkeys)
-            new = (gid < 0).nonzero()[0]
-            if new.size:
-                new = new[first_occurrences(wkeys[new])]
+            unknown = (gid < 0).nonzero()[0]
+            if unknown.size:
+                new, same = occurrences(wkeys[unknown])
+                new = unknown[new]
                 base = self.regions.count
                 try:
                     regions(self.pc, self.regions, entry[first][new], wanted[new])
                 except OverflowError as err:
                     raise Unsupported(str(err)) from None
                 self.by_wanted.add(wkeys[new], base + np.arange(new.size))
-                gid = self.by_wanted.find(wkeys)
+                gid[unknown] = base + same
             self.entered.add(keys[first], gid)
             counts, at = slices(self.regions.member_starts, gid)
             self.pairs.append(sid[first].repeat(counts) * self.P + self.regions.members[at])
-            found = self.entered.find(keys)
+            found[miss] = gid[again]
         return found
 
     def enter(self, sid: np.ndarray, entry: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -275,11 +277,12 @@ class _Explorer:
         node = self.index.find(keys)
         miss = (node < 0).nonzero()[0]
         if miss.size:
-            first = miss[first_occurrences(keys[miss])]
+            first, again = occurrences(keys[miss])
+            first = miss[first]
             ids = len(self.nodes) + np.arange(first.size)
             self.make_nodes(tsid[first], q[first], proh[first])
             self.index.add(keys[first], ids)
-            node = self.index.find(keys)
+            node[miss] = ids[again]
         return node, src
 
     def make_nodes(self, sid: np.ndarray, q: np.ndarray, proh: np.ndarray) -> None:

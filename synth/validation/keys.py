@@ -17,7 +17,8 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["Collision", "SortedKeys", "ROW_BITS", "distinct", "distinct_rows", "row_codes", "first_occurrences", "slices"]
+__all__ = ["Collision", "SortedKeys", "ROW_BITS", "distinct", "distinct_rows", "row_codes", "first_occurrences", "occurrences",
+           "slices"]
 
 
 class Collision(Exception):
@@ -110,6 +111,28 @@ def first_occurrences(keys: np.ndarray) -> np.ndarray:
     out = perm[change]
     out.sort()
     return out
+
+
+def occurrences(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`first_occurrences`, and for each position the index into them of its key's
+    first occurrence (a table's values for new keys set without looking them up again).
+
+    >>> first, at = occurrences(np.array([7, 3, 7, 5, 3]))
+    >>> first.tolist(), at.tolist()
+    ([0, 1, 3], [0, 1, 0, 2, 1])
+    """
+    perm = keys.argsort(kind="stable")
+    s = keys[perm]
+    change = np.empty(len(s), dtype=bool)
+    change[:1] = True
+    change[1:] = s[1:] != s[:-1]
+    firsts = perm[change]  # each key's first position, the keys in increasing order
+    order = firsts.argsort()  # the keys in order of occurrence
+    rank = np.empty(len(order), dtype=np.int64)
+    rank[order] = np.arange(len(order))
+    at = np.empty(len(keys), dtype=np.int64)
+    at[perm] = rank[change.cumsum() - 1]
+    return firsts[order], at
 
 
 def slices(starts: np.ndarray, groups: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
