@@ -206,6 +206,10 @@ class VectorMachine:
     def situation(self, a: np.ndarray, t: np.ndarray) -> Situation:
         """The situation of one row, as the machine builds it (steps, stored outputs and
         timers in their sorted orders: the columns read in those orders)."""
+        return self.situations(a[None, :], t[None, :])[0]
+
+    def situations(self, A: np.ndarray, T: np.ndarray) -> list[Situation]:
+        """:meth:`situation` of each row, the rows' columns read in one pass each."""
         if self._sorted is None:
             steps = sorted(range(len(self.step_names)), key=lambda i: step_key(self.step_names[i]))
             nt = len(self.timer_names)
@@ -214,9 +218,16 @@ class VectorMachine:
                             np.array(timers, dtype=np.int64), tuple(self.timer_names[i] for i in timers))
         steps_at, step_names, timers_at, timer_names = self._sorted
         nt = len(self.timer_names)
-        return Situation(tuple(step_names[i] for i in a[steps_at].nonzero()[0].tolist()),
-                         tuple(self.stored_names[i] for i in t[nt:].nonzero()[0].tolist()),  # sorted names
-                         tuple(timer_names[i] for i in t[timers_at].nonzero()[0].tolist()), ())
+
+        def named(bits: np.ndarray, labels: tuple[str, ...]) -> list[list[str]]:  # each row's true columns, in order
+            out: list[list[str]] = [[] for _ in range(len(bits))]
+            rows, cols = bits.nonzero()
+            for r, c in zip(rows.tolist(), cols.tolist()):
+                out[r].append(labels[c])
+            return out
+
+        return [Situation(tuple(s), tuple(o), tuple(e), ()) for s, o, e in  # the stored outputs' names are sorted
+                zip(named(A[:, steps_at], step_names), named(T[:, nt:], self.stored_names), named(T[:, timers_at], timer_names))]
 
     # ------------------------------------------------------------------ evolution
     def _fireable(self, A: np.ndarray, T: np.ndarray, I: np.ndarray, E: np.ndarray) -> np.ndarray:

@@ -116,14 +116,14 @@ class _Situations:
         for u, (r, b) in enumerate(zip(first.tolist(), keys)):
             hit = self._ids.get(b)
             if hit is None:
-                hit = self._ids[b] = len(self.items)
-                sit = given[r] if given is not None else self.vm.situation(A[r], T[r])
-                self.items.append(sit)
-                self.timers.append(self.vm.machine.timers(sit))
+                hit = self._ids[b] = len(self.items) + len(fresh)
                 fresh.append(r)
             ids[u] = hit
         out = ids[inverse]
         if fresh:
+            made = [given[r] for r in fresh] if given is not None else self.vm.situations(A[fresh], T[fresh])
+            self.items.extend(made)
+            self.timers.extend(self.vm.machine.timers(sit) for sit in made)
             self.A = np.vstack([self.A, A[fresh]])
             self.T = np.vstack([self.T, T[fresh]])
             self.O = np.vstack([self.O, self.vm.situation_orders(A[fresh], T[fresh])])

@@ -290,7 +290,7 @@ class PlantCodes:
             for j, term in enumerate(terms[c.moves[k].event] if at.size else ()):
                 edge[at, j] = self.holds(term.factors, digits, row[at])
         level = unpack(threats, len(self.oracle.level_terms))
-        bits = np.hstack([edge, level])
+        bits = np.concatenate([edge, level], axis=1)
         rank_bits = len(c.moves).bit_length()
         keys: list[int | tuple[int, bytes]]
         if bits.shape[1] + rank_bits <= ROW_BITS:  # (bits, move) as one integer
@@ -344,7 +344,7 @@ class Regions:
         (indices into ``met``) as one prohibition set: (the states, their set's index in
         :attr:`prohibitions`)."""
         starts = np.concatenate([[True], rows[1:] != rows[:-1]]).nonzero()[0]
-        bounds, ids = np.append(starts, len(rows)).tolist(), refusals.tolist()
+        bounds, ids = starts.tolist() + [len(rows)], refusals.tolist()
         out = np.empty(len(starts), dtype=np.int64)
         for u in range(len(starts)):
             key = tuple(ids[bounds[u]:bounds[u + 1]])
