@@ -148,6 +148,7 @@ class VectorMachine:
                 elif a.kind == STORED and a.condition is not None:
                     self._on_event.append((self._step[s.name], col, a.value, self._compile(a.condition)))
         self._sources_of, self._targets_of = _Lists(src), _Lists(dst)
+        self._shared = bool((src.sum(axis=0) > 1).any())  # a step two transitions leave: firing both is a conflict
         self._timer_cols = _Lists(timers_of)
         self._sets = {when: _Lists(m) for when, m in sets.items() if m.any()}
         self._resets = {when: _Lists(m) for when, m in resets.items() if m.any()}
@@ -263,7 +264,10 @@ class VectorMachine:
             live, a, t = live[firing], a[firing], t[firing]
             moved[live] = True
             row, tr = fire[firing].nonzero()  # the firing pairs, by row
-            deact, conflict = self._sources_of.mark_shared(row, tr, len(live))  # conflict: a step left twice
+            if self._shared:  # conflict: a step left twice
+                deact, conflict = self._sources_of.mark_shared(row, tr, len(live))
+            else:
+                deact, conflict = self._sources_of.mark(row, tr, len(live)), np.zeros(len(live), dtype=bool)
             act = self._targets_of.mark(row, tr, len(live))
             pending[live[conflict]] = True
             A[live] = (a & ~deact) | act
