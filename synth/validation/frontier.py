@@ -112,7 +112,7 @@ class _Situations:
         bits = np.concatenate([A, T], axis=1)
         first, inverse, keys = _distinct_keys(bits)
         ids = np.empty(len(first), dtype=np.int64)
-        fresh = []
+        fresh: list[int] = []
         for u, (r, b) in enumerate(zip(first.tolist(), keys)):
             hit = self._ids.get(b)
             if hit is None:
