@@ -71,10 +71,14 @@ one node at a time (a layer's numpy calls cost more than a small graph's nodes: 
 against 0.06 ms for the analysis of line_8's 48 edges in 32 layers)."""
 
 
-def coreachable(sync: Sync, targets: set[int]) -> set[int]:
+Predecessors = tuple[np.ndarray, np.ndarray]
+"""The edges grouped by target (:func:`_csr` of their targets), made once for an analysis."""
+
+
+def coreachable(sync: Sync, targets: set[int], into: Predecessors | None = None) -> set[int]:
     """Nodes from which some node of ``targets`` is reachable (targets included)."""
     if len(sync.edges) >= LAYERS:
-        return coreachable_by_layers(sync, targets)
+        return coreachable_by_layers(sync, targets, into)
     seen = set(targets)
     queue = deque(sorted(targets))
     while queue:
@@ -86,14 +90,14 @@ def coreachable(sync: Sync, targets: set[int]) -> set[int]:
     return seen
 
 
-def coreachable_by_layers(sync: Sync, targets: set[int]) -> set[int]:
+def coreachable_by_layers(sync: Sync, targets: set[int], into: Predecessors | None = None) -> set[int]:
     """:func:`coreachable`, breadth first backwards a whole layer of predecessors at a time."""
     src, dst = sync.edge_arrays()
     n = len(sync.nodes)
     seen = np.zeros(n, dtype=bool)
     layer = np.array(sorted(targets), dtype=np.int64)
     seen[layer] = True
-    into, starts = _csr(dst, n)
+    into, starts = into if into is not None else _csr(dst, n)
     while layer.size:
         prev = src[into[slices(starts, layer)[1]]]
         prev = prev[~seen[prev]]
@@ -209,7 +213,7 @@ def strongly_connected_components(nodes: list[int], succ: dict[int, list[int]]) 
     return out
 
 
-def held_nodes(sync: Sync) -> set[int]:
+def held_nodes(sync: Sync, into: Predecessors | None = None) -> set[int]:
     """Nodes from which no node with other active steps is reachable: whatever the plant
     and the operator do, the Grafcet stays in these steps for ever.
 
@@ -222,7 +226,7 @@ def held_nodes(sync: Sync) -> set[int]:
         ids: dict[tuple[str, ...], int] = {}
         steps = np.array([ids.setdefault(n.situation.steps, len(ids)) for n in sync.nodes], dtype=np.int64)
         changers = set(src[steps[src] != steps[dst]].tolist())
-    movable = coreachable(sync, changers)
+    movable = coreachable(sync, changers, into)
     return {i for i in range(len(sync.nodes)) if i not in movable}
 
 
@@ -237,13 +241,14 @@ def analyse(sync: Sync, homes: Iterable[int] | None = None) -> Analysis:
     if not sync.nodes:
         return Analysis((), {}, {}, frozenset(), (), {})
     home = set(sync.initial if homes is None else homes)
-    back = coreachable(sync, home)
+    into = _csr(sync.edge_arrays()[1], len(sync.nodes)) if len(sync.edges) >= LAYERS else None  # read twice
+    back = coreachable(sync, home, into)
     dist, parent = shortest_paths(sync)
     stuck = [i for i in range(len(sync.nodes)) if i not in back]
     succ = {i: sorted({e.target for e in sync.successors(i)}) for i in stuck}
     blocking: list[int] = []
     components: dict[int, tuple[int, ...]] = {}
-    held = held_nodes(sync)
+    held = held_nodes(sync, into)
     # a prohibited order holding the Grafcet in its steps for ever: blocking, home or not,
     # once per set of steps, at the nearest such state
     by_steps: dict[tuple[str, ...], list[int]] = {}
