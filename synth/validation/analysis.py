@@ -97,9 +97,9 @@ def coreachable_by_layers(sync: Sync, targets: set[int], into: Predecessors | No
     seen = np.zeros(n, dtype=bool)
     layer = np.array(sorted(targets), dtype=np.int64)
     seen[layer] = True
-    into, starts = into if into is not None else _csr(dst, n)
+    by_target, starts = into if into is not None else _csr(dst, n)
     while layer.size:
-        prev = src[into[slices(starts, layer)[1]]]
+        prev = src[by_target[slices(starts, layer)[1]]]
         prev = prev[~seen[prev]]
         seen[prev] = True
         layer = prev[distinct(prev)[0]]
