@@ -22,11 +22,12 @@ not which constraints forbid them. From that a verdict in plain words:
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import field
 from enum import StrEnum
 from itertools import combinations
 from typing import Any, Iterable, Sequence
 
+from synth.frozen import frozen
 from synth.grafcet.language import step_variable
 from synth.logic.events import Event
 from synth.plant.composition import Plant
@@ -54,7 +55,7 @@ class Verdict(StrEnum):
     UNKNOWN = "unknown"
 
 
-@dataclass(frozen=True)
+@frozen
 class Cause:
     """How an awaited sensor event could happen, seen from its element."""
 
@@ -82,7 +83,7 @@ class Cause:
         }
 
 
-@dataclass(frozen=True)
+@frozen
 class Awaited:
     """A transition a blocked Grafcet waits on, and why it cannot fire."""
 
@@ -109,7 +110,7 @@ class Awaited:
         }
 
 
-@dataclass(frozen=True)
+@frozen
 class Diagnosis:
     """The verdict on a blocking situation (or a Grafcet that never starts), its summary and its causes."""
 

@@ -22,10 +22,11 @@ Example
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
+
+from synth.frozen import frozen
 
 __all__ = ["RUN", "Run", "Runs", "Masks", "pack", "unpack"]
 
@@ -35,7 +36,7 @@ RUN = 4096
 BITS = 63
 
 
-@dataclass(frozen=True)
+@frozen
 class Run:
     """Consecutive elements ``members`` of word ``word``: joint index ``(word // base) % size``."""
 
