@@ -3,8 +3,12 @@
 Each constraint is put in disjunctive normal form; each monomial becomes per-element
 factors (the local states satisfying its level literals on that element). "Can reach a
 violation by uncontrollable events" is then a product of per-element closures
-(see :mod:`synth.sup.supervisor` and ``docs/method.md``). Every query costs
-O(monomials × elements), with no plant grid: this is what on-the-fly validation uses.
+(see :mod:`synth.sup.supervisor` and ``docs/method.md``). The questions about one state
+(kept, threatened, forbidding, move) read the factors as integers, one per element and
+local state whose bit ``i`` says whether term ``i``'s factor holds there: a query is one
+AND per element, with no plant grid (this is what on-the-fly validation uses), and the
+refusals of several moves from one state (:meth:`CompiledConstraints.verdicts`) share the
+state's ANDs.
 
 Example
 -------
