@@ -65,15 +65,20 @@ def _groups(perm: np.ndarray, change: np.ndarray) -> tuple[np.ndarray, np.ndarra
     return perm[change], inverse
 
 
-def distinct(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The distinct keys, in increasing order, as the position of their first occurrence;
-    and each position's rank among them."""
+def _changes(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A stable sorting permutation of ``keys``, and where the sorted keys change (first True)."""
     perm = keys.argsort(kind="stable")
     s = keys[perm]
     change = np.empty(len(s), dtype=bool)
     change[:1] = True
     change[1:] = s[1:] != s[:-1]
-    return _groups(perm, change)
+    return perm, change
+
+
+def distinct(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The distinct keys, in increasing order, as the position of their first occurrence;
+    and each position's rank among them."""
+    return _groups(*_changes(keys))
 
 
 ROW_BITS = 62
@@ -103,11 +108,7 @@ def distinct_rows(bits: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def first_occurrences(keys: np.ndarray) -> np.ndarray:
     """Positions of the first occurrence of each distinct key, in the order they occur."""
-    perm = keys.argsort(kind="stable")
-    s = keys[perm]
-    change = np.empty(len(s), dtype=bool)
-    change[:1] = True
-    change[1:] = s[1:] != s[:-1]
+    perm, change = _changes(keys)
     out = perm[change]
     out.sort()
     return out
@@ -121,18 +122,11 @@ def occurrences(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     >>> first.tolist(), at.tolist()
     ([0, 1, 3], [0, 1, 0, 2, 1])
     """
-    perm = keys.argsort(kind="stable")
-    s = keys[perm]
-    change = np.empty(len(s), dtype=bool)
-    change[:1] = True
-    change[1:] = s[1:] != s[:-1]
-    firsts = perm[change]  # each key's first position, the keys in increasing order
+    firsts, group = distinct(keys)  # each key's first position, the keys in increasing order
     order = firsts.argsort()  # the keys in order of occurrence
     rank = np.empty(len(order), dtype=np.int64)
     rank[order] = np.arange(len(order))
-    at = np.empty(len(keys), dtype=np.int64)
-    at[perm] = rank[change.cumsum() - 1]
-    return firsts[order], at
+    return firsts[order], rank[group]
 
 
 def slices(starts: np.ndarray, groups: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
