@@ -7,7 +7,7 @@ Each measure runs in a fresh process (``python -m synth`` or a short script, tha
 first on ``PYTHONPATH``, run from a neutral folder so the tree is the one imported) and
 is timed in CPU seconds (user + system of the child, ``resource.getrusage``): the machine
 is shared, wall time says little. Trees and runs are interleaved, so a change in the
-load hits every tree alike; the minimum of the runs is printed.
+load hits every tree alike; the minimum of the runs is printed, then their median.
 
 - ``four cylinders``: ``synth validate grafcets/four_cylinders.g7 --plant plants/four_cylinders.rules``
   (the whole command: start, constraints, SYNC, diagnosis, report text), its constraint
@@ -28,6 +28,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -106,6 +107,8 @@ def main() -> int:
         for name, argv in todo.items():
             best: dict[Path, str] = {}
             cpu: dict[Path, float] = {}
+            every: dict[Path, list[float]] = {tree: [] for tree in trees}  # the measure of each run, for the median
+            per_state = name.startswith("explicit ") and not name.startswith("explicit sup")  # µs per SYNC state
             for _ in range(args.runs):
                 for tree in trees:
                     seconds, out, code, peak = _child(tree, argv, args.timeout)
@@ -121,10 +124,14 @@ def main() -> int:
                         text = f"{seconds:.2f} CPU s, {data['states']} SYNC states, {1e6 * seconds / data['states']:.0f} µs/state"
                     else:
                         text = f"{seconds:.2f} CPU s"
+                    every[tree].append(1e6 * seconds / data["states"] if per_state else seconds)
                     if tree not in cpu or seconds < cpu[tree]:
                         cpu[tree], best[tree] = seconds, text
             for tree in trees:
-                print(f"{name:22} {str(tree):30} {best.get(tree, '-')}", flush=True)
+                runs = sorted(every[tree])
+                median = "" if not runs else (f", median {statistics.median(runs):.1f} µs/state" if per_state
+                                              else f", median {statistics.median(runs):.2f} CPU s")
+                print(f"{name:22} {str(tree):30} {best.get(tree, '-')}{median}", flush=True)
     return 0
 
 

@@ -326,12 +326,14 @@ def validate_models(
     if g.semantics is not Semantics.GRAFCET:
         options.add(Need.SFC)
 
+    from synth.validation.sync import Exploration
     from synth.validation.validate import validate_loaded
 
     explored = None
     if progress is not None:
         def explored(n: int, pending: int, show: Callable[[str], None] = progress) -> None:
             show(f"exploring SYNC: {n} aggregated states, {pending} to visit")
+    how = Exploration(max_states, explored)  # the explicit engine's run, watched or not
 
     ran: list[Validation] = []
 
@@ -339,8 +341,7 @@ def validate_models(
         from synth.probe import measure
 
         assert t.points is not None
-        counts, done = measure(rs, p, g, t.points, expert=expert, homes=homes, max_states=max_states,
-                               progress=explored)
+        counts, done = measure(rs, p, g, t.points, expert=expert, homes=homes, how=how)
         ran.extend([done] if done is not None else [])
         return counts
 
@@ -357,9 +358,9 @@ def validate_models(
         try:
             return symbolic(rs, p, g, expert=expert, homes=homes, max_nodes=max_nodes, progress=progress)
         except OutOfRange:  # the explicit engine says it with the shortest trace
-            validate_loaded(rs, p, g, expert=expert, homes=homes, max_states=max_states)
+            validate_loaded(rs, p, g, expert=expert, homes=homes, how=Exploration(max_states))
             raise
-    return validate_loaded(rs, p, g, expert=expert, homes=homes, max_states=max_states, progress=explored)
+    return validate_loaded(rs, p, g, expert=expert, homes=homes, how=how)
 
 
 @frozen

@@ -43,6 +43,7 @@ if TYPE_CHECKING:  # pragma: no cover - imported when measuring: synth.engines r
     from synth.plant.composition import Plant
     from synth.plant.rules import RuleSet
     from synth.validation.result import Validation
+    from synth.validation.sync import Exploration
 
 __all__ = ["Stop", "Points", "Growth", "measure"]
 
@@ -137,22 +138,24 @@ class _Watch:
 
 
 def measure(rs: RuleSet, p: Plant, g: Grafcet, points: Points, *, expert: bool = False, homes: Sequence[str] = (),
-            max_states: int | None = None,
-            progress: Callable[[int, int], None] | None = None) -> tuple[Growth, Validation | None]:
+            how: Exploration | None = None) -> tuple[Growth, Validation | None]:
     """What ``validate --engine auto`` measures (see the module docstring): the counts, and
     the explicit engine's result when it is the one to keep (:attr:`Stop.RAN`,
     :attr:`Stop.NARROW`); None when the symbolic engine is to run (:attr:`Stop.STEEP`) or
     the explicit engine is to run again and say where a variable went out of range
-    (:attr:`Stop.ERROR`). ``max_states`` bounds the run as it bounds the explicit engine: met
-    before the decision point, the counts there decide (the explicit engine, chosen, says
-    it is over); ``progress``: the explicit engine's progress lines."""
+    (:attr:`Stop.ERROR`). ``how``: the explicit engine's exploration (watched here): its
+    ``max_states`` bounds the run as it bounds the explicit engine (met before the decision
+    point, the counts there decide; the explicit engine, chosen, says it is over), its
+    ``progress`` gets the explicit engine's progress."""
+    from dataclasses import replace
+
     from synth.grafcet.situation import OutOfRange
+    from synth.validation.sync import Exploration
     from synth.validation.validate import validate_loaded
 
     watch = _Watch(p, g, points)
     try:
-        done = validate_loaded(rs, p, g, expert=expert, homes=homes, max_states=max_states, progress=progress,
-                               watch=watch)
+        done = validate_loaded(rs, p, g, expert=expert, homes=homes, how=replace(how or Exploration(), watch=watch))
     except _Steep:
         assert watch.growth is not None
         return watch.growth, None

@@ -10,6 +10,7 @@ import json
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from synth.errors import InputError, SynthError
@@ -437,3 +438,20 @@ def test_random_grafcets_with_stored_actions(tmp_path):
         compared += 1
         stored += any(n.situation.stored for n in a.nodes)
     assert compared >= 16 and stored >= 4
+
+
+def test_occurrences_against_a_plain_reading():
+    """keys.occurrences: each distinct key's first position in order of occurrence, and for
+    each position the rank of its key among them (what a dictionary filled in order gives)."""
+    from synth.validation.keys import occurrences
+
+    rng = np.random.default_rng(37)
+    for size in (0, 1, 2, 17, 300):
+        keys = rng.integers(0, max(1, size // 3), size)
+        first, at = occurrences(keys)
+        seen: dict[int, int] = {}
+        for i, k in enumerate(keys.tolist()):
+            seen.setdefault(k, i)
+        assert first.tolist() == list(seen.values())
+        rank = {k: r for r, k in enumerate(seen)}
+        assert at.tolist() == [rank[k] for k in keys.tolist()]

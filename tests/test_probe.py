@@ -17,6 +17,7 @@ from synth.errors import LimitExceeded
 from synth.grafcet.situation import OutOfRange
 from synth.probe import Growth, Points, Stop, measure
 from synth.validation.result import load_model
+from synth.validation.sync import Exploration
 from synth.validation.validate import validate_loaded
 
 from conftest import ROOT
@@ -157,11 +158,11 @@ def test_a_limit_met_before_the_decision_point_is_judged_there(tmp_path):
     steep, the symbolic engine runs (it has no such bound), narrow, the explicit engine's
     limit is the error."""
     rs, p, g = model("par", 7, tmp_path)
-    counts, done = measure(rs, p, g, POINTS, max_states=300)
+    counts, done = measure(rs, p, g, POINTS, how=Exploration(300))
     assert (counts.stop, counts.met, counts.waiting, done) == (Stop.STEEP, 148, 106, None)
     rs, p, g = model("branches", 3, tmp_path)
     with pytest.raises(LimitExceeded, match="more than 300 aggregated states"):
-        measure(rs, p, g, POINTS, max_states=300)
+        measure(rs, p, g, POINTS, how=Exploration(300))
 
 
 def test_an_assignment_out_of_range_stops_the_run_and_the_explicit_engine_says_where(tmp_path):

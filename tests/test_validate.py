@@ -173,6 +173,9 @@ class _GridOracle:
             ok = ok and not self.sup.forbid[t.event][local]
         return ok, ([] if ok else self.lazy.move(t, local)[1])
 
+    def verdicts(self, ts, local):
+        return [self.move(t, local) for t in ts]
+
     def __getattr__(self, name):
         return getattr(self.lazy, name)
 

@@ -125,7 +125,10 @@ class VectorMachine:
         self._first_source = np.array([self._step[t.sources[0]] if t.sources else len(self.step_names)
                                        for t in trans], dtype=np.int64)
         self._sourceless = any(not t.sources for t in trans)
-        self._more_sources = [(j, self._step[s]) for j, t in enumerate(trans) for s in t.sources[1:]]
+        # the k-th further source of every transition that has one, one pass per k
+        self._more_sources = [(np.array([j for j, t in enumerate(trans) if len(t.sources) > k], dtype=np.int64),
+                               np.array([self._step[t.sources[k]] for t in trans if len(t.sources) > k], dtype=np.int64))
+                              for k in range(1, max((len(t.sources) for t in trans), default=0))]
         self.stored_names = tuple(sorted({a.order for s in g.steps for a in s.actions if a.kind == STORED}))
         nt = len(self.timer_names)
         self.memory = nt + len(self.stored_names)
@@ -145,6 +148,7 @@ class VectorMachine:
                 elif a.kind == STORED and a.condition is not None:
                     self._on_event.append((self._step[s.name], col, a.value, self._compile(a.condition)))
         self._sources_of, self._targets_of = _Lists(src), _Lists(dst)
+        self._shared = bool((src.sum(axis=0) > 1).any())  # a step two transitions leave: firing both is a conflict
         self._timer_cols = _Lists(timers_of)
         self._sets = {when: _Lists(m) for when, m in sets.items() if m.any()}
         self._resets = {when: _Lists(m) for when, m in resets.items() if m.any()}
@@ -203,6 +207,10 @@ class VectorMachine:
     def situation(self, a: np.ndarray, t: np.ndarray) -> Situation:
         """The situation of one row, as the machine builds it (steps, stored outputs and
         timers in their sorted orders: the columns read in those orders)."""
+        return self.situations(a[None, :], t[None, :])[0]
+
+    def situations(self, A: np.ndarray, T: np.ndarray) -> list[Situation]:
+        """:meth:`situation` of each row, the rows' columns read in one pass each."""
         if self._sorted is None:
             steps = sorted(range(len(self.step_names)), key=lambda i: step_key(self.step_names[i]))
             nt = len(self.timer_names)
@@ -211,9 +219,16 @@ class VectorMachine:
                             np.array(timers, dtype=np.int64), tuple(self.timer_names[i] for i in timers))
         steps_at, step_names, timers_at, timer_names = self._sorted
         nt = len(self.timer_names)
-        return Situation(tuple(step_names[i] for i in a[steps_at].nonzero()[0].tolist()),
-                         tuple(self.stored_names[i] for i in t[nt:].nonzero()[0].tolist()),  # sorted names
-                         tuple(timer_names[i] for i in t[timers_at].nonzero()[0].tolist()), ())
+
+        def named(bits: np.ndarray, labels: tuple[str, ...]) -> list[list[str]]:  # each row's true columns, in order
+            out: list[list[str]] = [[] for _ in range(len(bits))]
+            rows, cols = bits.nonzero()
+            for r, c in zip(rows.tolist(), cols.tolist()):
+                out[r].append(labels[c])
+            return out
+
+        return [Situation(tuple(s), tuple(o), tuple(e), ()) for s, o, e in  # the stored outputs' names are sorted
+                zip(named(A[:, steps_at], step_names), named(T[:, nt:], self.stored_names), named(T[:, timers_at], timer_names))]
 
     # ------------------------------------------------------------------ evolution
     def _fireable(self, A: np.ndarray, T: np.ndarray, I: np.ndarray, E: np.ndarray) -> np.ndarray:
@@ -222,8 +237,8 @@ class VectorMachine:
         Z = np.zeros(n, dtype=bool)
         steps = np.hstack([A, np.ones((n, 1), dtype=bool)]) if self._sourceless else A
         out = np.asfortranarray(steps[:, self._first_source])  # the transitions enabled
-        for j, s in self._more_sources:
-            out[:, j] &= A[:, s]
+        for cols, further in self._more_sources:
+            out[:, cols] &= A[:, further]
         for j in np.logical_or.reduce(out, axis=0).nonzero()[0].tolist():
             out[:, j] &= self._rec[j](I, A, T, E, Z)
         return out
@@ -248,8 +263,11 @@ class VectorMachine:
             firing = fire.any(axis=1)
             live, a, t = live[firing], a[firing], t[firing]
             moved[live] = True
-            row, tr = np.nonzero(fire[firing])  # the firing pairs, by row
-            deact, conflict = self._sources_of.mark_shared(row, tr, len(live))  # conflict: a step left twice
+            row, tr = fire[firing].nonzero()  # the firing pairs, by row
+            if self._shared:  # conflict: a step left twice
+                deact, conflict = self._sources_of.mark_shared(row, tr, len(live))
+            else:
+                deact, conflict = self._sources_of.mark(row, tr, len(live)), np.zeros(len(live), dtype=bool)
             act = self._targets_of.mark(row, tr, len(live))
             pending[live[conflict]] = True
             A[live] = (a & ~deact) | act
@@ -262,7 +280,8 @@ class VectorMachine:
                 t = self._stored_phase(t, act & ~a, ON_ACTIVATION)
             T[live] = t
             live = live[~conflict]
-            ev = np.full(len(live), -1)
+            ev = np.empty(len(live), dtype=np.int64)
+            ev.fill(-1)
         pending[live] = True
         return A, T, moved, pending
 
@@ -325,7 +344,8 @@ class _Lists:
     def _spread(self, row: np.ndarray, item: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(row, column) for each column of each pair's ``item``."""
         counts = self.starts[item + 1] - self.starts[item]
-        at = (self.starts[item] - counts.cumsum() + counts).repeat(counts) + np.arange(int(counts.sum()))
+        ends = counts.cumsum()
+        at = (self.starts[item] - ends + counts).repeat(counts) + np.arange(int(ends[-1]) if ends.size else 0)
         return row.repeat(counts), self.cols[at]
 
     def mark(self, row: np.ndarray, item: np.ndarray, n: int) -> np.ndarray:
@@ -335,7 +355,8 @@ class _Lists:
     def mark_shared(self, row: np.ndarray, item: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
         """:meth:`mark`, and the rows where two pairs' items share a column."""
         r, c = self._spread(row, item)
-        key = np.sort(r * self.width + c)
+        key = r * self.width + c
+        key.sort()
         twice = np.zeros(n, dtype=bool)
         twice[key[1:][key[1:] == key[:-1]] // max(self.width, 1)] = True
         return self._marked(r, c, n), twice

@@ -3,8 +3,12 @@
 Each constraint is put in disjunctive normal form; each monomial becomes per-element
 factors (the local states satisfying its level literals on that element). "Can reach a
 violation by uncontrollable events" is then a product of per-element closures
-(see :mod:`synth.sup.supervisor` and ``docs/method.md``). Every query costs
-O(monomials × elements), with no plant grid: this is what on-the-fly validation uses.
+(see :mod:`synth.sup.supervisor` and ``docs/method.md``). The questions about one state
+(kept, threatened, forbidding, move) read the factors as integers, one per element and
+local state whose bit ``i`` says whether term ``i``'s factor holds there: a query is one
+AND per element, with no plant grid (this is what on-the-fly validation uses), and the
+refusals of several moves from one state (:meth:`CompiledConstraints.verdicts`) share the
+state's ANDs.
 
 Example
 -------
@@ -123,21 +127,21 @@ class CompiledConstraints:
         # (a move depends on other elements' values); one exact grid per term instead
         self.reach_grids: list[np.ndarray] | None = _reach_grids(p, self.constraints, self.level_terms) if p.reads else None
         self._kept: dict[tuple[int, ...], bool] = {}
+        self._masks: _Bits | None = None
+        self._level_names: dict[int, list[str]] = {}
         self.edge_terms: dict[str, list[Term]] = {}
         for t in self.terms:
             if t.event is not None:
                 self.edge_terms.setdefault(t.event, []).append(t)
 
-
     # ------------------------------------------------------------------ one state at a time
-    @staticmethod
-    def _ids(pairs: Iterable[tuple[Term, Sequence[tuple[int, np.ndarray]]]], local: tuple[int, ...]) -> list[str]:
-        """Constraint ids (first-seen order, no repeats) of the terms whose factors hold at ``local``."""
-        ids: list[str] = []
-        for term, factors in pairs:
-            if term.constraint not in ids and all(vec[local[a]] for a, vec in factors):
-                ids.append(term.constraint)
-        return ids
+    def _bits(self) -> _Bits:
+        """The level terms' reach factors and the edge terms' factors as bit masks per
+        element and local state (made on the first question of one state)."""
+        if self._masks is None:
+            self._masks = _Bits(self.plant, self.level_reach if self.reach_grids is None else None,
+                                [t for t in self.terms if t.event is not None])
+        return self._masks
 
     def kept(self, local: tuple[int, ...]) -> bool:
         """No constraint violation is reachable from ``local`` by uncontrollable events
@@ -147,29 +151,132 @@ class CompiledConstraints:
             if self.reach_grids is not None:
                 hit = not any(g[local] for g in self.reach_grids)
             else:
-                hit = not any(all(vec[local[a]] for a, vec in factors) for factors in self.level_reach)
+                hit = not self._bits().reach(local)
             self._kept[local] = hit
         return hit
 
     def violated(self, local: tuple[int, ...]) -> list[str]:
         """Ids of the constraints the state violates (levels)."""
-        return self._ids(((t, t.factors) for t in self.level_terms), local)
+        ids: list[str] = []
+        for term in self.level_terms:
+            if term.constraint not in ids and all(vec[local[a]] for a, vec in term.factors):
+                ids.append(term.constraint)
+        return ids
 
     def threatened(self, local: tuple[int, ...]) -> list[str]:
         """Ids of the constraints whose violation is reachable by uncontrollable events."""
         if self.reach_grids is not None:
             return list(dict.fromkeys(t.constraint for t, g in zip(self.level_terms, self.reach_grids) if g[local]))
-        return self._ids(zip(self.level_terms, self.level_reach), local)
+        return self._level_ids(self._bits().reach(local))
 
     def forbidding(self, event: str, local: tuple[int, ...]) -> list[str]:
         """Ids of the edge constraints that forbid controllable ``event`` in this state."""
-        return self._ids(((t, t.factors) for t in self.edge_terms.get(event, ())), local)
+        bits = self._bits()
+        return bits.edge_ids(bits.edges(local) & bits.of_event.get(event, 0))
 
     def move(self, t: LocalTransition, local: tuple[int, ...]) -> tuple[bool, list[str]]:
         """Whether SUP allows transition ``t`` from ``local`` (a source in SUP), and if
         not, the ids of the constraints responsible."""
-        target = list(local)
-        target[t.axis] = t.dst
-        why = self.forbidding(t.event, local) if t.controllable else []
-        why += [c for c in self.threatened(tuple(target)) if c not in why]
-        return (not why, why)
+        return self.verdicts([t], local)[0]
+
+    def verdicts(self, ts: Sequence[LocalTransition], local: tuple[int, ...]) -> list[tuple[bool, list[str]]]:
+        """:meth:`move` of each of ``ts`` from ``local``, the state's masks read once."""
+        bits = self._bits()
+        edges = bits.edges(local) if bits.of_event else 0
+        if self.reach_grids is None:
+            others = bits.reach_without(local)
+            reach = bits.reach_table
+        out = []
+        for t in ts:
+            why = bits.edge_ids(edges & bits.of_event.get(t.event, 0)) if t.controllable and edges else []
+            if self.reach_grids is None:
+                threat = self._level_ids(others[t.axis] & reach[t.axis][t.dst])
+            else:
+                target = list(local)
+                target[t.axis] = t.dst
+                threat = self.threatened(tuple(target))
+            if why:
+                why += [c for c in threat if c not in why]
+            else:
+                why = threat
+            out.append((not why, why))
+        return out
+
+    def _level_ids(self, mask: int) -> list[str]:
+        """Constraint ids (first-seen order, no repeats) of the level terms in ``mask``."""
+        hit = self._level_names.get(mask)
+        if hit is None:
+            hit = self._level_names[mask] = _ids(self.level_terms, mask)
+        return list(hit)
+
+
+def _ids(terms: Sequence[Term], mask: int) -> list[str]:
+    """Constraint ids (first-seen order, no repeats) of the terms whose bit is in ``mask``."""
+    return list(dict.fromkeys(terms[i].constraint for i in range(mask.bit_length()) if mask >> i & 1))
+
+
+class _Bits:
+    """Per element and local state, an integer whose bit ``i`` says that term ``i``'s factor
+    on that element holds there (set where the term has no factor on the element): a term
+    holds at a state when its bit survives the AND over the elements. ``reach_table``: the
+    level terms' reach factors (none where the plant's elements read each other);
+    ``edge_table``: the edge terms' factors, ``of_event``: each event's edge terms."""
+
+    def __init__(self, p: Plant, level_reach: Sequence[Sequence[tuple[int, np.ndarray]]] | None,
+                 edge_terms: list[Term]) -> None:
+        self.reach_table = self._table(p, level_reach or [])
+        self.reach_full = (1 << len(level_reach or [])) - 1
+        self.edge_terms = edge_terms
+        self.edge_table = self._table(p, [t.factors for t in edge_terms])
+        self.edge_full = (1 << len(edge_terms)) - 1
+        self.of_event: dict[str, int] = {}
+        for i, t in enumerate(edge_terms):
+            assert t.event is not None
+            self.of_event[t.event] = self.of_event.get(t.event, 0) | 1 << i
+        self._edge_names: dict[int, list[str]] = {}
+
+    @staticmethod
+    def _table(p: Plant, factors: Sequence[Sequence[tuple[int, np.ndarray]]]) -> list[list[int]]:
+        full = (1 << len(factors)) - 1
+        table = [[full] * n for n in p.shape]
+        for i, term in enumerate(factors):
+            for a, vec in term:
+                row = table[a]
+                for s in (~vec.astype(bool)).nonzero()[0].tolist():
+                    row[s] &= ~(1 << i)
+        return table
+
+    def reach(self, local: tuple[int, ...]) -> int:
+        """The level terms whose violation ``local`` can reach."""
+        out = self.reach_full
+        for row, s in zip(self.reach_table, local):
+            out &= row[s]
+        return out
+
+    def reach_without(self, local: tuple[int, ...]) -> list[int]:
+        """Per element ``a``, :meth:`reach` of ``local`` with element ``a`` left out (a move
+        of ``a`` then ANDs its target's row)."""
+        n = len(local)
+        before, after = [self.reach_full] * (n + 1), [self.reach_full] * (n + 1)
+        table = self.reach_table
+        for a in range(n):
+            before[a + 1] = before[a] & table[a][local[a]]
+        for a in range(n - 1, -1, -1):
+            after[a] = after[a + 1] & table[a][local[a]]
+        return [before[a] & after[a + 1] for a in range(n)]
+
+    def edges(self, local: tuple[int, ...]) -> int:
+        """The edge terms whose level factors hold at ``local``."""
+        out = self.edge_full
+        for row, s in zip(self.edge_table, local):
+            out &= row[s]
+        return out
+
+    def edge_ids(self, mask: int) -> list[str]:
+        """Constraint ids (first-seen order, no repeats) of the edge terms in ``mask``."""
+        if not mask:
+            return []
+        hit = self._edge_names.get(mask)
+        if hit is None:
+            hit = self._edge_names[mask] = _ids(self.edge_terms, mask)
+        return list(hit)

@@ -23,6 +23,7 @@ Example
 from __future__ import annotations
 
 from collections import deque
+from operator import attrgetter
 from typing import Iterable
 
 import numpy as np
@@ -70,10 +71,14 @@ one node at a time (a layer's numpy calls cost more than a small graph's nodes: 
 against 0.06 ms for the analysis of line_8's 48 edges in 32 layers)."""
 
 
-def coreachable(sync: Sync, targets: set[int]) -> set[int]:
+Predecessors = tuple[np.ndarray, np.ndarray]
+"""The edges grouped by target (:func:`_csr` of their targets), made once for an analysis."""
+
+
+def coreachable(sync: Sync, targets: set[int], into: Predecessors | None = None) -> set[int]:
     """Nodes from which some node of ``targets`` is reachable (targets included)."""
     if len(sync.edges) >= LAYERS:
-        return coreachable_by_layers(sync, targets)
+        return coreachable_by_layers(sync, targets, into)
     seen = set(targets)
     queue = deque(sorted(targets))
     while queue:
@@ -85,16 +90,16 @@ def coreachable(sync: Sync, targets: set[int]) -> set[int]:
     return seen
 
 
-def coreachable_by_layers(sync: Sync, targets: set[int]) -> set[int]:
+def coreachable_by_layers(sync: Sync, targets: set[int], into: Predecessors | None = None) -> set[int]:
     """:func:`coreachable`, breadth first backwards a whole layer of predecessors at a time."""
     src, dst = sync.edge_arrays()
     n = len(sync.nodes)
     seen = np.zeros(n, dtype=bool)
     layer = np.array(sorted(targets), dtype=np.int64)
     seen[layer] = True
-    into, starts = _csr(dst, n)
+    by_target, starts = into if into is not None else _csr(dst, n)
     while layer.size:
-        prev = src[into[slices(starts, layer)[1]]]
+        prev = src[by_target[slices(starts, layer)[1]]]
         prev = prev[~seen[prev]]
         seen[prev] = True
         layer = prev[distinct(prev)[0]]
@@ -124,10 +129,13 @@ def shortest_paths_by_layers(sync: Sync) -> tuple[dict[int, int], dict[int, tupl
     distances and parents, in the same order)."""
     src, dst = sync.edge_arrays()
     n = len(sync.nodes)
-    events = [e.event for e in sync.edges]
+    events = list(map(attrgetter("event"), sync.edges))
     rank = {ev: r for r, ev in enumerate(sorted(set(events)))}
     event = np.fromiter(map(rank.__getitem__, events), dtype=np.int64, count=len(events))
-    order = np.lexsort((dst, event, src))  # each node's edges by (event, target)
+    if n * n * max(1, len(rank)) < 1 << 62:  # each node's edges by (event, target): one key, one stable sort
+        order = ((src * len(rank) + event) * n + dst).argsort(kind="stable")
+    else:
+        order = np.lexsort((dst, event, src))
     starts = np.searchsorted(src[order], np.arange(n + 1))
     known = np.zeros(n, dtype=bool)
     layer = np.array(list(dict.fromkeys(sync.initial)), dtype=np.int64)
@@ -205,7 +213,7 @@ def strongly_connected_components(nodes: list[int], succ: dict[int, list[int]]) 
     return out
 
 
-def held_nodes(sync: Sync) -> set[int]:
+def held_nodes(sync: Sync, into: Predecessors | None = None) -> set[int]:
     """Nodes from which no node with other active steps is reachable: whatever the plant
     and the operator do, the Grafcet stays in these steps for ever.
 
@@ -218,7 +226,7 @@ def held_nodes(sync: Sync) -> set[int]:
         ids: dict[tuple[str, ...], int] = {}
         steps = np.array([ids.setdefault(n.situation.steps, len(ids)) for n in sync.nodes], dtype=np.int64)
         changers = set(src[steps[src] != steps[dst]].tolist())
-    movable = coreachable(sync, changers)
+    movable = coreachable(sync, changers, into)
     return {i for i in range(len(sync.nodes)) if i not in movable}
 
 
@@ -233,13 +241,14 @@ def analyse(sync: Sync, homes: Iterable[int] | None = None) -> Analysis:
     if not sync.nodes:
         return Analysis((), {}, {}, frozenset(), (), {})
     home = set(sync.initial if homes is None else homes)
-    back = coreachable(sync, home)
+    into = _csr(sync.edge_arrays()[1], len(sync.nodes)) if len(sync.edges) >= LAYERS else None  # read twice
+    back = coreachable(sync, home, into)
     dist, parent = shortest_paths(sync)
     stuck = [i for i in range(len(sync.nodes)) if i not in back]
     succ = {i: sorted({e.target for e in sync.successors(i)}) for i in stuck}
     blocking: list[int] = []
     components: dict[int, tuple[int, ...]] = {}
-    held = held_nodes(sync)
+    held = held_nodes(sync, into)
     # a prohibited order holding the Grafcet in its steps for ever: blocking, home or not,
     # once per set of steps, at the nearest such state
     by_steps: dict[tuple[str, ...], list[int]] = {}

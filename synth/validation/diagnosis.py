@@ -22,11 +22,12 @@ not which constraints forbid them. From that a verdict in plain words:
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import field
 from enum import StrEnum
 from itertools import combinations
 from typing import Any, Iterable, Sequence
 
+from synth.frozen import frozen
 from synth.grafcet.language import step_variable
 from synth.logic.events import Event
 from synth.plant.composition import Plant
@@ -54,7 +55,7 @@ class Verdict(StrEnum):
     UNKNOWN = "unknown"
 
 
-@dataclass(frozen=True)
+@frozen
 class Cause:
     """How an awaited sensor event could happen, seen from its element."""
 
@@ -82,7 +83,7 @@ class Cause:
         }
 
 
-@dataclass(frozen=True)
+@frozen
 class Awaited:
     """A transition a blocked Grafcet waits on, and why it cannot fire."""
 
@@ -109,7 +110,7 @@ class Awaited:
         }
 
 
-@dataclass(frozen=True)
+@frozen
 class Diagnosis:
     """The verdict on a blocking situation (or a Grafcet that never starts), its summary and its causes."""
 
@@ -182,13 +183,9 @@ def _fewest_changes(a: ElementAutomaton, k: int, event: Event, orders: Sequence[
 
 
 def _emitting_steps(sync: Sync, node: Node, order: str) -> tuple[str, ...]:
-    g = sync.machine.grafcet
-    out = []
-    for s in node.situation.steps:
-        step = g.step(s)
-        if any(act.order == order for act in step.actions):
-            out.append(s)
-    return tuple(out)
+    """The active steps of ``node`` with an action on ``order``."""
+    emitting = {s.name for s in sync.machine.grafcet.steps if any(act.order == order for act in s.actions)}
+    return tuple(s for s in node.situation.steps if s in emitting)
 
 
 def _labels(sync: Sync) -> dict[str, str]:

@@ -48,7 +48,7 @@ from synth.plant.composition import Plant
 from synth.plant.rules import Constraint
 from synth.sup.constraints import CompiledConstraints
 from synth.validation.conflicts import Conflict, ConflictLog
-from synth.validation.keys import ROW_BITS, Collision, SortedKeys, distinct, distinct_rows, first_occurrences, row_codes, slices
+from synth.validation.keys import ROW_BITS, Collision, SortedKeys, distinct, distinct_rows, occurrences, row_codes, slices
 from synth.validation.regions import PlantCodes, Regions, regions
 from synth.validation.sync import Edge, Exploration, Node, Partial, Sync, many_edges, many_nodes, synchronous_product
 
@@ -109,21 +109,21 @@ class _Situations:
 
     def number(self, A: np.ndarray, T: np.ndarray, given: list[Situation] | None = None) -> np.ndarray:
         """The numbers of the rows' situations (a new one numbered when first met)."""
-        bits = np.hstack([A, T])
+        bits = np.concatenate([A, T], axis=1)
         first, inverse, keys = _distinct_keys(bits)
         ids = np.empty(len(first), dtype=np.int64)
-        fresh = []
+        fresh: list[int] = []
         for u, (r, b) in enumerate(zip(first.tolist(), keys)):
             hit = self._ids.get(b)
             if hit is None:
-                hit = self._ids[b] = len(self.items)
-                sit = given[r] if given is not None else self.vm.situation(A[r], T[r])
-                self.items.append(sit)
-                self.timers.append(self.vm.machine.timers(sit))
+                hit = self._ids[b] = len(self.items) + len(fresh)
                 fresh.append(r)
             ids[u] = hit
         out = ids[inverse]
         if fresh:
+            made = [given[r] for r in fresh] if given is not None else self.vm.situations(A[fresh], T[fresh])
+            self.items.extend(made)
+            self.timers.extend(self.vm.machine.timers(sit) for sit in made)
             self.A = np.vstack([self.A, A[fresh]])
             self.T = np.vstack([self.T, T[fresh]])
             self.O = np.vstack([self.O, self.vm.situation_orders(A[fresh], T[fresh])])
@@ -213,8 +213,7 @@ class _Explorer:
         self.targets: list[np.ndarray] = []
         self.conflicts: list[Conflict] = []
         self.log = ConflictLog()
-        self._emitted: dict[int | bytes, frozenset[str]] = {}  # a node's orders, per row of bits
-        self._set: dict[int | bytes, tuple[str, ...]] = {}
+        self._orders: dict[int | bytes, tuple[frozenset[str], tuple[str, ...]]] = {}  # a node's orders, per row of bits
         self.pairs: list[np.ndarray] = []  # (situation, member) keys of the regions entered
         # the Grafcet's order columns in the regions' order of the plant's orders
         self._move_events = [t.event for t in self.pc.uncontrollable]
@@ -239,29 +238,31 @@ class _Explorer:
         found = self.entered.find(keys)
         if (found < 0).any():
             miss = (found < 0).nonzero()[0]
-            first = miss[first_occurrences(keys[miss])]
+            first, again = occurrences(keys[miss])
+            first = miss[first]
             emitted = self.orders(sid[first], entry[first])
-            wanted = np.hstack([emitted, np.zeros((len(first), 1), dtype=bool)])[:, self._order_cols]
+            wanted = np.concatenate([emitted, np.zeros((len(first), 1), dtype=bool)], axis=1)[:, self._order_cols]
             _, inverse, rows = _distinct_keys(wanted)
             wid = np.array([self._wanted.setdefault(w, len(self._wanted)) for w in rows], dtype=np.int64)[inverse]
             if len(self._wanted) * self.P >= 1 << 62:
                 raise Unsupported("region keys past 64 bits")
             wkeys = wid * self.P + entry[first]
             gid = self.by_wanted.find(wkeys)
-            new = (gid < 0).nonzero()[0]
-            if new.size:
-                new = new[first_occurrences(wkeys[new])]
+            unknown = (gid < 0).nonzero()[0]
+            if unknown.size:
+                new, same = occurrences(wkeys[unknown])
+                new = unknown[new]
                 base = self.regions.count
                 try:
                     regions(self.pc, self.regions, entry[first][new], wanted[new])
                 except OverflowError as err:
                     raise Unsupported(str(err)) from None
                 self.by_wanted.add(wkeys[new], base + np.arange(new.size))
-                gid = self.by_wanted.find(wkeys)
+                gid[unknown] = base + same
             self.entered.add(keys[first], gid)
             counts, at = slices(self.regions.member_starts, gid)
             self.pairs.append(sid[first].repeat(counts) * self.P + self.regions.members[at])
-            found = self.entered.find(keys)
+            found[miss] = gid[again]
         return found
 
     def enter(self, sid: np.ndarray, entry: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -276,20 +277,25 @@ class _Explorer:
         node = self.index.find(keys)
         miss = (node < 0).nonzero()[0]
         if miss.size:
-            first = miss[first_occurrences(keys[miss])]
+            first, again = occurrences(keys[miss])
+            first = miss[first]
             ids = len(self.nodes) + np.arange(first.size)
             self.make_nodes(tsid[first], q[first], proh[first])
             self.index.add(keys[first], ids)
-            node = self.index.find(keys)
+            node[miss] = ids[again]
         return node, src
 
     def make_nodes(self, sid: np.ndarray, q: np.ndarray, proh: np.ndarray) -> None:
         emitted = self.orders(sid, q)
         digits = self.pc.digits(q)
         names = self.vm.order_names
-        wanted = _per_row(emitted, lambda row: frozenset(names[i] for i in row.nonzero()[0]), self._emitted)
-        set_ = _per_row(emitted & self.pc.values(names, digits), lambda row: tuple(names[i] for i in row.nonzero()[0]),
-                        self._set)
+        k = len(names)
+
+        def made(row: np.ndarray) -> tuple[frozenset[str], tuple[str, ...]]:  # the orders emitted, and those set
+            return frozenset(names[i] for i in row[:k].nonzero()[0]), tuple(names[i] for i in row[k:].nonzero()[0])
+
+        wanted, set_ = zip(*_per_row(np.concatenate([emitted, emitted & self.pc.values(names, digits)], axis=1), made,
+                                     self._orders))
         items, prohs = self.sits.items, self.regions.prohibitions
         self.nodes.extend(many_nodes([items[s] for s in sid.tolist()], map(tuple, digits.full().T.tolist()), wanted, set_,
                                      [prohs[pr] for pr in proh.tolist()]))
@@ -357,8 +363,8 @@ class _Explorer:
         """Every event from the nodes ``lo:hi``, in the machine's path's order."""
         sid, codes = self.node_sit[lo:hi], self.node_code[lo:hi]
         row, rank, entry = self.pc.successors(codes)
-        before = self.inputs(codes)
-        after = self.inputs(entry)
+        inputs = self.inputs(np.concatenate([codes, entry]))  # before and after, one pass
+        before, after = inputs[:len(codes)], inputs[len(codes):]
         changed = before[row] ^ after
         count = changed.sum(axis=1)
         if (count > 1).any():
@@ -392,15 +398,20 @@ class _Explorer:
                 ranks.append(np.array([first_timer + j]))
                 entries.append(codes[r:r + 1])
                 sids.append(self.sits.of([sit]))
-        row, rank, entry, nsid, ev = (np.concatenate(x) for x in (rows, ranks, entries, sids, evid))
-        order = np.lexsort((rank, row))
+        if len(rows) > 1:  # timers: their candidates put in the order of their nodes
+            row, rank, entry, nsid, ev = (np.concatenate(x) for x in (rows, ranks, entries, sids, evid))
+            order = (row * (int(rank.max()) + 1) + rank).argsort(kind="stable")  # by node, then rank
+        else:  # the moves alone, sorted by node then rank already
+            ev, order = rank, None
         if traced:
-            where = np.empty(len(order), dtype=np.int64)
-            where[order] = np.arange(len(order))
+            where = np.arange(len(row))
+            if order is not None:
+                where[order] = np.arange(len(order))
             for c in sorted(traced, key=lambda c: where[c]):
                 i = lo + int(row[c])
                 self.conflicts.extend(Conflict(i, table[ev[c]], st, names) for st, names in self.log.fresh(traced[c]))
-        row, entry, nsid, ev = row[order], entry[order], nsid[order], ev[order]
+        if order is not None:
+            row, entry, nsid, ev = row[order], entry[order], nsid[order], ev[order]
         node, src = self.enter(nsid, entry)
         self.sources.append(lo + row[src])
         self.targets.append(node)

@@ -17,7 +17,8 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["Collision", "SortedKeys", "ROW_BITS", "distinct", "distinct_rows", "row_codes", "first_occurrences", "slices"]
+__all__ = ["Collision", "SortedKeys", "ROW_BITS", "distinct", "distinct_rows", "row_codes", "first_occurrences", "occurrences",
+           "slices"]
 
 
 class Collision(Exception):
@@ -38,7 +39,8 @@ class SortedKeys:
         """The value of each key, -1 where absent."""
         if not self.keys.size:
             return np.full(len(keys), -1, dtype=np.int64)
-        pos = np.minimum(np.searchsorted(self.keys, keys), self.keys.size - 1)
+        pos = self.keys.searchsorted(keys)
+        np.minimum(pos, self.keys.size - 1, out=pos)
         return np.where(self.keys[pos] == keys, self.values[pos], -1)
 
     def add(self, keys: np.ndarray, values: np.ndarray) -> None:
@@ -46,7 +48,7 @@ class SortedKeys:
         order = keys.argsort(kind="stable")
         keys, values = keys[order], values[order]
         n, m = self.keys.size, keys.size
-        at = np.searchsorted(self.keys, keys) + np.arange(m)  # the new keys' places in the merged table
+        at = self.keys.searchsorted(keys) + np.arange(m)  # the new keys' places in the merged table
         old = np.ones(n + m, dtype=bool)
         old[at] = False
         merged, merged_values = np.empty(n + m, dtype=np.int64), np.empty(n + m, dtype=np.int64)
@@ -63,15 +65,20 @@ def _groups(perm: np.ndarray, change: np.ndarray) -> tuple[np.ndarray, np.ndarra
     return perm[change], inverse
 
 
-def distinct(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The distinct keys, in increasing order, as the position of their first occurrence;
-    and each position's rank among them."""
+def _changes(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A stable sorting permutation of ``keys``, and where the sorted keys change (first True)."""
     perm = keys.argsort(kind="stable")
     s = keys[perm]
     change = np.empty(len(s), dtype=bool)
     change[:1] = True
     change[1:] = s[1:] != s[:-1]
-    return _groups(perm, change)
+    return perm, change
+
+
+def distinct(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The distinct keys, in increasing order, as the position of their first occurrence;
+    and each position's rank among them."""
+    return _groups(*_changes(keys))
 
 
 ROW_BITS = 62
@@ -101,12 +108,25 @@ def distinct_rows(bits: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def first_occurrences(keys: np.ndarray) -> np.ndarray:
     """Positions of the first occurrence of each distinct key, in the order they occur."""
-    perm = keys.argsort(kind="stable")
-    s = keys[perm]
-    change = np.empty(len(s), dtype=bool)
-    change[:1] = True
-    change[1:] = s[1:] != s[:-1]
-    return np.sort(perm[change])
+    perm, change = _changes(keys)
+    out = perm[change]
+    out.sort()
+    return out
+
+
+def occurrences(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`first_occurrences`, and for each position the index into them of its key's
+    first occurrence (a table's values for new keys set without looking them up again).
+
+    >>> first, at = occurrences(np.array([7, 3, 7, 5, 3]))
+    >>> first.tolist(), at.tolist()
+    ([0, 1, 3], [0, 1, 0, 2, 1])
+    """
+    firsts, group = distinct(keys)  # each key's first position, the keys in increasing order
+    order = firsts.argsort()  # the keys in order of occurrence
+    rank = np.empty(len(order), dtype=np.int64)
+    rank[order] = np.arange(len(order))
+    return firsts[order], rank[group]
 
 
 def slices(starts: np.ndarray, groups: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -118,5 +138,6 @@ def slices(starts: np.ndarray, groups: np.ndarray) -> tuple[np.ndarray, np.ndarr
     ([3, 2], [2, 3, 4, 0, 1])
     """
     counts = starts[groups + 1] - starts[groups]
-    at = (starts[groups] - counts.cumsum() + counts).repeat(counts) + np.arange(int(counts.sum()))
+    ends = counts.cumsum()
+    at = (starts[groups] - ends + counts).repeat(counts) + np.arange(int(ends[-1]) if ends.size else 0)
     return counts, at

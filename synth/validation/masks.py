@@ -22,10 +22,11 @@ Example
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
+
+from synth.frozen import frozen
 
 __all__ = ["RUN", "Run", "Runs", "Masks", "pack", "unpack"]
 
@@ -35,7 +36,7 @@ RUN = 4096
 BITS = 63
 
 
-@dataclass(frozen=True)
+@frozen
 class Run:
     """Consecutive elements ``members`` of word ``word``: joint index ``(word // base) % size``."""
 
@@ -120,14 +121,16 @@ class Masks:
         self.identity = pack(np.full((1, k), conj, dtype=bool))[0]
         self.tables: list[tuple[int, np.ndarray]] = []
         for g, run in enumerate(runs.items):
-            mine = [(j, tables[a]) for j, a in enumerate(run.members) if a in tables]
+            mine = [(j, pack(tables[a])) for j, a in enumerate(run.members) if a in tables]  # packed per element
             if not mine:
                 continue
             local = runs.local(g)
-            joint = np.full((run.size, k), conj, dtype=bool)
-            for j, t in mine:
-                joint = joint & t[local[:, j]] if conj else joint | t[local[:, j]]
-            self.tables.append((g, pack(joint)))
+            joint: np.ndarray | None = None
+            for j, t in mine:  # the members' packed words combined at each joint index
+                v = t[local[:, j]]
+                joint = v if joint is None else (joint & v if conj else joint | v)
+            assert joint is not None
+            self.tables.append((g, joint))
 
     def of(self, index: Callable[[int], np.ndarray], n: int) -> np.ndarray:
         """The packed bits (n × words) of states whose run ``g`` has joint index ``index(g)``."""

@@ -65,6 +65,8 @@ class Digits:
         """Each word of the codes, one column per word (the flat codes themselves when not wide)."""
 
     def __getitem__(self, axis: int) -> np.ndarray:
+        if self._full is not None:
+            return self._full[axis]
         hit = self._axes.get(axis)
         if hit is None:
             pc = self._pc
@@ -86,20 +88,28 @@ class Digits:
             else:
                 lay, words = self._wide
                 self._full = np.ascontiguousarray(lay.decode(words).T)
-            self._axes = dict(enumerate(self._full))
         return self._full
+
+    def moved(self, moves: _Moves, rank: np.ndarray, row: np.ndarray) -> np.ndarray:
+        """The index of the element of move ``rank[i]`` (of ``moves``) at state ``row[i]``."""
+        if self._full is not None:
+            return self._full[moves.axis[rank], row]
+        w = self.codes[row] if self._wide is None else self._wide[1][row, moves.word[rank]]
+        return (w // moves.stride[rank]) % moves.radix[rank]
 
 
 class _Moves:
     """Local transitions as columns: element, source, code difference, order column."""
 
     def __init__(self, moves: list[LocalTransition], strides: tuple[int, ...] | np.ndarray, column: list[int],
-                 word: np.ndarray | None = None) -> None:
+                 word: np.ndarray, shape: tuple[int, ...]) -> None:
         self.moves = moves
         self.axis = np.array([t.axis for t in moves], dtype=np.int64)
         self.src = np.array([t.src for t in moves], dtype=np.int64)
+        self.stride = np.array([int(strides[t.axis]) for t in moves], dtype=np.int64)  # its element's, in its word
+        self.radix = np.array([shape[t.axis] for t in moves], dtype=np.int64)
         self.delta = np.array([(t.dst - t.src) * int(strides[t.axis]) for t in moves], dtype=np.int64)
-        self.word = word[self.axis] if word is not None else np.zeros(len(moves), dtype=np.int64)
+        self.word = word[self.axis]
         self.column = np.array(column, dtype=np.int64)
         self.guarded = [k for k, t in enumerate(moves) if t.guard is not None]
         self.forbidding: list[int] = []  # moves an edge constraint may forbid
@@ -130,9 +140,10 @@ class PlantCodes:
         self.orders = tuple(sorted(self.moves))  # the region's order of the orders
         self._values: dict[tuple[str, ...], Masks] = {}
         self._guards: dict[int, tuple[list[tuple[int, np.ndarray]], np.ndarray]] = {}
-        self._u = _Moves(self.uncontrollable, code_strides, [0] * len(self.uncontrollable), word)
+        self._u = _Moves(self.uncontrollable, code_strides, [0] * len(self.uncontrollable), word, p.shape)
         controllable = [t for o in self.orders for t in self.moves[o]]
-        self._c = _Moves(controllable, code_strides, [j for j, o in enumerate(self.orders) for _ in self.moves[o]], word)
+        self._c = _Moves(controllable, code_strides, [j for j, o in enumerate(self.orders) for _ in self.moves[o]], word,
+                         p.shape)
         self._c.forbidding = [k for k, t in enumerate(controllable) if oracle.edge_terms.get(t.event)]
         self.controllable_moves = self._c
         self.order_starts = np.searchsorted(self._c.column, np.arange(len(self.orders) + 1))
@@ -167,9 +178,9 @@ class PlantCodes:
 
     def encode(self, states: list[tuple[int, ...]]) -> np.ndarray:
         """The codes of plant states given as element-local tuples."""
-        if self.layout is None or self.interned is None:
-            return np.array([self.plant.index(q) for q in states], dtype=np.int64)
         local = np.array(states, dtype=np.int64).reshape(len(states), len(self.radix))
+        if self.layout is None or self.interned is None:  # below 2^40 states: the flat code fits
+            return (local * self.strides).sum(axis=1)
         return self.interned.find_or_add(self.layout.encode(local))
 
     def step(self, codes: np.ndarray, moves: _Moves, rank: np.ndarray) -> np.ndarray:
@@ -242,9 +253,11 @@ class PlantCodes:
             rows = ok[:, k].nonzero()[0]
             if rows.size:
                 ok[rows, k] = self._guard(k, digits, rows)
-        row, rank = np.nonzero(ok)  # row-major: by row, then rank
+        row, rank = ok.nonzero()  # row-major: by row, then rank
         target = self.step(codes[row], u, rank)
         keep = self.kept(target)  # cannot fail from a SUP state; kept for safety, as the machine's path
+        if keep.all():
+            return row, rank, target
         return row[keep], rank[keep], target[keep]
 
     def _guard(self, k: int, digits: Digits, rows: np.ndarray) -> np.ndarray:
@@ -277,7 +290,7 @@ class PlantCodes:
             for j, term in enumerate(terms[c.moves[k].event] if at.size else ()):
                 edge[at, j] = self.holds(term.factors, digits, row[at])
         level = unpack(threats, len(self.oracle.level_terms))
-        bits = np.hstack([edge, level])
+        bits = np.concatenate([edge, level], axis=1)
         rank_bits = len(c.moves).bit_length()
         keys: list[int | tuple[int, bytes]]
         if bits.shape[1] + rank_bits <= ROW_BITS:  # (bits, move) as one integer
@@ -331,7 +344,7 @@ class Regions:
         (indices into ``met``) as one prohibition set: (the states, their set's index in
         :attr:`prohibitions`)."""
         starts = np.concatenate([[True], rows[1:] != rows[:-1]]).nonzero()[0]
-        bounds, ids = np.append(starts, len(rows)).tolist(), refusals.tolist()
+        bounds, ids = starts.tolist() + [len(rows)], refusals.tolist()
         out = np.empty(len(starts), dtype=np.int64)
         for u in range(len(starts)):
             key = tuple(ids[bounds[u]:bounds[u + 1]])
@@ -363,10 +376,10 @@ def regions(pc: PlantCodes, store: Regions, entries: np.ndarray, wanted: np.ndar
     while cur.size:
         digits = pc.digits(cur)
         c = pc.controllable_moves
-        row, order = np.nonzero(unpack(pc.order_bits(digits) ^ wanted_bits[reg], k))  # the orders to change, row-major
+        row, order = unpack(pc.order_bits(digits) ^ wanted_bits[reg], k).nonzero()  # the orders to change, row-major
         counts, rank = slices(pc.order_starts, order)  # their moves (the region's order of the moves)
         row = row.repeat(counts)
-        app = digits.full()[c.axis[rank], row] == c.src[rank]
+        app = digits.moved(c, rank, row) == c.src[rank]
         row, rank = row[app], rank[app]  # by row, then rank
         target = pc.step(cur[row], c, rank)
         threat = pc.threats(target)
@@ -386,12 +399,9 @@ def regions(pc: PlantCodes, store: Regions, entries: np.ndarray, wanted: np.ndar
         if not ok.any():
             break
         nreg, target = reg[row[ok]], target[ok]
-        fresh = []  # the first move into each state not met before, in order
-        for i, key in enumerate((nreg * pc.P + target).tolist()):
-            if key not in seen:
-                seen.add(key)
-                fresh.append(i)
-        first = np.array(fresh, dtype=np.int64)
+        add = seen.add  # the first move into each state not met before, in order
+        first = np.array([i for i, key in enumerate((nreg * pc.P + target).tolist()) if key not in seen and not add(key)],
+                         dtype=np.int64)
         reg, cur = nreg[first], target[first]
         member_parts.append((reg, cur))
     _store(store, R, member_parts, settled_parts)

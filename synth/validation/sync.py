@@ -138,8 +138,8 @@ class Edge:
     target: int
 
 
-def many_nodes(situations: list[Situation], plants: Iterable[Local], emitted: list[frozenset[str]],
-               ords: list[tuple[str, ...]], prohs: list[tuple[Prohibition, ...]]) -> list[Node]:
+def many_nodes(situations: list[Situation], plants: Iterable[Local], emitted: Sequence[frozenset[str]],
+               ords: Sequence[tuple[str, ...]], prohs: list[tuple[Prohibition, ...]]) -> list[Node]:
     """``Node(*row)`` for each row of the columns given, made in bulk: the same objects,
     their attributes written once each without a call of ``__init__`` per node (a frontier
     makes thousands at once; the call was half their cost)."""
@@ -273,32 +273,27 @@ def region(
     seen = {entry}
     settled: list[tuple[Local, tuple[Prohibition, ...]]] = []
     queue = deque([entry])
+    orders = sorted(moves)
     while queue:
         cur = queue.popleft()
         val = p.valuation(cur)
         progressed = False
         refused: list[Prohibition] = []
-        for order in sorted(moves):
-            want = order in wanted
-            if val[order] == want:
+        ts = [t for order in orders if val[order] != (order in wanted) for t in moves[order] if t.src == cur[t.axis]]
+        for t, (ok, why) in zip(ts, oracle.verdicts(ts, cur)):
+            if not ok:
+                refused.append(Prohibition(t.event, tuple(why)))
                 continue
-            for t in moves[order]:
-                if t.src != cur[t.axis]:
-                    continue
-                ok, why = oracle.move(t, cur)
-                if not ok:
-                    refused.append(Prohibition(t.event, tuple(why)))
-                    continue
-                progressed = True
-                nxt = list(cur)
-                nxt[t.axis] = t.dst
-                n = tuple(nxt)
-                if n not in seen:
-                    seen.add(n)
-                    members.append(n)
-                    queue.append(n)
-                    if limit is not None and len(members) > limit:
-                        raise LimitExceeded(f"a region of more than {limit} states")
+            progressed = True
+            nxt = list(cur)
+            nxt[t.axis] = t.dst
+            n = tuple(nxt)
+            if n not in seen:
+                seen.add(n)
+                members.append(n)
+                queue.append(n)
+                if limit is not None and len(members) > limit:
+                    raise LimitExceeded(f"a region of more than {limit} states")
         if not progressed:
             settled.append((cur, tuple(sorted(refused))))
     return members, settled

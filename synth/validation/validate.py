@@ -36,7 +36,9 @@ def home_states(sync: Sync, conditions: Sequence[Expr]) -> frozenset[int]:
     plant values)."""
     homes = set(sync.initial)
     start = {(n.situation.steps, n.situation.stored, n.plant) for n in (sync.nodes[i] for i in sync.initial)}
-    homes.update(i for i, n in enumerate(sync.nodes) if (n.situation.steps, n.situation.stored, n.plant) in start)
+    plants = {q for _, _, q in start}  # read first: most nodes are elsewhere
+    homes.update(i for i, n in enumerate(sync.nodes)
+                 if n.plant in plants and (n.situation.steps, n.situation.stored, n.plant) in start)
     for i, n in enumerate(sync.nodes if conditions else ()):
         val = sync.plant.valuation(n.plant)
         steps = set(n.situation.step_variables)
@@ -75,7 +77,7 @@ def validate(
 ) -> Validation:
     """Run the whole method on a Grafcet and a plant; ``homes`` are ``--home`` conditions."""
     rs, p, g = load_model(grafcet_path, rules_path)
-    return validate_loaded(rs, p, g, expert=expert, homes=homes, max_states=max_states, progress=progress)
+    return validate_loaded(rs, p, g, expert=expert, homes=homes, how=Exploration(max_states, progress))
 
 
 def validate_loaded(
@@ -85,13 +87,10 @@ def validate_loaded(
     *,
     expert: bool = False,
     homes: Sequence[str] = (),
-    max_states: int | None = None,
-    progress: Callable[[int, int], None] | None = None,
-    watch: Callable[[int, int], None] | None = None,
+    how: Exploration = Exploration(),
 ) -> Validation:
-    """:func:`validate` on a rule set, its plant and a Grafcet already loaded;
-    ``progress(aggregated states, states to visit)`` is called now and then, ``watch``
-    after each step of the exploration (:func:`explore`)."""
+    """:func:`validate` on a rule set, its plant and a Grafcet already loaded, SYNC explored
+    as ``how`` says (its limit, progress and watch: :func:`explore`)."""
     conditions = home_conditions(homes, p, g)
     machine = GrafcetMachine(g)
     # the run's objects (nodes, edges, situations, their indexes) make no reference cycles:
@@ -99,7 +98,7 @@ def validate_loaded(
     collecting = gc.isenabled()
     gc.disable()
     try:
-        sync = explore(p, rs.constraints, machine, Exploration(max_states, progress, watch))
+        sync = explore(p, rs.constraints, machine, how)
         sup_empty = not sync.oracle.kept(p.initial)  # the constraints compiled once
         analysis = analyse(sync, home_states(sync, conditions))
         if not (analysis.blocking or analysis.never_starts or analysis.prohibited):  # a passing run imports no diagnosis
