@@ -1,5 +1,5 @@
-"""The filter on truth tables, past the symbolic chain's work limit (``synth.filter.solve``'s
-``CHAIN_WORK``, lowered here so that small filters take that form): what ``solve`` says, the
+"""The filter on truth tables, past the size of what the symbolic chain decides against its
+order (``synth.filter.solve``'s ``TABLES_SIZE``, lowered here so that small filters take that form): what ``solve`` says, the
 block ``filter st`` writes (compiled by MATIEC's ``iec2c`` and gcc, cycle by cycle equal to
 the synthesis's functions and to ``synth.filter.local``'s model, past values included), and
 ``filter run``'s refusal."""
@@ -22,21 +22,22 @@ from synth.filter import local
 from synth.filter.block import algebraic_equations
 from synth.filter.cycle import Algorithm, FilterCycle
 from synth.filter.language_check import parse_filter
-from synth.filter.solve import CHAIN_WORK, synthesis
+from synth.filter.solve import TABLES_SIZE, synthesis
 from synth.logic.past import pre_name
 from synth.output.filter_text import synthesis_json, synthesis_text
 
 sys.path.insert(0, str(ROOT / "bench"))
 from filter_scale import grid_edges_filter, ring_filter  # noqa: E402
 
-NOTE = ("the chain of narrowings passed 1000 BDD lookups at criterion 3 of 38: the filter is its chain run on "
+NOTE = ("the chain of narrowings decides outputs against its order (size 41 over the limit of 40; 2 outputs "
+        "carried back across one cut): the filter is its chain run on "
         "truth tables each cycle (16 bags, 118 entries; filter st writes it); no equations, the criteria's effects "
         "not decided")
 
 
 def _grid() -> tuple[object, object]:
     f = parse_filter(grid_edges_filter(16), "grid_edges.filter")
-    return f, synthesis(f, chain_work=1000)
+    return f, synthesis(f, tables_size=40)
 
 
 def test_past_the_limit_solve_prints_the_criteria_and_says_why():
@@ -52,13 +53,14 @@ def test_past_the_limit_solve_prints_the_criteria_and_says_why():
     assert j["equations"] == {} and j["chained"] == {"order": [], "equations": {}}
     assert {(c["narrows"], c["effect"]) for c in j["criteria"]} == {(None, None)}
     assert_valid("filter_solve", j)
-    assert synthesis(f, chain_work=CHAIN_WORK).plan is None  # below the limit: the equations, as before
+    assert synthesis(f, tables_size=41).plan is None  # at the limit: the equations, as before
+    assert synthesis(f).plan is None and TABLES_SIZE > 41
 
 
 def test_past_the_limit_every_output_needs_its_sim():
     f = parse_filter("outputs a, b\nsafety K: a & b keep a\nmaximize sim a\n", "partial.filter")
     with pytest.raises(LimitExceeded, match="b has no similarity criterion"):
-        synthesis(f, chain_work=-1)
+        synthesis(f, tables_size=-1)
 
 
 def test_filter_run_evaluates_the_tables():
@@ -86,7 +88,7 @@ def test_filter_run_evaluates_the_tables():
 def test_the_compiled_tables_block_is_the_synthesis(case, tmp_path):
     f = parse_filter(grid_edges_filter(16) if case == "grid_edges_16" else ring_filter(4), f"{case}.filter")
     solved = synthesis(f)  # the equations: the oracle
-    s = synthesis(f, chain_work=-1)
+    s = synthesis(f, tables_size=-1)
     assert solved.plan is None and s.plan is not None
     block = filter_block(f, synthesis=s)
     plc = CompiledProgram(StProgram(block.text, block.name, (), (block.pou,)), tmp_path, pou=block.name)
