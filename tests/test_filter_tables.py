@@ -18,16 +18,20 @@ from schemas import assert_valid
 from synth.codegen.filter_st import filter_block
 from synth.codegen.program import StProgram
 from synth.errors import LimitExceeded
-from synth.filter import local
+from synth.filter import local, narrowing
 from synth.filter.block import algebraic_equations
 from synth.filter.cycle import Algorithm, FilterCycle
-from synth.filter.language_check import parse_filter
-from synth.filter.solve import TABLES_SIZE, synthesis
+from synth.filter.language import Filter, Sense
+from synth.filter.language_check import load_filter, parse_filter
+from synth.filter.model import functions
+from synth.filter.solve import TABLES_SIZE, criteria, synthesis
 from synth.logic.past import pre_name
 from synth.output.filter_text import synthesis_json, synthesis_text
 
 sys.path.insert(0, str(ROOT / "bench"))
-from filter_scale import grid_edges_filter, ring_filter  # noqa: E402
+from filter_scale import FAMILIES, grid_edges_filter, ring_filter  # noqa: E402
+
+BUNDLED = sorted([*ROOT.glob("plants/*.filter"), *ROOT.glob("tests/data/**/*.filter"), *ROOT.glob("lines/**/*.filter")])
 
 NOTE = ("the chain of narrowings decides outputs against its order (size 41 over the limit of 40; 2 outputs "
         "carried back across one cut): the filter is its chain run on "
@@ -55,6 +59,45 @@ def test_past_the_limit_solve_prints_the_criteria_and_says_why():
     assert_valid("filter_solve", j)
     assert synthesis(f, tables_size=41).plan is None  # at the limit: the equations, as before
     assert synthesis(f).plan is None and TABLES_SIZE > 41
+
+
+def _against(f: Filter) -> tuple[int, int]:
+    """``narrowing.against`` on the partition ``solve`` lays out: the size the form is decided by, and the most
+    outputs carried back across one cut."""
+    m = functions(f)
+    goods = [m.engine.expr(c.expr) if c.sense is Sense.MAX else ~m.engine.expr(c.expr) for c in criteria(f)]
+    return narrowing.against(narrowing.layout(m, goods), goods)
+
+
+@pytest.mark.parametrize("case, size", [("ring_32", (31, 1)), ("chain_256", (0, 0)), ("grid_64", (0, 0)),
+                                        ("grid_edges_24", (133, 3)), ("grid_edges_32", (341, 4)),
+                                        ("grid_edges_40", (765, 5)), ("grid_edges_64", (4805, 8))])
+def test_the_form_is_decided_on_the_filter(case, size):
+    """The bench families take the form they took when the chain's BDD lookups decided (10^7, docs/performance.md,
+    "Session 29"): equations up to grid_edges 8 × 4 (341: at most 4 outputs carried back across a cut), tables
+    from 8 × 5 (765) on; the rings carry one output back, the chains and grids none."""
+    family, _, n = case.rpartition("_")
+    assert _against(parse_filter(FAMILIES[family](int(n)), f"{case}.filter")) == size
+    assert (size[0] > TABLES_SIZE) == (case in ("grid_edges_40", "grid_edges_64"))
+
+
+def test_grid_edges_8_by_5_is_on_tables():
+    """8 × 5, the first of the family past the limit: no symbolic chain runs (8 × 4's is what its equations cost,
+    4.6 M BDD lookups; 8 × 5's would be 21 M), the plan comes from the layout alone."""
+    s = synthesis(parse_filter(grid_edges_filter(40), "grid_edges_40.filter"))
+    assert s.plan is not None and (len(s.plan.bags), s.plan.width, s.plan.entries) == (40, 6, 1806)
+    assert s.notes == ["the chain of narrowings decides outputs against its order (size 765 over the limit of 500; "
+                       "5 outputs carried back across one cut): the filter is its chain run on truth tables each "
+                       "cycle (40 bags, 1806 entries; filter st writes it); no equations, the criteria's effects not "
+                       "decided"]
+
+
+@pytest.mark.parametrize("path", BUNDLED, ids=lambda p: p.name)
+def test_bundled_filters_keep_their_equations(path):
+    f = load_filter(path)
+    s = synthesis(f)
+    assert s.plan is None and s.chained
+    assert _against(f)[0] <= 3
 
 
 def test_past_the_limit_every_output_needs_its_sim():
