@@ -52,8 +52,8 @@ TABLES_SIZE = 500
 back across it, added up), the filter is its chain run on truth tables (:mod:`synth.filter.local`),
 no equations: a figure read on the filter and its partition before the chain runs, which no
 faster BDD code moves. The symbolic chain's work grows with it (docs/performance.md, "Session
-30"): grid_edges 8 × 4 341 (4.6 M CUDD lookups), 6 × 5 455 (8.7 M), 7 × 5 610 (14 M), 8 × 5 765
-(21 M), 8 × 8 4 805; the bundled filters at most 3, the bench's rings, chains and grids at most 31."""
+30"): grid_edges 8 × 4 341 (4.6 M CUDD lookups), 10 stations × 4 461 (8.0 M), 12 × 4 581
+(12.3 M), 8 × 5 765 (21 M), 8 × 8 4 805; the bundled filters at most 3, the bench's rings, chains and grids at most 31."""
 
 
 def sim_expr(output: str) -> Expr:
