@@ -1,5 +1,5 @@
-"""The filter on truth tables, past the symbolic chain's work limit (``synth.filter.solve``'s
-``CHAIN_WORK``, lowered here so that small filters take that form): what ``solve`` says, the
+"""The filter on truth tables, past the size of what the symbolic chain decides against its
+order (``synth.filter.solve``'s ``TABLES_SIZE``, lowered here so that small filters take that form): what ``solve`` says, the
 block ``filter st`` writes (a fixed loop nest over constant tables; compiled by MATIEC's
 ``iec2c`` and gcc, directly and through Beremiz's generator from ``filter st --xml``, cycle by
 cycle equal to the synthesis's functions and to ``synth.filter.local``'s model, past values
@@ -23,27 +23,31 @@ from synth.codegen.program import StProgram
 from synth.codegen.st import SectionKind
 from synth.codegen.targets import Target, render
 from synth.errors import InputError, LimitExceeded
-from synth.filter import local
+from synth.filter import local, narrowing
 from synth.filter.block import algebraic_equations
 from synth.filter.cycle import Algorithm, FilterCycle
-from synth.filter.language import Filter
-from synth.filter.language_check import parse_filter
-from synth.filter.solve import CHAIN_WORK, Synthesis, synthesis
+from synth.filter.language import Filter, Sense
+from synth.filter.language_check import load_filter, parse_filter
+from synth.filter.model import functions
+from synth.filter.solve import TABLES_SIZE, Synthesis, criteria, synthesis
 from synth.logic.past import pre_name
 from synth.output.filter_text import synthesis_json, synthesis_text
 
 sys.path.insert(0, str(ROOT / "bench"))
-from filter_scale import grid_edges_filter, ring_filter  # noqa: E402
+from filter_scale import FAMILIES, grid_edges_filter, ring_filter  # noqa: E402
 from test_sfc_beremiz import beremiz_text  # noqa: E402
 
-NOTE = ("the chain of narrowings passed 1000 BDD lookups at criterion 3 of 38: the filter is its chain run on "
+BUNDLED = sorted([*ROOT.glob("plants/*.filter"), *ROOT.glob("tests/data/**/*.filter"), *ROOT.glob("lines/**/*.filter")])
+
+NOTE = ("the chain of narrowings decides outputs against its order (size 41 over the limit of 40; 2 outputs "
+        "carried back across one cut): the filter is its chain run on "
         "truth tables each cycle (16 bags, 118 entries; filter st writes it); no equations, the criteria's effects "
         "not decided")
 
 
 def _grid() -> tuple[object, object]:
     f = parse_filter(grid_edges_filter(16), "grid_edges.filter")
-    return f, synthesis(f, chain_work=1000)
+    return f, synthesis(f, tables_size=40)
 
 
 def test_past_the_limit_solve_prints_the_criteria_and_says_why():
@@ -59,13 +63,53 @@ def test_past_the_limit_solve_prints_the_criteria_and_says_why():
     assert j["equations"] == {} and j["chained"] == {"order": [], "equations": {}}
     assert {(c["narrows"], c["effect"]) for c in j["criteria"]} == {(None, None)}
     assert_valid("filter_solve", j)
-    assert synthesis(f, chain_work=CHAIN_WORK).plan is None  # below the limit: the equations, as before
+    assert synthesis(f, tables_size=41).plan is None  # at the limit: the equations, as before
+    assert synthesis(f).plan is None and TABLES_SIZE > 41
+
+
+def _against(f: Filter) -> tuple[int, int]:
+    """``narrowing.against`` on the partition ``solve`` lays out: the size the form is decided by, and the most
+    outputs carried back across one cut."""
+    m = functions(f)
+    goods = [m.engine.expr(c.expr) if c.sense is Sense.MAX else ~m.engine.expr(c.expr) for c in criteria(f)]
+    return narrowing.against(narrowing.layout(m, goods), goods)
+
+
+@pytest.mark.parametrize("case, size", [("ring_32", (31, 1)), ("chain_256", (0, 0)), ("grid_64", (0, 0)),
+                                        ("grid_edges_24", (133, 3)), ("grid_edges_32", (341, 4)),
+                                        ("grid_edges_40", (765, 5)), ("grid_edges_64", (4805, 8))])
+def test_the_form_is_decided_on_the_filter(case, size):
+    """The bench families take the form they took when the chain's BDD lookups decided (10^7, docs/performance.md,
+    "Session 29"): equations up to grid_edges 8 × 4 (341: at most 4 outputs carried back across a cut), tables
+    from 8 × 5 (765) on; the rings carry one output back, the chains and grids none."""
+    family, _, n = case.rpartition("_")
+    assert _against(parse_filter(FAMILIES[family](int(n)), f"{case}.filter")) == size
+    assert (size[0] > TABLES_SIZE) == (case in ("grid_edges_40", "grid_edges_64"))
+
+
+def test_grid_edges_8_by_5_is_on_tables():
+    """8 × 5, the first of the family past the limit: no symbolic chain runs (8 × 4's is what its equations cost,
+    4.6 M BDD lookups; 8 × 5's would be 21 M), the plan comes from the layout alone."""
+    s = synthesis(parse_filter(grid_edges_filter(40), "grid_edges_40.filter"))
+    assert s.plan is not None and (len(s.plan.bags), s.plan.width, s.plan.entries) == (40, 6, 1806)
+    assert s.notes == ["the chain of narrowings decides outputs against its order (size 765 over the limit of 500; "
+                       "5 outputs carried back across one cut): the filter is its chain run on truth tables each "
+                       "cycle (40 bags, 1806 entries; filter st writes it); no equations, the criteria's effects not "
+                       "decided"]
+
+
+@pytest.mark.parametrize("path", BUNDLED, ids=lambda p: p.name)
+def test_bundled_filters_keep_their_equations(path):
+    f = load_filter(path)
+    s = synthesis(f)
+    assert s.plan is None and s.chained
+    assert _against(f)[0] <= 3
 
 
 def test_past_the_limit_every_output_needs_its_sim():
     f = parse_filter("outputs a, b\nsafety K: a & b keep a\nmaximize sim a\n", "partial.filter")
     with pytest.raises(LimitExceeded, match="b has no similarity criterion"):
-        synthesis(f, chain_work=-1)
+        synthesis(f, tables_size=-1)
 
 
 def test_filter_run_evaluates_the_tables():
@@ -100,7 +144,7 @@ def _cases(case: str) -> tuple[Filter, Synthesis, Synthesis]:
     """The filter of ``case``, its equations (the oracle) and its tables form."""
     f = _filter(case)
     solved = synthesis(f)
-    s = synthesis(f, chain_work=-1)
+    s = synthesis(f, tables_size=-1)
     assert solved.plan is None and s.plan is not None
     return f, solved, s
 
@@ -145,7 +189,7 @@ def test_the_tables_are_data_and_the_loop_is_fixed():
     """The block's statements do not grow with the filter: a fixed loop nest, one row line per
     cofactor that reads the cycle's inputs, one line per output; the rest is constant data."""
     f = _filter("grid_edges_16")
-    block = filter_block(f, synthesis=synthesis(f, chain_work=-1))
+    block = filter_block(f, synthesis=synthesis(f, tables_size=-1))
     body = block.pou.body
     rows = [line for line in body if line.startswith("TabR[")]
     assert len(rows) == 16 + 22 + 2 * 16  # each bag's relation once, each priority once, each sim twice
@@ -162,7 +206,7 @@ def test_the_tables_are_data_and_the_loop_is_fixed():
                                                        "TabSK", "TabSU"]
     assert constant.declarations[0].init == "[0, 8, 16, 24, 32, 40, 48, 56, 64, 72, 80, 88, 96, 104, 112, 116, 118]"
     ring = _filter("ring_4")
-    other = filter_block(ring, synthesis=synthesis(ring, chain_work=-1)).pou.body
+    other = filter_block(ring, synthesis=synthesis(ring, tables_size=-1)).pou.body
     assert len(loop) == 96 and loop == _loop_nest(other)  # the same statements but for the counts of bags and steps
     assert sum(x.lstrip().startswith("WHILE") for x in loop) == 11
 
@@ -173,7 +217,7 @@ def test_the_plcopen_tables_block_is_valid_tc6_with_its_data_constant():
     from tc6schema import validation_errors
 
     f = _filter("ring_4")
-    block = filter_block(f, synthesis=synthesis(f, chain_work=-1))
+    block = filter_block(f, synthesis=synthesis(f, tables_size=-1))
     [(_, xml)] = render(Target.PLCOPEN, [block.pou], text=block.text, name=block.name, header=["test"])
     assert validation_errors(xml) == []
     ns = {"tc6": "http://www.plcopen.org/xml/tc6_0201"}
@@ -185,7 +229,7 @@ def test_the_plcopen_tables_block_is_valid_tc6_with_its_data_constant():
 def test_a_filter_name_the_tables_need_is_refused():
     f = parse_filter("inputs TabVF\noutputs a, b\nsafety K: a & b & TabVF keep a\n", "clash.filter")
     with pytest.raises(InputError, match="TabVF is a name the generated block needs for itself"):
-        filter_block(f, synthesis=synthesis(f, chain_work=-1))
+        filter_block(f, synthesis=synthesis(f, tables_size=-1))
 
 
 @pytest.mark.slow  # 5-10 s a case: iec2c and gcc, then the model at each of 300 cycles

@@ -35,20 +35,12 @@ from typing import Callable, Sequence
 
 from synth.filter import points
 from synth.filter.at_point import AtPoint
+from synth.filter.language import request_name
 from synth.filter.model import FilterFunctions
 from synth.logic.bdd import Function
 from synth.logic.partition import Partition, State
 
-__all__ = ["Narrowing", "ChainTooLarge", "monolithic", "partitioned", "layout", "decided"]
-
-
-class ChainTooLarge(Exception):
-    """The chain of narrowings passed its BDD work ``budget`` (:func:`partitioned`) at
-    criterion ``step`` (from 1) of ``steps``."""
-
-    def __init__(self, budget: int, step: int, steps: int) -> None:
-        super().__init__(f"more than {budget} BDD lookups at criterion {step} of {steps}")
-        self.budget, self.step, self.steps = budget, step, steps
+__all__ = ["Narrowing", "monolithic", "partitioned", "layout", "against", "decided"]
 
 
 @dataclass(eq=False)
@@ -116,25 +108,21 @@ def _race_monolithic(i: int, goods: Sequence[Function], states: Sequence[Functio
 
 
 def partitioned(m: FilterFunctions, goods: Sequence[Function], order: Sequence[str] | None = None,
-                budget: int | None = None) -> Narrowing:
+                partition: Partition | None = None) -> Narrowing:
     """The chain with each ``S_j`` a partition state, the same BDDs as :func:`monolithic`.
     The outputs are eliminated in ``order``, by default in the order the criteria name them
-    (so that a race moves along it), unless the BDDs' variable order gives smaller bags.
-    ``budget``: :class:`ChainTooLarge` when the criteria's narrowings pass this BDD work
-    (CUDD's computed-table lookups, :meth:`~synth.logic.bdd.Engine.work`), checked after each."""
+    (so that a race moves along it), unless the BDDs' variable order gives smaller bags;
+    ``partition``: the one :func:`layout` gave already (``order`` is then not read)."""
     e, outs = m.engine, m.outputs
     if not outs:
         return monolithic(m, goods)
-    p = layout(m, goods, order)
+    p = layout(m, goods, order) if partition is None else partition
     order = list(p.anchors)
     where = [p.position(g) for g in goods]
     states: list[State] = [p.initial]
     bests: list[Function] = []
     drops: list[Function] = []
-    start = e.work()
     for g, k in zip(goods, where):
-        if budget is not None and e.work() - start > budget:
-            raise ChainTooLarge(budget, len(bests) + 1, len(goods))
         s = states[-1]
         best = p.project(s, k, g)
         bests.append(best)
@@ -182,6 +170,42 @@ def layout(m: FilterFunctions, goods: Sequence[Function], order: Sequence[str] |
                             factors, named),
                   Partition(e, [o for o in e.variable_order if o in outs], factors, named)]
     return min(candidates, key=lambda c: c.width)
+
+
+def against(p: Partition, goods: Sequence[Function]) -> tuple[int, int]:
+    """How much the chain of ``goods`` on ``p`` decides against its elimination order: the
+    size ``Σ (2^n − 1)`` over the cuts between two bags, ``n`` the outputs after the cut that
+    some criterion decides from the request of an output before it, and the largest ``n``.
+    A priority ``Min(R_a ∧ R_b ∧ ¬b)`` (keep ``b``) decides ``b``, and ``a`` yields to it: when
+    ``b`` is eliminated after ``a``, ``a``'s value at each Y waits on ``b``'s, so the chain's
+    messages carry ``b`` back across every cut between them (docs/filter.md, "The chain on
+    tables"). A criterion decides the outputs it reads at t, and yields those whose request it
+    reads and not the output itself. Read on the filter and the partition alone, no chain run.
+
+    >>> from synth.filter.language_check import parse_filter
+    >>> from synth.filter.model import functions
+    >>> from synth.filter.solve import criteria
+    >>> f = parse_filter("outputs a, b, c\\nsafety K: a & b  keep b\\nsafety L: a & c  keep c", "x.filter")
+    >>> m = functions(f)
+    >>> goods = [~m.engine.expr(c.expr) for c in criteria(f)[:2]]  # the two priorities (Min)
+    >>> against(layout(m, goods, ["a", "b", "c"]), goods)  # b and c carried back across a's cut, c across b's
+    (4, 2)
+    >>> p = layout(m, goods)  # by default the order the criteria name the outputs in: b, c, then a
+    >>> p.anchors, against(p, goods)
+    (('b', 'c', 'a'), (0, 0))
+    """
+    e = p.engine
+    position = {o: p.anchor_position(o) for o in p.anchors}
+    yields = {request_name(o): o for o in p.anchors}
+    behind: list[set[str]] = [set() for _ in p.anchors]
+    for g in goods:
+        read = e.support(g)
+        decides = [o for o in read if o in position]
+        for y in (yields[r] for r in read if r in yields and yields[r] not in decides):
+            for o in decides:
+                for k in range(position[y], position[o]):
+                    behind[k].add(o)
+    return sum((1 << len(b)) - 1 for b in behind), max(len(b) for b in behind)
 
 
 def decided(p: Partition, s: State, outputs: Sequence[str]) -> tuple[Function, dict[str, Function], dict[str, Function]]:

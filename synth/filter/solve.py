@@ -35,8 +35,9 @@ from synth.logic.past import pre_name
 from synth.filter import local, narrowing
 from synth.filter.model import FilterFunctions, equation_functions, functions
 from synth.logic.expr import And, Const, Edge, Expr, Not, Or, Var
+from synth.logic.partition import Partition
 
-__all__ = ["IMPLICIT", "FLAT_PROBE", "FLAT_LIMIT", "CHAIN_WORK", "Applied", "Synthesis", "synthesis", "chained_equations", "criteria", "priority_criteria", "priority_criterion", "requested", "sim_expr",
+__all__ = ["IMPLICIT", "FLAT_PROBE", "FLAT_LIMIT", "TABLES_SIZE", "Applied", "Synthesis", "synthesis", "chained_equations", "criteria", "priority_criteria", "priority_criterion", "requested", "sim_expr",
            "differences", "printed"]
 
 
@@ -45,11 +46,14 @@ FLAT_PROBE = 64
 """Cubes: a Y-only (flat) equation is written only when its cover is this small, unless asked."""
 FLAT_LIMIT = 4096
 """Cubes: past this, a flat equation asked for (``solve --flat``) is refused (exit 2)."""
-CHAIN_WORK = 10_000_000
-"""BDD work (CUDD's lookups) of the symbolic chain of narrowings: past it, the filter is
-its chain run on truth tables (:mod:`synth.filter.local`), no equations (grid_edges 8 × 5:
-18 M; the grid of 64 and grid_edges 8 × 4 3.5–3.8 M, the ring of 32 2.8 M, the chain of 256
-0.9 M)."""
+TABLES_SIZE = 500
+"""Past this size of the outputs the chain of narrowings decides against its elimination order
+(:func:`synth.filter.narrowing.against`: per cut, ``2^n − 1`` for the ``n`` outputs carried
+back across it, added up), the filter is its chain run on truth tables (:mod:`synth.filter.local`),
+no equations: a figure read on the filter and its partition before the chain runs, which no
+faster BDD code moves. The symbolic chain's work grows with it (docs/performance.md, "Session
+30"): grid_edges 8 × 4 341 (4.6 M CUDD lookups), 10 stations × 4 461 (8.0 M), 12 × 4 581
+(12.3 M), 8 × 5 765 (21 M), 8 × 8 4 805; the bundled filters at most 3, the bench's rings, chains and grids at most 31."""
 
 
 def sim_expr(output: str) -> Expr:
@@ -164,7 +168,7 @@ class Synthesis:
     inconsistent: Cube | None = None
     inconsistent_text: str = ""
     notes: list[str] = field(default_factory=list)
-    plan: local.Plan | None = None  # the filter on tables (past CHAIN_WORK): no equations
+    plan: local.Plan | None = None  # the filter on tables (past TABLES_SIZE): no equations
 
     @property
     def admissible(self) -> Function:
@@ -203,15 +207,16 @@ class Synthesis:
 
 def synthesis(f: Filter | FilterFunctions, order: Sequence[str] | None = None, *, flat: bool = False,
               applied: Sequence[Criterion] | None = None, partitioned: bool = True,
-              chain_work: int | None = CHAIN_WORK) -> Synthesis:
+              tables_size: int | None = TABLES_SIZE) -> Synthesis:
     """Solve the filter's constraints with its criteria (the relational semantics of 004).
     ``flat``: write every Y-only equation (:class:`LimitExceeded` past FLAT_LIMIT cubes),
     not only those of at most FLAT_PROBE cubes. ``applied``: the criteria to apply instead
     of :func:`criteria` (a cluster's share of its whole filter's, :mod:`synth.filter.clusters`).
     ``partitioned``: keep each admissible set as a conjunction of factors, one BDD otherwise
-    (:mod:`synth.filter.narrowing`; the same result). ``chain_work``: past this BDD work the
-    partitioned chain stops and the filter is its chain on truth tables (:mod:`synth.filter.local`),
-    unless ``flat`` asks for the equations."""
+    (:mod:`synth.filter.narrowing`; the same result). ``tables_size``: past this size of what
+    the partitioned chain decides against its order (:data:`TABLES_SIZE`), the filter is its
+    chain on truth tables (:mod:`synth.filter.local`) and no symbolic chain runs, unless
+    ``flat`` asks for the equations."""
     m = f if isinstance(f, FilterFunctions) else functions(f)
     e = m.engine
     steps = [(c, e.expr(c.expr)) for c in (criteria(m.filter, order) if applied is None else applied)]
@@ -219,11 +224,16 @@ def synthesis(f: Filter | FilterFunctions, order: Sequence[str] | None = None, *
     goods = [u if c.sense is Sense.MAX else ~u for c, u in steps]  # Min(c) is Max(!c)
     if not partitioned:
         chain = narrowing.monolithic(m, goods)
+    elif flat or not m.outputs or tables_size is None:
+        chain = narrowing.partitioned(m, goods)
     else:
-        try:
-            chain = narrowing.partitioned(m, goods, budget=None if flat or not m.outputs else chain_work)
-        except narrowing.ChainTooLarge as big:
-            return _on_tables(m, steps, goods, big)
+        p = narrowing.layout(m, goods)
+        size, widest = narrowing.against(p, goods)
+        if size > tables_size:
+            why = (f"the chain of narrowings decides outputs against its order (size {size} over the limit of "
+                   f"{tables_size}; {widest} outputs carried back across one cut)")
+            return _on_tables(m, steps, goods, p, why)
+        chain = narrowing.partitioned(m, goods, partition=p)
     verdicts = [Applied(c, narrows, effect) for (c, _), narrows, effect in zip(steps, chain.narrows, chain.effects)]
     result = Synthesis(m, chain, chain.care, verdicts)
     stated = any(isinstance(c, Criterion) for c in m.filter.criteria)
@@ -243,19 +253,17 @@ def synthesis(f: Filter | FilterFunctions, order: Sequence[str] | None = None, *
 
 
 def _on_tables(m: FilterFunctions, steps: Sequence[tuple[Criterion, Function]], goods: Sequence[Function],
-               big: narrowing.ChainTooLarge) -> Synthesis:
+               p: Partition, why: str) -> Synthesis:
     """The filter as its chain of narrowings on truth tables (:mod:`synth.filter.local`): the
     criteria in order, the care set ``∃O.S_0`` (the narrowings keep it), no equations, the
     criteria's verdicts not decided. Functional by construction when every output has its
     Sim criterion (it fixes that output at every Y); otherwise refused."""
     e, file = m.engine, m.filter.file
-    why = f"the chain of narrowings passed {big.budget} BDD lookups at criterion {big.step} of {big.steps}"
     sims = {c.origin.rpartition(" ")[2] for c, _ in steps if c.origin.split(" ")[-2:-1] == ["sim"]}
     missing = [o for o in m.outputs if o not in sims]
     if missing:
         raise LimitExceeded(f"{file}: {why}, and {missing[0]} has no similarity criterion: the filter on "
                             "truth tables needs one per output (maximize sim)")
-    p = narrowing.layout(m, goods)
     plan = local.plan_of(m, p, goods)
     care = p.project(p.initial, 0)
     chain = narrowing.Narrowing([], [], care, {}, {}, lambda: _no_relation(file))
