@@ -121,10 +121,10 @@ def grammar_text(name: str) -> str:
 
 
 @lru_cache(maxsize=None)
-def parser(name: str, start: str = "start") -> Lark:
-    """A cached LALR parser for ``grammars/<name>.lark`` from rule ``start`` (positions propagated)."""
+def parser(name: str, start: str = "start", text: str | None = None) -> Lark:
+    """A cached LALR parser for ``grammars/<name>.lark`` (or the grammar ``text`` called ``name``) from rule ``start``."""
     options = dict(parser="lalr", propagate_positions=True, maybe_placeholders=True, start=start, _plugins=plugins())
-    text = grammar_text(name)
+    text = grammar_text(name) if text is None else text
     cache = _cache_file(name, start, text)
     if cache is not None:
         try:  # the compiled LALR tables, in the user's cache folder

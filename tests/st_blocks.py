@@ -1,5 +1,5 @@
-"""Generated filter blocks, parsed by blark and compiled by the ST interpreter once per
-test session: blark's Earley parser takes about a second per block."""
+"""Generated filter blocks, parsed into blark's tree and compiled by the ST interpreter once
+per test session."""
 
 from __future__ import annotations
 

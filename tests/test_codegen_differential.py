@@ -29,13 +29,13 @@ DEPTH = {"tri.g7": 3, "tri_missing_order.g7": 3, "tri_boxes.g7": 3}  # 11 inputs
 # The CI slice of the random differential: 15 of the 40 seeds the suite ran until session 29
 # (every third of 1-119), chosen so that each construct of the generator is in at least two of
 # the programs the differential explores past their first cycle (test_random_grafcets; the other
-# ones are never stable, seed 4 stands for them), at two fifths of the ST for blark to parse (the
-# parse is most of the time); the other 25 and 1 000 more run nightly.
+# ones are never stable, seed 4 stands for them), at two fifths of the ST to parse (blark's Earley
+# parse was most of the time until session 30); the other 25 and 1 000 more run nightly.
 RANDOM_SEEDS = (4, 13, 16, 22, 34, 40, 46, 58, 61, 79, 88, 94, 103, 112, 115)
 NIGHTLY_SEEDS = [s for s in range(1, 120, 3) if s not in RANDOM_SEEDS] + list(range(120, 1120))
 
 
-@pytest.mark.slow  # about 60 s: blark parses each program (about 1 ms per character)
+@pytest.mark.slow  # tens of seconds: the depth-4 explorations of the three largest (the parse: 0.1 s a program)
 @pytest.mark.parametrize("path", BUNDLED, ids=lambda p: str(p.relative_to(ROOT)))
 def test_bundled_grafcets_exhaustively(path: Path):
     """Also the test that blark parses the program of every bundled Grafcet: the interpreter
@@ -76,7 +76,7 @@ def _random_programs(seeds: Sequence[int]) -> list[tuple[int, int, int, str]]:
     return results
 
 
-@pytest.mark.slow  # about 15 s on 2 cores: 15 programs for blark to parse
+@pytest.mark.slow  # about 3 s: 15 programs parsed and explored
 def test_random_grafcets():
     results = _random_programs(RANDOM_SEEDS)
     assert sum(cycles for _, _, cycles, _ in results) > 700  # 1 037 (the 40 seeds gave 2 177)

@@ -5,7 +5,7 @@ situation and plays each one on both sides:
 
 * synth's :class:`~synth.grafcet.machine.GrafcetMachine` (what ``synth run`` steps), one input
   event (``↑x``/``↓x``) or timer event (``2s/X101``) at a time;
-* the generated program (:func:`~synth.codegen.grafcet_st.generate_program`) parsed by blark and
+* the generated program (:func:`~synth.codegen.grafcet_st.generate_program`) parsed into blark's tree and
   run by :mod:`synth.codegen.interpreter.machine`, one PLC cycle per event; a timer event is the clock
   advanced to 1 ms before the timer's preset, one cycle with unchanged inputs in which nothing
   may change (a timer that fires early is seen there), then 1 ms more and one cycle in which the
@@ -139,7 +139,7 @@ class ProgramRunner(Protocol):
 
 
 class InterpretedProgram:
-    """The generated program parsed by blark and run by :mod:`synth.codegen.interpreter.machine`."""
+    """The generated program parsed into blark's tree and run by :mod:`synth.codegen.interpreter.machine`."""
 
     def __init__(self, program: StProgram, file: str) -> None:
         from synth.codegen.interpreter.machine import load_st

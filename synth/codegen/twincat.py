@@ -77,13 +77,14 @@ def tcpou(pou: Pou, header: Sequence[str] = ()) -> bytes:
 def st_of_tcpou(data: bytes, file: str) -> str:
     """The POU of a ``.TcPOU`` file as one ST text (declaration, implementation, ``END_…``),
     read by blark's TwinCAT loader, which also parses it: a text blark refuses is an error."""
-    from blark.parse import parse_item
     from blark.solution import TcPOU, TcSource
+
+    from synth.codegen.interpreter.parsing import parse_item
 
     source = TcSource.from_contents(data, filename=None)
     if not isinstance(source, TcPOU) or source.decl.declaration is None:
         raise InputError("not a TwinCAT POU file (a TcPlcObject holding one POU)", Location(file, 1, 1, "", 1))
-    for result in (r for item in source.to_blark() for r in parse_item(item)):
+    for result in (r for item in source.to_blark() for r in parse_item(item, file)):
         if result.exception is not None:
             raise InputError(f"blark cannot parse this TwinCAT POU: {result.exception}", Location(file, 1, 1, "", 1))
     declaration = source.decl.declaration.value.rstrip("\n")

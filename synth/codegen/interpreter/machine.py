@@ -1,8 +1,10 @@
 """An interpreter for the IEC 61131-3 Structured Text that synth emits, on blark's parse tree.
 
 It is the independent half of the proof "what runs is what was proven": the generated
-text is parsed by `blark <https://pypi.org/project/blark/>`_ (a lark-based IEC 61131-3
-parser written by others), and its dataclass tree is executed cycle by cycle. Nothing
+text is parsed into the tree of `blark <https://pypi.org/project/blark/>`_ (a lark-based IEC
+61131-3 parser written by others; :mod:`synth.codegen.interpreter.parsing` reads synth's own
+ST faster with blark's rules under LALR, into the very tree blark's parser gives, which the
+tests check against it), and blark's dataclass tree is executed cycle by cycle. Nothing
 here reads synth's own models, so a wrong emitter cannot agree with itself.
 
 The subset: ``PROGRAM`` and ``FUNCTION_BLOCK``; ``VAR``, ``VAR_INPUT``, ``VAR_OUTPUT``,
@@ -89,8 +91,9 @@ class Module:
 
 
 def load_st(text: str, file: str = "<st>") -> Module:
-    """Parse ``text`` with blark and compile its PROGRAMs and FUNCTION_BLOCKs."""
-    from blark.parse import parse_source_code
+    """Parse ``text`` into blark's tree (:func:`~synth.codegen.interpreter.parsing.parse_st`)
+    and compile its PROGRAMs and FUNCTION_BLOCKs."""
+    from synth.codegen.interpreter.parsing import parse_st
 
     text = text.replace("\r\n", "\n").replace("\r", "\n")  # CRLF (Windows IDEs): the same lines and columns
     # trailing blanks dropped: blark's scanner is quadratic in a run of blanks (20 000: 15 s)
@@ -99,7 +102,7 @@ def load_st(text: str, file: str = "<st>") -> Module:
     if stray is not None:
         raise stray
     try:
-        result = parse_source_code(text, fn=file)
+        result = parse_st(text, file)
     except (IndexError, RuntimeError, ValueError) as failure:  # blark's comment scanner on what _comment_error missed
         raise InputError(f"not valid IEC 61131-3 Structured Text (blark: {failure})",
                          location_in(file, text, 1, 1)) from None
