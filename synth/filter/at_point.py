@@ -65,27 +65,52 @@ class AtPoint:
     criterion finds a solution there), as :meth:`synth.filter.points.Points.chain` gives
     them as single BDDs."""
 
-    def __init__(self, points: Points, point: Mapping[str, bool]) -> None:
+    def __init__(self, points: Points, point: Mapping[str, bool], like: AtPoint | None = None) -> None:
         self.points = points
         self.engine = points.engine
         self.bdd = points.bdd
+        self.false = points.bdd.false
         self.point = point
         self.there = points.there(point)
         last: dict[str, int] = {v: -1 for v in points.anchors}
         for j, g in enumerate(self.there):
             for v in points.reads(g):
                 last[v] = j
-        self._last = last
-        s = Fixed({}, points.base_at(point))
-        self.states, self.bests = [s], []
-        for g in self.there:
-            s, best = self.narrow(s, g)
-            self.states.append(s)
-            self.bests.append(best)
+        self.last_read = last
+        """Per output (internal name): the last criterion reading it at the point (-1: none)."""
+        if like is not None and (like.points is not points or like.last_read != last):
+            like = None  # another chain, or the outputs read last elsewhere: the horizons would differ
+        self.states, self.bests = self._chain(Fixed({}, points.base_at(point)), like)
         self._free: list[Function | None] | None = None
         self._projected: dict[int, Function] = {}
         self.agreed = 0
         """Races :meth:`race` ended because ``Z`` and the chain agreed (for tests and benchmarks)."""
+
+    def _chain(self, s: Fixed, like: AtPoint | None) -> tuple[list[Fixed], list[bool]]:
+        """``S_0 … S_n`` and the verdicts from ``s`` (``S_0``). With ``like`` (the chain at
+        another point, whose outputs are read last at the same steps): wherever this chain's
+        ``S_j`` is ``like``'s as a relation (the same outputs fixed to the same values, the same
+        rest) and criterion ``j`` is the same there, ``S_{j+1}`` is ``like``'s (the same
+        object: its ``added`` is relative to an equal ``S_j``), no narrowing run; the witnesses
+        are made sparse a few variables at a time, so most steps are met again."""
+        states, bests = [s], []
+        if like is None:
+            for g in self.there:
+                s, best = self.narrow(s, g)
+                states.append(s)
+                bests.append(best)
+            return states, bests
+        theirs, their_there, their_bests = like.states, like.there, like.bests
+        same = _equal(s, theirs[0])
+        for j, g in enumerate(self.there):
+            if same and g == their_there[j]:
+                s, best = theirs[j + 1], their_bests[j]
+            else:
+                s, best = self.narrow(s, g)
+                same = _equal(s, theirs[j + 1])
+            states.append(s)
+            bests.append(best)
+        return states, bests
 
     # ---- relations
     def _literal(self, v: str, value: bool) -> Function:
@@ -93,8 +118,8 @@ class AtPoint:
         return x if value else ~x
 
     def _cofactor(self, u: Function, v: str, value: bool) -> Function:
-        """``u`` with output ``v`` at ``value`` (and-abstract over ``v``'s cube)."""
-        return self.engine.and_exists(u, self._literal(v, value), [v])
+        """``u`` with output ``v`` at ``value`` (CUDD's cofactor on the literal)."""
+        return self.points.cofactor(u, v, value)
 
     def _restricted(self, s: Fixed, g: Function) -> Function:
         """``g`` with the outputs ``s`` fixes set to their values (``g``: a criterion at the point)."""
@@ -107,23 +132,28 @@ class AtPoint:
         return self.engine.and_exists(g, cube, [v for v, _ in values])
 
     def _fixing(self, s: Fixed, v: str, value: bool, rest: Function) -> Fixed:
-        return Fixed({**s.fixed, v: value}, rest, max(s.horizon, self._last[v]), v)
+        return Fixed({**s.fixed, v: value}, rest, max(s.horizon, self.last_read[v]), v)
 
     def narrow(self, s: Fixed, g: Function) -> tuple[Fixed, bool]:
         """``Max(g)`` on ``s`` (:func:`synth.filter.points.narrow`): ``s ∧ g`` where it is
         not empty, else ``s ∧ ¬g``; and whether it was not."""
-        false = self.bdd.false
-        if g.var is not None:
+        false = self.false
+        shape = self.points.shape(g)
+        if shape is None:  # another function: its outputs s fixes set, it may be constant or a literal then
             g = self._restricted(s, g)
-        if g.var is None:  # constant: s as it is
-            return (s, False) if g == false else (s, s.rest != false)
-        if g.low.var is None and g.high.var is None:  # a literal: a cofactor of the rest
-            v = g.var
-            value = g == self.bdd.var(v)
-            kept = self._cofactor(s.rest, v, value)
+            shape = self.points.shape(g)
+        elif shape is not True and shape is not False and shape[0] in s.fixed:  # a literal on an output s fixes
+            shape = s.fixed[shape[0]] == shape[1]
+        if shape is False:  # constant: s as it is
+            return s, False
+        if shape is True:
+            return s, s.rest != false
+        if shape is not None:  # a literal: a cofactor of the rest
+            v, value = shape
+            kept = self.points.cofactor(s.rest, v, value)
             if kept != false:
                 return self._fixing(s, v, value, kept), True
-            return self._fixing(s, v, not value, self._cofactor(s.rest, v, not value)), False
+            return self._fixing(s, v, not value, self.points.cofactor(s.rest, v, not value)), False
         kept = s.rest & g
         if kept != false:
             return Fixed(s.fixed, kept, s.horizon), True
@@ -187,7 +217,7 @@ class AtPoint:
         """Per step j: the cube of the outputs no criterion from j on reads (None: none)."""
         if self._free is None:
             freed: dict[int, list[str]] = {}
-            for v, j in self._last.items():
+            for v, j in self.last_read.items():
                 freed.setdefault(j + 1, []).append(v)
             bdd, cube = self.bdd, None
             out: list[Function | None] = []
@@ -270,6 +300,11 @@ class AtPoint:
             if (self.can(z, v, True), self.can(z, v, False)) != (self.can(last, v, True), self.can(last, v, False)):
                 out.append(o)
         return out
+
+
+def _equal(a: Fixed, b: Fixed) -> bool:
+    """Whether ``a`` and ``b`` fix the same outputs to the same values and have the same rest."""
+    return a is b or (a.rest == b.rest and a.fixed == b.fixed)
 
 
 def _moved(apart: set[str], z: Fixed, z_before: Fixed, s: Fixed, s_before: Fixed) -> None:

@@ -26,6 +26,7 @@ from operator import itemgetter
 from typing import Any, Callable, Mapping, Sequence
 
 from synth.logic.bdd import Function
+from synth.logic.native import native
 from synth.logic.partition import Partition
 
 __all__ = ["Points", "race_at_point", "POINT_DEFAULTS", "POINT_ROUNDS", "POINT_SEED", "random_point"]
@@ -59,6 +60,11 @@ class Points:
         self._outputs_read: dict[Function, frozenset[str]] = {}
         self._last: tuple[dict[str, bool], tuple[Function, ...]] | None = None  # the last point and its criteria there
         self._readers: dict[str, list[int]] = {}  # a variable -> the criteria (positions) reading it
+        self._shapes: dict[Function, tuple[str, bool] | bool | None] = {}
+        fast = native(self.bdd) if e.cudd else None
+        self.cofactor: Callable[[Function, str, bool], Function] = fast.cofactor if fast is not None else \
+            (lambda u, v, value: self.bdd.let({v: value}, u))
+        """``u`` with the variable ``v`` (internal name) at ``value``: CUDD's cofactor on the literal."""
 
     def point(self, picked: Mapping[str, bool], default: bool) -> dict[str, bool]:
         """``picked`` completed with ``default`` for the variables it leaves free."""
@@ -127,6 +133,22 @@ class Points:
         found = self._outputs_read.get(g)
         if found is None:
             found = self._outputs_read[g] = frozenset(self.bdd.support(g))
+        return found
+
+    def shape(self, g: Function) -> tuple[str, bool] | bool | None:
+        """What ``g`` (a criterion at a point) is: its value when constant, ``(v, value)`` when
+        the literal ``v`` (``value``: positive), else None (remembered per function: dd reads
+        a node's children as new objects)."""
+        try:
+            return self._shapes[g]
+        except KeyError:
+            pass
+        found: tuple[str, bool] | bool | None = None
+        if g.var is None:
+            found = g == self.bdd.true
+        elif g.low.var is None and g.high.var is None:
+            found = (g.var, g == self.bdd.var(g.var))
+        self._shapes[g] = found
         return found
 
     def base_at(self, point: Mapping[str, bool]) -> Function:

@@ -180,19 +180,18 @@ class SpellingChain:
         whole set, then halves, and so on), wherever alternative ``n`` still differs; the
         outputs it drives differently at the point left."""
         point = dict(point)
-
         region = self._region(n)
-
-        def differs() -> list[str]:
-            return self._differ_at(AtPoint(at, point), n) if at.holds(region, point) else []
-
+        here = AtPoint(at, dict(point))  # the chain at the point so far: each trial's runs from it where they agree
         groups = [[v for v in at.others if point[v]]]  # a stack, not a recursive closure (no cycle to collect)
         while groups:
             group = groups.pop()
             for v in group:
                 point[v] = False
-            if differs():
-                continue
+            if at.holds(region, point):
+                trial = AtPoint(at, dict(point), like=here)
+                if self._differ_at(trial, n):
+                    here = trial
+                    continue
             for v in group:
                 point[v] = True
             if len(group) > 1:
@@ -204,7 +203,7 @@ class SpellingChain:
             for name, bits in ((i.name, i.bits), (pre_name(i.name), [pre_name(b) for b in i.bits])):
                 if all(b in value for b in bits):
                     integers.append((name, i.low + sum(value.pop(b) << k for k, b in enumerate(bits))))
-        return Witness(tuple(differs()), tuple(x for x, v in value.items() if v), tuple(integers))
+        return Witness(tuple(self._differ_at(here, n)), tuple(x for x, v in value.items() if v), tuple(integers))
 
     def differ(self, n: int) -> list[str] | None:
         """The outputs alternative ``n`` drives differently (another ``∃O.(S∧o)`` or
