@@ -56,7 +56,9 @@ class SpellingChain:
         self.bests: list[Function] = []
         self._regions: dict[int, Function] = {}
         self.budget: int | None = None
-        """While set, the work (:meth:`Engine.work`) past which running the chain gives up."""
+        """While set, the size past which running the chain gives up: the BDD nodes of the
+        local relation (:meth:`Partition.local <synth.logic.partition.Partition.local>`) at the
+        criterion it is to apply next."""
         self.coarse = False
         """Whether the regions are taken on ``S_0`` (:meth:`sparse_points`)."""
 
@@ -64,9 +66,9 @@ class SpellingChain:
         """The chain's ``S_j``, the chain run that far if it is not yet (the points need it
         only up to the last relief's criterion)."""
         while len(self.states) <= j:
-            if self.budget is not None and self.m.engine.work() > self.budget:
-                raise TooWide
             n = len(self.bests)
+            if self.budget is not None and len(self.p.local(self.states[-1], self.where[n])) > self.budget:
+                raise TooWide
             state, best = self._step(self.states[-1], self.where[n], self.goods[n])
             self.states.append(state)
             self.bests.append(best)
@@ -109,12 +111,13 @@ class SpellingChain:
         return (p.project(s, self.where[i], good) & p.project(s, self.where[i], ~good)) | \
             (p.project(s, k, g) & p.project(s, k, ~g))
 
-    def sparse_points(self, candidates: Sequence[int], work: int) -> dict[int, Witness]:
+    def sparse_points(self, candidates: Sequence[int], size: int) -> dict[int, Witness]:
         """:meth:`at_points` with the free variables 0, its regions on the chain's ``S_i``
-        while running the chain that far costs at most ``work``; past it, on ``S_0``
-        (:meth:`_initial_region`, :attr:`coarse`: the chain is not run, and
+        while the chain's local relation at each criterion on the way there has at most
+        ``size`` nodes (:attr:`budget`); past it, on ``S_0`` (:meth:`_initial_region`,
+        :attr:`coarse`: the chain is not run further, and
         :func:`synth.filter.reliefs.spelling_warnings` compares nothing on every input)."""
-        self.budget = self.m.engine.work() + work
+        self.budget = size
         try:
             return self.at_points(candidates, points.POINT_DEFAULTS[:1], 0)
         except TooWide:
