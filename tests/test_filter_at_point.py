@@ -159,8 +159,9 @@ def test_same_relation_whatever_the_outputs_kept_apart() -> None:
 def test_a_chain_run_from_another_points_chain_is_the_chain_run_alone(case: str) -> None:
     """``AtPoint(at, point, like=other)`` (the steps where both chains' relations and criteria
     agree taken from ``other``) against ``AtPoint(at, point)``: the same relations, outputs
-    fixed, horizons and verdicts at every step, the same races and spellings, on a walk of
-    random points one to three variables apart (as the witnesses are made sparse)."""
+    fixed, horizons and verdicts at every step, the same races and spellings (those run from
+    the other point's runs too), on a walk of random points one to three variables apart (as
+    the witnesses are made sparse)."""
     f = CASES[case]()
     swapped = [(s, dataclasses.replace(s, keep=o.keep, force=o.force))
                for s in f.combined if s.has_priority for o in (_other(s),) if o is not None]
@@ -168,7 +169,10 @@ def test_a_chain_run_from_another_points_chain_is_the_chain_run_alone(case: str)
     at = points.Points(chain.p, chain.goods)
     rng = random.Random(5)
     here = AtPoint(at, {v: rng.random() < 0.5 for v in at.others})
-    taken = run = races = 0
+    alternatives = [a for a in chain.alternatives if a is not None]
+    for alternative in alternatives:
+        here.differ(*alternative, chain.m.outputs)
+    taken = run = races = shared = 0
     for _ in range(30):
         point = dict(here.point)
         for v in rng.sample(at.others, min(len(at.others), rng.choice((1, 1, 2, 3)))):
@@ -180,11 +184,12 @@ def test_a_chain_run_from_another_points_chain_is_the_chain_run_alone(case: str)
             if near.bests[i] and near.dropped(i).rest != at.engine.false:
                 assert near.race(i, near.dropped(i)) == alone.race(i, alone.dropped(i))
                 races += 1
-        for alternative in chain.alternatives:
-            if alternative is not None:
-                assert near.differ(*alternative, chain.m.outputs) == alone.differ(*alternative, chain.m.outputs)
+        for alternative in alternatives:
+            assert near.differ(*alternative, chain.m.outputs, here) == alone.differ(*alternative, chain.m.outputs)
+        shared += sum(mine[0] and theirs[0] and mine[0][0] is theirs[0][0]
+                      for key, mine in near.runs.items() for theirs in (here.runs.get(key),) if theirs is not None)
         mine = sum(s is t for s, t in zip(near.states[1:], here.states[1:]))
         taken, run = taken + mine, run + len(near.states) - 1 - mine
         if rng.random() < 0.5:
             here = near
-    assert taken > 0 and run > 0 and races > 0
+    assert taken > 0 and run > 0 and races > 0 and shared > 0

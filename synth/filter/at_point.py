@@ -83,6 +83,9 @@ class AtPoint:
         self.states, self.bests = self._chain(Fixed({}, points.base_at(point)), like)
         self._free: list[Function | None] | None = None
         self._projected: dict[int, Function] = {}
+        self.runs: dict[tuple[int, Function], tuple[list[Fixed], list[str], bool]] = {}
+        """:meth:`differ`'s runs: per criterion and other criterion at the point, each step's
+        ``z``, the answer, and whether it was reached by this chain alone (for ``like``)."""
         self.agreed = 0
         """Races :meth:`race` ended because ``Z`` and the chain agreed (for tests and benchmarks)."""
 
@@ -265,41 +268,93 @@ class AtPoint:
         return True
 
     # ---- the keep/force spellings
-    def differ(self, i: int, g: Function, outputs: Sequence[str]) -> list[str]:
+    def differ(self, i: int, g: Function, outputs: Sequence[str], like: AtPoint | None = None) -> list[str]:
         """The ``outputs`` (the engine's names, in their order) the chain with criterion
         ``i`` replaced by ``g`` drives differently at the point, none where it rejoins the
-        chain (:meth:`synth.filter.reliefs._Chain.differ` at a point)."""
-        points, states = self.points, self.states
+        chain (:meth:`synth.filter.spelling_chain.SpellingChain.differ` at a point).
+
+        With ``like`` (the chain at another point, which asked the same before: a witness's
+        trials ask it of the chain at the point so far), its run is taken where it is this
+        one's: its ``z`` at every step while both chains and their criteria agree from the
+        start, and its answer once this ``z`` is its ``z`` at a step from which both chains
+        and their criteria agree to the end (the answer depends only on ``z`` there and on
+        the chain after it)."""
+        points, states, there = self.points, self.states, self.there
         g = points.at(g, self.point)
-        if g == self.there[i]:  # the same criterion at the point: the chain itself
+        if g == there[i]:  # the same criterion at the point: the chain itself
             return []
-        z, _ = self.narrow(states[i], g)
-        # the outputs z and the chain fix apart, kept step by step: each narrowing fixes one at most
-        # (a shortcut only: a chain that rejoins gives the same relation at the end); where
-        # they fix outputs apart, asked at steps i+1, i+2, i+4, … only (each asking costs
-        # cofactors), where they fix the same ones, at every step (their rests compared)
-        apart: set[str] = set()
-        _moved(apart, z, states[i], states[i + 1], states[i])
-        ask = i + 1
-        for j in range(i + 1, len(self.there)):
+        theirs = None if like is None else like.runs.get((i, g))
+        start, agree = i + 1, len(there) + 1  # agree: from where both chains agree to the end
+        if theirs is not None:
+            assert like is not None
+            zs, answer, complete = theirs
+            first = _disagreeing(states, there, like, range(len(there) + 1), len(there) + 1)  # both agree before
+            agree = _disagreeing(states, there, like, range(len(there), -1, -1), -1) + 1
+            if i < first:  # the same z from i + 1 up to the first step they disagree at
+                reached = i + len(zs)
+                if (complete and reached < first) or agree <= i + 1:
+                    self.runs[(i, g)] = theirs
+                    return answer
+                start = min(first, reached)
+        if start > i + 1:
+            assert theirs is not None
+            z = theirs[0][start - i - 1]
+            mine = list(theirs[0][:start - i])
+            apart = {v for v in z.fixed.keys() | states[start].fixed.keys()
+                     if z.fixed.get(v) != states[start].fixed.get(v)}
+        else:
+            z, _ = self.narrow(states[i], g)
+            mine = [z]
+            # the outputs z and the chain fix apart, kept step by step: each narrowing fixes one at
+            # most (a shortcut only: a chain that rejoins gives the same relation at the end); where
+            # they fix outputs apart, asked at steps i+1, i+2, i+4, … only (each asking costs
+            # cofactors), where they fix the same ones, at every step (their rests compared)
+            apart = set()
+            _moved(apart, z, states[i], states[i + 1], states[i])
+        answer, complete = self._run(i, z, start, apart, mine, agree, theirs, outputs)
+        self.runs[(i, g)] = (mine, answer, complete)
+        return answer
+
+    def _run(self, i: int, z: Fixed, start: int, apart: set[str], mine: list[Fixed], agree: int,
+             theirs: tuple[list[Fixed], list[str], bool] | None, outputs: Sequence[str]) -> tuple[list[str], bool]:
+        """:meth:`differ` from step ``start`` (``z`` there, ``apart`` the outputs it and the
+        chain fix apart), each ``z`` appended to ``mine``; the answer and whether it was
+        reached by this chain alone (not taken from ``theirs`` at a step past ``agree``)."""
+        states, there = self.states, self.there
+        ask = start
+        for j in range(start, len(there)):
             s = states[j]
+            if theirs is not None and j >= agree and j - i - 1 < len(theirs[0]) and _equal(z, theirs[0][j - i - 1]):
+                return theirs[1], False
             if z is s or (not apart and z.rest == s.rest):
-                return []
+                return [], True
             if apart and j == ask:
                 if self._same_apart(z, s, _items(apart, z, s)):
-                    return []
+                    return [], True
                 ask += ask - i
-            before, (z, _) = z, self.narrow(z, self.there[j])
+            before, (z, _) = z, self.narrow(z, there[j])
+            mine.append(z)
             _moved(apart, z, before, states[j + 1], s)
         last = states[-1]
         if z is last or (self._same_apart(z, last, _items(apart, z, last)) if apart else z.rest == last.rest):
-            return []
+            return [], True
         out = []
         for o in outputs:
             v = self.engine.declare(o)
             if (self.can(z, v, True), self.can(z, v, False)) != (self.can(last, v, True), self.can(last, v, False)):
                 out.append(o)
-        return out
+        return out, True
+
+
+def _disagreeing(states: Sequence[Fixed], there: Sequence[Function], like: AtPoint, steps: Iterable[int],
+                 default: int) -> int:
+    """The first of ``steps`` where ``states`` and ``like``'s are other relations or the criteria
+    there are others (``default``: none)."""
+    n = len(there)
+    for j in steps:
+        if not _equal(states[j], like.states[j]) or (j < n and there[j] != like.there[j]):
+            return j
+    return default
 
 
 def _equal(a: Fixed, b: Fixed) -> bool:

@@ -170,13 +170,14 @@ class SpellingChain:
     def _at(self) -> points.Points:
         return points.Points(self.p, self.goods)
 
-    def _differ_at(self, here: AtPoint, n: int) -> list[str]:
+    def _differ_at(self, here: AtPoint, n: int, like: AtPoint | None = None) -> list[str]:
         """The outputs alternative ``n`` drives differently at the point ``here`` (the chain
-        there), none where it rejoins the chain."""
+        there), none where it rejoins the chain; ``like``: the chain at a point that asked it
+        before (:meth:`AtPoint.differ <synth.filter.at_point.AtPoint.differ>`)."""
         alternative = self.alternatives[n]
         assert alternative is not None
         i, g = alternative
-        return here.differ(i, g, self.m.outputs)
+        return here.differ(i, g, self.m.outputs, like)
 
     def _witness(self, at: points.Points, n: int, point: dict[str, bool]) -> Witness:
         """``point`` made sparse: its variables at 1 set to 0, all of a group at once (the
@@ -192,7 +193,7 @@ class SpellingChain:
                 point[v] = False
             if at.holds(region, point):
                 trial = AtPoint(at, dict(point), like=here)
-                if self._differ_at(trial, n):
+                if self._differ_at(trial, n, here):
                     here = trial
                     continue
             for v in group:
