@@ -65,7 +65,8 @@ class AtPoint:
     criterion finds a solution there), as :meth:`synth.filter.points.Points.chain` gives
     them as single BDDs."""
 
-    def __init__(self, points: Points, point: Mapping[str, bool], like: AtPoint | None = None) -> None:
+    def __init__(self, points: Points, point: Mapping[str, bool], like: AtPoint | None = None,
+                 base: Function | None = None) -> None:
         self.points = points
         self.engine = points.engine
         self.bdd = points.bdd
@@ -80,7 +81,8 @@ class AtPoint:
         """Per output (internal name): the last criterion reading it at the point (-1: none)."""
         if like is not None and (like.points is not points or like.last_read != last):
             like = None  # another chain, or the outputs read last elsewhere: the horizons would differ
-        self.states, self.bests = self._chain(Fixed({}, points.base_at(point)), like)
+        base = points.base_at(point) if base is None else base  # S_0 at the point, when the caller has it
+        self.states, self.bests = self._chain(Fixed({}, base), like)
         self._free: list[Function | None] | None = None
         self._projected: dict[int, Function] = {}
         self.runs: dict[tuple[int, Function], tuple[list[Fixed], list[str], bool]] = {}

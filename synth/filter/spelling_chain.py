@@ -185,14 +185,15 @@ class SpellingChain:
         outputs it drives differently at the point left."""
         point = dict(point)
         region = self._region(n)
-        here = AtPoint(at, dict(point))  # the chain at the point so far: each trial's runs from it where they agree
+        base = at.partial({v: False for v in at.others if not point[v]})  # S_0 at the trials: those stay 0
+        here = AtPoint(at, dict(point), base=base(point))  # the chain at the point so far: each trial's runs from it
         groups = [[v for v in at.others if point[v]]]  # a stack, not a recursive closure (no cycle to collect)
         while groups:
             group = groups.pop()
             for v in group:
                 point[v] = False
             if at.holds(region, point):
-                trial = AtPoint(at, dict(point), like=here)
+                trial = AtPoint(at, dict(point), like=here, base=base(point))
                 if self._differ_at(trial, n, here):
                     here = trial
                     continue
