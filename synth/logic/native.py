@@ -32,7 +32,7 @@ True
 True
 >>> n is None or (n.cofactor(v, "x", False), n.cofactor(v, "x", True)) == (b.true, b.add_expr("z"))
 True
->>> n is None or (n.assigner(["x", "z"])(v, [True, False]), n.assigner(["z"])(v, [True])) == (b.false, b.true)
+>>> n is None or (n.assigner(["z", "x"])(v, [False, True]), n.assigner(["z"])(v, [True])) == (b.false, b.true)
 True
 >>> n is None or n.prime(b.add_expr("x & y & z"), u | b.add_expr("z")) == b.add_expr("z")
 True
@@ -105,18 +105,21 @@ class Native:
     def assigner(self, names: Sequence[str]) -> Callable[[Function, Sequence[bool]], Function]:
         """A function giving ``u`` with the variables ``names`` at ``values`` (one per name):
         CUDD's cofactor on their cube, the cube built by CUDD from an array of the variables
-        made here once (dd's ``let`` fills an array over every declared variable per call and
-        composes: 0.4 ms for 384 variables on 8 000 nodes, against 0.2 ms)."""
+        made here once, in level order so that CUDD builds it in one pass from the bottom up
+        (dd's ``let`` fills an array over every declared variable per call)."""
         import ctypes
+        from operator import itemgetter
 
         count = len(names)
-        nodes = (ctypes.c_void_p * count)(*(int(self.bdd.var(v)) - 2 for v in names))
+        order = sorted(range(count), key=lambda i: self.bdd.level_of_var(names[i]))  # CUDD's cube: one pass up
+        nodes = (ctypes.c_void_p * count)(*(int(self.bdd.var(names[i])) - 2 for i in order))
         phases = ctypes.c_int * count
+        ordered = itemgetter(*order) if count > 1 else (lambda values: tuple(values))
 
         def assigned(u: Function, values: Sequence[bool]) -> Function:
             if not count:
                 return u
-            cube = self._cube(self.manager, nodes, phases(*values), count)
+            cube = self._cube(self.manager, nodes, phases(*ordered(values)), count)
             held = self.wrapped(cube) if cube else None  # referenced while the cofactor runs
             r = self._cofactor(self.manager, int(u) - 2, cube) if held is not None else 0
             if not r:  # CUDD gave up (memory): dd's call reports it
