@@ -135,9 +135,10 @@ def spelling_warnings(f: Filter, safeties: Sequence[Safety] | None = None,
     (the first always);
     those left tried at the other points (free variables 1, random), and the rest listed,
     not compared. When the chain's local relation at a criterion up to the last relief's
-    has more than ``regions`` nodes (-1: always), the points are taken where the criteria narrow ``S_0`` and none is compared on every input
-    (:meth:`SpellingChain.sparse_points`). ``limit`` None: every relief compared on every input,
-    each warning naming every output it drives differently."""
+    has more than ``regions`` nodes (-1: always), the points are taken where the criteria
+    narrow ``S_0`` and none is compared on every input (:meth:`SpellingChain.sparse_points`).
+    ``limit`` None: every relief compared on every input, each warning naming every output it
+    drives differently."""
     swapped: list[tuple[Safety, Safety]] = []  # each relief and the same constraint written the other way
     for s in (safeties if safeties is not None else f.combined):
         other = _other(s) if s.has_priority else None
