@@ -193,3 +193,20 @@ def test_a_chain_run_from_another_points_chain_is_the_chain_run_alone(case: str)
         if rng.random() < 0.5:
             here = near
     assert taken > 0 and run > 0 and races > 0 and shared > 0
+
+
+@pytest.mark.parametrize("case", ["ring_4", "grid_edges_16", "palletizer"])
+def test_s0_set_in_parts_is_s0_at_the_point(case: str) -> None:
+    """``S_0`` with a point's variables at 0 set first (``Points.partial``), then the others in
+    two halves (``Points.restrict``), as a witness made sparse sets them: ``S_0`` at the point."""
+    at, _ = _setup(CASES[case]())
+    rng = random.Random(3)
+    differ = 0
+    for point in _points(at, 10):
+        ones = [v for v in at.others if point[v]]
+        half = rng.randrange(len(ones) + 1)
+        root = at.partial({v: False for v in at.others if not point[v]})
+        parts = at.restrict(at.restrict(root, ones[:half], point), ones[half:], point)
+        assert parts == at.base_at(point) == at.bdd.let(dict(point), at.partial({}))
+        differ += root != parts
+    assert differ > 0

@@ -185,22 +185,28 @@ class SpellingChain:
         outputs it drives differently at the point left."""
         point = dict(point)
         region = self._region(n)
-        base = at.partial({v: False for v in at.others if not point[v]})  # S_0 at the trials: those stay 0
-        here = AtPoint(at, dict(point), base=base(point))  # the chain at the point so far: each trial's runs from it
-        groups = [[v for v in at.others if point[v]]]  # a stack, not a recursive closure (no cycle to collect)
+        ones = [v for v in at.others if point[v]]
+        root = at.partial({v: False for v in at.others if not point[v]})  # they stay 0
+        here = AtPoint(at, dict(point), base=at.restrict(root, ones, point))  # the chain at the point so far
+        # a stack, not a recursive closure (no cycle to collect): each group with S_0 set outside
+        # its parent group, and the parent's other half, to set when the group is reached (after
+        # the first half's trials: its variables then have their values for good)
+        groups: list[tuple[list[str], Function, list[str]]] = [(ones, root, [])]
         while groups:
-            group = groups.pop()
+            group, parent, other = groups.pop()
+            outside = at.restrict(parent, other, point)  # S_0 with every variable outside the group set
             for v in group:
                 point[v] = False
             if at.holds(region, point):
-                trial = AtPoint(at, dict(point), like=here, base=base(point))
+                trial = AtPoint(at, dict(point), like=here, base=at.restrict(outside, group, point))
                 if self._differ_at(trial, n, here):
                     here = trial
                     continue
             for v in group:
                 point[v] = True
             if len(group) > 1:
-                groups += [group[len(group) // 2:], group[:len(group) // 2]]
+                first, second = group[:len(group) // 2], group[len(group) // 2:]
+                groups += [(second, outside, first), (first, outside, second)]
         e = self.m.engine
         value = {x: point[e.declare(x)] for x in e.names if e.declare(x) in point}
         integers: list[tuple[str, int]] = []
