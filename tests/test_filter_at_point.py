@@ -153,3 +153,60 @@ def test_same_relation_whatever_the_outputs_kept_apart() -> None:
     assert here.same(Fixed({o1: True, o2: False}, bdd.true), Fixed({o2: False}, x1))
     assert not here.same(Fixed({o1: True, o2: False}, bdd.true), Fixed({o3: False}, x1 & ~x2))
     assert here.same(Fixed({o1: True}, bdd.false), Fixed({o2: False}, bdd.false))
+
+
+@pytest.mark.parametrize("case", ["chain_12", "ring_4", "grid_edges_16", "four_cylinders", "palletizer"])
+def test_a_chain_run_from_another_points_chain_is_the_chain_run_alone(case: str) -> None:
+    """``AtPoint(at, point, like=other)`` (the steps where both chains' relations and criteria
+    agree taken from ``other``) against ``AtPoint(at, point)``: the same relations, outputs
+    fixed, horizons and verdicts at every step, the same races and spellings (those run from
+    the other point's runs too), on a walk of random points one to three variables apart (as
+    the witnesses are made sparse)."""
+    f = CASES[case]()
+    swapped = [(s, dataclasses.replace(s, keep=o.keep, force=o.force))
+               for s in f.combined if s.has_priority for o in (_other(s),) if o is not None]
+    chain = _Chain(f, swapped)
+    at = points.Points(chain.p, chain.goods)
+    rng = random.Random(5)
+    here = AtPoint(at, {v: rng.random() < 0.5 for v in at.others})
+    alternatives = [a for a in chain.alternatives if a is not None]
+    for alternative in alternatives:
+        here.differ(*alternative, chain.m.outputs)
+    taken = run = races = shared = 0
+    for _ in range(30):
+        point = dict(here.point)
+        for v in rng.sample(at.others, min(len(at.others), rng.choice((1, 1, 2, 3)))):
+            point[v] = not point[v]
+        alone, near = AtPoint(at, point), AtPoint(at, point, like=here)
+        assert near.bests == alone.bests
+        assert [(s.fixed, s.rest, s.horizon) for s in near.states] == [(s.fixed, s.rest, s.horizon) for s in alone.states]
+        for i in range(len(chain.goods)):
+            if near.bests[i] and near.dropped(i).rest != at.engine.false:
+                assert near.race(i, near.dropped(i)) == alone.race(i, alone.dropped(i))
+                races += 1
+        for alternative in alternatives:
+            assert near.differ(*alternative, chain.m.outputs, here) == alone.differ(*alternative, chain.m.outputs)
+        shared += sum(mine[0] and theirs[0] and mine[0][0] is theirs[0][0]
+                      for key, mine in near.runs.items() for theirs in (here.runs.get(key),) if theirs is not None)
+        mine = sum(s is t for s, t in zip(near.states[1:], here.states[1:]))
+        taken, run = taken + mine, run + len(near.states) - 1 - mine
+        if rng.random() < 0.5:
+            here = near
+    assert taken > 0 and run > 0 and races > 0 and shared > 0
+
+
+@pytest.mark.parametrize("case", ["ring_4", "grid_edges_16", "palletizer"])
+def test_s0_set_in_parts_is_s0_at_the_point(case: str) -> None:
+    """``S_0`` with a point's variables at 0 set first (``Points.partial``), then the others in
+    two halves (``Points.restrict``), as a witness made sparse sets them: ``S_0`` at the point."""
+    at, _ = _setup(CASES[case]())
+    rng = random.Random(3)
+    differ = 0
+    for point in _points(at, 10):
+        ones = [v for v in at.others if point[v]]
+        half = rng.randrange(len(ones) + 1)
+        root = at.partial({v: False for v in at.others if not point[v]})
+        parts = at.restrict(at.restrict(root, ones[:half], point), ones[half:], point)
+        assert parts == at.base_at(point) == at.bdd.let(dict(point), at.partial({}))
+        differ += root != parts
+    assert differ > 0

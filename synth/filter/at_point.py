@@ -65,27 +65,57 @@ class AtPoint:
     criterion finds a solution there), as :meth:`synth.filter.points.Points.chain` gives
     them as single BDDs."""
 
-    def __init__(self, points: Points, point: Mapping[str, bool]) -> None:
+    def __init__(self, points: Points, point: Mapping[str, bool], like: AtPoint | None = None,
+                 base: Function | None = None) -> None:
         self.points = points
         self.engine = points.engine
         self.bdd = points.bdd
+        self.false = points.bdd.false
         self.point = point
         self.there = points.there(point)
         last: dict[str, int] = {v: -1 for v in points.anchors}
         for j, g in enumerate(self.there):
             for v in points.reads(g):
                 last[v] = j
-        self._last = last
-        s = Fixed({}, points.base_at(point))
-        self.states, self.bests = [s], []
-        for g in self.there:
-            s, best = self.narrow(s, g)
-            self.states.append(s)
-            self.bests.append(best)
+        self.last_read = last
+        """Per output (internal name): the last criterion reading it at the point (-1: none)."""
+        if like is not None and (like.points is not points or like.last_read != last):
+            like = None  # another chain, or the outputs read last elsewhere: the horizons would differ
+        base = points.base_at(point) if base is None else base  # S_0 at the point, when the caller has it
+        self.states, self.bests = self._chain(Fixed({}, base), like)
         self._free: list[Function | None] | None = None
         self._projected: dict[int, Function] = {}
+        self.runs: dict[tuple[int, Function], tuple[list[Fixed], list[str], bool]] = {}
+        """:meth:`differ`'s runs: per criterion and other criterion at the point, each step's
+        ``z``, the answer, and whether it was reached by this chain alone (for ``like``)."""
         self.agreed = 0
         """Races :meth:`race` ended because ``Z`` and the chain agreed (for tests and benchmarks)."""
+
+    def _chain(self, s: Fixed, like: AtPoint | None) -> tuple[list[Fixed], list[bool]]:
+        """``S_0 … S_n`` and the verdicts from ``s`` (``S_0``). With ``like`` (the chain at
+        another point, whose outputs are read last at the same steps): wherever this chain's
+        ``S_j`` is ``like``'s as a relation (the same outputs fixed to the same values, the same
+        rest) and criterion ``j`` is the same there, ``S_{j+1}`` is ``like``'s (the same
+        object: its ``added`` is relative to an equal ``S_j``), no narrowing run; the witnesses
+        are made sparse a few variables at a time, so most steps are met again."""
+        states, bests = [s], []
+        if like is None:
+            for g in self.there:
+                s, best = self.narrow(s, g)
+                states.append(s)
+                bests.append(best)
+            return states, bests
+        theirs, their_there, their_bests = like.states, like.there, like.bests
+        same = _equal(s, theirs[0])
+        for j, g in enumerate(self.there):
+            if same and g == their_there[j]:
+                s, best = theirs[j + 1], their_bests[j]
+            else:
+                s, best = self.narrow(s, g)
+                same = _equal(s, theirs[j + 1])
+            states.append(s)
+            bests.append(best)
+        return states, bests
 
     # ---- relations
     def _literal(self, v: str, value: bool) -> Function:
@@ -93,8 +123,8 @@ class AtPoint:
         return x if value else ~x
 
     def _cofactor(self, u: Function, v: str, value: bool) -> Function:
-        """``u`` with output ``v`` at ``value`` (and-abstract over ``v``'s cube)."""
-        return self.engine.and_exists(u, self._literal(v, value), [v])
+        """``u`` with output ``v`` at ``value`` (CUDD's cofactor on the literal)."""
+        return self.points.cofactor(u, v, value)
 
     def _restricted(self, s: Fixed, g: Function) -> Function:
         """``g`` with the outputs ``s`` fixes set to their values (``g``: a criterion at the point)."""
@@ -107,23 +137,28 @@ class AtPoint:
         return self.engine.and_exists(g, cube, [v for v, _ in values])
 
     def _fixing(self, s: Fixed, v: str, value: bool, rest: Function) -> Fixed:
-        return Fixed({**s.fixed, v: value}, rest, max(s.horizon, self._last[v]), v)
+        return Fixed({**s.fixed, v: value}, rest, max(s.horizon, self.last_read[v]), v)
 
     def narrow(self, s: Fixed, g: Function) -> tuple[Fixed, bool]:
         """``Max(g)`` on ``s`` (:func:`synth.filter.points.narrow`): ``s ∧ g`` where it is
         not empty, else ``s ∧ ¬g``; and whether it was not."""
-        false = self.bdd.false
-        if g.var is not None:
+        false = self.false
+        shape = self.points.shape(g)
+        if shape is None:  # another function: its outputs s fixes set, it may be constant or a literal then
             g = self._restricted(s, g)
-        if g.var is None:  # constant: s as it is
-            return (s, False) if g == false else (s, s.rest != false)
-        if g.low.var is None and g.high.var is None:  # a literal: a cofactor of the rest
-            v = g.var
-            value = g == self.bdd.var(v)
-            kept = self._cofactor(s.rest, v, value)
+            shape = self.points.shape(g)
+        elif shape is not True and shape is not False and shape[0] in s.fixed:  # a literal on an output s fixes
+            shape = s.fixed[shape[0]] == shape[1]
+        if shape is False:  # constant: s as it is
+            return s, False
+        if shape is True:
+            return s, s.rest != false
+        if shape is not None:  # a literal: a cofactor of the rest
+            v, value = shape
+            kept = self.points.cofactor(s.rest, v, value)
             if kept != false:
                 return self._fixing(s, v, value, kept), True
-            return self._fixing(s, v, not value, self._cofactor(s.rest, v, not value)), False
+            return self._fixing(s, v, not value, self.points.cofactor(s.rest, v, not value)), False
         kept = s.rest & g
         if kept != false:
             return Fixed(s.fixed, kept, s.horizon), True
@@ -187,7 +222,7 @@ class AtPoint:
         """Per step j: the cube of the outputs no criterion from j on reads (None: none)."""
         if self._free is None:
             freed: dict[int, list[str]] = {}
-            for v, j in self._last.items():
+            for v, j in self.last_read.items():
                 freed.setdefault(j + 1, []).append(v)
             bdd, cube = self.bdd, None
             out: list[Function | None] = []
@@ -235,41 +270,98 @@ class AtPoint:
         return True
 
     # ---- the keep/force spellings
-    def differ(self, i: int, g: Function, outputs: Sequence[str]) -> list[str]:
+    def differ(self, i: int, g: Function, outputs: Sequence[str], like: AtPoint | None = None) -> list[str]:
         """The ``outputs`` (the engine's names, in their order) the chain with criterion
         ``i`` replaced by ``g`` drives differently at the point, none where it rejoins the
-        chain (:meth:`synth.filter.reliefs._Chain.differ` at a point)."""
-        points, states = self.points, self.states
+        chain (:meth:`synth.filter.spelling_chain.SpellingChain.differ` at a point).
+
+        With ``like`` (the chain at another point, which asked the same before: a witness's
+        trials ask it of the chain at the point so far), its run is taken where it is this
+        one's: its ``z`` at every step while both chains and their criteria agree from the
+        start, and its answer once this ``z`` is its ``z`` at a step from which both chains
+        and their criteria agree to the end (the answer depends only on ``z`` there and on
+        the chain after it)."""
+        points, states, there = self.points, self.states, self.there
         g = points.at(g, self.point)
-        if g == self.there[i]:  # the same criterion at the point: the chain itself
+        if g == there[i]:  # the same criterion at the point: the chain itself
             return []
-        z, _ = self.narrow(states[i], g)
-        # the outputs z and the chain fix apart, kept step by step: each narrowing fixes one at most
-        # (a shortcut only: a chain that rejoins gives the same relation at the end); where
-        # they fix outputs apart, asked at steps i+1, i+2, i+4, … only (each asking costs
-        # cofactors), where they fix the same ones, at every step (their rests compared)
-        apart: set[str] = set()
-        _moved(apart, z, states[i], states[i + 1], states[i])
-        ask = i + 1
-        for j in range(i + 1, len(self.there)):
+        theirs = None if like is None else like.runs.get((i, g))
+        start, agree = i + 1, len(there) + 1  # agree: from where both chains agree to the end
+        if theirs is not None:
+            assert like is not None
+            zs, answer, complete = theirs
+            first = _disagreeing(states, there, like, range(len(there) + 1), len(there) + 1)  # both agree before
+            agree = _disagreeing(states, there, like, range(len(there), -1, -1), -1) + 1
+            if i < first:  # the same z from i + 1 up to the first step they disagree at
+                reached = i + len(zs)
+                if (complete and reached < first) or agree <= i + 1:
+                    self.runs[(i, g)] = theirs
+                    return answer
+                start = min(first, reached)
+        if start > i + 1:
+            assert theirs is not None
+            z = theirs[0][start - i - 1]
+            mine = list(theirs[0][:start - i])
+            apart = {v for v in z.fixed.keys() | states[start].fixed.keys()
+                     if z.fixed.get(v) != states[start].fixed.get(v)}
+        else:
+            z, _ = self.narrow(states[i], g)
+            mine = [z]
+            # the outputs z and the chain fix apart, kept step by step: each narrowing fixes one at
+            # most (a shortcut only: a chain that rejoins gives the same relation at the end); where
+            # they fix outputs apart, asked at steps i+1, i+2, i+4, … only (each asking costs
+            # cofactors), where they fix the same ones, at every step (their rests compared)
+            apart = set()
+            _moved(apart, z, states[i], states[i + 1], states[i])
+        answer, complete = self._run(i, z, start, apart, mine, agree, theirs, outputs)
+        self.runs[(i, g)] = (mine, answer, complete)
+        return answer
+
+    def _run(self, i: int, z: Fixed, start: int, apart: set[str], mine: list[Fixed], agree: int,
+             theirs: tuple[list[Fixed], list[str], bool] | None, outputs: Sequence[str]) -> tuple[list[str], bool]:
+        """:meth:`differ` from step ``start`` (``z`` there, ``apart`` the outputs it and the
+        chain fix apart), each ``z`` appended to ``mine``; the answer and whether it was
+        reached by this chain alone (not taken from ``theirs`` at a step past ``agree``)."""
+        states, there = self.states, self.there
+        ask = start
+        for j in range(start, len(there)):
             s = states[j]
+            if theirs is not None and j >= agree and j - i - 1 < len(theirs[0]) and _equal(z, theirs[0][j - i - 1]):
+                return theirs[1], False
             if z is s or (not apart and z.rest == s.rest):
-                return []
+                return [], True
             if apart and j == ask:
                 if self._same_apart(z, s, _items(apart, z, s)):
-                    return []
+                    return [], True
                 ask += ask - i
-            before, (z, _) = z, self.narrow(z, self.there[j])
+            before, (z, _) = z, self.narrow(z, there[j])
+            mine.append(z)
             _moved(apart, z, before, states[j + 1], s)
         last = states[-1]
         if z is last or (self._same_apart(z, last, _items(apart, z, last)) if apart else z.rest == last.rest):
-            return []
+            return [], True
         out = []
         for o in outputs:
             v = self.engine.declare(o)
             if (self.can(z, v, True), self.can(z, v, False)) != (self.can(last, v, True), self.can(last, v, False)):
                 out.append(o)
-        return out
+        return out, True
+
+
+def _disagreeing(states: Sequence[Fixed], there: Sequence[Function], like: AtPoint, steps: Iterable[int],
+                 default: int) -> int:
+    """The first of ``steps`` where ``states`` and ``like``'s are other relations or the criteria
+    there are others (``default``: none)."""
+    n = len(there)
+    for j in steps:
+        if not _equal(states[j], like.states[j]) or (j < n and there[j] != like.there[j]):
+            return j
+    return default
+
+
+def _equal(a: Fixed, b: Fixed) -> bool:
+    """Whether ``a`` and ``b`` fix the same outputs to the same values and have the same rest."""
+    return a is b or (a.rest == b.rest and a.fixed == b.fixed)
 
 
 def _moved(apart: set[str], z: Fixed, z_before: Fixed, s: Fixed, s_before: Fixed) -> None:

@@ -26,6 +26,7 @@ from operator import itemgetter
 from typing import Any, Callable, Mapping, Sequence
 
 from synth.logic.bdd import Function
+from synth.logic.native import native
 from synth.logic.partition import Partition
 
 __all__ = ["Points", "race_at_point", "POINT_DEFAULTS", "POINT_ROUNDS", "POINT_SEED", "random_point"]
@@ -59,6 +60,12 @@ class Points:
         self._outputs_read: dict[Function, frozenset[str]] = {}
         self._last: tuple[dict[str, bool], tuple[Function, ...]] | None = None  # the last point and its criteria there
         self._readers: dict[str, list[int]] = {}  # a variable -> the criteria (positions) reading it
+        self._shapes: dict[Function, tuple[str, bool] | bool | None] = {}
+        self._fast = fast = native(self.bdd) if e.cudd else None
+        self.cofactor: Callable[[Function, str, bool], Function] = fast.cofactor if fast is not None else \
+            (lambda u, v, value: self.bdd.let({v: value}, u))
+        """``u`` with the variable ``v`` (internal name) at ``value``: CUDD's cofactor on the literal."""
+        self._assign = self.assigner(self.others)
 
     def point(self, picked: Mapping[str, bool], default: bool) -> dict[str, bool]:
         """``picked`` completed with ``default`` for the variables it leaves free."""
@@ -129,9 +136,45 @@ class Points:
             found = self._outputs_read[g] = frozenset(self.bdd.support(g))
         return found
 
+    def shape(self, g: Function) -> tuple[str, bool] | bool | None:
+        """What ``g`` (a criterion at a point) is: its value when constant, ``(v, value)`` when
+        the literal ``v`` (``value``: positive), else None (remembered per function: dd reads
+        a node's children as new objects)."""
+        try:
+            return self._shapes[g]
+        except KeyError:
+            pass
+        found: tuple[str, bool] | bool | None = None
+        if g.var is None:
+            found = g == self.bdd.true
+        elif g.low.var is None and g.high.var is None:
+            found = (g.var, g == self.bdd.var(g.var))
+        self._shapes[g] = found
+        return found
+
     def base_at(self, point: Mapping[str, bool]) -> Function:
         """``S_0`` at ``point``: a relation on the outputs alone."""
-        return self.bdd.let(dict(point), self._base)
+        return self._assign(self._base, point)
+
+    def partial(self, values: Mapping[str, bool]) -> Function:
+        """``S_0`` with the variables of ``values`` set: :meth:`restrict` sets the others at a
+        point (a cofactor walks the whole of ``S_0``, 7 000–8 400 nodes on grid_edges 8 × 8,
+        where a witness is made sparse by a few thousand trials a few variables apart)."""
+        return self.bdd.let(dict(values), self._base) if values else self._base
+
+    def restrict(self, u: Function, names: Sequence[str], point: Mapping[str, bool]) -> Function:
+        """``u`` with the variables ``names`` at their values at ``point``."""
+        return self.assigner(names)(u, point) if names else u
+
+    def assigner(self, names: Sequence[str]) -> Callable[[Function, Mapping[str, bool]], Function]:
+        """A function giving ``u`` with the variables ``names`` at their values at a point:
+        CUDD's cofactor on their cube (:meth:`synth.logic.native.Native.assigner`), dd's
+        ``let`` without CUDD."""
+        names = list(names)
+        if self._fast is None:
+            return lambda u, point: self.bdd.let({v: point[v] for v in names}, u)
+        cofactor = self._fast.assigner(names)
+        return lambda u, point: cofactor(u, [point[v] for v in names])
 
 
 def narrow(s: Function, g: Function, false: Function) -> tuple[Function, bool]:

@@ -37,7 +37,7 @@ from synth.filter.language_check import output_polarities
 from synth.filter.spelling_chain import SpellingChain, Witness
 from synth.logic.expr import And, Expr, Not, Var
 
-__all__ = ["REGION_WORK", "SPELLING_SIZE", "Spelling", "Spellings", "Witness", "other_spellings", "spelling_warnings"]
+__all__ = ["REGION_SIZE", "SPELLING_SIZE", "Spelling", "Spellings", "Witness", "other_spellings", "spelling_warnings"]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -87,12 +87,14 @@ and 7.9·10^7 spent before their last relief); it stops the ring of 32 after K19
 8 × 4 after V3_2 (1.44·10^8 with it), where 10^7 lookups of CUDD's computed table, the limit
 before, stopped them too."""
 
-REGION_WORK = 10_000_000
-"""The BDD work ``filter check`` spends on running the chain of narrowings up to the last
-relief's criterion, for the regions its points are taken in: past it, the regions are
-taken on ``S_0`` and no relief is compared on every input (grid_edges of 8 × 5 outputs
-and more: 13 M at 8 × 5, over 50 M at 8 × 8; the grid of 64 and grid_edges 8 × 4 need 3.4
-M, the chain of 256 0.6 M, the ring of 32 1.2 M)."""
+REGION_SIZE = 10_000
+"""How wide a chain of narrowings ``filter check`` runs up to the last relief's criterion, for
+the regions its points are taken in: the BDD nodes of its local relation at each criterion
+(a size read on the filter and its chain, not on the work done, as :data:`SPELLING_SIZE`).
+Past it, the regions are taken on ``S_0`` and no relief is compared on every input:
+grid_edges of 8 × 5 outputs and more (8 × 5 passes it at its 37th criterion, 8 × 8 at its
+46th, with 10 916 and 10 999 nodes); below it, grid_edges 8 × 4 (7 090 nodes at most), the
+grid of 64 (6 471), the ring of 32 (4 347) and of 48 (6 499), the chain of 256 (259)."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -123,7 +125,7 @@ def _relief_loc(s: Safety) -> Location | None:
 
 
 def spelling_warnings(f: Filter, safeties: Sequence[Safety] | None = None,
-                      limit: int | None = SPELLING_SIZE, regions: int = REGION_WORK) -> Spellings:
+                      limit: int | None = SPELLING_SIZE, regions: int = REGION_SIZE) -> Spellings:
     """A located warning for each relief whose other spelling gives a different algebraic
     filter: another care set, or an output that may be on or may be off on some input.
 
@@ -132,10 +134,11 @@ def spelling_warnings(f: Filter, safeties: Sequence[Safety] | None = None,
     every input while the sizes of those compared (:meth:`SpellingChain.size`) stay under ``limit``
     (the first always);
     those left tried at the other points (free variables 1, random), and the rest listed,
-    not compared. When the chain up to the last relief costs more than ``regions``, the
-    points are taken where the criteria narrow ``S_0`` and none is compared on every input
-    (:meth:`SpellingChain.sparse_points`). ``limit`` None: every relief compared on every input,
-    each warning naming every output it drives differently."""
+    not compared. When the chain's local relation at a criterion up to the last relief's
+    has more than ``regions`` nodes (-1: always), the points are taken where the criteria
+    narrow ``S_0`` and none is compared on every input (:meth:`SpellingChain.sparse_points`).
+    ``limit`` None: every relief compared on every input, each warning naming every output it
+    drives differently."""
     swapped: list[tuple[Safety, Safety]] = []  # each relief and the same constraint written the other way
     for s in (safeties if safeties is not None else f.combined):
         other = _other(s) if s.has_priority else None

@@ -56,7 +56,9 @@ class SpellingChain:
         self.bests: list[Function] = []
         self._regions: dict[int, Function] = {}
         self.budget: int | None = None
-        """While set, the work (:meth:`Engine.work`) past which running the chain gives up."""
+        """While set, the size past which running the chain gives up: the BDD nodes of the
+        local relation (:meth:`Partition.local <synth.logic.partition.Partition.local>`) at the
+        criterion it is to apply next."""
         self.coarse = False
         """Whether the regions are taken on ``S_0`` (:meth:`sparse_points`)."""
 
@@ -64,9 +66,9 @@ class SpellingChain:
         """The chain's ``S_j``, the chain run that far if it is not yet (the points need it
         only up to the last relief's criterion)."""
         while len(self.states) <= j:
-            if self.budget is not None and self.m.engine.work() > self.budget:
-                raise TooWide
             n = len(self.bests)
+            if self.budget is not None and len(self.p.local(self.states[-1], self.where[n])) > self.budget:
+                raise TooWide
             state, best = self._step(self.states[-1], self.where[n], self.goods[n])
             self.states.append(state)
             self.bests.append(best)
@@ -109,12 +111,13 @@ class SpellingChain:
         return (p.project(s, self.where[i], good) & p.project(s, self.where[i], ~good)) | \
             (p.project(s, k, g) & p.project(s, k, ~g))
 
-    def sparse_points(self, candidates: Sequence[int], work: int) -> dict[int, Witness]:
+    def sparse_points(self, candidates: Sequence[int], size: int) -> dict[int, Witness]:
         """:meth:`at_points` with the free variables 0, its regions on the chain's ``S_i``
-        while running the chain that far costs at most ``work``; past it, on ``S_0``
-        (:meth:`_initial_region`, :attr:`coarse`: the chain is not run, and
+        while the chain's local relation at each criterion on the way there has at most
+        ``size`` nodes (:attr:`budget`); past it, on ``S_0`` (:meth:`_initial_region`,
+        :attr:`coarse`: the chain is not run further, and
         :func:`synth.filter.reliefs.spelling_warnings` compares nothing on every input)."""
-        self.budget = self.m.engine.work() + work
+        self.budget = size
         try:
             return self.at_points(candidates, points.POINT_DEFAULTS[:1], 0)
         except TooWide:
@@ -167,36 +170,43 @@ class SpellingChain:
     def _at(self) -> points.Points:
         return points.Points(self.p, self.goods)
 
-    def _differ_at(self, here: AtPoint, n: int) -> list[str]:
+    def _differ_at(self, here: AtPoint, n: int, like: AtPoint | None = None) -> list[str]:
         """The outputs alternative ``n`` drives differently at the point ``here`` (the chain
-        there), none where it rejoins the chain."""
+        there), none where it rejoins the chain; ``like``: the chain at a point that asked it
+        before (:meth:`AtPoint.differ <synth.filter.at_point.AtPoint.differ>`)."""
         alternative = self.alternatives[n]
         assert alternative is not None
         i, g = alternative
-        return here.differ(i, g, self.m.outputs)
+        return here.differ(i, g, self.m.outputs, like)
 
     def _witness(self, at: points.Points, n: int, point: dict[str, bool]) -> Witness:
         """``point`` made sparse: its variables at 1 set to 0, all of a group at once (the
         whole set, then halves, and so on), wherever alternative ``n`` still differs; the
         outputs it drives differently at the point left."""
         point = dict(point)
-
         region = self._region(n)
-
-        def differs() -> list[str]:
-            return self._differ_at(AtPoint(at, point), n) if at.holds(region, point) else []
-
-        groups = [[v for v in at.others if point[v]]]  # a stack, not a recursive closure (no cycle to collect)
+        ones = [v for v in at.others if point[v]]
+        root = at.partial({v: False for v in at.others if not point[v]})  # they stay 0
+        here = AtPoint(at, dict(point), base=at.restrict(root, ones, point))  # the chain at the point so far
+        # a stack, not a recursive closure (no cycle to collect): each group with S_0 set outside
+        # its parent group, and the parent's other half, to set when the group is reached (after
+        # the first half's trials: its variables then have their values for good)
+        groups: list[tuple[list[str], Function, list[str]]] = [(ones, root, [])]
         while groups:
-            group = groups.pop()
+            group, parent, other = groups.pop()
+            outside = at.restrict(parent, other, point)  # S_0 with every variable outside the group set
             for v in group:
                 point[v] = False
-            if differs():
-                continue
+            if at.holds(region, point):
+                trial = AtPoint(at, dict(point), like=here, base=at.restrict(outside, group, point))
+                if self._differ_at(trial, n, here):
+                    here = trial
+                    continue
             for v in group:
                 point[v] = True
             if len(group) > 1:
-                groups += [group[len(group) // 2:], group[:len(group) // 2]]
+                first, second = group[:len(group) // 2], group[len(group) // 2:]
+                groups += [(second, outside, first), (first, outside, second)]
         e = self.m.engine
         value = {x: point[e.declare(x)] for x in e.names if e.declare(x) in point}
         integers: list[tuple[str, int]] = []
@@ -204,7 +214,7 @@ class SpellingChain:
             for name, bits in ((i.name, i.bits), (pre_name(i.name), [pre_name(b) for b in i.bits])):
                 if all(b in value for b in bits):
                     integers.append((name, i.low + sum(value.pop(b) << k for k, b in enumerate(bits))))
-        return Witness(tuple(differs()), tuple(x for x, v in value.items() if v), tuple(integers))
+        return Witness(tuple(self._differ_at(here, n)), tuple(x for x, v in value.items() if v), tuple(integers))
 
     def differ(self, n: int) -> list[str] | None:
         """The outputs alternative ``n`` drives differently (another ``∃O.(S∧o)`` or

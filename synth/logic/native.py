@@ -2,7 +2,7 @@
 a cube built once, the test ``u ≤ v`` (dd has none: ``u & ~v == false`` builds the
 conjunction, ``let`` of a cube builds the cofactor), the count of computed-table lookups,
 the indices of a support (dd's ``support`` builds a set of names), the cofactor on one
-literal (dd's ``let`` first fills an array over every declared variable), the expansion
+literal or on a cube of many (dd's ``let`` first fills an array over every declared variable), the expansion
 of a cube to a prime implicant, and the transfer of a function to another manager (dd's
 ``copy`` first lists its support by name).
 
@@ -32,6 +32,8 @@ True
 True
 >>> n is None or (n.cofactor(v, "x", False), n.cofactor(v, "x", True)) == (b.true, b.add_expr("z"))
 True
+>>> n is None or (n.assigner(["z", "x"])(v, [False, True]), n.assigner(["z"])(v, [True])) == (b.false, b.true)
+True
 >>> n is None or n.prime(b.add_expr("x & y & z"), u | b.add_expr("z")) == b.add_expr("z")
 True
 >>> n is None or (n.quantified(v, [0, 2], True), n.quantified(v, [0, 2], False)) == (b.false, b.true)
@@ -41,7 +43,7 @@ True
 from __future__ import annotations
 
 from functools import lru_cache
-from typing import Any
+from typing import Any, Callable, Sequence
 
 __all__ = ["Native", "native"]
 
@@ -70,6 +72,7 @@ class Native:
         self._abstract = {False: _typed(library.Cudd_bddExistAbstract, ptr, ptr, ptr, ptr),
                           True: _typed(library.Cudd_bddUnivAbstract, ptr, ptr, ptr, ptr)}
         self._prime = _typed(library.Cudd_bddMakePrime, ptr, ptr, ptr, ptr)
+        self._cube = _typed(library.Cudd_bddComputeCube, ptr, ptr, ctypes.POINTER(ptr), ctypes.POINTER(c_int), c_int)
         self._indices = _typed(library.Cudd_SupportIndices, c_int, ptr, ptr, ctypes.POINTER(ctypes.POINTER(c_int)))
         self._array = ctypes.POINTER(ctypes.c_int)()
         self._array_ref = ctypes.byref(self._array)
@@ -98,6 +101,32 @@ class Native:
         if not r:  # CUDD gave up (memory): dd's call reports it
             return self.bdd.let({name: value}, u)
         return self.wrapped(r)
+
+    def assigner(self, names: Sequence[str]) -> Callable[[Function, Sequence[bool]], Function]:
+        """A function giving ``u`` with the variables ``names`` at ``values`` (one per name):
+        CUDD's cofactor on their cube, the cube built by CUDD from an array of the variables
+        made here once, in level order so that CUDD builds it in one pass from the bottom up
+        (dd's ``let`` fills an array over every declared variable per call)."""
+        import ctypes
+        from operator import itemgetter
+
+        count = len(names)
+        order = sorted(range(count), key=lambda i: self.bdd.level_of_var(names[i]))  # CUDD's cube: one pass up
+        nodes = (ctypes.c_void_p * count)(*(int(self.bdd.var(names[i])) - 2 for i in order))
+        phases = ctypes.c_int * count
+        ordered = itemgetter(*order) if count > 1 else (lambda values: tuple(values))
+
+        def assigned(u: Function, values: Sequence[bool]) -> Function:
+            if not count:
+                return u
+            cube = self._cube(self.manager, nodes, phases(*ordered(values)), count)
+            held = self.wrapped(cube) if cube else None  # referenced while the cofactor runs
+            r = self._cofactor(self.manager, int(u) - 2, cube) if held is not None else 0
+            if not r:  # CUDD gave up (memory): dd's call reports it
+                return self.bdd.let(dict(zip(names, values)), u)
+            return self.wrapped(r)
+
+        return assigned
 
     def prime(self, cube: Function, u: Function) -> Function | None:
         """CUDD's prime implicant of ``u`` from the implicant ``cube``: each of the cube's
