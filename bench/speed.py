@@ -38,7 +38,8 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 
 EXPLICIT = r"""
-import json, sys, time
+import json, os, sys, time
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")  # as the synth console script runs (cli.main.one_blas_thread)
 from synth.validation.result import load_model
 from synth.validation.validate import validate_loaded
 rs, p, g = load_model(sys.argv[1], sys.argv[2])

@@ -85,3 +85,32 @@ def test_a_command_parsed_alone_as_among_all(argv, capsys) -> None:
     alone, among = outcome(build_parser(argv[0])), outcome(build_parser())
     assert alone == among
     assert alone[0] in (0, 2)  # each line above asks for help or is wrong
+
+
+BLAS = """
+import atexit, os, sys
+sys.argv = ["synth", "validate", "grafcets/tri.g7", "--plant", "plants/tri.rules"]
+def report():
+    threads = [line.split()[1] for line in open("/proc/self/status") if line.startswith("Threads:")]
+    print("BLAS", os.environ.get("OPENBLAS_NUM_THREADS"), "numpy" in sys.modules, threads)
+atexit.register(report)
+from synth.cli.main import entry
+entry()
+"""
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc/self/status")
+@pytest.mark.parametrize("chosen, expected", [(None, "1"), ("3", "3")])
+def test_the_console_script_runs_numpy_on_one_blas_thread_unless_told(chosen, expected):
+    """numpy's OpenBLAS would start a spinning thread per core at import (``one_blas_thread``):
+    the command runs on its one thread; a value the user set is kept."""
+    env = {k: v for k, v in __import__("os").environ.items() if k != "OPENBLAS_NUM_THREADS"}
+    if chosen is not None:
+        env["OPENBLAS_NUM_THREADS"] = chosen
+    run = subprocess.run([sys.executable, "-c", BLAS], cwd=ROOT, capture_output=True, text=True,
+                         env=env)
+    assert run.returncode == 0, run.stderr
+    last = run.stdout.strip().splitlines()[-1]
+    assert last.startswith(f"BLAS {expected} True ["), last
+    if chosen is None:
+        assert last == "BLAS 1 True ['1']"
